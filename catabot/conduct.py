@@ -1,0 +1,68 @@
+"""`catabot conductor`: the conductor as a program; progress as JSON lines on stdout.
+
+The launcher reads those lines to draw its progress bar; on another machine the same
+program runs alone against a router.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import logging
+import signal
+import sys
+from dataclasses import asdict
+
+from catabot.clock import Policy
+from catabot.conductor import ClockSpec, Conductor, Progress
+from catabot.keys import Keys
+from catabot.scenario import Scenario, ScenarioError, load_scenario
+from catabot.session import SessionError, add_connection_args, connection_from_args, open_session
+from catabot.streams import participants
+
+log = logging.getLogger("catabot.conductor")
+
+
+def clock_spec(scenario: Scenario) -> ClockSpec:
+    c = scenario.clock
+    return ClockSpec(
+        dt_ns=scenario.dt_ns,
+        ticks=scenario.ticks,
+        participants=tuple(participants(scenario)),
+        deadline_s=c.deadline_s,
+        start_timeout_s=c.start_timeout_s,
+        policy=Policy(c.policy),
+        realtime_factor=c.realtime_factor,
+    )
+
+
+def emit(kind: str, **fields: object) -> None:
+    print(json.dumps({"kind": kind, **fields}), flush=True)
+
+
+def main(argv: list[str] | None = None) -> int:
+    parser = argparse.ArgumentParser(prog="catabot conductor")
+    parser.add_argument("--scenario", help="scenario file (default: the bundled default)")
+    add_connection_args(parser)
+    args = parser.parse_args(argv)
+    logging.basicConfig(level=logging.INFO, format="%(asctime)s %(name)s %(levelname)s %(message)s")
+    try:
+        scenario = load_scenario(args.scenario)
+        session = open_session(connection_from_args(args))
+    except (ScenarioError, SessionError) as exc:
+        emit("result", ticks=0, wall_s=0.0, error=str(exc), dropped=[])
+        return 2
+    conductor = Conductor(session, Keys(scenario.name), clock_spec(scenario))
+    for sig in (signal.SIGINT, signal.SIGTERM):
+        signal.signal(sig, lambda *_: conductor.stop("interrupted"))
+    result = conductor.run(lambda p: emit("progress", **asdict(p)))
+    emit("result", **asdict(result))
+    if result.error:
+        log.error("run ended by a fault: %s", result.error)
+    conductor.close()
+    session.close()
+    return 1 if result.error else (130 if result.reason == "interrupted" else 0)
+
+
+if __name__ == "__main__":
+    sys.exit(main())

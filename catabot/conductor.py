@@ -1,0 +1,197 @@
+"""The conductor: owns the clock, publishes ticks, collects acks, ends the run.
+
+Zenoh callbacks only put events on a queue (they must never block); the conductor's
+own thread takes them off with a timeout, which is how the per-tick deadline and
+liveliness faults are noticed without polling.
+"""
+
+from __future__ import annotations
+
+import logging
+import queue
+import time
+import uuid
+from collections.abc import Callable
+from dataclasses import dataclass, field
+
+import zenoh
+
+from catabot import codec
+from catabot.clock import ClockError, Policy
+from catabot.keys import Keys
+from catabot.messages import Ack, End, Tick
+
+log = logging.getLogger("catabot.conductor")
+CONDUCTOR = "conductor"
+
+
+@dataclass(frozen=True)
+class ClockSpec:
+    dt_ns: int
+    ticks: int
+    participants: tuple[str, ...]
+    deadline_s: float = 10.0
+    start_timeout_s: float = 60.0
+    policy: Policy = Policy.ABORT
+    realtime_factor: float | None = None
+
+
+@dataclass
+class Progress:
+    tick: int
+    stamp_ns: int
+    ticks_per_s: float
+    realtime_factor: float
+
+
+@dataclass
+class RunResult:
+    ticks_done: int
+    wall_s: float
+    error: str = ""
+    dropped: list[str] = field(default_factory=list)
+    reason: str = "completed"
+
+
+class Conductor:
+    def __init__(self, session: zenoh.Session, keys: Keys, spec: ClockSpec) -> None:
+        self.session, self.keys, self.spec = session, keys, spec
+        self.run_id = uuid.uuid4().hex[:12]
+        self.events: queue.SimpleQueue[tuple[str, str, bytes]] = queue.SimpleQueue()
+        self.members: set[str] = set()
+        self.dropped: list[str] = []
+        self._stop_reason = ""
+        opts = {"congestion_control": zenoh.CongestionControl.BLOCK}
+        self._tick_pub = session.declare_publisher(keys.tick(), **opts)
+        self._end_pub = session.declare_publisher(keys.end(), **opts)
+        self._token = session.liveliness().declare_token(keys.live(CONDUCTOR))
+        self._subs = [
+            session.declare_subscriber(keys.acks(), self._on_ack),
+            session.liveliness().declare_subscriber(keys.lives(), self._on_live, history=True),
+        ]
+
+    def _on_ack(self, sample: zenoh.Sample) -> None:
+        self.events.put(("ack", str(sample.key_expr), sample.payload.to_bytes()))
+
+    def _on_live(self, sample: zenoh.Sample) -> None:
+        kind = "join" if sample.kind == zenoh.SampleKind.PUT else "leave"
+        self.events.put((kind, str(sample.key_expr), b""))
+
+    def stop(self, reason: str) -> None:
+        """Ask the run to end at the next tick boundary (Ctrl-C, a signal)."""
+        self._stop_reason = reason
+        self.events.put(("stop", "", b""))
+
+    # -- run ---------------------------------------------------------------------------
+
+    def run(self, on_progress: Callable[[Progress], None] | None = None) -> RunResult:
+        start = time.monotonic()
+        done = 0
+        try:
+            self._await_members()
+            done = self._tick_loop(on_progress, start)
+            error = ""
+        except ClockError as exc:
+            error = str(exc)
+        reason = self._stop_reason or ("completed" if not error else "fault")
+        self._end_pub.put(codec.encode(End(self.run_id, done - 1, reason, error)))
+        return RunResult(done, time.monotonic() - start, error, list(self.dropped), reason)
+
+    def _await_members(self) -> None:
+        expected = set(self.spec.participants)
+        limit = time.monotonic() + self.spec.start_timeout_s
+        while not expected <= self.members:
+            if self._stop_reason:
+                return
+            if self._next_event(limit)[0] == "late":
+                raise ClockError(self._start_timeout(expected))
+
+    def _start_timeout(self, expected: set[str]) -> str:
+        missing = ", ".join(sorted(expected - self.members))
+        return f"participant(s) never joined within {self.spec.start_timeout_s:g} s: {missing}"
+
+    def _tick_loop(self, on_progress: Callable[[Progress], None] | None, start: float) -> int:
+        last_report, k = start, 0
+        for k in range(self.spec.ticks):
+            if self._stop_reason:
+                return k
+            self._pace(k)
+            self._publish_tick(k)
+            self._await_acks(k)
+            now = time.monotonic()
+            if on_progress and now - last_report >= 0.25:
+                on_progress(self._progress(k, now - start))
+                last_report = now
+        if on_progress:
+            on_progress(self._progress(self.spec.ticks - 1, time.monotonic() - start))
+        return self.spec.ticks
+
+    def _progress(self, k: int, wall: float) -> Progress:
+        sim_s = (k + 1) * self.spec.dt_ns / 1e9
+        return Progress(k, (k + 1) * self.spec.dt_ns, (k + 1) / max(wall, 1e-9), sim_s / wall)
+
+    def _pace(self, k: int) -> None:
+        factor = self.spec.realtime_factor
+        if factor:
+            if not hasattr(self, "_t0"):
+                self._t0 = time.monotonic()
+            delay = self._t0 + k * self.spec.dt_ns / 1e9 / factor - time.monotonic()
+            if delay > 0:
+                time.sleep(delay)
+
+    def _publish_tick(self, k: int) -> None:
+        tick = Tick(self.run_id, k, k * self.spec.dt_ns, self.spec.dt_ns, tuple(self.dropped))
+        self._tick_pub.put(codec.encode(tick))
+
+    def _await_acks(self, k: int) -> None:
+        waiting = set(self.spec.participants) - set(self.dropped)
+        for name in sorted(waiting - self.members):
+            self._fault(name, f"left the run before tick {k}", waiting)
+        deadline = time.monotonic() + self.spec.deadline_s
+        while waiting:
+            kind, key, payload = self._next_event(deadline)
+            if kind == "ack":
+                self._take_ack(k, key, payload, waiting)
+            elif kind == "leave" and self.keys.participant_of(key) in waiting:
+                self._fault(self.keys.participant_of(key), f"left the run at tick {k}", waiting)
+            elif kind == "late":
+                for name in sorted(waiting):
+                    self._fault(name, f"missed the {self.spec.deadline_s:g} s deadline of tick {k}",
+                                waiting)  # fmt: skip
+            elif kind == "stop":
+                return
+
+    def _take_ack(self, k: int, key: str, payload: bytes, waiting: set[str]) -> None:
+        try:
+            ack = codec.decode(payload, Ack)
+        except codec.CodecError as exc:
+            log.warning("malformed ack on %s: %s", key, exc)
+            return
+        if ack.run == self.run_id and ack.tick == k:
+            waiting.discard(self.keys.participant_of(key))
+
+    def _fault(self, name: str, what: str, waiting: set[str]) -> None:
+        message = f"participant {name!r} {what}"
+        if self.spec.policy is Policy.ABORT:
+            raise ClockError(message)
+        log.error("%s; dropping it and going on (policy drop)", message)
+        self.dropped.append(name)
+        waiting.discard(name)
+
+    def _next_event(self, deadline: float) -> tuple[str, str, bytes]:
+        """Wait for one event ("late" when the deadline passes); membership is tracked here."""
+        try:
+            event = self.events.get(timeout=max(deadline - time.monotonic(), 0.0))
+        except queue.Empty:
+            return ("late", "", b"")
+        kind, key, _ = event
+        if kind == "join":
+            self.members.add(self.keys.participant_of(key))
+        elif kind == "leave":
+            self.members.discard(self.keys.participant_of(key))
+        return event
+
+    def close(self) -> None:
+        for sub in self._subs:
+            sub.undeclare()
+        self._token.undeclare()

@@ -1,0 +1,101 @@
+"""Every Zenoh key expression of a world (DESIGN.md §3).
+
+No other module spells a key by hand: a typo in a key is a silent loss of data on a
+pub/sub bus, so keys are built in exactly one place and names are checked here.
+"""
+
+from __future__ import annotations
+
+import re
+from dataclasses import dataclass
+
+ROOT = "catabot"
+_NAME = re.compile(r"^[A-Za-z0-9_.\-]+$")
+
+
+class KeyError_(ValueError):
+    """A name that cannot be one chunk of a Zenoh key expression."""
+
+
+def check_name(kind: str, name: str) -> str:
+    """Refuse names that would change a key's meaning ('/', wildcards, '$', spaces)."""
+    if not isinstance(name, str) or not _NAME.match(name):
+        raise KeyError_(
+            f"{kind} name {name!r} is not allowed in a key: use letters, digits, '_', '-' or '.'"
+        )
+    return name
+
+
+@dataclass(frozen=True)
+class Keys:
+    """The key expressions of one world: `catabot/<world>/...`."""
+
+    world: str
+
+    def __post_init__(self) -> None:
+        check_name("world", self.world)
+
+    @property
+    def prefix(self) -> str:
+        return f"{ROOT}/{self.world}"
+
+    def all(self) -> str:
+        return f"{self.prefix}/**"
+
+    def tick(self) -> str:
+        return f"{self.prefix}/clock/tick"
+
+    def ack(self, participant: str) -> str:
+        return f"{self.prefix}/clock/ack/{check_name('participant', participant)}"
+
+    def acks(self) -> str:
+        return f"{self.prefix}/clock/ack/*"
+
+    def end(self) -> str:
+        return f"{self.prefix}/clock/end"
+
+    def live(self, participant: str) -> str:
+        return f"{self.prefix}/live/{check_name('participant', participant)}"
+
+    def lives(self) -> str:
+        return f"{self.prefix}/live/*"
+
+    def vessel_state(self, vessel: str) -> str:
+        return f"{self.prefix}/vessel/{check_name('vessel', vessel)}/state"
+
+    def vessel_states(self) -> str:
+        return f"{self.prefix}/vessel/*/state"
+
+    def cmd_thrust(self, vessel: str) -> str:
+        return f"{self.prefix}/vessel/{check_name('vessel', vessel)}/cmd/thrust"
+
+    def cmd_twist(self, vessel: str) -> str:
+        return f"{self.prefix}/vessel/{check_name('vessel', vessel)}/cmd/twist"
+
+    def cmd_waypoints(self, vessel: str) -> str:
+        return f"{self.prefix}/vessel/{check_name('vessel', vessel)}/cmd/waypoints"
+
+    def cmds(self) -> str:
+        return f"{self.prefix}/vessel/*/cmd/*"
+
+    def sensor(self, vessel: str, sensor: str) -> str:
+        return (
+            f"{self.prefix}/sensor/{check_name('vessel', vessel)}/{check_name('sensor', sensor)}"
+        )
+
+    def env_state(self) -> str:
+        return f"{self.prefix}/env/state"
+
+    def config(self, name: str) -> str:
+        return f"{self.prefix}/config/{check_name('config', name)}"
+
+    def relative(self, key: str) -> str:
+        """The part of a key after `catabot/<world>/`, used to name files and topics."""
+        head = self.prefix + "/"
+        if not key.startswith(head):
+            raise KeyError_(f"key {key!r} is not in world {self.world!r}")
+        return key[len(head) :]
+
+    def participant_of(self, key: str) -> str:
+        """The participant named by the last chunk of an ack or liveliness key."""
+        return key.rsplit("/", 1)[-1]

@@ -1,0 +1,179 @@
+"""`catabot run`: the conductor and every service as separate OS processes.
+
+The launcher owns no simulation state: it checks the scenario, makes the run folder,
+starts the processes with their logs in `log/`, draws progress from the conductor's
+JSON lines, and turns the end of the run into a summary and an exit code.
+"""
+
+from __future__ import annotations
+
+import json
+import signal
+import subprocess
+import sys
+import threading
+import time
+from dataclasses import dataclass
+from datetime import datetime
+from pathlib import Path
+
+from catabot.progress import ProgressBar
+from catabot.scenario import Scenario, ScenarioError, load_scenario
+from catabot.session import free_port
+from catabot.streams import participants
+from catabot.vessel import VesselModelError, load_vessel_model
+
+SERVICE_MODULES = {
+    "physics": "services.physics",
+    "sensors": "services.sensors",
+    "recorder": "services.recorder",
+}
+
+
+class LaunchError(RuntimeError):
+    """The run could not start (bad scenario, missing model, unknown service)."""
+
+
+@dataclass(frozen=True)
+class RunOptions:
+    scenario: str | None = None
+    duration_s: float | None = None
+    realtime: float | None = None
+    out: Path = Path("runs")
+    connect: tuple[str, ...] = ()
+    quiet: bool = False
+
+
+def prepare(opts: RunOptions) -> Scenario:
+    """Everything that can be refused is refused here, before any process starts."""
+    scenario = load_scenario(opts.scenario)
+    data = scenario.model_dump()
+    if opts.duration_s is not None:
+        data["duration_s"] = opts.duration_s
+    if opts.realtime is not None:
+        data["clock"]["realtime_factor"] = opts.realtime
+    from catabot.scenario import parse_scenario
+
+    scenario = parse_scenario(data, source="command line")
+    for vessel in scenario.vessels:
+        load_vessel_model(vessel.model)
+    for name in participants(scenario):
+        if name not in SERVICE_MODULES:
+            raise LaunchError(f"scenario needs service {name!r}, which this version does not have")
+    return scenario
+
+
+def make_run_dir(out: Path, scenario: Scenario) -> Path:
+    stamp = datetime.now().strftime("%Y%m%d-%H%M%S")
+    base = out / f"{scenario.name}-{stamp}"
+    run_dir, n = base, 1
+    while run_dir.exists():
+        n += 1
+        run_dir = Path(f"{base}-{n}")
+    (run_dir / "log").mkdir(parents=True)
+    (run_dir / "scenario.json").write_text(scenario.model_dump_json(indent=2) + "\n")
+    return run_dir
+
+
+def _endpoints(opts: RunOptions) -> tuple[list[str], list[str]]:
+    """Flags for the conductor and for the services: embedded peer mesh, or a router."""
+    if opts.connect:
+        flags = [f for ep in opts.connect for f in ("--connect", ep)] + ["--mode", "client"]
+        return flags, flags
+    listen = f"tcp/127.0.0.1:{free_port()}"
+    return ["--listen", listen], ["--connect", listen]
+
+
+def _spawn(args: list[str], log_file: Path, *, stdout_pipe: bool = False) -> subprocess.Popen[str]:
+    log = log_file.open("w")
+    return subprocess.Popen(
+        [sys.executable, "-m", *args],
+        stdout=subprocess.PIPE if stdout_pipe else log,
+        stderr=log,
+        text=True,
+        start_new_session=True,  # Ctrl-C reaches the launcher only; it ends the run cleanly
+    )
+
+
+def run(opts: RunOptions) -> int:
+    try:
+        scenario = prepare(opts)
+    except (ScenarioError, VesselModelError, LaunchError) as exc:
+        print(f"catabot run: {exc}", file=sys.stderr)
+        return 2
+    run_dir = make_run_dir(opts.out, scenario)
+    cond_flags, svc_flags = _endpoints(opts)
+    scen = str(run_dir / "scenario.json")
+    conductor = _spawn(["catabot.conduct", "--scenario", scen, *cond_flags],
+                       run_dir / "log" / "conductor.log", stdout_pipe=True)  # fmt: skip
+    services = {
+        name: _spawn([SERVICE_MODULES[name], "--scenario", scen, "--run-dir", str(run_dir),
+                      *svc_flags], run_dir / "log" / f"{name}.log")  # fmt: skip
+        for name in participants(scenario)
+    }
+    return Supervisor(scenario, run_dir, conductor, services, quiet=opts.quiet).wait()
+
+
+class Supervisor:
+    """Watches the processes of one run until all have ended."""
+
+    def __init__(self, scenario: Scenario, run_dir: Path, conductor: subprocess.Popen[str],
+                 services: dict[str, subprocess.Popen[str]], *, quiet: bool) -> None:  # fmt: skip
+        self.scenario, self.run_dir = scenario, run_dir
+        self.conductor, self.services = conductor, services
+        self.bar = ProgressBar(scenario.duration_ns, enabled=not quiet)
+        self.result: dict[str, object] = {}
+
+    def wait(self) -> int:
+        previous = signal.signal(signal.SIGINT, lambda *_: self.conductor.send_signal(signal.SIGINT))
+        try:
+            self._read_conductor()
+            self._reap_services(timeout_s=15.0)
+        finally:
+            signal.signal(signal.SIGINT, previous)
+        return self._summary()
+
+    def _read_conductor(self) -> None:
+        """Follow the conductor's lines; stop it if a service dies before it notices."""
+        reader = threading.Thread(target=self._follow, daemon=True)
+        reader.start()
+        stopped = False
+        while reader.is_alive():
+            reader.join(timeout=0.1)
+            died = [n for n, p in self.services.items() if p.poll() not in (None, 0)]
+            if died and not stopped and self.conductor.poll() is None:
+                self.conductor.send_signal(signal.SIGTERM)
+                stopped = True
+        self.conductor.wait()
+        self.bar.close()
+
+    def _follow(self) -> None:
+        assert self.conductor.stdout is not None
+        for line in self.conductor.stdout:
+            try:
+                event = json.loads(line)
+            except json.JSONDecodeError:
+                continue
+            if event.get("kind") == "progress":
+                self.bar.update(event)
+            elif event.get("kind") == "result":
+                self.result = event
+
+    def _reap_services(self, *, timeout_s: float) -> None:
+        limit = time.monotonic() + timeout_s
+        for proc in self.services.values():
+            try:
+                proc.wait(timeout=max(limit - time.monotonic(), 0.1))
+            except subprocess.TimeoutExpired:
+                proc.terminate()
+                try:
+                    proc.wait(timeout=3)
+                except subprocess.TimeoutExpired:
+                    proc.kill()
+                    proc.wait()
+
+    def _summary(self) -> int:
+        from catabot.summary import summarise
+
+        return summarise(self.scenario, self.run_dir, self.result, self.conductor.returncode,
+                         {n: p.returncode for n, p in self.services.items()})  # fmt: skip

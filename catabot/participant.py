@@ -1,0 +1,168 @@
+"""A stepping participant: joins the lockstep, waits for due inputs, steps, acks.
+
+Services write only a `step(tick, inputs)` function; this class owns the protocol of
+DESIGN.md §4: membership by a liveliness token, Jacobi input release (a sample tagged
+k is handed over at tick k+1, never earlier), waiting for due samples, malformed
+payloads logged with their key and dropped, and a clean end on `clock/end`.
+"""
+
+from __future__ import annotations
+
+import logging
+import queue
+import time
+from collections.abc import Callable, Sequence
+
+import zenoh
+
+from catabot import codec
+from catabot.clock import ClockError, Stream
+from catabot.conductor import CONDUCTOR
+from catabot.inbox import Inbox, Inputs
+from catabot.keys import Keys
+from catabot.messages import Ack, End, Message, Tick
+
+log = logging.getLogger("catabot.participant")
+StepFn = Callable[[Tick, Inputs], None]
+EndFn = Callable[[End, Inputs], None]
+_BLOCK = {"congestion_control": zenoh.CongestionControl.BLOCK}
+
+
+class Participant:
+    def __init__(
+        self,
+        session: zenoh.Session,
+        keys: Keys,
+        name: str,
+        *,
+        inputs: Sequence[Stream] = (),
+        peers: Sequence[str] = (),
+        drain_s: float = 5.0,
+    ) -> None:
+        self.session, self.keys, self.name = session, keys, name
+        self.inbox = Inbox(inputs)
+        self.peers = set(peers) - {name}
+        self.drain_s = drain_s
+        self.events: queue.SimpleQueue[tuple[str, str, bytes]] = queue.SimpleQueue()
+        self.present: set[str] = set()
+        self.run_id = ""
+        self._pubs: dict[str, zenoh.Publisher] = {}
+        self._subs = [
+            session.declare_subscriber(keys.tick(), self._push("tick")),
+            session.declare_subscriber(keys.end(), self._push("end")),
+            session.liveliness().declare_subscriber(keys.lives(), self._on_live, history=True),
+        ]
+        self._subs += [session.declare_subscriber(key, self._push("data")) for key in self.inbox.keys]
+        self._ack = session.declare_publisher(keys.ack(name), **_BLOCK)
+        self._token = session.liveliness().declare_token(keys.live(name))
+
+    def _push(self, kind: str) -> Callable[[zenoh.Sample], None]:
+        def on_sample(sample: zenoh.Sample) -> None:
+            self.events.put((kind, str(sample.key_expr), sample.payload.to_bytes()))
+
+        return on_sample
+
+    def _on_live(self, sample: zenoh.Sample) -> None:
+        kind = "join" if sample.kind == zenoh.SampleKind.PUT else "leave"
+        self.events.put((kind, self.keys.participant_of(str(sample.key_expr)), b""))
+
+    def publish(self, key: str, msg: Message) -> None:
+        """Publish an output; lockstep data is never dropped under congestion."""
+        pub = self._pubs.get(key)
+        if pub is None:
+            pub = self._pubs[key] = self.session.declare_publisher(key, **_BLOCK)
+        pub.put(codec.encode(msg))
+
+    # -- the loop ------------------------------------------------------------------------
+
+    def run(self, step: StepFn, on_end: EndFn | None = None) -> End:
+        """Step every tick until the conductor ends the run; returns the end message."""
+        pending: Tick | None = None
+        waiting_since = 0.0
+        while True:
+            kind, key, payload = self._next()
+            if kind == "data":
+                self._take_data(key, payload)
+            elif kind == "tick":
+                pending, waiting_since = self._take_tick(payload) or pending, time.monotonic()
+            elif kind == "end":
+                end = self._take_end(payload)
+                if end is not None:
+                    return self._finish(end, on_end)
+            if pending is not None and self._ready(pending, waiting_since):
+                step(pending, self.inbox.release(pending.tick))
+                self._ack.put(codec.encode(Ack(pending.run, pending.tick)))
+                pending = None
+
+    def _next(self) -> tuple[str, str, bytes]:
+        try:
+            event = self.events.get(timeout=1.0)
+        except queue.Empty:
+            return ("idle", "", b"")
+        kind, who, _ = event
+        if kind == "join":
+            self.present.add(who)
+        elif kind == "leave":
+            self.present.discard(who)
+            if who == CONDUCTOR and self.run_id:
+                raise ClockError(f"{self.name}: the conductor disappeared; ending")
+        return event
+
+    def _take_data(self, key: str, payload: bytes) -> None:
+        try:
+            self.inbox.add(key, payload)
+        except codec.CodecError as exc:
+            log.warning("%s: dropped malformed payload on %s: %s", self.name, key, exc)
+
+    def _take_tick(self, payload: bytes) -> Tick | None:
+        try:
+            tick = codec.decode(payload, Tick)
+        except codec.CodecError as exc:
+            log.warning("%s: malformed tick: %s", self.name, exc)
+            return None
+        if not self.run_id:
+            self.run_id = tick.run
+        if tick.run != self.run_id:
+            return None
+        self.inbox.drop_producers(tick.dropped)
+        return tick
+
+    def _take_end(self, payload: bytes) -> End | None:
+        try:
+            end = codec.decode(payload, End)
+        except codec.CodecError as exc:
+            log.warning("%s: malformed end: %s", self.name, exc)
+            return None
+        return end if not self.run_id or end.run == self.run_id else None
+
+    def _ready(self, tick: Tick, since: float) -> bool:
+        """Peers seen (so they know our subscriptions) and every due input arrived."""
+        missing = self.inbox.missing(tick.tick)
+        if not missing and self.peers <= self.present:
+            return True
+        if time.monotonic() - since > 5.0:
+            log.warning("%s: tick %d still waits for %s (peers absent: %s)", self.name, tick.tick,
+                        missing, sorted(self.peers - self.present))  # fmt: skip
+        return False
+
+    def _finish(self, end: End, on_end: EndFn | None) -> End:
+        """Collect samples due up to the last complete tick, bounded in time."""
+        limit = time.monotonic() + (self.drain_s if not end.error else 1.0)
+        while self.inbox.missing(end.tick + 1) and time.monotonic() < limit:
+            try:
+                kind, key, payload = self.events.get(timeout=max(limit - time.monotonic(), 0))
+            except queue.Empty:
+                break
+            if kind == "data":
+                self._take_data(key, payload)
+        if self.inbox.missing(end.tick + 1):
+            log.warning("%s: run ended without samples from %s", self.name,
+                        self.inbox.missing(end.tick + 1))  # fmt: skip
+        if on_end is not None:
+            on_end(end, self.inbox.release(end.tick + 1))
+        return end
+
+    def close(self) -> None:
+        self._token.undeclare()
+        for sub in self._subs:
+            sub.undeclare()

@@ -1,0 +1,41 @@
+"""The launcher's progress line: simulated time, ticks per second, real-time factor."""
+
+from __future__ import annotations
+
+import sys
+import time
+from collections.abc import Mapping
+from typing import Any
+
+
+class ProgressBar:
+    def __init__(self, total_ns: int, *, enabled: bool = True, width: int = 28) -> None:
+        self.total_ns, self.enabled, self.width = total_ns, enabled, width
+        self.tty = sys.stderr.isatty()
+        self.last_print = 0.0
+        self.shown = False
+
+    def line(self, event: Mapping[str, Any]) -> str:
+        frac = min(event["stamp_ns"] / self.total_ns, 1.0)
+        filled = int(frac * self.width)
+        bar = "#" * filled + "-" * (self.width - filled)
+        return (
+            f"[{bar}] {event['stamp_ns'] / 1e9:8.2f}/{self.total_ns / 1e9:.2f} s sim"
+            f" | {event['ticks_per_s']:8.0f} ticks/s | RTF {event['realtime_factor']:7.2f}x"
+        )
+
+    def update(self, event: Mapping[str, Any]) -> None:
+        if not self.enabled:
+            return
+        now = time.monotonic()
+        if self.tty:
+            sys.stderr.write("\r" + self.line(event))
+            sys.stderr.flush()
+            self.shown = True
+        elif now - self.last_print >= 2.0 or event["stamp_ns"] >= self.total_ns:
+            sys.stderr.write(self.line(event) + "\n")
+            self.last_print = now
+
+    def close(self) -> None:
+        if self.enabled and self.tty and self.shown:
+            sys.stderr.write("\n")

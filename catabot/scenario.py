@@ -1,0 +1,216 @@
+"""The scenario file (DESIGN.md §6): JSON in, validated models out.
+
+Validation happens before any process starts, and every error names the field and
+what is allowed, because a typo found after a ten-minute run is a lost ten minutes.
+Files in the original simulator's `SettingsConfig.json` format are mapped by
+`catabot.settings_config`.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+from pathlib import Path
+from typing import Any, Literal
+
+from pydantic import BaseModel, ConfigDict, Field, ValidationError, field_validator, model_validator
+
+from catabot.clock import NS_PER_S, ClockError, period_in_ticks, ticks_for
+from catabot.keys import check_name
+
+BUNDLED = Path(__file__).parent / "data" / "scenarios"
+
+
+class ScenarioError(ValueError):
+    """A scenario that cannot run; the message names the file, field and allowed values."""
+
+
+class _Model(BaseModel):
+    model_config = ConfigDict(extra="forbid", frozen=True)
+
+
+class ClockConfig(_Model):
+    deadline_s: float = Field(10.0, gt=0, description="per-tick deadline for every participant")
+    start_timeout_s: float = Field(60.0, gt=0, description="time allowed for services to join")
+    policy: Literal["abort", "drop"] = "abort"
+    realtime_factor: float | None = Field(None, gt=0, description="1.0 = wall clock; null = AFAP")
+
+
+class Pose(_Model):
+    """Start pose in `map` (ENU); z is ignored for floating vessels (they settle)."""
+
+    x_m: float = 0.0
+    y_m: float = 0.0
+    yaw_rad: float = 0.0
+
+
+class TwistStep(_Model):
+    surge_mps: float
+    yaw_rate_radps: float
+
+
+class ScriptStep(_Model):
+    """From `t_s` on, the vessel gets this command (until the next step)."""
+
+    t_s: float = Field(ge=0)
+    thrust: list[float] | None = None
+    twist: TwistStep | None = None
+
+    @model_validator(mode="after")
+    def _one_command(self) -> ScriptStep:
+        if (self.thrust is None) == (self.twist is None):
+            raise ValueError("give exactly one of 'thrust' or 'twist'")
+        if self.thrust is not None and not all(-1 <= v <= 1 for v in self.thrust):
+            raise ValueError("thrust commands are normalised: each in [-1, 1]")
+        return self
+
+
+class SensorConfig(_Model):
+    name: str
+    type: Literal["imu", "gps"]
+    rate_hz: float = Field(gt=0)
+    noise: bool = True
+
+    @field_validator("name")
+    @classmethod
+    def _key_safe(cls, v: str) -> str:
+        return check_name("sensor", v)
+
+    @property
+    def period_ns(self) -> int:
+        return round(NS_PER_S / self.rate_hz)
+
+
+class VesselConfig(_Model):
+    id: str
+    model: str = "catabot"
+    pose: Pose = Pose()
+    script: list[ScriptStep] = []
+    sensors: list[SensorConfig] = []
+
+    @field_validator("id")
+    @classmethod
+    def _key_safe(cls, v: str) -> str:
+        return check_name("vessel", v)
+
+
+class WaterConfig(_Model):
+    density_kg_m3: float = Field(1025.0, gt=900, lt=1100)
+
+
+class Origin(_Model):
+    """WGS84 position of the world origin (the terrain image's bottom-left corner)."""
+
+    latitude_deg: float = Field(0.0, ge=-90, le=90)
+    longitude_deg: float = Field(0.0, ge=-180, le=180)
+    altitude_m: float = 0.0
+
+
+class RecordingConfig(_Model):
+    csv: bool = True
+    mcap: bool = True
+
+
+class Scenario(_Model):
+    name: str = "default"
+    seed: int = 0
+    duration_s: float = Field(60.0, gt=0)
+    dt_ns: int = Field(10_000_000, gt=0, description="physics tick, integer nanoseconds")
+    clock: ClockConfig = ClockConfig()
+    origin: Origin = Origin()
+    water: WaterConfig = WaterConfig()
+    vessels: list[VesselConfig] = Field(min_length=1)
+    recording: RecordingConfig = RecordingConfig()
+
+    @field_validator("name")
+    @classmethod
+    def _key_safe(cls, v: str) -> str:
+        return check_name("world", v)
+
+    @model_validator(mode="after")
+    def _consistent(self) -> Scenario:
+        ids = [v.id for v in self.vessels]
+        if len(set(ids)) != len(ids):
+            raise ValueError(f"vessel ids must be unique (got {ids})")
+        for v in self.vessels:
+            names = [s.name for s in v.sensors]
+            if len(set(names)) != len(names):
+                raise ValueError(f"vessel {v.id!r}: sensor names must be unique (got {names})")
+        return self
+
+    @property
+    def duration_ns(self) -> int:
+        return round(self.duration_s * NS_PER_S)
+
+    @property
+    def ticks(self) -> int:
+        return ticks_for(self.duration_ns, self.dt_ns)
+
+
+def check_rates(scenario: Scenario) -> None:
+    """Refuse sensor rates that are not a whole number of ticks (DESIGN.md §4)."""
+    for v_index, vessel in enumerate(scenario.vessels):
+        for s_index, sensor in enumerate(vessel.sensors):
+            where = f"vessels.{v_index}.sensors.{s_index}.rate_hz ({vessel.id}/{sensor.name})"
+            exact = NS_PER_S / sensor.rate_hz
+            if not math.isclose(exact, round(exact), abs_tol=1e-6):
+                raise ScenarioError(f"{where}: {sensor.rate_hz} Hz is not a whole number of ns")
+            try:
+                period_in_ticks(sensor.period_ns, scenario.dt_ns, what=where)
+            except ClockError as exc:
+                raise ScenarioError(str(exc)) from None
+    try:
+        scenario.ticks  # noqa: B018 - validates duration against dt
+    except ClockError as exc:
+        raise ScenarioError(f"duration_s: {exc}") from None
+
+
+def parse_scenario(data: Any, *, source: str = "<data>") -> Scenario:
+    from catabot.settings_config import is_settings_config, map_settings_config
+
+    if isinstance(data, dict) and is_settings_config(data):
+        data = map_settings_config(data, source=source)
+    try:
+        scenario = Scenario.model_validate(data)
+    except ValidationError as exc:
+        raise ScenarioError(f"scenario {source}: {explain(exc)}") from None
+    check_rates(scenario)
+    return scenario
+
+
+def load_scenario(path: str | Path | None = None) -> Scenario:
+    """Load a scenario file, or the bundled default when `path` is None."""
+    file = BUNDLED / "default.json" if path is None else Path(path)
+    if not file.is_file():
+        bundled = BUNDLED / f"{file.name}.json"
+        if path is not None and "/" not in str(path) and bundled.is_file():
+            file = bundled
+        else:
+            raise ScenarioError(f"scenario file {str(file)!r} does not exist")
+    try:
+        data = json.loads(file.read_text())
+    except json.JSONDecodeError as exc:
+        raise ScenarioError(f"scenario {file}: not valid JSON: {exc}") from None
+    return parse_scenario(data, source=str(file))
+
+
+def explain(exc: ValidationError) -> str:
+    """One line per problem: the dotted field path, what is wrong and what is allowed."""
+    lines = []
+    for err in exc.errors():
+        where = ".".join(str(p) for p in err["loc"]) or "(top level)"
+        msg = err["msg"].removeprefix("Value error, ")
+        if err["type"] == "extra_forbidden":
+            msg = "unknown field"
+        got = err.get("input")
+        shown = f" (got {got!r})" if not isinstance(got, dict | list) else ""
+        lines.append(f"{where}: {msg}{shown}")
+    return "; ".join(lines)
+
+
+def json_schema() -> dict[str, Any]:
+    """The scenario's JSON Schema, for editors (`catabot scenario schema`)."""
+    schema = Scenario.model_json_schema()
+    schema["$schema"] = "https://json-schema.org/draft/2020-12/schema"
+    schema["title"] = "CataBot scenario"
+    return schema

@@ -1,0 +1,79 @@
+"""What every service program shares: flags, logging, the session, the exit code.
+
+A service is `def build(ctx) -> (participant, step, on_end)`; this module opens Zenoh,
+runs the lockstep loop, and turns faults into one clear log line and a non-zero exit.
+"""
+
+from __future__ import annotations
+
+import argparse
+import logging
+import signal
+import sys
+from collections.abc import Callable
+from dataclasses import dataclass
+from pathlib import Path
+
+import zenoh
+
+from catabot.clock import ClockError
+from catabot.keys import Keys
+from catabot.participant import EndFn, Participant, StepFn
+from catabot.scenario import Scenario, ScenarioError, load_scenario
+from catabot.session import SessionError, add_connection_args, connection_from_args, open_session
+from catabot.streams import participants
+
+log = logging.getLogger("catabot.service")
+
+
+@dataclass
+class ServiceContext:
+    name: str
+    scenario: Scenario
+    keys: Keys
+    session: zenoh.Session
+    run_dir: Path
+    peers: list[str]
+
+
+Built = tuple[Participant, StepFn, EndFn | None]
+BuildFn = Callable[[ServiceContext], Built]
+
+
+def service_parser(name: str) -> argparse.ArgumentParser:
+    parser = argparse.ArgumentParser(prog=f"catabot service {name}")
+    parser.add_argument("--scenario", help="scenario file (default: the bundled default)")
+    parser.add_argument("--run-dir", default=".", help="run folder for outputs")
+    add_connection_args(parser)
+    return parser
+
+
+def setup_logging() -> None:
+    logging.basicConfig(
+        level=logging.INFO, stream=sys.stderr, format="%(asctime)s %(name)s %(levelname)s %(message)s"
+    )
+
+
+def run_service(name: str, build: BuildFn, argv: list[str] | None = None) -> int:
+    """Run one stepping service to the end of the run; returns the process exit code."""
+    args = service_parser(name).parse_args(argv)
+    setup_logging()
+    signal.signal(signal.SIGTERM, lambda *_: sys.exit(143))
+    try:
+        scenario = load_scenario(args.scenario)
+        session = open_session(connection_from_args(args))
+    except (ScenarioError, SessionError) as exc:
+        log.error("%s: %s", name, exc)
+        return 2
+    ctx = ServiceContext(name, scenario, Keys(scenario.name), session, Path(args.run_dir),
+                         participants(scenario))  # fmt: skip
+    try:
+        participant, step, on_end = build(ctx)
+        end = participant.run(step, on_end)
+    except ClockError as exc:
+        log.error("%s", exc)
+        return 3
+    finally:
+        session.close()
+    log.info("%s: run ended at tick %d (%s) %s", name, end.tick, end.reason, end.error)
+    return 0

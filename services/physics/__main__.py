@@ -1,0 +1,5 @@
+import sys
+
+from services.physics.service import main
+
+sys.exit(main())

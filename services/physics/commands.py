@@ -1,0 +1,61 @@
+"""Which command each vessel follows at a tick: scripted, or the latest from the bus.
+
+Scripted steps are applied at the first tick boundary at or after their time; a command
+from the bus replaces the scripted one from the next tick on and stays until another
+arrives (the vessel keeps the last order it was given, as a real autopilot does).
+"""
+
+from __future__ import annotations
+
+import bisect
+import logging
+from dataclasses import dataclass
+
+from catabot import codec
+from catabot.clock import NS_PER_S
+from catabot.messages import Message, ThrustCmd, TwistCmd
+from catabot.scenario import ScriptStep, VesselConfig
+
+log = logging.getLogger("physics.commands")
+
+
+@dataclass(frozen=True)
+class Order:
+    """A vessel's current order: direct thrust or a velocity set-point."""
+
+    thrust: tuple[float, ...] | None = None
+    twist: tuple[float, float] | None = None
+
+
+class CommandBook:
+    def __init__(self, vessels: list[VesselConfig], thrusters: dict[str, int]) -> None:
+        self.thrusters = thrusters
+        self.scripts = {v.id: sorted(v.script, key=lambda s: s.t_s) for v in vessels}
+        self.times = {vid: [round(s.t_s * NS_PER_S) for s in steps] for vid, steps in self.scripts.items()}
+        self.external: dict[str, Order] = {}
+
+    def order(self, vessel: str, stamp_ns: int) -> Order:
+        if vessel in self.external:
+            return self.external[vessel]
+        index = bisect.bisect_right(self.times[vessel], stamp_ns) - 1
+        return _from_step(self.scripts[vessel][index]) if index >= 0 else Order()
+
+    def take(self, vessel: str, key: str, msgs: list[Message]) -> None:
+        """Adopt the newest valid command from the bus; refuse non-finite ones loudly."""
+        for msg in msgs:
+            if isinstance(msg, ThrustCmd) and len(msg.thrust) != self.thrusters[vessel]:
+                log.error("refused command on %s: %d values for %d thrusters", key,
+                          len(msg.thrust), self.thrusters[vessel])  # fmt: skip
+            elif isinstance(msg, ThrustCmd) and codec.finite(msg.thrust):
+                self.external[vessel] = Order(thrust=msg.thrust)
+            elif isinstance(msg, TwistCmd) and codec.finite((msg.surge, msg.yaw_rate)):
+                self.external[vessel] = Order(twist=(msg.surge, msg.yaw_rate))
+            else:
+                log.error("refused command on %s: non-finite value in %s", key, msg)
+
+
+def _from_step(step: ScriptStep) -> Order:
+    if step.thrust is not None:
+        return Order(thrust=tuple(step.thrust))
+    assert step.twist is not None
+    return Order(twist=(step.twist.surge_mps, step.twist.yaw_rate_radps))

@@ -1,0 +1,222 @@
+"""Hydrostatic and hydrodynamic forces for all vessels at once, vectorised with NumPy.
+
+Every per-vessel quantity is stored padded to a common width: columns as (N, C) arrays,
+thrusters as (N, T). Padding entries have zero area / zero force, so they contribute nothing
+and the hot path needs no Python loop over vessels. Wrenches are 6-vectors in Fossen order
+[X, Y, Z, K, M, N] (force then moment), in the body frame (FLU), about the body origin.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Sequence
+
+import numpy as np
+from numpy.typing import NDArray
+
+from catabot.vessel import Hull, Thruster, VesselModel
+
+Array = NDArray[np.float64]
+WaterHeight = Callable[[Array, Array, float], Array]
+
+
+def water_height(x: Array, y: Array, time_s: float = 0.0) -> Array:
+    """Height of the water surface at world points (x, y): calm water at z = 0.
+
+    The hook where waves plug in later: any function with this signature, taking arrays of
+    any shape and returning heights of that shape (or broadcastable to it). Calm water
+    returns a read-only broadcast view, so it allocates nothing.
+    """
+    del y, time_s
+    return np.broadcast_to(np.float64(0.0), np.shape(x))
+
+
+# --- buoyancy columns -------------------------------------------------------------------
+
+
+class Columns:
+    """Vertical buoyancy columns of every vessel, padded to (N, C), plus scratch buffers.
+
+    bottom_m: column bottom points in the body frame, stored (N, 3, C) so that one batched
+    matmul moves them all; height_m: extent along body z; area_m2: horizontal cross-section
+    (0 for padding). The scratch buffers are reused every step: fresh arrays of this size cost
+    more in page faults than the arithmetic itself. Not thread-safe, by design (one world).
+    """
+
+    def __init__(self, bottom_m: Array, height_m: Array, area_m2: Array) -> None:
+        self.bottom_m = np.ascontiguousarray(np.asarray(bottom_m).transpose(0, 2, 1))
+        self.height_m = np.ascontiguousarray(height_m, dtype=np.float64)
+        self.area_m2 = np.ascontiguousarray(area_m2, dtype=np.float64)
+        self.volume_m3 = self.height_m * self.area_m2
+        n, c = self.height_m.shape
+        self._world = np.empty((n, 3, c))
+        self._scratch = np.empty((3, n, c))
+
+
+def hull_columns(hull: Hull) -> tuple[Array, Array, Array]:
+    """Discretise one hull into columns: (bottom points (K, 3), heights (K,), areas (K,)).
+
+    A box column spans the full hull height. A cylinder (axis along body x) is cut into strips
+    across its diameter; each strip's height is its mean chord (strip area / strip width), so
+    the columns hold exactly the cylinder's volume and follow its circular bottom closely.
+    """
+    n_x, n_y = hull.columns_along, hull.across
+    dx, dy = hull.length_m / n_x, hull.beam_m / n_y
+    cx, cy, cz = hull.center_m
+    xs = cx - hull.length_m / 2 + dx * (np.arange(n_x) + 0.5)
+    edges = -hull.beam_m / 2 + dy * np.arange(n_y + 1)
+    ys = (edges[:-1] + edges[1:]) / 2
+    if hull.shape == "box":
+        assert hull.height_m is not None
+        heights = np.full(n_y, hull.height_m)
+    else:
+        r = hull.beam_m / 2
+        e = np.clip(edges, -r, r)
+        primitive = e * np.sqrt(np.maximum(r * r - e * e, 0.0)) + r * r * np.arcsin(e / r)
+        heights = np.diff(primitive) / dy
+    gx, gi = np.meshgrid(xs, np.arange(n_y), indexing="ij")
+    h = heights[gi].ravel()
+    bottom = np.stack([gx.ravel(), cy + ys[gi].ravel(), cz - h / 2], axis=1)
+    return bottom, h, np.full(h.shape, dx * dy)
+
+
+def build_columns(models: Sequence[VesselModel]) -> Columns:
+    """Columns of all vessels, padded to the largest count (set-up time only)."""
+    per_vessel = []
+    for model in models:
+        parts = [hull_columns(h) for h in model.hulls]
+        per_vessel.append(tuple(np.concatenate(p) for p in zip(*parts, strict=True)))
+    c_max = max(len(h) for _, h, _ in per_vessel)
+    n = len(models)
+    bottom, height, area = np.zeros((n, c_max, 3)), np.zeros((n, c_max)), np.zeros((n, c_max))
+    for i, (b, h, a) in enumerate(per_vessel):
+        bottom[i, : len(h)], height[i, : len(h)], area[i, : len(h)] = b, h, a
+    return Columns(bottom, height, area)
+
+
+def buoyancy_wrench(
+    cols: Columns,
+    rot: Array,
+    pos: Array,
+    *,
+    density: float,
+    gravity: float,
+    time_s: float = 0.0,
+    surface: WaterHeight = water_height,
+) -> Array:
+    """Body-frame buoyancy wrench (N, 6) of all vessels given rotations (N,3,3), positions (N,3).
+
+    Each column's submerged fraction f is measured along its own axis (body z) from whichever
+    end is lower, so a tilted or capsized hull is handled. Its force rho*g*A*h*f points up
+    (world +z) and acts at the centroid of the submerged part: the total is rho*g times the
+    submerged volume (Archimedes, exact for boxes) and tilt gives a restoring moment.
+    """
+    bottom_w = np.matmul(rot, cols.bottom_m, out=cols._world)  # (N, 3, C), world frame
+    bottom_w += pos[:, :, None]
+    cos_tilt = rot[:, 2, 2:3]  # world z of the body z axis, (N, 1)
+    rise, frac, work = cols._scratch  # (N, C) buffers, overwritten below
+    np.multiply(cols.height_m, cos_tilt, out=rise)  # signed world-vertical extent
+    np.minimum(rise, 0.0, out=frac)
+    frac += bottom_w[:, 2]  # z of the lower end
+    eta = surface(bottom_w[:, 0], bottom_w[:, 1], time_s)
+    np.subtract(eta, frac, out=frac)
+    np.abs(rise, out=work)
+    np.maximum(work, 1e-12, out=work)
+    frac /= work
+    np.clip(frac, 0.0, 1.0, out=frac)  # submerged fraction of each column
+    force = np.multiply(cols.volume_m3, frac, out=work)
+    force *= density * gravity  # (N, C), newtons
+    # Centroid of the submerged part along body z, from the bottom (or the top when capsized).
+    along = np.multiply(frac, cols.height_m, out=rise)
+    along *= 0.5
+    inverted = np.flatnonzero(cos_tilt[:, 0] < 0.0)
+    if inverted.size:
+        along[inverted] = cols.height_m[inverted] - along[inverted]
+    first_moment = np.matmul(cols.bottom_m, force[:, :, None])[:, :, 0]
+    first_moment[:, 2] += np.einsum("nc,nc->n", force, along)
+    up_body = rot[:, 2, :]  # world +z expressed in the body frame
+    total = force.sum(axis=1)
+    return np.concatenate([total[:, None] * up_body, np.cross(first_moment, up_body)], axis=1)
+
+
+# --- damping ----------------------------------------------------------------------------
+
+
+def damping_wrench(
+    nu_body: Array, linear: Array, quadratic: Array, water_velocity_body: Array | None = None
+) -> Array:
+    """Fossen damping (N, 6): -(linear + quadratic*|nu_r|)*nu_r, per DOF, body frame.
+
+    nu_body is [u, v, w, p, q, r] (N, 6); water_velocity_body (N, 3) is the current seen in the
+    body frame, so damping acts on the velocity relative to the water.
+    """
+    nu_r = nu_body.copy()
+    if water_velocity_body is not None:
+        nu_r[:, :3] -= water_velocity_body
+    return -(linear + quadratic * np.abs(nu_r)) * nu_r
+
+
+# --- thrusters --------------------------------------------------------------------------
+
+
+class ThrusterBank:
+    """Thrusters of all vessels, padded to (N, T), with first-order lag on each force."""
+
+    def __init__(self, layouts: Sequence[Sequence[Thruster]], dt_s: float) -> None:
+        n, t_max = len(layouts), max((len(t) for t in layouts), default=0)
+        self.count = [len(t) for t in layouts]
+        self.position_m = np.zeros((n, t_max, 3))
+        self.direction = np.zeros((n, t_max, 3))
+        self.max_forward_n = np.zeros((n, t_max))
+        self.max_reverse_n = np.zeros((n, t_max))
+        self.alpha = np.ones((n, t_max))  # exact ZOH factor 1 - exp(-dt/tau)
+        for i, layout in enumerate(layouts):
+            for k, th in enumerate(layout):
+                self.position_m[i, k] = th.position_m
+                self.direction[i, k] = (np.cos(th.yaw_rad), np.sin(th.yaw_rad), 0.0)
+                self.max_forward_n[i, k] = th.max_forward_n
+                self.max_reverse_n[i, k] = th.max_reverse_n
+                if th.time_constant_s > 0:
+                    self.alpha[i, k] = -np.expm1(-dt_s / th.time_constant_s)
+        self.command = np.zeros((n, t_max))
+        self.force_n = np.zeros((n, t_max))
+
+    def set_command(self, index: int, command: Array) -> None:
+        """Store a validated, clamped command vector for vessel `index`."""
+        self.command[index, : self.count[index]] = command
+
+    def advance(self) -> None:
+        """Move each delivered force one time step towards its commanded force."""
+        c = self.command
+        target = np.where(c >= 0.0, c * self.max_forward_n, c * self.max_reverse_n)
+        self.force_n += self.alpha * (target - self.force_n)
+
+    def wrench(self) -> Array:
+        """Body-frame wrench (N, 6) of the delivered thruster forces about the body origin."""
+        f = self.force_n[..., None] * self.direction
+        moment = np.cross(self.position_m, f)
+        return np.concatenate([f.sum(axis=1), moment.sum(axis=1)], axis=1)
+
+
+# --- rotations --------------------------------------------------------------------------
+
+
+def quat_from_rotvec(rv: Array) -> Array:
+    """Unit quaternions (x, y, z, w) from rotation vectors (N, 3), stable near zero angle."""
+    theta = np.linalg.norm(rv, axis=1)
+    small = theta < 1e-6
+    safe = np.where(small, 1.0, theta)
+    scale = np.where(small, 0.5 - theta * theta / 48.0, np.sin(0.5 * safe) / safe)
+    return np.concatenate([rv * scale[:, None], np.cos(0.5 * theta)[:, None]], axis=1)
+
+
+def rot_from_quat(q: Array) -> Array:
+    """Rotation matrices (N, 3, 3), body to world, from unit quaternions (x, y, z, w)."""
+    x, y, z, w = q[:, 0], q[:, 1], q[:, 2], q[:, 3]
+    return np.stack(
+        [
+            np.stack([1 - 2 * (y * y + z * z), 2 * (x * y - z * w), 2 * (x * z + y * w)], -1),
+            np.stack([2 * (x * y + z * w), 1 - 2 * (x * x + z * z), 2 * (y * z - x * w)], -1),
+            np.stack([2 * (x * z - y * w), 2 * (y * z + x * w), 1 - 2 * (x * x + y * y)], -1),
+        ],
+        axis=1,
+    )

@@ -1,0 +1,269 @@
+"""PhysicsWorld: every vessel as a DART free rigid body, driven by vectorised hydro forces.
+
+DART conventions this relies on (checked against dartpy 6.20, see tests): a FreeJoint's
+generalized positions are [rotation vector (3), translation (3)] of the body frame in the world;
+its generalized velocities are [angular velocity (3), linear velocity of the body-frame origin
+(3)] both expressed in the WORLD frame (not the body frame), and its generalized forces are the
+matching [torque about the body origin, force at the body origin], world frame. State is read
+and forces are written through these per-skeleton vectors, which is much cheaper than querying
+body transforms one by one.
+
+The body node's frame is the vessel's body frame (FLU, origin at the waterline reference
+point); the centre of gravity is set as the body's local centre of mass, so reported positions
+and velocities are those of the body origin, as the message contract expects.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Sequence
+from dataclasses import dataclass
+
+import dartpy as dart
+import numpy as np
+
+from catabot.vessel import VesselModel
+from services.physics.hydro import (
+    Array,
+    ThrusterBank,
+    build_columns,
+    buoyancy_wrench,
+    damping_wrench,
+    quat_from_rotvec,
+    rot_from_quat,
+)
+
+StartPose = tuple[float, float, float, float]  # x, y, z (m, map ENU), yaw (rad)
+
+
+@dataclass(frozen=True)
+class VesselKinematics:
+    """One vessel's state: pose in `map` (ENU), twist and acceleration in the body frame (FLU).
+
+    Accelerations are the body origin's kinematic acceleration (zero when floating at rest; an
+    accelerometer there would read it minus the gravity vector), from the change of world
+    velocity over the last step, rotated into the current body frame.
+    """
+
+    position: Array  # (3,) m
+    orientation: Array  # (4,) quaternion x, y, z, w
+    linear_velocity: Array  # (3,) m/s
+    angular_velocity: Array  # (3,) rad/s
+    linear_acceleration: Array  # (3,) m/s^2
+    angular_acceleration: Array  # (3,) rad/s^2
+
+
+@dataclass(frozen=True)
+class KinematicsArrays:
+    """The same state for every vessel at once, rows in `PhysicsWorld.vessel_ids` order."""
+
+    position: Array  # (N, 3)
+    orientation: Array  # (N, 4)
+    linear_velocity: Array  # (N, 3)
+    angular_velocity: Array  # (N, 3)
+    linear_acceleration: Array  # (N, 3)
+    angular_acceleration: Array  # (N, 3)
+
+
+class PhysicsWorld:
+    """Vessels on calm water: buoyancy by columns, Fossen damping, lagged thrusters, DART."""
+
+    def __init__(
+        self,
+        vessels: Sequence[tuple[str, VesselModel, StartPose]],
+        *,
+        dt_s: float,
+        water_density: float = 1025.0,
+        gravity: float = 9.81,
+    ) -> None:
+        _check_setup(vessels, dt_s, water_density, gravity)
+        self._ids = [vid for vid, _, _ in vessels]
+        self._index = {vid: i for i, vid in enumerate(self._ids)}
+        models = [model for _, model, _ in vessels]
+        self._dt, self._rho, self._g = float(dt_s), float(water_density), float(gravity)
+        self._steps = 0
+        self._world = dart.simulation.World()
+        self._world.setGravity([0.0, 0.0, -self._g])
+        self._world.setTimeStep(self._dt)
+        self._skeletons = [_make_skeleton(vid, m, p) for vid, m, p in vessels]
+        for skel in self._skeletons:
+            self._world.addSkeleton(skel)
+        self._columns = build_columns(models)
+        self._thrusters = ThrusterBank([m.thrusters for m in models], self._dt)
+        self._lin = np.array([m.damping.linear for m in models], dtype=np.float64)
+        self._quad = np.array([m.damping.quadratic for m in models], dtype=np.float64)
+        self._current_w = np.zeros((len(models), 3))  # water velocity, world frame (none yet)
+        self._read_state()
+        self._acc_w = np.zeros((len(models), 6))
+
+    # --- public API -----------------------------------------------------------------
+
+    @property
+    def time_s(self) -> float:
+        """Simulated time: whole steps times dt, so it does not drift with rounding."""
+        return self._steps * self._dt
+
+    @property
+    def vessel_ids(self) -> list[str]:
+        return list(self._ids)
+
+    def set_thrust(self, vessel_id: str, command: Sequence[float]) -> None:
+        """Set a vessel's normalised thruster commands (-1 full reverse .. +1 full forward).
+
+        Raises ValueError for an unknown vessel, a wrong number of values or a non-finite one;
+        finite values outside [-1, 1] are clamped. Takes effect from the next `step()`.
+        """
+        index = self._index.get(vessel_id)
+        if index is None:
+            raise ValueError(f"unknown vessel id {vessel_id!r} (known: {', '.join(self._ids)})")
+        values = np.asarray(command, dtype=np.float64).ravel()
+        expected = self._thrusters.count[index]
+        if values.size != expected:
+            raise ValueError(
+                f"thrust command for vessel {vessel_id!r}: expected {expected} values "
+                f"(one per thruster), got {values.size}"
+            )
+        bad = np.flatnonzero(~np.isfinite(values))
+        if bad.size:
+            raise ValueError(
+                f"thrust command for vessel {vessel_id!r}: value {int(bad[0])} is not finite "
+                f"({values[bad[0]]})"
+            )
+        self._thrusters.set_command(index, np.clip(values, -1.0, 1.0))
+
+    def step(self) -> None:
+        """Advance every vessel by dt: compute all forces vectorised, apply, step DART."""
+        self._thrusters.advance()
+        wrench_b = self._body_wrench()
+        # Body-frame [F, M] about the origin -> DART's world-frame [M, F] generalized forces.
+        force_w = np.einsum("nij,nj->ni", self._rot, wrench_b[:, :3])
+        moment_w = np.einsum("nij,nj->ni", self._rot, wrench_b[:, 3:])
+        generalized = np.concatenate([moment_w, force_w], axis=1)
+        for skel, tau in zip(self._skeletons, generalized, strict=True):
+            skel.setForces(tau)
+        vel_before = self._vel_w
+        self._world.step()
+        self._steps += 1
+        self._read_state()
+        self._acc_w = (self._vel_w - vel_before) / self._dt
+
+    def state_arrays(self) -> KinematicsArrays:
+        """Every vessel's state as stacked arrays (copies), rows in `vessel_ids` order."""
+        rot_t = self._rot.transpose(0, 2, 1)
+        to_body = lambda v: np.einsum("nij,nj->ni", rot_t, v)  # noqa: E731
+        return KinematicsArrays(
+            position=self._pos.copy(),
+            orientation=self._quat.copy(),
+            linear_velocity=to_body(self._vel_w[:, 3:]),
+            angular_velocity=to_body(self._vel_w[:, :3]),
+            linear_acceleration=to_body(self._acc_w[:, 3:]),
+            angular_acceleration=to_body(self._acc_w[:, :3]),
+        )
+
+    def states(self) -> dict[str, VesselKinematics]:
+        """Every vessel's state keyed by vessel id."""
+        a = self.state_arrays()
+        return {
+            vid: VesselKinematics(
+                a.position[i],
+                a.orientation[i],
+                a.linear_velocity[i],
+                a.angular_velocity[i],
+                a.linear_acceleration[i],
+                a.angular_acceleration[i],
+            )
+            for i, vid in enumerate(self._ids)
+        }
+
+    def thruster_forces(self, vessel_id: str) -> Array:
+        """Delivered (lagged) force of each thruster of a vessel, newtons."""
+        index = self._index[vessel_id]
+        return self._thrusters.force_n[index, : self._thrusters.count[index]].copy()
+
+    # --- internals ------------------------------------------------------------------
+
+    def _read_state(self) -> None:
+        """Cache pose and world-frame velocity of all vessels from the generalized vectors."""
+        q = np.array([s.getPositions() for s in self._skeletons], dtype=np.float64)
+        self._vel_w = np.array([s.getVelocities() for s in self._skeletons], dtype=np.float64)
+        self._pos = q[:, 3:]
+        self._quat = quat_from_rotvec(q[:, :3])
+        self._rot = rot_from_quat(self._quat)
+
+    def _body_wrench(self) -> Array:
+        """Sum of buoyancy, damping and thrust, body frame, Fossen order, about the origin."""
+        rot_t = self._rot.transpose(0, 2, 1)
+        nu = np.concatenate(
+            [
+                np.einsum("nij,nj->ni", rot_t, self._vel_w[:, 3:]),
+                np.einsum("nij,nj->ni", rot_t, self._vel_w[:, :3]),
+            ],
+            axis=1,
+        )
+        current_b = np.einsum("nij,nj->ni", rot_t, self._current_w)
+        return (
+            buoyancy_wrench(
+                self._columns,
+                self._rot,
+                self._pos,
+                density=self._rho,
+                gravity=self._g,
+                time_s=self.time_s,
+            )
+            + damping_wrench(nu, self._lin, self._quad, current_b)
+            + self._thrusters.wrench()
+        )
+
+
+def _check_setup(
+    vessels: Sequence[tuple[str, VesselModel, StartPose]],
+    dt_s: float,
+    water_density: float,
+    gravity: float,
+) -> None:
+    """Reject a set-up that would give a meaningless or non-deterministic world."""
+    if not vessels:
+        raise ValueError("PhysicsWorld needs at least one vessel")
+    if not (math.isfinite(dt_s) and dt_s > 0):
+        raise ValueError(f"dt_s must be a finite number > 0 (got {dt_s})")
+    if not (math.isfinite(water_density) and water_density > 0):
+        raise ValueError(f"water_density must be a finite number > 0 (got {water_density})")
+    if not (math.isfinite(gravity) and gravity >= 0):
+        raise ValueError(f"gravity must be a finite number >= 0 (got {gravity})")
+    seen: set[str] = set()
+    for vid, _, pose in vessels:
+        if not vid or vid in seen:
+            raise ValueError(f"vessel ids must be unique and non-empty (got {vid!r} twice)")
+        seen.add(vid)
+        if len(pose) != 4 or not all(math.isfinite(v) for v in pose):
+            raise ValueError(f"vessel {vid!r}: start pose must be 4 finite numbers (x, y, z, yaw)")
+
+
+def _make_skeleton(vessel_id: str, model: VesselModel, pose: StartPose) -> dart.dynamics.Skeleton:
+    """One free rigid body: mass and inertia at the COG, a box collision shape over the hulls."""
+    skel = dart.dynamics.Skeleton(vessel_id)
+    _, body = skel.createFreeJointAndBodyNodePair()
+    body.setName(vessel_id)
+    body.setMass(model.mass_kg)
+    ixx, iyy, izz = model.inertia_kgm2
+    body.setMomentOfInertia(ixx, iyy, izz, 0.0, 0.0, 0.0)
+    body.setLocalCOM(np.asarray(model.cog_m, dtype=np.float64))
+    lo, hi = _hull_bounds(model)
+    node = body.createShapeNode(dart.dynamics.BoxShape(hi - lo))
+    node.setRelativeTranslation((lo + hi) / 2)
+    node.createCollisionAspect()
+    node.createDynamicsAspect()
+    x, y, z, yaw = pose
+    skel.setPositions(np.array([0.0, 0.0, yaw, x, y, z]))
+    return skel
+
+
+def _hull_bounds(model: VesselModel) -> tuple[Array, Array]:
+    """Axis-aligned body-frame box around all hulls."""
+    lows, highs = [], []
+    for hull in model.hulls:
+        half = np.array([hull.length_m, hull.beam_m, hull.vertical_extent_m]) / 2
+        centre = np.asarray(hull.center_m, dtype=np.float64)
+        lows.append(centre - half)
+        highs.append(centre + half)
+    return np.min(lows, axis=0), np.max(highs, axis=0)

@@ -1,0 +1,5 @@
+import sys
+
+from services.recorder.service import main
+
+sys.exit(main())

@@ -1,0 +1,116 @@
+"""Time-synchronous CSV files, one per stream (DESIGN.md §7).
+
+Rows are held in memory and reach the file only in `flush()`, which the recorder calls once
+per tick: a run killed at any moment therefore leaves whole rows of whole ticks on disk,
+never a half-written line. The header is taken from the first sample of each stream, so a
+sample of another shape (a different number of thrusters, another message type) is refused
+with `RecorderError` instead of silently shifting columns under the header.
+"""
+
+from __future__ import annotations
+
+import csv
+import io
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import TextIO
+
+from catabot import tabular
+from catabot.messages import Message
+
+
+class RecorderError(ValueError):
+    """A sample the recorder cannot write without corrupting a file; the service logs it."""
+
+
+def stream_filename(stream: str, suffix: str) -> str:
+    """`vessel/ego/state` -> `vessel.ego.state<suffix>`: flat, and never escapes the folder."""
+    name = stream.strip("/").replace("/", ".")
+    if not name or name.startswith(".") or "\\" in name or "\x00" in name:
+        raise RecorderError(f"stream {stream!r} cannot name a file")
+    return name + suffix
+
+
+@dataclass
+class _CsvFile:
+    """One open CSV file, its header shape and the rows not yet written."""
+
+    stream: str
+    handle: TextIO
+    cls: type[Message]
+    width: int
+    pending: io.StringIO = field(default_factory=io.StringIO)
+
+    def __post_init__(self) -> None:
+        self.writer = csv.writer(self.pending, lineterminator="\n")
+
+
+class CsvSink:
+    """Writes every sample of every stream as one CSV row; `flush()` once per tick."""
+
+    def __init__(self, directory: Path) -> None:
+        self._dir = Path(directory)
+        self._dir.mkdir(parents=True, exist_ok=True)
+        self._files: dict[str, _CsvFile] = {}
+        self._closed = False
+
+    def path(self, stream: str) -> Path:
+        """Where the rows of `stream` go."""
+        return self._dir / stream_filename(stream, ".csv")
+
+    def write(self, stream: str, msg: Message) -> None:
+        """Queue one row; the first sample of a stream creates its file and header."""
+        if self._closed:
+            raise RecorderError(f"{stream}: the CSV sink is closed")
+        out = self._files.get(stream) or self._open(stream, msg)
+        if type(msg) is not out.cls:
+            raise RecorderError(
+                f"{stream}: a {type(msg).__name__} sample on a stream of {out.cls.__name__}; "
+                "not written"
+            )
+        try:
+            cells = tabular.row(msg)
+        except TypeError as exc:
+            raise RecorderError(f"{stream}: {exc}; not written") from exc
+        if len(cells) != out.width:
+            raise RecorderError(
+                f"{stream}: sample has {len(cells)} columns but the header has {out.width} "
+                "(set by the first sample); not written"
+            )
+        out.writer.writerow(cells)
+
+    def _open(self, stream: str, msg: Message) -> _CsvFile:
+        path = self.path(stream)
+        if any(o.handle.name == str(path) for o in self._files.values()):
+            raise RecorderError(f"{stream}: file {path.name} is already used by another stream")
+        header = tabular.sample_columns(msg)
+        handle = open(path, "w", newline="", encoding="utf-8")  # noqa: SIM115
+        out = _CsvFile(stream, handle, type(msg), len(header))
+        out.writer.writerow(header)
+        self._files[stream] = out
+        return out
+
+    def flush(self) -> None:
+        """Write the rows queued since the last call and flush every file (once per tick)."""
+        for out in self._files.values():
+            text = out.pending.getvalue()
+            if text:
+                out.handle.write(text)
+                out.pending.seek(0)
+                out.pending.truncate()
+            out.handle.flush()
+
+    def close(self) -> None:
+        """Flush and close every file; further writes are refused."""
+        if self._closed:
+            return
+        self.flush()
+        for out in self._files.values():
+            out.handle.close()
+        self._closed = True
+
+    def __enter__(self) -> CsvSink:
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        self.close()

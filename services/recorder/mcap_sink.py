@@ -1,0 +1,295 @@
+"""`run.mcap`: every stream as an MCAP channel (DESIGN.md §7).
+
+Vessel states are ROS 2 `nav_msgs/msg/Odometry` (CDR); every other message is JSON with a
+JSON Schema derived from its dataclass, so Foxglove Studio opens every channel.
+
+Why it is written this way:
+- Unchunked records, and bytes reach the file only in `flush()` (once per tick): a recorder
+  killed at any moment leaves a file whose records are all complete up to the last tick,
+  which `read_mcap_messages` reads without the summary that only `close()` writes.
+- log time = publish time = `stamp_ns` and a per-channel sequence number: nothing in the file
+  comes from the wall clock or a random source, so two identical runs give identical bytes.
+"""
+
+from __future__ import annotations
+
+import io
+import json
+import struct
+import typing
+from collections.abc import Iterator
+from dataclasses import dataclass
+from pathlib import Path
+from typing import IO, Any, BinaryIO
+
+from mcap.exceptions import EndOfFile
+from mcap.opcode import Opcode
+from mcap.records import Channel, Schema
+from mcap.records import Message as McapMessage
+from mcap.stream_reader import MAGIC_SIZE, StreamReader
+from mcap.well_known import MessageEncoding, SchemaEncoding
+from mcap.writer import LIBRARY_IDENTIFIER, CompressionType, Writer
+from mcap_ros2._dynamic import serialize_dynamic
+from mcap_ros2.decoder import DecoderFactory
+
+from catabot.messages import Message, VesselState
+from services.recorder import json_schemas, ros2_msgdefs
+from services.recorder.csv_sink import RecorderError
+
+_RECORD_HEAD = struct.Struct("<BQ")  # opcode, length of the record body
+
+
+class _TickBuffer(io.BufferedIOBase):
+    """A write-only file whose bytes reach the disk only on flush (tick-atomic records)."""
+
+    def __init__(self, path: Path) -> None:
+        super().__init__()
+        self._file = open(path, "wb")  # noqa: SIM115
+        self._pending = bytearray()
+
+    def writable(self) -> bool:
+        return True
+
+    def write(self, data: Any) -> int:
+        self._pending += data
+        return len(data)
+
+    def tell(self) -> int:
+        return self._file.tell() + len(self._pending)
+
+    def flush(self) -> None:
+        if self._file.closed:
+            return  # IOBase.close() flushes once more after our file is closed
+        if self._pending:
+            self._file.write(self._pending)
+            self._pending.clear()
+        self._file.flush()
+
+    def close(self) -> None:
+        if not self._file.closed:
+            self.flush()
+            self._file.close()
+        super().close()
+
+
+@dataclass
+class _Channel:
+    """A registered channel and how its messages become bytes."""
+
+    id: int
+    cls: type[Message]
+    encode: typing.Callable[[Message, int], bytes]
+    sequence: int = 0
+
+
+class McapSink:
+    """Writes every stream to one MCAP file; `flush()` once per tick, `close()` at the end."""
+
+    def __init__(self, path: Path) -> None:
+        self._out = _TickBuffer(Path(path))
+        self._writer = Writer(
+            typing.cast(IO[Any], self._out),
+            compression=CompressionType.NONE,
+            use_chunking=False,
+        )
+        # profile "": channels mix CDR and JSON. The file is valid from the first byte on.
+        self._writer.start(profile="", library=f"catabot {LIBRARY_IDENTIFIER}")
+        self._out.flush()
+        self._schemas: dict[type[Message], int] = {}
+        self._channels: dict[str, _Channel] = {}
+        self._closed = False
+
+    def write(self, stream: str, msg: Message, *, stamp_ns: int) -> None:
+        """Add one message to channel `/<stream>`, stamped with simulated time."""
+        if self._closed:
+            raise RecorderError(f"{stream}: the MCAP sink is closed")
+        chan = self._channels.get(stream) or self._register(stream, msg)
+        if type(msg) is not chan.cls:
+            raise RecorderError(
+                f"{stream}: a {type(msg).__name__} sample on a channel of {chan.cls.__name__}; "
+                "not written"
+            )
+        try:
+            data = chan.encode(msg, stamp_ns)
+        except (ValueError, TypeError, IndexError, struct.error) as exc:
+            raise RecorderError(f"{stream}: cannot encode {type(msg).__name__}: {exc}") from exc
+        self._writer.add_message(
+            channel_id=chan.id,
+            log_time=stamp_ns,
+            publish_time=stamp_ns,
+            data=data,
+            sequence=chan.sequence,
+        )
+        chan.sequence += 1
+
+    def _register(self, stream: str, msg: Message) -> _Channel:
+        cls = type(msg)
+        if cls is VesselState:
+            encoding, encode = MessageEncoding.CDR, _odometry_encoder(_vessel_of(stream))
+        else:
+            encoding, encode = MessageEncoding.JSON, _json_encoder
+        topic = "/" + stream.strip("/")
+        channel_id = self._writer.register_channel(topic, encoding, self._schema(cls))
+        chan = _Channel(channel_id, cls, encode)
+        self._channels[stream] = chan
+        return chan
+
+    def _schema(self, cls: type[Message]) -> int:
+        if cls not in self._schemas:
+            if cls is VesselState:
+                text = ros2_msgdefs.ODOMETRY_MSGDEF.encode()
+                sid = self._writer.register_schema(ros2_msgdefs.ODOMETRY, SchemaEncoding.ROS2, text)
+            else:
+                text = json.dumps(json_schemas.json_schema(cls), separators=(",", ":")).encode()
+                sid = self._writer.register_schema(
+                    json_schemas.schema_name(cls), SchemaEncoding.JSONSchema, text
+                )
+            self._schemas[cls] = sid
+        return self._schemas[cls]
+
+    def flush(self) -> None:
+        """Put every record written so far into the file (call once per tick)."""
+        # Unchunked, the writer hands each message (with the schema and channel registered
+        # just before it) to our buffer at once, so flushing the buffer is enough; this also
+        # avoids Writer.flush(), which only mcap >= 1.6 has.
+        if not self._closed:
+            self._out.flush()
+
+    def close(self) -> None:
+        """Write the summary and footer, then close the file."""
+        if self._closed:
+            return
+        self._writer.finish()
+        self._out.close()
+        self._closed = True
+
+    def __enter__(self) -> McapSink:
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        self.close()
+
+
+def _vessel_of(stream: str) -> str:
+    """`vessel/<id>/state` -> `<id>`, the Odometry child frame (the body frame)."""
+    parts = stream.strip("/").split("/")
+    if len(parts) == 3 and parts[0] == "vessel" and parts[2] == "state":
+        return parts[1]
+    raise RecorderError(f"{stream}: a VesselState stream must be named vessel/<id>/state")
+
+
+def _odometry_encoder(vessel: str) -> typing.Callable[[Message, int], bytes]:
+    """CDR encoder of one vessel's Odometry (mcap_ros2's writer always chunks, so we
+    use its serializer with our own unchunked writer)."""
+    defs = serialize_dynamic(ros2_msgdefs.ODOMETRY, ros2_msgdefs.ODOMETRY_MSGDEF)
+    serialize = defs[ros2_msgdefs.ODOMETRY]
+
+    def encode(msg: Message, stamp_ns: int) -> bytes:
+        assert isinstance(msg, VesselState)
+        return bytes(serialize(ros2_msgdefs.odometry(msg, vessel, stamp_ns)))
+
+    return encode
+
+
+def _json_encoder(msg: Message, stamp_ns: int) -> bytes:
+    return json_schemas.encode(msg)
+
+
+@dataclass(frozen=True)
+class ReadMessage:
+    """One message read back: `decoded` is a dict (JSON) or a ROS 2 message object (CDR)."""
+
+    topic: str
+    schema_name: str
+    log_time: int
+    publish_time: int
+    sequence: int
+    data: bytes
+    decoded: Any
+
+
+class _Bounded(io.RawIOBase):
+    """The first `limit` bytes of a file, so the stream reader never sees a torn record."""
+
+    def __init__(self, f: BinaryIO, limit: int) -> None:
+        super().__init__()
+        self._f, self._left = f, limit
+
+    def readable(self) -> bool:
+        return True
+
+    def readinto(self, buffer: Any) -> int:
+        view = memoryview(buffer).cast("B")[: self._left]
+        n = self._f.readinto(view)  # type: ignore[attr-defined]
+        self._left -= n
+        return n
+
+
+def _complete_length(f: BinaryIO) -> int:
+    """Bytes up to the end of the last complete record (a killed writer leaves a torn tail)."""
+    size = f.seek(0, io.SEEK_END)
+    pos = MAGIC_SIZE
+    while pos + _RECORD_HEAD.size <= size:
+        f.seek(pos)
+        opcode, length = _RECORD_HEAD.unpack(f.read(_RECORD_HEAD.size))
+        end = pos + _RECORD_HEAD.size + length
+        if end > size:
+            break
+        pos = end
+        if opcode == Opcode.FOOTER:
+            return min(size, pos + MAGIC_SIZE)
+    return min(pos, size)
+
+
+def _records(path: Path) -> Iterator[Any]:
+    """Every complete record of the file, in file order; stops quietly at a torn tail."""
+    with open(path, "rb") as f:
+        limit = _complete_length(f)
+        if limit < MAGIC_SIZE:
+            return  # killed before anything reached the file
+        f.seek(0)
+        try:
+            yield from StreamReader(_Bounded(f, limit)).records
+        except EndOfFile:
+            return  # no footer: the writer did not close; every complete record was read
+
+
+def read_mcap_messages(path: Path) -> list[ReadMessage]:
+    """Every message of an MCAP file in file order, decoded; tolerates a truncated tail.
+
+    Works on a finished file and on one whose writer was killed before `close()`: messages
+    up to the last complete record are returned (with `McapSink`, the last flushed tick).
+    """
+    ros2 = DecoderFactory()
+    schemas: dict[int, Schema] = {}
+    channels: dict[int, Channel] = {}
+    out: list[ReadMessage] = []
+    for record in _records(Path(path)):
+        if isinstance(record, Schema):
+            schemas[record.id] = record
+        elif isinstance(record, Channel):
+            channels[record.id] = record
+        elif isinstance(record, McapMessage):
+            chan = channels[record.channel_id]
+            schema = schemas.get(chan.schema_id)
+            out.append(_decoded(record, chan, schema, ros2))
+    return out
+
+
+def _decoded(
+    record: McapMessage, chan: Channel, schema: Schema | None, ros2: DecoderFactory
+) -> ReadMessage:
+    if chan.message_encoding == MessageEncoding.JSON:
+        decoded: Any = json.loads(record.data)
+    else:
+        decoder = ros2.decoder_for(chan.message_encoding, schema)
+        decoded = decoder(record.data) if decoder else None
+    return ReadMessage(
+        topic=chan.topic,
+        schema_name=schema.name if schema else "",
+        log_time=record.log_time,
+        publish_time=record.publish_time,
+        sequence=record.sequence,
+        data=bytes(record.data),
+        decoded=decoded,
+    )

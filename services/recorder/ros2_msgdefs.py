@@ -1,0 +1,120 @@
+"""ROS 2 message definitions written into `run.mcap`, and the mapping onto them.
+
+MCAP's `ros2msg` schema encoding carries the full text of a message and of every message it
+uses, concatenated with `===...` separators and `MSG: pkg/Type` lines (the form rosbag2 writes).
+The text is spelled out here, rather than read from a ROS installation, so recording needs no
+ROS and Foxglove Studio or `ros2 bag` read the file as native `nav_msgs/msg/Odometry`.
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+from catabot.messages import VesselState
+
+ODOMETRY = "nav_msgs/msg/Odometry"
+WORLD_FRAME = "map"
+
+_SEPARATOR = "=" * 80
+
+_ODOMETRY_TEXT = """\
+# Estimate of a position and velocity in free space.
+# The pose is in the frame given by header.frame_id;
+# the twist is in the frame given by child_frame_id.
+std_msgs/Header header
+string child_frame_id
+geometry_msgs/PoseWithCovariance pose
+geometry_msgs/TwistWithCovariance twist
+"""
+
+_DEPENDENCIES = {
+    "std_msgs/Header": """\
+builtin_interfaces/Time stamp
+string frame_id
+""",
+    "builtin_interfaces/Time": """\
+int32 sec
+uint32 nanosec
+""",
+    "geometry_msgs/PoseWithCovariance": """\
+Pose pose
+float64[36] covariance
+""",
+    "geometry_msgs/Pose": """\
+Point position
+Quaternion orientation
+""",
+    "geometry_msgs/Point": """\
+float64 x
+float64 y
+float64 z
+""",
+    "geometry_msgs/Quaternion": """\
+float64 x 0
+float64 y 0
+float64 z 0
+float64 w 1
+""",
+    "geometry_msgs/TwistWithCovariance": """\
+Twist twist
+float64[36] covariance
+""",
+    "geometry_msgs/Twist": """\
+Vector3 linear
+Vector3 angular
+""",
+    "geometry_msgs/Vector3": """\
+float64 x
+float64 y
+float64 z
+""",
+}
+
+
+def _concatenated(main: str, deps: dict[str, str]) -> str:
+    parts = [main]
+    for name, text in deps.items():
+        parts.append(f"{_SEPARATOR}\nMSG: {name}\n{text}")
+    return "\n".join(parts)
+
+
+ODOMETRY_MSGDEF = _concatenated(_ODOMETRY_TEXT, _DEPENDENCIES)
+"""`nav_msgs/msg/Odometry` with its dependencies, in the format `mcap_ros2` parses."""
+
+_ZERO_COVARIANCE = [0.0] * 36  # unknown covariance; the simulator has the exact state
+
+
+def _xyz(v: tuple[float, ...]) -> dict[str, float]:
+    return {"x": v[0], "y": v[1], "z": v[2]}
+
+
+def stamp(stamp_ns: int) -> dict[str, int]:
+    """builtin_interfaces/Time from simulated nanoseconds (floor division keeps nanosec >= 0)."""
+    sec, nanosec = divmod(stamp_ns, 1_000_000_000)
+    return {"sec": sec, "nanosec": nanosec}
+
+
+def odometry(state: VesselState, child_frame_id: str, stamp_ns: int) -> dict[str, Any]:
+    """A VesselState as Odometry: pose in `map`, twist in the body frame (`child_frame_id`).
+
+    The accelerations have no place in Odometry; they are in the CSV of the same stream.
+    """
+    x, y, z, w = state.orientation
+    return {
+        "header": {"stamp": stamp(stamp_ns), "frame_id": WORLD_FRAME},
+        "child_frame_id": child_frame_id,
+        "pose": {
+            "pose": {
+                "position": _xyz(state.position),
+                "orientation": {"x": x, "y": y, "z": z, "w": w},
+            },
+            "covariance": _ZERO_COVARIANCE,
+        },
+        "twist": {
+            "twist": {
+                "linear": _xyz(state.linear_velocity),
+                "angular": _xyz(state.angular_velocity),
+            },
+            "covariance": _ZERO_COVARIANCE,
+        },
+    }

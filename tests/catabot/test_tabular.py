@@ -1,0 +1,92 @@
+"""CSV columns come from message metadata, with units, and cells are byte-stable."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from catabot import tabular
+from catabot.messages import Ack, ThrustCmd, TwistCmd, VesselState
+
+
+def _state() -> VesselState:
+    return VesselState(
+        tick=7,
+        stamp_ns=700_000_000,
+        position=(1.0, -2.5, 0.1),
+        orientation=(0.0, 0.0, 0.38268343236508984, 0.9238795325112867),
+        linear_velocity=(1.5, 0.0, 0.0),
+        angular_velocity=(0.0, 0.0, 0.05),
+        linear_acceleration=(0.0, 0.0, 0.0),
+        angular_acceleration=(0.0, 0.0, 1e-05),
+    )
+
+
+def test_vessel_state_columns_have_units_and_axes() -> None:
+    assert tabular.columns(VesselState) == [
+        "stamp_ns",
+        "tick",
+        "position_x[m]",
+        "position_y[m]",
+        "position_z[m]",
+        "orientation_x",
+        "orientation_y",
+        "orientation_z",
+        "orientation_w",
+        "linear_velocity_x[m/s]",
+        "linear_velocity_y[m/s]",
+        "linear_velocity_z[m/s]",
+        "angular_velocity_x[rad/s]",
+        "angular_velocity_y[rad/s]",
+        "angular_velocity_z[rad/s]",
+        "linear_acceleration_x[m/s^2]",
+        "linear_acceleration_y[m/s^2]",
+        "linear_acceleration_z[m/s^2]",
+        "angular_acceleration_x[rad/s^2]",
+        "angular_acceleration_y[rad/s^2]",
+        "angular_acceleration_z[rad/s^2]",
+    ]
+
+
+def test_variable_length_vector_takes_width() -> None:
+    assert tabular.columns(ThrustCmd, width=2) == ["stamp_ns", "tick", "thrust_0", "thrust_1"]
+    with pytest.raises(ValueError, match="thrust"):
+        tabular.columns(ThrustCmd)
+
+
+def test_sample_columns_size_by_sample() -> None:
+    cmd = ThrustCmd(thrust=(0.5, -0.5, 0.0), tick=3, stamp_ns=300)
+    assert tabular.sample_columns(cmd) == tabular.columns(ThrustCmd, width=3)
+    assert tabular.row(cmd) == ["300", "3", "0.5", "-0.5", "0.0"]
+
+
+def test_scalars_with_units() -> None:
+    assert tabular.columns(TwistCmd) == ["stamp_ns", "tick", "surge[m/s]", "yaw_rate[rad/s]"]
+    assert tabular.row(TwistCmd(surge=2.0, yaw_rate=-0.1, tick=1, stamp_ns=10)) == [
+        "10",
+        "1",
+        "2.0",
+        "-0.1",
+    ]
+
+
+def test_row_matches_columns_and_round_trips() -> None:
+    state = _state()
+    cells = tabular.row(state)
+    assert len(cells) == len(tabular.columns(VesselState))
+    assert cells[:2] == ["700000000", "7"]
+    assert cells[-1] == "1e-05"
+    assert float(cells[7]) == state.orientation[1 + 1]  # shortest repr round-trips exactly
+
+
+def test_message_without_stamp_or_tick_fields() -> None:
+    assert tabular.columns(Ack) == ["tick", "run"]
+    assert tabular.row(Ack(run="r1", tick=4)) == ["4", "r1"]
+
+
+def test_formatting_is_deterministic_for_numpy_and_specials() -> None:
+    assert tabular.fmt(np.float64(0.1)) == "0.1"
+    assert tabular.fmt(np.int64(-3)) == "-3"
+    assert tabular.fmt(float("nan")) == "nan"
+    assert tabular.fmt(float("-inf")) == "-inf"
+    assert tabular.fmt(True) == "true"
