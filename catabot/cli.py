@@ -16,9 +16,13 @@ from catabot.session import Connection, SessionError, add_connection_args, open_
 
 def _run(args: argparse.Namespace) -> int:
     opts = launcher.RunOptions(
-        scenario=args.scenario, duration_s=args.duration, realtime=args.realtime,
-        out=Path(args.out), connect=tuple(args.connect), quiet=args.quiet,
-    )  # fmt: skip
+        scenario=args.scenario,
+        duration_s=args.duration,
+        realtime=args.realtime,
+        out=Path(args.out),
+        connect=tuple(args.connect),
+        quiet=args.quiet,
+    )
     return launcher.run(opts)
 
 
@@ -39,7 +43,9 @@ def _service(args: argparse.Namespace, rest: list[str]) -> int:
 def _router(args: argparse.Namespace) -> int:
     listen = tuple(args.listen) or ("tcp/0.0.0.0:7447",)
     try:
-        session = open_session(Connection(connect=tuple(args.connect), listen=listen, mode="router"))
+        session = open_session(
+            Connection(connect=tuple(args.connect), listen=listen, mode="router")
+        )
     except SessionError as exc:
         print(f"catabot router: {exc}", file=sys.stderr)
         return 2
@@ -65,7 +71,8 @@ def _scenario(args: argparse.Namespace) -> int:
     except ScenarioError as exc:
         print(f"catabot scenario validate: {exc}", file=sys.stderr)
         return 2
-    print(f"{args.file or 'default'}: valid ({len(scenario.vessels)} vessel(s), {scenario.ticks} ticks)")
+    counts = f"{len(scenario.vessels)} vessel(s), {scenario.ticks} ticks"
+    print(f"{args.file or 'default'}: valid ({counts})")
     return 0
 
 
@@ -77,8 +84,13 @@ def parser() -> argparse.ArgumentParser:
     run.add_argument("--duration", type=float, help="simulated seconds (overrides the scenario)")
     run.add_argument("--realtime", type=float, metavar="FACTOR", help="pace: 1.0 = wall clock")
     run.add_argument("--out", default="runs", help="folder for run folders (default: runs)")
-    run.add_argument("--connect", action="append", default=[], metavar="ENDPOINT",
-                     help="use a zenoh router instead of the embedded peer mesh")  # fmt: skip
+    run.add_argument(
+        "--connect",
+        action="append",
+        default=[],
+        metavar="ENDPOINT",
+        help="use a zenoh router instead of the embedded peer mesh",
+    )
     run.add_argument("--quiet", action="store_true", help="no progress bar")
     svc = sub.add_parser("service", help="run one service (conductor, physics, ...) alone")
     svc.add_argument("name")

@@ -10,7 +10,7 @@ arrived. That rule, not message ordering, makes runs deterministic across routes
 from __future__ import annotations
 
 from dataclasses import dataclass
-from enum import Enum
+from enum import StrEnum
 
 from catabot.messages import Message
 
@@ -21,7 +21,7 @@ class ClockError(RuntimeError):
     """The run cannot go on: a participant vanished, missed the deadline or never came."""
 
 
-class Policy(str, Enum):
+class Policy(StrEnum):
     """What the conductor does with a faulty participant."""
 
     ABORT = "abort"

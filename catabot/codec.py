@@ -97,7 +97,9 @@ def decode(payload: bytes | bytearray | memoryview, expect: type[M]) -> M:
     wire = body.pop("type", None)
     if wire != expect.TYPE:
         known = ", ".join(sorted(MESSAGE_TYPES))
-        raise CodecError(f"message type {wire!r} where {expect.TYPE!r} was expected (known: {known})")
+        raise CodecError(
+            f"message type {wire!r} where {expect.TYPE!r} was expected (known: {known})"
+        )
     return expect(**_validated_fields(expect, body))
 
 
@@ -159,7 +161,11 @@ def _check(type_name: str, name: str, kind: str, length: int | None, value: Any)
         if not all(type(v) in (int, float) for v in value):
             raise CodecError(f"{where}: every entry must be a number")
         return tuple(float(v) for v in value)
-    if kind == "names" and isinstance(value, list | tuple) and all(isinstance(v, str) for v in value):
+    if (
+        kind == "names"
+        and isinstance(value, list | tuple)
+        and all(isinstance(v, str) for v in value)
+    ):
         return tuple(value)
     raise CodecError(f"{where}: expected {kind}, got {type(value).__name__}")
 

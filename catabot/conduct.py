@@ -14,7 +14,7 @@ import sys
 from dataclasses import asdict
 
 from catabot.clock import Policy
-from catabot.conductor import ClockSpec, Conductor, Progress
+from catabot.conductor import ClockSpec, Conductor
 from catabot.keys import Keys
 from catabot.scenario import Scenario, ScenarioError, load_scenario
 from catabot.session import SessionError, add_connection_args, connection_from_args, open_session

@@ -23,6 +23,7 @@ from catabot.messages import Ack, End, Tick
 
 log = logging.getLogger("catabot.conductor")
 CONDUCTOR = "conductor"
+BLOCK = zenoh.CongestionControl.BLOCK
 
 
 @dataclass(frozen=True)
@@ -61,9 +62,8 @@ class Conductor:
         self.members: set[str] = set()
         self.dropped: list[str] = []
         self._stop_reason = ""
-        opts = {"congestion_control": zenoh.CongestionControl.BLOCK}
-        self._tick_pub = session.declare_publisher(keys.tick(), **opts)
-        self._end_pub = session.declare_publisher(keys.end(), **opts)
+        self._tick_pub = session.declare_publisher(keys.tick(), congestion_control=BLOCK)
+        self._end_pub = session.declare_publisher(keys.end(), congestion_control=BLOCK)
         self._token = session.liveliness().declare_token(keys.live(CONDUCTOR))
         self._subs = [
             session.declare_subscriber(keys.acks(), self._on_ack),
@@ -156,8 +156,9 @@ class Conductor:
                 self._fault(self.keys.participant_of(key), f"left the run at tick {k}", waiting)
             elif kind == "late":
                 for name in sorted(waiting):
-                    self._fault(name, f"missed the {self.spec.deadline_s:g} s deadline of tick {k}",
-                                waiting)  # fmt: skip
+                    self._fault(
+                        name, f"missed the {self.spec.deadline_s:g} s deadline of tick {k}", waiting
+                    )
             elif kind == "stop":
                 return
 

@@ -79,9 +79,7 @@ class Keys:
         return f"{self.prefix}/vessel/*/cmd/*"
 
     def sensor(self, vessel: str, sensor: str) -> str:
-        return (
-            f"{self.prefix}/sensor/{check_name('vessel', vessel)}/{check_name('sensor', sensor)}"
-        )
+        return f"{self.prefix}/sensor/{check_name('vessel', vessel)}/{check_name('sensor', sensor)}"
 
     def env_state(self) -> str:
         return f"{self.prefix}/env/state"

@@ -104,11 +104,16 @@ def run(opts: RunOptions) -> int:
     run_dir = make_run_dir(opts.out, scenario)
     cond_flags, svc_flags = _endpoints(opts)
     scen = str(run_dir / "scenario.json")
-    conductor = _spawn(["catabot.conduct", "--scenario", scen, *cond_flags],
-                       run_dir / "log" / "conductor.log", stdout_pipe=True)  # fmt: skip
+    conductor = _spawn(
+        ["catabot.conduct", "--scenario", scen, *cond_flags],
+        run_dir / "log" / "conductor.log",
+        stdout_pipe=True,
+    )
     services = {
-        name: _spawn([SERVICE_MODULES[name], "--scenario", scen, "--run-dir", str(run_dir),
-                      *svc_flags], run_dir / "log" / f"{name}.log")  # fmt: skip
+        name: _spawn(
+            [SERVICE_MODULES[name], "--scenario", scen, "--run-dir", str(run_dir), *svc_flags],
+            run_dir / "log" / f"{name}.log",
+        )
         for name in participants(scenario)
     }
     return Supervisor(scenario, run_dir, conductor, services, quiet=opts.quiet).wait()
@@ -117,15 +122,24 @@ def run(opts: RunOptions) -> int:
 class Supervisor:
     """Watches the processes of one run until all have ended."""
 
-    def __init__(self, scenario: Scenario, run_dir: Path, conductor: subprocess.Popen[str],
-                 services: dict[str, subprocess.Popen[str]], *, quiet: bool) -> None:  # fmt: skip
+    def __init__(
+        self,
+        scenario: Scenario,
+        run_dir: Path,
+        conductor: subprocess.Popen[str],
+        services: dict[str, subprocess.Popen[str]],
+        *,
+        quiet: bool,
+    ) -> None:
         self.scenario, self.run_dir = scenario, run_dir
         self.conductor, self.services = conductor, services
         self.bar = ProgressBar(scenario.duration_ns, enabled=not quiet)
         self.result: dict[str, object] = {}
 
     def wait(self) -> int:
-        previous = signal.signal(signal.SIGINT, lambda *_: self.conductor.send_signal(signal.SIGINT))
+        previous = signal.signal(
+            signal.SIGINT, lambda *_: self.conductor.send_signal(signal.SIGINT)
+        )
         try:
             self._read_conductor()
             self._reap_services(timeout_s=15.0)
@@ -175,5 +189,10 @@ class Supervisor:
     def _summary(self) -> int:
         from catabot.summary import summarise
 
-        return summarise(self.scenario, self.run_dir, self.result, self.conductor.returncode,
-                         {n: p.returncode for n, p in self.services.items()})  # fmt: skip
+        return summarise(
+            self.scenario,
+            self.run_dir,
+            self.result,
+            self.conductor.returncode,
+            {n: p.returncode for n, p in self.services.items()},
+        )

@@ -17,7 +17,7 @@ import zenoh
 
 from catabot import codec
 from catabot.clock import ClockError, Stream
-from catabot.conductor import CONDUCTOR
+from catabot.conductor import BLOCK, CONDUCTOR
 from catabot.inbox import Inbox, Inputs
 from catabot.keys import Keys
 from catabot.messages import Ack, End, Message, Tick
@@ -25,7 +25,6 @@ from catabot.messages import Ack, End, Message, Tick
 log = logging.getLogger("catabot.participant")
 StepFn = Callable[[Tick, Inputs], None]
 EndFn = Callable[[End, Inputs], None]
-_BLOCK = {"congestion_control": zenoh.CongestionControl.BLOCK}
 
 
 class Participant:
@@ -52,8 +51,10 @@ class Participant:
             session.declare_subscriber(keys.end(), self._push("end")),
             session.liveliness().declare_subscriber(keys.lives(), self._on_live, history=True),
         ]
-        self._subs += [session.declare_subscriber(key, self._push("data")) for key in self.inbox.keys]
-        self._ack = session.declare_publisher(keys.ack(name), **_BLOCK)
+        self._subs += [
+            session.declare_subscriber(key, self._push("data")) for key in self.inbox.keys
+        ]
+        self._ack = session.declare_publisher(keys.ack(name), congestion_control=BLOCK)
         self._token = session.liveliness().declare_token(keys.live(name))
 
     def _push(self, kind: str) -> Callable[[zenoh.Sample], None]:
@@ -70,7 +71,7 @@ class Participant:
         """Publish an output; lockstep data is never dropped under congestion."""
         pub = self._pubs.get(key)
         if pub is None:
-            pub = self._pubs[key] = self.session.declare_publisher(key, **_BLOCK)
+            pub = self._pubs[key] = self.session.declare_publisher(key, congestion_control=BLOCK)
         pub.put(codec.encode(msg))
 
     # -- the loop ------------------------------------------------------------------------
@@ -141,8 +142,13 @@ class Participant:
         if not missing and self.peers <= self.present:
             return True
         if time.monotonic() - since > 5.0:
-            log.warning("%s: tick %d still waits for %s (peers absent: %s)", self.name, tick.tick,
-                        missing, sorted(self.peers - self.present))  # fmt: skip
+            log.warning(
+                "%s: tick %d still waits for %s (peers absent: %s)",
+                self.name,
+                tick.tick,
+                missing,
+                sorted(self.peers - self.present),
+            )
         return False
 
     def _finish(self, end: End, on_end: EndFn | None) -> End:
@@ -156,8 +162,9 @@ class Participant:
             if kind == "data":
                 self._take_data(key, payload)
         if self.inbox.missing(end.tick + 1):
-            log.warning("%s: run ended without samples from %s", self.name,
-                        self.inbox.missing(end.tick + 1))  # fmt: skip
+            log.warning(
+                "%s: run ended without samples from %s", self.name, self.inbox.missing(end.tick + 1)
+            )
         if on_end is not None:
             on_end(end, self.inbox.release(end.tick + 1))
         return end

@@ -50,7 +50,9 @@ def service_parser(name: str) -> argparse.ArgumentParser:
 
 def setup_logging() -> None:
     logging.basicConfig(
-        level=logging.INFO, stream=sys.stderr, format="%(asctime)s %(name)s %(levelname)s %(message)s"
+        level=logging.INFO,
+        stream=sys.stderr,
+        format="%(asctime)s %(name)s %(levelname)s %(message)s",
     )
 
 
@@ -65,8 +67,9 @@ def run_service(name: str, build: BuildFn, argv: list[str] | None = None) -> int
     except (ScenarioError, SessionError) as exc:
         log.error("%s: %s", name, exc)
         return 2
-    ctx = ServiceContext(name, scenario, Keys(scenario.name), session, Path(args.run_dir),
-                         participants(scenario))  # fmt: skip
+    ctx = ServiceContext(
+        name, scenario, Keys(scenario.name), session, Path(args.run_dir), participants(scenario)
+    )
     try:
         participant, step, on_end = build(ctx)
         end = participant.run(step, on_end)

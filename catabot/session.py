@@ -63,13 +63,21 @@ def free_port() -> int:
 def add_connection_args(parser: argparse.ArgumentParser) -> None:
     """The connection flags every CataBot program shares."""
     parser.add_argument(
-        "--connect", "-e", action="append", default=[], metavar="ENDPOINT",
+        "--connect",
+        "-e",
+        action="append",
+        default=[],
+        metavar="ENDPOINT",
         help="zenoh endpoint to connect to, e.g. tcp/192.168.1.10:7447 (repeatable)",
-    )  # fmt: skip
+    )
     parser.add_argument(
-        "--listen", "-l", action="append", default=[], metavar="ENDPOINT",
+        "--listen",
+        "-l",
+        action="append",
+        default=[],
+        metavar="ENDPOINT",
         help="zenoh endpoint to listen on (default tcp/127.0.0.1:0 in peer mode)",
-    )  # fmt: skip
+    )
     parser.add_argument("--mode", choices=MODES, default="peer", help="zenoh session mode")
 
 

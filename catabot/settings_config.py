@@ -13,10 +13,17 @@ from typing import Any
 log = logging.getLogger("catabot.settings_config")
 
 BOOL_KEYS = (
-    "radarActive", "lidarActive", "imuActive", "minimapActive", "screenshotsSaveToFile",
-    "screenshotsColorActive", "screenshotsSegmentationActive", "screenshotsDepthActive",
-    "screenshotsNormalActive", "terrainFromFile",
-)  # fmt: skip
+    "radarActive",
+    "lidarActive",
+    "imuActive",
+    "minimapActive",
+    "screenshotsSaveToFile",
+    "screenshotsColorActive",
+    "screenshotsSegmentationActive",
+    "screenshotsDepthActive",
+    "screenshotsNormalActive",
+    "terrainFromFile",
+)
 NUMBER_RANGES = {
     "rainIntensity": (0.0, 50.0),
     "boatsNumberActive": (0, 100),
@@ -58,7 +65,9 @@ def map_settings_config(data: dict[str, Any], *, source: str) -> dict[str, Any]:
     except SettingsConfigError as exc:
         raise ScenarioError(f"settings file {source}: {exc}") from None
     _warn_unsupported(data, source)
-    sensors = [{"name": "imu", "type": "imu", "rate_hz": 100.0}] if data.get("imuActive", True) else []
+    sensors = (
+        [{"name": "imu", "type": "imu", "rate_hz": 100.0}] if data.get("imuActive", True) else []
+    )
     sensors.append({"name": "gps", "type": "gps", "rate_hz": 10.0})
     return {
         "name": "settings-config",
@@ -79,8 +88,14 @@ def _check(data: dict[str, Any]) -> None:
             raise SettingsConfigError(f"{key}: must be true or false (got {value!r})")
         if key in NUMBER_RANGES:
             lo, hi = NUMBER_RANGES[key]
-            if isinstance(value, bool) or not isinstance(value, int | float) or not lo <= value <= hi:
-                raise SettingsConfigError(f"{key}: must be a number in [{lo}, {hi}] (got {value!r})")
+            if (
+                isinstance(value, bool)
+                or not isinstance(value, int | float)
+                or not lo <= value <= hi
+            ):
+                raise SettingsConfigError(
+                    f"{key}: must be a number in [{lo}, {hi}] (got {value!r})"
+                )
         if key in CHOICES and value not in CHOICES[key]:
             raise SettingsConfigError(f"{key}: must be one of {list(CHOICES[key])} (got {value!r})")
         if key in STRING_KEYS and not isinstance(value, str):
@@ -93,8 +108,12 @@ def _check(data: dict[str, Any]) -> None:
 def _warn_unsupported(data: dict[str, Any], source: str) -> None:
     for key, feature in NOT_YET.items():
         if data.get(key, key in ("radarActive", "lidarActive", "minimapActive")):
-            log.warning("%s: %s=true asks for %s, not in this CataBot version; ignored",
-                        source, key, feature)  # fmt: skip
+            log.warning(
+                "%s: %s=true asks for %s, not in this CataBot version; ignored",
+                source,
+                key,
+                feature,
+            )
     if data.get("rainIntensity", 0.0) > 0:
         log.warning("%s: rainIntensity only affects LiDAR, not in this version; ignored", source)
     if data.get("boatsNumberActive", 0) > 0:

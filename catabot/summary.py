@@ -24,8 +24,13 @@ def describe_exit(code: int | None) -> str:
     return f"exit code {code}"
 
 
-def summarise(scenario: Scenario, run_dir: Path, result: Mapping[str, object],
-              conductor_code: int | None, service_codes: Mapping[str, int | None]) -> int:  # fmt: skip
+def summarise(
+    scenario: Scenario,
+    run_dir: Path,
+    result: Mapping[str, object],
+    conductor_code: int | None,
+    service_codes: Mapping[str, int | None],
+) -> int:
     ticks = int(result.get("ticks_done", 0))  # type: ignore[call-overload]
     wall = float(result.get("wall_s", 0.0))  # type: ignore[arg-type]
     sim_s = ticks * scenario.dt_ns / 1e9
@@ -35,16 +40,26 @@ def summarise(scenario: Scenario, run_dir: Path, result: Mapping[str, object],
         error = error or f"the conductor ended without a result ({describe_exit(conductor_code)})"
     elif not error and failed:
         error = "service(s) failed: " + ", ".join(failed)
-    record = {"ticks": ticks, "sim_s": sim_s, "wall_s": wall, "error": error,
-              "reason": result.get("reason", ""), "services": dict(service_codes)}  # fmt: skip
+    record = {
+        "ticks": ticks,
+        "sim_s": sim_s,
+        "wall_s": wall,
+        "error": error,
+        "reason": result.get("reason", ""),
+        "services": dict(service_codes),
+    }
     (run_dir / "log" / "run.json").write_text(json.dumps(record, indent=2) + "\n")
     rtf = sim_s / wall if wall > 0 else 0.0
-    print(f"{ticks} ticks, {sim_s:.2f} s simulated in {wall:.2f} s "
-          f"({ticks / max(wall, 1e-9):.0f} ticks/s, real-time factor {rtf:.1f})")  # fmt: skip
+    print(
+        f"{ticks} ticks, {sim_s:.2f} s simulated in {wall:.2f} s "
+        f"({ticks / max(wall, 1e-9):.0f} ticks/s, real-time factor {rtf:.1f})"
+    )
     for name, code in service_codes.items():
         if code not in (0, None):
-            print(f"  {name}: {describe_exit(code)} (see {run_dir / 'log' / (name + '.log')})",
-                  file=sys.stderr)  # fmt: skip
+            print(
+                f"  {name}: {describe_exit(code)} (see {run_dir / 'log' / (name + '.log')})",
+                file=sys.stderr,
+            )
     print(f"run folder: {run_dir}")
     if error:
         print(f"run failed: {error}", file=sys.stderr)

@@ -31,7 +31,9 @@ class CommandBook:
     def __init__(self, vessels: list[VesselConfig], thrusters: dict[str, int]) -> None:
         self.thrusters = thrusters
         self.scripts = {v.id: sorted(v.script, key=lambda s: s.t_s) for v in vessels}
-        self.times = {vid: [round(s.t_s * NS_PER_S) for s in steps] for vid, steps in self.scripts.items()}
+        self.times = {
+            vid: [round(s.t_s * NS_PER_S) for s in steps] for vid, steps in self.scripts.items()
+        }
         self.external: dict[str, Order] = {}
 
     def order(self, vessel: str, stamp_ns: int) -> Order:
@@ -44,8 +46,12 @@ class CommandBook:
         """Adopt the newest valid command from the bus; refuse non-finite ones loudly."""
         for msg in msgs:
             if isinstance(msg, ThrustCmd) and len(msg.thrust) != self.thrusters[vessel]:
-                log.error("refused command on %s: %d values for %d thrusters", key,
-                          len(msg.thrust), self.thrusters[vessel])  # fmt: skip
+                log.error(
+                    "refused command on %s: %d values for %d thrusters",
+                    key,
+                    len(msg.thrust),
+                    self.thrusters[vessel],
+                )
             elif isinstance(msg, ThrustCmd) and codec.finite(msg.thrust):
                 self.external[vessel] = Order(thrust=msg.thrust)
             elif isinstance(msg, TwistCmd) and codec.finite((msg.surge, msg.yaw_rate)):

@@ -13,7 +13,9 @@ from catabot.vessel import VesselModel
 
 
 class TwistController:
-    def __init__(self, model: VesselModel, *, dt_s: float, kp: float = 2.0, ki: float = 0.5) -> None:
+    def __init__(
+        self, model: VesselModel, *, dt_s: float, kp: float = 2.0, ki: float = 0.5
+    ) -> None:
         lin, quad = model.damping.linear, model.damping.quadratic
         self.damp = np.array([[lin[0], quad[0]], [lin[5], quad[5]]])
         self.inertia = np.array([model.mass_kg, model.inertia_kgm2[2]])

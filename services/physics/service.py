@@ -30,15 +30,24 @@ class PhysicsService:
         self.keys = ctx.keys
         self.dt_ns = scenario.dt_ns
         self.world = PhysicsWorld(
-            [(v.id, models[v.id], (v.pose.x_m, v.pose.y_m, 0.0, v.pose.yaw_rad)) for v in scenario.vessels],
+            [
+                (v.id, models[v.id], (v.pose.x_m, v.pose.y_m, 0.0, v.pose.yaw_rad))
+                for v in scenario.vessels
+            ],
             dt_s=scenario.dt_ns / 1e9,
             water_density=scenario.water.density_kg_m3,
         )
-        self.controllers = {vid: TwistController(m, dt_s=self.dt_ns / 1e9) for vid, m in models.items()}
-        self.book = CommandBook(scenario.vessels, {vid: len(m.thrusters) for vid, m in models.items()})
+        self.controllers = {
+            vid: TwistController(m, dt_s=self.dt_ns / 1e9) for vid, m in models.items()
+        }
+        self.book = CommandBook(
+            scenario.vessels, {vid: len(m.thrusters) for vid, m in models.items()}
+        )
         self.streams = command_streams(scenario, ctx.keys)
         self.vessel_of = {s.key: s.key.split("/")[-3] for s in self.streams}
-        self.participant = Participant(ctx.session, ctx.keys, ctx.name, inputs=self.streams, peers=ctx.peers)
+        self.participant = Participant(
+            ctx.session, ctx.keys, ctx.name, inputs=self.streams, peers=ctx.peers
+        )
 
     def step(self, tick: Tick, inputs: Inputs) -> None:
         for key, msgs in inputs.items():
@@ -66,10 +75,19 @@ class PhysicsService:
     def _publish(self, tick: Tick) -> None:
         stamp = tick.stamp_ns + self.dt_ns
         for vid, s in self.world.states().items():
-            self.participant.publish(self.keys.vessel_state(vid), VesselState(
-                tick.tick, stamp, _t(s.position), _t(s.orientation), _t(s.linear_velocity),
-                _t(s.angular_velocity), _t(s.linear_acceleration), _t(s.angular_acceleration),
-            ))  # fmt: skip
+            self.participant.publish(
+                self.keys.vessel_state(vid),
+                VesselState(
+                    tick.tick,
+                    stamp,
+                    _t(s.position),
+                    _t(s.orientation),
+                    _t(s.linear_velocity),
+                    _t(s.angular_velocity),
+                    _t(s.linear_acceleration),
+                    _t(s.angular_acceleration),
+                ),
+            )
 
 
 def _t(values: object) -> tuple[float, ...]:

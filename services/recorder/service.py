@@ -29,7 +29,9 @@ class Recorder:
         self.csv = CsvSink(ctx.run_dir) if rec.csv else None
         self.mcap = McapSink(ctx.run_dir / "run.mcap") if rec.mcap else None
         streams = world_streams(ctx.scenario, ctx.keys) + command_streams(ctx.scenario, ctx.keys)
-        self.participant = Participant(ctx.session, ctx.keys, ctx.name, inputs=streams, peers=ctx.peers)
+        self.participant = Participant(
+            ctx.session, ctx.keys, ctx.name, inputs=streams, peers=ctx.peers
+        )
 
     def step(self, tick: Tick, inputs: Inputs) -> None:
         for key in sorted(inputs):
