@@ -21,6 +21,7 @@ def _run(args: argparse.Namespace) -> int:
         realtime=args.realtime,
         out=Path(args.out),
         connect=tuple(args.connect),
+        listen=args.listen,
         quiet=args.quiet,
     )
     return launcher.run(opts)
@@ -90,6 +91,11 @@ def parser() -> argparse.ArgumentParser:
         default=[],
         metavar="ENDPOINT",
         help="use a zenoh router instead of the embedded peer mesh",
+    )
+    run.add_argument(
+        "--listen",
+        metavar="ENDPOINT",
+        help="embedded mesh endpoint (default tcp/127.0.0.1:<free port>)",
     )
     run.add_argument("--quiet", action="store_true", help="no progress bar")
     svc = sub.add_parser("service", help="run one service (conductor, physics, ...) alone")

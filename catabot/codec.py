@@ -35,8 +35,9 @@ def _array_to_ext(arr: np.ndarray) -> msgpack.ExtType:
     dtype = arr.dtype.newbyteorder("<") if arr.dtype.byteorder == ">" else arr.dtype
     if dtype.str not in ALLOWED_DTYPES:
         raise CodecError(f"arrays of dtype {arr.dtype} cannot be sent; use one of numeric/bool")
+    shape = list(arr.shape)  # before ascontiguousarray, which turns 0-d into 1-d
     arr = np.ascontiguousarray(arr, dtype=dtype)
-    header = msgpack.packb([dtype.str, list(arr.shape)])
+    header = msgpack.packb([dtype.str, shape])
     return msgpack.ExtType(ARRAY_EXT, bytes([len(header)]) + header + arr.tobytes())
 
 
@@ -48,6 +49,8 @@ def _ext_to_array(code: int, data: bytes) -> Any:
         dtype_str, shape = msgpack.unpackb(data[1 : 1 + hlen])
         if dtype_str not in ALLOWED_DTYPES:
             raise CodecError(f"array dtype {dtype_str!r} is not allowed")
+        if not isinstance(shape, list) or not all(type(n) is int and n >= 0 for n in shape):
+            raise CodecError(f"malformed array extension: shape {shape!r}")
         arr = np.frombuffer(data, dtype=np.dtype(dtype_str), offset=1 + hlen)
         return arr.reshape(shape)
     except CodecError:
@@ -105,7 +108,7 @@ def decode(payload: bytes | bytearray | memoryview, expect: type[M]) -> M:
 
 def _validated_fields(cls: type[Message], body: dict[str, Any]) -> dict[str, Any]:
     specs = _field_specs(cls)
-    unknown = sorted(set(body) - set(specs))
+    unknown = sorted(set(body) - set(specs), key=repr)  # keys may mix str and bytes
     if unknown:
         raise CodecError(f"{cls.TYPE}: unknown field(s) {unknown}; fields are {sorted(specs)}")
     out: dict[str, Any] = {}

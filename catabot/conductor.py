@@ -62,6 +62,7 @@ class Conductor:
         self.members: set[str] = set()
         self.dropped: list[str] = []
         self._stop_reason = ""
+        self._done = 0
         self._tick_pub = session.declare_publisher(keys.tick(), congestion_control=BLOCK)
         self._end_pub = session.declare_publisher(keys.end(), congestion_control=BLOCK)
         self._token = session.liveliness().declare_token(keys.live(CONDUCTOR))
@@ -86,13 +87,13 @@ class Conductor:
 
     def run(self, on_progress: Callable[[Progress], None] | None = None) -> RunResult:
         start = time.monotonic()
-        done = 0
         try:
             self._await_members()
-            done = self._tick_loop(on_progress, start)
+            self._tick_loop(on_progress, start)
             error = ""
         except ClockError as exc:
             error = str(exc)
+        done = self._done  # complete ticks, also when a fault or a stop cut the run short
         reason = self._stop_reason or ("completed" if not error else "fault")
         self._end_pub.put(codec.encode(End(self.run_id, done - 1, reason, error)))
         return RunResult(done, time.monotonic() - start, error, list(self.dropped), reason)
@@ -117,7 +118,9 @@ class Conductor:
                 return k
             self._pace(k)
             self._publish_tick(k)
-            self._await_acks(k)
+            if not self._await_acks(k):
+                return k
+            self._done = k + 1
             now = time.monotonic()
             if on_progress and now - last_report >= 0.25:
                 on_progress(self._progress(k, now - start))
@@ -143,7 +146,8 @@ class Conductor:
         tick = Tick(self.run_id, k, k * self.spec.dt_ns, self.spec.dt_ns, tuple(self.dropped))
         self._tick_pub.put(codec.encode(tick))
 
-    def _await_acks(self, k: int) -> None:
+    def _await_acks(self, k: int) -> bool:
+        """Wait until every participant acked tick `k` or was dropped; False on a stop."""
         waiting = set(self.spec.participants) - set(self.dropped)
         for name in sorted(waiting - self.members):
             self._fault(name, f"left the run before tick {k}", waiting)
@@ -160,7 +164,8 @@ class Conductor:
                         name, f"missed the {self.spec.deadline_s:g} s deadline of tick {k}", waiting
                     )
             elif kind == "stop":
-                return
+                return False
+        return True
 
     def _take_ack(self, k: int, key: str, payload: bytes, waiting: set[str]) -> None:
         try:

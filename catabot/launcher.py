@@ -20,7 +20,7 @@ from pathlib import Path
 from catabot.progress import ProgressBar
 from catabot.scenario import Scenario, ScenarioError, load_scenario
 from catabot.session import free_port
-from catabot.streams import participants
+from catabot.streams import services as needed_services
 from catabot.vessel import VesselModelError, load_vessel_model
 
 SERVICE_MODULES = {
@@ -41,6 +41,7 @@ class RunOptions:
     realtime: float | None = None
     out: Path = Path("runs")
     connect: tuple[str, ...] = ()
+    listen: str | None = None
     quiet: bool = False
 
 
@@ -57,7 +58,7 @@ def prepare(opts: RunOptions) -> Scenario:
     scenario = parse_scenario(data, source="command line")
     for vessel in scenario.vessels:
         load_vessel_model(vessel.model)
-    for name in participants(scenario):
+    for name in needed_services(scenario):
         if name not in SERVICE_MODULES:
             raise LaunchError(f"scenario needs service {name!r}, which this version does not have")
     return scenario
@@ -80,7 +81,7 @@ def _endpoints(opts: RunOptions) -> tuple[list[str], list[str]]:
     if opts.connect:
         flags = [f for ep in opts.connect for f in ("--connect", ep)] + ["--mode", "client"]
         return flags, flags
-    listen = f"tcp/127.0.0.1:{free_port()}"
+    listen = opts.listen or f"tcp/127.0.0.1:{free_port()}"
     return ["--listen", listen], ["--connect", listen]
 
 
@@ -103,6 +104,12 @@ def run(opts: RunOptions) -> int:
         return 2
     run_dir = make_run_dir(opts.out, scenario)
     cond_flags, svc_flags = _endpoints(opts)
+    if not opts.quiet:
+        print(
+            f"run folder: {run_dir}\nzenoh: clients connect to {svc_flags[1]} (world "
+            f"{scenario.name!r}, keys catabot/{scenario.name}/...)",
+            flush=True,
+        )
     scen = str(run_dir / "scenario.json")
     conductor = _spawn(
         ["catabot.conduct", "--scenario", scen, *cond_flags],
@@ -114,7 +121,7 @@ def run(opts: RunOptions) -> int:
             [SERVICE_MODULES[name], "--scenario", scen, "--run-dir", str(run_dir), *svc_flags],
             run_dir / "log" / f"{name}.log",
         )
-        for name in participants(scenario)
+        for name in needed_services(scenario)
     }
     return Supervisor(scenario, run_dir, conductor, services, quiet=opts.quiet).wait()
 

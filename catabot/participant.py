@@ -23,6 +23,7 @@ from catabot.keys import Keys
 from catabot.messages import Ack, End, Message, Tick
 
 log = logging.getLogger("catabot.participant")
+ORPHAN_GRACE_S = 0.5
 StepFn = Callable[[Tick, Inputs], None]
 EndFn = Callable[[End, Inputs], None]
 
@@ -45,6 +46,7 @@ class Participant:
         self.events: queue.SimpleQueue[tuple[str, str, bytes]] = queue.SimpleQueue()
         self.present: set[str] = set()
         self.run_id = ""
+        self._orphaned_at = 0.0
         self._pubs: dict[str, zenoh.Publisher] = {}
         self._subs = [
             session.declare_subscriber(keys.tick(), self._push("tick")),
@@ -96,8 +98,11 @@ class Participant:
                 pending = None
 
     def _next(self) -> tuple[str, str, bytes]:
+        """The next event; an End may trail the conductor's token, so allow it a grace."""
+        if self._orphaned_at and time.monotonic() - self._orphaned_at > ORPHAN_GRACE_S:
+            raise ClockError(f"{self.name}: the conductor disappeared without ending the run")
         try:
-            event = self.events.get(timeout=1.0)
+            event = self.events.get(timeout=0.1 if self._orphaned_at else 1.0)
         except queue.Empty:
             return ("idle", "", b"")
         kind, who, _ = event
@@ -105,8 +110,8 @@ class Participant:
             self.present.add(who)
         elif kind == "leave":
             self.present.discard(who)
-            if who == CONDUCTOR and self.run_id:
-                raise ClockError(f"{self.name}: the conductor disappeared; ending")
+            if who == CONDUCTOR:
+                self._orphaned_at = time.monotonic()
         return event
 
     def _take_data(self, key: str, payload: bytes) -> None:
@@ -126,6 +131,7 @@ class Participant:
         if tick.run != self.run_id:
             return None
         self.inbox.drop_producers(tick.dropped)
+        self.peers -= set(tick.dropped)  # a dropped peer that crashed will never be present
         return tick
 
     def _take_end(self, payload: bytes) -> End | None:

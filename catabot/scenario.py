@@ -26,7 +26,7 @@ class ScenarioError(ValueError):
 
 
 class _Model(BaseModel):
-    model_config = ConfigDict(extra="forbid", frozen=True)
+    model_config = ConfigDict(extra="forbid", frozen=True, allow_inf_nan=False)
 
 
 class ClockConfig(_Model):
@@ -34,6 +34,14 @@ class ClockConfig(_Model):
     start_timeout_s: float = Field(60.0, gt=0, description="time allowed for services to join")
     policy: Literal["abort", "drop"] = "abort"
     realtime_factor: float | None = Field(None, gt=0, description="1.0 = wall clock; null = AFAP")
+    external_participants: list[str] = Field(
+        [], description="names of stepping participants started outside `catabot run`"
+    )
+
+    @field_validator("external_participants")
+    @classmethod
+    def _names(cls, names: list[str]) -> list[str]:
+        return [check_name("participant", n) for n in names]
 
 
 class Pose(_Model):
@@ -93,6 +101,14 @@ class VesselConfig(_Model):
     def _key_safe(cls, v: str) -> str:
         return check_name("vessel", v)
 
+    @field_validator("sensors")
+    @classmethod
+    def _unique_names(cls, sensors: list[SensorConfig]) -> list[SensorConfig]:
+        names = [s.name for s in sensors]
+        if len(set(names)) != len(names):
+            raise ValueError(f"sensor names must be unique (got {names})")
+        return sensors
+
 
 class WaterConfig(_Model):
     density_kg_m3: float = Field(1025.0, gt=900, lt=1100)
@@ -127,16 +143,13 @@ class Scenario(_Model):
     def _key_safe(cls, v: str) -> str:
         return check_name("world", v)
 
-    @model_validator(mode="after")
-    def _consistent(self) -> Scenario:
-        ids = [v.id for v in self.vessels]
+    @field_validator("vessels")
+    @classmethod
+    def _unique_ids(cls, vessels: list[VesselConfig]) -> list[VesselConfig]:
+        ids = [v.id for v in vessels]
         if len(set(ids)) != len(ids):
             raise ValueError(f"vessel ids must be unique (got {ids})")
-        for v in self.vessels:
-            names = [s.name for s in v.sensors]
-            if len(set(names)) != len(names):
-                raise ValueError(f"vessel {v.id!r}: sensor names must be unique (got {names})")
-        return self
+        return vessels
 
     @property
     def duration_ns(self) -> int:
@@ -152,13 +165,13 @@ def check_rates(scenario: Scenario) -> None:
     for v_index, vessel in enumerate(scenario.vessels):
         for s_index, sensor in enumerate(vessel.sensors):
             where = f"vessels.{v_index}.sensors.{s_index}.rate_hz ({vessel.id}/{sensor.name})"
-            exact = NS_PER_S / sensor.rate_hz
-            if not math.isclose(exact, round(exact), abs_tol=1e-6):
-                raise ScenarioError(f"{where}: {sensor.rate_hz} Hz is not a whole number of ns")
-            try:
+            try:  # first, so that e.g. 30 Hz at 10 ms names the allowed rates
                 period_in_ticks(sensor.period_ns, scenario.dt_ns, what=where)
             except ClockError as exc:
                 raise ScenarioError(str(exc)) from None
+            exact = NS_PER_S / sensor.rate_hz
+            if not math.isclose(exact, round(exact), rel_tol=1e-12, abs_tol=1e-6):
+                raise ScenarioError(f"{where}: {sensor.rate_hz} Hz is not a whole number of ns")
     try:
         scenario.ticks  # noqa: B018 - validates duration against dt
     except ClockError as exc:

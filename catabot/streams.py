@@ -47,7 +47,12 @@ def world_streams(scenario: Scenario, keys: Keys) -> list[Stream]:
 
 
 def participants(scenario: Scenario) -> list[str]:
-    """The stepping participants a scenario needs, in start order."""
+    """Every stepping participant of the run: services, then external ones."""
+    return services(scenario) + list(scenario.clock.external_participants)
+
+
+def services(scenario: Scenario) -> list[str]:
+    """The CataBot services a scenario needs, in start order."""
     names = ["physics"]
     if any(v.sensors for v in scenario.vessels):
         names.append("sensors")

@@ -7,11 +7,12 @@ leaves readable CSV and MCAP up to the last complete tick.
 
 from __future__ import annotations
 
+import dataclasses
 import logging
 import sys
 
 from catabot.inbox import Inputs
-from catabot.messages import End, Tick
+from catabot.messages import End, Message, Tick
 from catabot.participant import Participant
 from catabot.service import Built, ServiceContext, run_service
 from catabot.streams import command_streams, world_streams
@@ -37,15 +38,15 @@ class Recorder:
         for key in sorted(inputs):
             stream = self.keys.relative(key)
             for msg in inputs[key]:
-                self._write(stream, msg)
+                self._write(stream, _stamped(msg, tick))
         self._flush()
 
-    def _write(self, stream: str, msg: object) -> None:
+    def _write(self, stream: str, msg: Message) -> None:
         try:
             if self.csv is not None:
-                self.csv.write(stream, msg)  # type: ignore[arg-type]
+                self.csv.write(stream, msg)
             if self.mcap is not None:
-                self.mcap.write(stream, msg, stamp_ns=int(getattr(msg, "stamp_ns", 0)))  # type: ignore[arg-type]
+                self.mcap.write(stream, msg, stamp_ns=int(getattr(msg, "stamp_ns", 0)))
         except RecorderError as exc:
             log.error("not recorded: %s", exc)
 
@@ -62,6 +63,13 @@ class Recorder:
         if self.mcap is not None:
             self.mcap.close()
         log.info("recorder closed its files after tick %d", end.tick)
+
+
+def _stamped(msg: Message, tick: Tick) -> Message:
+    """Samples from outside the lockstep (tick -1) are recorded at the tick they arrived."""
+    if getattr(msg, "tick", 0) == -1:
+        return dataclasses.replace(msg, tick=tick.tick - 1, stamp_ns=tick.stamp_ns)  # type: ignore[call-arg]
+    return msg
 
 
 def build(ctx: ServiceContext) -> Built:

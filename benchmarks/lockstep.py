@@ -1,0 +1,91 @@
+"""Empty-tick rate of the lockstep against a raw Zenoh tick-and-ack loop.
+
+Both use real processes and the same embedded peer mesh on loopback; the raw loop is
+the floor cost of one broadcast plus N acks, so the ratio is what the protocol
+(codec, Jacobi inbox, deadline bookkeeping) costs on top of Zenoh itself.
+"""
+
+from __future__ import annotations
+
+import queue
+import subprocess
+import sys
+import time
+
+import zenoh
+
+from catabot.conductor import ClockSpec, Conductor
+from catabot.keys import Keys
+from catabot.session import Connection, free_port, open_session
+
+TICKS = 3000
+PEERS = (1, 2, 4, 8)
+
+
+def _spawn(mode: str, endpoint: str, world: str, names: list[str]) -> list[subprocess.Popen[bytes]]:
+    cmd = [sys.executable, "-m", "benchmarks.peer", mode, "--connect", endpoint, "--world", world]
+    return [subprocess.Popen([*cmd, "--name", n, "--peers", ",".join(names)]) for n in names]
+
+
+def catabot_rate(n: int) -> float:
+    port = free_port()
+    session = open_session(Connection(listen=(f"tcp/127.0.0.1:{port}",)))
+    names = [f"p{i}" for i in range(n)]
+    world = f"bench{n}"
+    procs = _spawn("catabot", f"tcp/127.0.0.1:{port}", world, names)
+    spec = ClockSpec(dt_ns=1_000_000, ticks=TICKS, participants=tuple(names), deadline_s=10)
+    conductor = Conductor(session, Keys(world), spec)
+    result = conductor.run()
+    conductor.close()
+    for p in procs:
+        p.wait(timeout=30)
+    session.close()
+    if result.error:
+        raise RuntimeError(result.error)
+    return TICKS / result.wall_s
+
+
+def raw_rate(n: int) -> float:
+    port = free_port()
+    session = open_session(Connection(listen=(f"tcp/127.0.0.1:{port}",)))
+    world = f"raw{n}"
+    names = [f"r{i}" for i in range(n)]
+    acks = session.declare_subscriber(f"raw/{world}/ack/*", zenoh.handlers.FifoChannel(4096))
+    present: queue.SimpleQueue[str] = queue.SimpleQueue()
+    live = session.liveliness().declare_subscriber(
+        f"raw/{world}/live/*", lambda s: present.put(str(s.key_expr)), history=True
+    )
+    procs = _spawn("raw", f"tcp/127.0.0.1:{port}", world, names)
+    for _ in names:
+        present.get(timeout=30)
+    time.sleep(0.3)  # let gossip finish the mesh, as the participant's peer wait does
+    pub = session.declare_publisher(
+        f"raw/{world}/tick", congestion_control=zenoh.CongestionControl.BLOCK
+    )
+    start = time.perf_counter()
+    for k in range(TICKS):
+        pub.put(k.to_bytes(4, "little"))
+        for _ in names:
+            acks.recv()
+    rate = TICKS / (time.perf_counter() - start)
+    pub.put(b"end")
+    for p in procs:
+        p.wait(timeout=30)
+    live.undeclare()
+    session.close()
+    return rate
+
+
+def main() -> None:
+    print("\nLockstep empty-tick rate (real processes, loopback peer mesh)")
+    print(
+        f"{'participants':>12} | {'catabot ticks/s':>15} | {'raw zenoh ticks/s':>17} | {'ratio':>5}"
+    )
+    print(f"{'-' * 12}-|-{'-' * 15}-|-{'-' * 17}-|------")
+    for n in PEERS:
+        ours, raw = catabot_rate(n), raw_rate(n)
+        print(f"{n:>12} | {ours:>15.0f} | {raw:>17.0f} | {ours / raw:>5.2f}")
+
+
+if __name__ == "__main__":
+    main()

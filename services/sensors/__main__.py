@@ -1,0 +1,5 @@
+import sys
+
+from services.sensors.service import main
+
+sys.exit(main())

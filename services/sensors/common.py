@@ -1,0 +1,73 @@
+"""What every sensor model shares: its error class, its seeded noise stream, frame helpers.
+
+A sensor's noise comes from its own generator, seeded from the scenario seed and the
+sensor's name (`<vessel>/<sensor>`) through a stable hash (CRC-32, not Python's salted
+`hash`), so a run's samples do not depend on which process hosts the sensor, on how many
+other sensors exist, or on the order they were built in (DESIGN.md §2).
+"""
+
+from __future__ import annotations
+
+import math
+import zlib
+from collections.abc import Sequence
+
+import numpy as np
+from numpy.typing import NDArray
+
+Array = NDArray[np.float64]
+
+
+class SensorError(ValueError):
+    """A sensor configuration or input that cannot give a meaningful sample."""
+
+
+def stable_hash(name: str) -> int:
+    """A 32-bit hash of `name` that is the same in every process and Python version."""
+    return zlib.crc32(name.encode("utf-8"))
+
+
+def sensor_rng(seed: int, name: str) -> np.random.Generator:
+    """The noise generator of the source `name` in a scenario with `seed`.
+
+    Negative seeds are folded into 64 bits because NumPy's SeedSequence takes only
+    non-negative entropy.
+    """
+    if not name:
+        raise SensorError("a random source needs a non-empty name")
+    return np.random.default_rng([int(seed) % 2**64, stable_hash(name)])
+
+
+def finite_vector(values: Sequence[float], what: str, length: int = 3) -> Array:
+    """`values` as a float array of `length`, refusing NaN/inf with a message naming `what`."""
+    arr = np.asarray(values, dtype=np.float64)
+    if arr.shape != (length,) or not np.isfinite(arr).all():
+        raise SensorError(f"{what} must be {length} finite numbers (got {tuple(values)!r})")
+    return arr
+
+
+def non_negative(value: float, what: str) -> float:
+    """A finite, non-negative float (a standard deviation, a rate...)."""
+    if not (math.isfinite(value) and value >= 0.0):
+        raise SensorError(f"{what} must be a finite number >= 0 (got {value!r})")
+    return float(value)
+
+
+def rotation_from_quaternion(q: Sequence[float]) -> Array:
+    """Body-to-map rotation matrix of a unit quaternion (x, y, z, w); v_map = R @ v_body.
+
+    The quaternion is normalised first so that a state rounded in transit (float32,
+    text) still gives a proper rotation; a zero or non-finite one is refused.
+    """
+    x, y, z, w = finite_vector(q, "orientation quaternion (x, y, z, w)", 4)
+    norm = math.sqrt(x * x + y * y + z * z + w * w)
+    if norm < 1e-9:
+        raise SensorError(f"orientation quaternion has zero length (got {tuple(q)!r})")
+    x, y, z, w = x / norm, y / norm, z / norm, w / norm
+    return np.array(
+        [
+            [1 - 2 * (y * y + z * z), 2 * (x * y - z * w), 2 * (x * z + y * w)],
+            [2 * (x * y + z * w), 1 - 2 * (x * x + z * z), 2 * (y * z - x * w)],
+            [2 * (x * z - y * w), 2 * (y * z + x * w), 1 - 2 * (x * x + y * y)],
+        ]
+    )

@@ -1,0 +1,110 @@
+"""GPS model: the antenna's `map` (ENU) position, plus noise, as a WGS84 fix.
+
+`method="wgs84"` (default) converts exactly (catabot.geo.EnuFrame, < 1 mm); a fix taken
+far from the origin then shows the Earth's curvature, e.g. +31 m of altitude at 20 km,
+because `map` is the tangent plane at the origin. `method="paper_table"` reproduces the
+original simulator's eq. (8)-(9) tables, which ignore curvature (errors in the docstring
+of catabot.geo.paper_table_enu_to_geodetic).
+
+Noise is white Gaussian, drawn in metres before the conversion: `horizontal_sigma` on each
+of east and north, `vertical_sigma` on up. Defaults 0.5 m and 1.0 m: a good single-band
+receiver with SBAS under open sky (vertical error is about twice horizontal, as the
+satellites are all above). Real GPS errors are correlated over minutes; a Gauss-Markov
+term belongs here when a consumer needs it. The fix reports the sigmas it was drawn with
+(zero with `noise=False`), like NavSatFix's covariance.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from typing import ClassVar, Literal
+
+import numpy as np
+
+from catabot.geo import EnuFrame, GeoError, paper_table_enu_to_geodetic
+from catabot.messages import GpsFix, Message, VesselState
+from services.sensors.common import (
+    SensorError,
+    finite_vector,
+    non_negative,
+    rotation_from_quaternion,
+    sensor_rng,
+)
+
+Method = Literal["wgs84", "paper_table"]
+METHODS: tuple[Method, ...] = ("wgs84", "paper_table")
+
+
+class GpsModel:
+    """One GPS receiver. Deterministic: the same seed and name give the same fixes."""
+
+    message: ClassVar[type[Message]] = GpsFix
+
+    def __init__(
+        self,
+        *,
+        origin_lat_deg: float = 0.0,
+        origin_lon_deg: float = 0.0,
+        origin_alt_m: float = 0.0,
+        horizontal_sigma: float = 0.5,
+        vertical_sigma: float = 1.0,
+        antenna_offset: Sequence[float] = (0.0, 0.0, 0.0),
+        method: Method = "wgs84",
+        noise: bool = True,
+        seed: int = 0,
+        name: str = "gps",
+    ) -> None:
+        if method not in METHODS:
+            raise SensorError(f"GPS method must be one of {METHODS} (got {method!r})")
+        try:
+            self.frame = EnuFrame(origin_lat_deg, origin_lon_deg, origin_alt_m)
+        except GeoError as exc:
+            raise SensorError(f"GPS {name!r} origin: {exc}") from None
+        self.method: Method = method
+        self.horizontal_sigma = non_negative(horizontal_sigma, "horizontal_sigma (m)")
+        self.vertical_sigma = non_negative(vertical_sigma, "vertical_sigma (m)")
+        self.antenna_offset = finite_vector(antenna_offset, "antenna_offset (m, body FLU)")
+        self.noise, self.name = bool(noise), name
+        self._rng = sensor_rng(seed, name)
+
+    @property
+    def sigmas(self) -> tuple[float, float]:
+        """Horizontal and vertical 1-sigma (m) of the fixes; zero when noise is off."""
+        return (self.horizontal_sigma, self.vertical_sigma) if self.noise else (0.0, 0.0)
+
+    def antenna_position(self, state: VesselState) -> np.ndarray:
+        """The antenna's position in `map` (m): the body origin plus the rotated offset."""
+        rot = rotation_from_quaternion(state.orientation)
+        return finite_vector(state.position, "position (m)") + rot @ self.antenna_offset
+
+    def sample(self, state: VesselState, *, tick: int, stamp_ns: int) -> GpsFix:
+        """One fix of the antenna at the state's pose."""
+        enu = self.antenna_position(state)
+        h_sigma, v_sigma = self.sigmas
+        if self.noise:
+            enu = enu + np.array([h_sigma, h_sigma, v_sigma]) * self._rng.standard_normal(3)
+        lat, lon, alt = self.to_geodetic(enu)
+        return GpsFix(
+            tick=tick,
+            stamp_ns=stamp_ns,
+            latitude=lat,
+            longitude=lon,
+            altitude=alt,
+            horizontal_sigma=h_sigma,
+            vertical_sigma=v_sigma,
+        )
+
+    def to_geodetic(self, enu: np.ndarray) -> tuple[float, float, float]:
+        """Latitude, longitude (deg), altitude (m) of a `map` position by this GPS's method."""
+        f = self.frame
+        try:
+            if self.method == "wgs84":
+                lat, lon, alt = f.to_geodetic(enu[0], enu[1], enu[2])
+            else:
+                origin = (f.latitude_deg, f.longitude_deg, f.altitude_m)
+                lat, lon, alt = paper_table_enu_to_geodetic(enu[0], enu[1], enu[2], origin=origin)
+        except GeoError as exc:
+            raise SensorError(
+                f"GPS {self.name!r}: position {tuple(enu)} has no fix: {exc}"
+            ) from None
+        return float(lat), float(lon), float(alt)

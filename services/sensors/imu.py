@@ -1,0 +1,144 @@
+"""IMU model: specific force and angular rate in the body frame (FLU), with noise and bias.
+
+An accelerometer measures specific force f = a - g: the inertial acceleration of its
+mounting point minus gravity, in its own axes, so at rest and level it reads +g on z.
+`VesselState.linear_acceleration` is the body origin's inertial acceleration expressed in
+body axes, and a sensor at lever arm r (body frame) adds alpha x r + w x (w x r).
+
+Errors, per axis and independent (ImuModel's defaults):
+- white noise per sample, sigma 0.009 rad/s and 0.021 m/s^2 (VRX's WAM-V IMU). These are
+  per-sample values, as VRX specifies them, so they do not change with the rate;
+- bias instability, a first-order Gauss-Markov process with correlation time 300 s and
+  stationary sigma 0.0008 rad/s (~165 deg/h) and 0.004 m/s^2 (~0.4 mg), typical of
+  the low-cost MEMS units on small ASVs. The bias starts drawn from its stationary
+  law, so it also plays the turn-on bias;
+- bias random walk (rad/s/sqrt(s), m/s^2/sqrt(s)): off by default, because it grows
+  without bound over long runs; turn it on to model rate random walk.
+With `noise=False` the IMU is ideal. Orientation is passed through from the state.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Sequence
+from typing import ClassVar
+
+import numpy as np
+
+from catabot.messages import ImuSample, Message, VesselState
+from services.sensors.common import (
+    Array,
+    SensorError,
+    finite_vector,
+    non_negative,
+    rotation_from_quaternion,
+    sensor_rng,
+)
+
+GRAVITY = 9.81  # m/s^2, the physics service's default (services/physics/world.py)
+UP = np.array([0.0, 0.0, 1.0])
+
+
+class ImuModel:
+    """One IMU. Deterministic: the same seed and name give the same samples."""
+
+    message: ClassVar[type[Message]] = ImuSample
+
+    def __init__(
+        self,
+        *,
+        gyro_sigma: float = 0.009,
+        accel_sigma: float = 0.021,
+        gyro_bias_instability: float = 0.0008,
+        accel_bias_instability: float = 0.004,
+        bias_tau_s: float = 300.0,
+        gyro_random_walk: float = 0.0,
+        accel_random_walk: float = 0.0,
+        lever_arm: Sequence[float] = (0.0, 0.0, 0.0),
+        gravity: float = GRAVITY,
+        noise: bool = True,
+        seed: int = 0,
+        name: str = "imu",
+    ) -> None:
+        self.sigma = np.array(
+            [
+                non_negative(gyro_sigma, "gyro_sigma (rad/s)"),
+                non_negative(accel_sigma, "accel_sigma (m/s^2)"),
+            ]
+        )
+        self.bias_sigma = np.array(
+            [
+                non_negative(gyro_bias_instability, "gyro_bias_instability (rad/s)"),
+                non_negative(accel_bias_instability, "accel_bias_instability (m/s^2)"),
+            ]
+        )
+        self.walk = np.array(
+            [
+                non_negative(gyro_random_walk, "gyro_random_walk (rad/s/sqrt(s))"),
+                non_negative(accel_random_walk, "accel_random_walk (m/s^2/sqrt(s))"),
+            ]
+        )
+        if not (math.isfinite(bias_tau_s) and bias_tau_s > 0.0):
+            raise SensorError(f"bias_tau_s must be a finite number > 0 (got {bias_tau_s!r})")
+        self.bias_tau_s = float(bias_tau_s)
+        self.lever_arm = finite_vector(lever_arm, "lever_arm (m, body FLU)")
+        self.gravity = non_negative(gravity, "gravity (m/s^2)")
+        self.noise, self.name = bool(noise), name
+        self._rng = sensor_rng(seed, name)
+        # rows: gyro, accel; Gauss-Markov part drawn from its stationary law, walk from 0
+        self._markov = self.bias_sigma[:, None] * self._rng.standard_normal((2, 3))
+        self._walked = np.zeros((2, 3))
+        self._last_stamp_ns: int | None = None
+
+    @property
+    def bias(self) -> Array:
+        """Current bias, rows gyro (rad/s) and accel (m/s^2); zero when noise is off."""
+        return (self._markov + self._walked) if self.noise else np.zeros((2, 3))
+
+    def ideal(self, state: VesselState) -> tuple[Array, Array]:
+        """Error-free angular rate (rad/s) and specific force (m/s^2) at the sensor, body axes."""
+        rot = rotation_from_quaternion(state.orientation)
+        w = finite_vector(state.angular_velocity, "angular_velocity (rad/s)")
+        alpha = finite_vector(state.angular_acceleration, "angular_acceleration (rad/s^2)")
+        acc = finite_vector(state.linear_acceleration, "linear_acceleration (m/s^2)")
+        r = self.lever_arm
+        acc_sensor = acc + np.cross(alpha, r) + np.cross(w, np.cross(w, r))
+        return w, acc_sensor + self.gravity * (rot.T @ UP)  # f = a - g, g = -gravity * up
+
+    def sample(
+        self, state: VesselState, *, tick: int, stamp_ns: int, dt_s: float | None = None
+    ) -> ImuSample:
+        """One sample; `dt_s` (time since the last sample) defaults to the stamp difference."""
+        dt = self._elapsed(stamp_ns, dt_s)
+        rate, force = self.ideal(state)
+        if self.noise:
+            draws = self._rng.standard_normal((3, 2, 3))  # fixed count: stream stays aligned
+            self._propagate_bias(dt, draws[1], draws[2])
+            measured = np.stack([rate, force]) + self.bias + self.sigma[:, None] * draws[0]
+            rate, force = measured[0], measured[1]
+        return ImuSample(
+            tick=tick,
+            stamp_ns=stamp_ns,
+            orientation=tuple(float(v) for v in state.orientation),
+            angular_velocity=tuple(float(v) for v in rate),
+            linear_acceleration=tuple(float(v) for v in force),
+        )
+
+    def _elapsed(self, stamp_ns: int, dt_s: float | None) -> float:
+        """Seconds since the previous sample (0 for the first), refusing time running back."""
+        last, self._last_stamp_ns = self._last_stamp_ns, stamp_ns
+        if dt_s is not None:
+            return non_negative(dt_s, "dt_s (s)")
+        if last is None:
+            return 0.0
+        if stamp_ns < last:
+            raise SensorError(f"IMU {self.name!r}: stamp_ns went back from {last} to {stamp_ns}")
+        return (stamp_ns - last) * 1e-9
+
+    def _propagate_bias(self, dt: float, markov_draw: Array, walk_draw: Array) -> None:
+        """Exact discretisation of the Gauss-Markov bias (any dt) plus the random walk."""
+        phi = math.exp(-dt / self.bias_tau_s)
+        self._markov = phi * self._markov + (
+            self.bias_sigma[:, None] * math.sqrt(1.0 - phi * phi) * markov_draw
+        )
+        self._walked = self._walked + self.walk[:, None] * math.sqrt(dt) * walk_draw

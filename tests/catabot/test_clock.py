@@ -1,0 +1,255 @@
+"""The lockstep rules without I/O: due samples, tick counts, Jacobi release (DESIGN.md §4)."""
+
+from __future__ import annotations
+
+import pytest
+
+from catabot import codec
+from catabot.clock import ClockError, Policy, Stream, period_in_ticks, ticks_for
+from catabot.codec import CodecError
+from catabot.inbox import Inbox
+from catabot.keys import Keys
+from catabot.messages import GpsFix, ImuSample, ThrustCmd, VesselState
+from catabot.scenario import parse_scenario
+from catabot.streams import participants, world_streams
+
+KEYS = Keys("w")
+STATE = KEYS.vessel_state("ego")
+GPS = KEYS.sensor("ego", "gps")
+CMD = KEYS.cmd_thrust("ego")
+
+
+def _state(tick: int) -> bytes:
+    zero3 = (0.0, 0.0, 0.0)
+    return codec.encode(
+        VesselState(tick, tick * 10, (float(tick), 0.0, 0.0), (0.0, 0.0, 0.0, 1.0), *[zero3] * 4)
+    )
+
+
+def _gps(tick: int) -> bytes:
+    return codec.encode(GpsFix(tick, tick * 10, 40.0, -74.0, 0.0, 0.0, 0.0))
+
+
+def _cmd(value: float) -> bytes:
+    return codec.encode(ThrustCmd(thrust=(value, value)))
+
+
+def _inbox() -> Inbox:
+    return Inbox(
+        [
+            Stream(STATE, VesselState, "physics", 1),
+            Stream(GPS, GpsFix, "sensors", 10),
+            Stream(CMD, ThrustCmd, "external", None),
+        ]
+    )
+
+
+# -- Stream -------------------------------------------------------------------------------
+
+
+def test_due_before_period_1() -> None:
+    s = Stream("k", VesselState, "p", 1)
+    assert [s.due_before(k) for k in range(5)] == [-1, 0, 1, 2, 3]
+    assert [s.due_through(k) for k in range(5)] == [0, 1, 2, 3, 4]
+
+
+def test_due_before_period_3() -> None:
+    s = Stream("k", VesselState, "p", 3)
+    assert [s.due_before(k) for k in range(9)] == [-1, 0, 0, 0, 3, 3, 3, 6, 6]
+    assert [s.due_through(k) for k in range(9)] == [0, 0, 0, 3, 3, 3, 6, 6, 6]
+
+
+def test_due_before_period_10() -> None:
+    s = Stream("k", GpsFix, "p", 10)
+    assert s.due_before(0) == -1
+    assert all(s.due_before(k) == 0 for k in range(1, 11))
+    assert s.due_before(11) == 10
+    assert s.due_before(20) == 10
+    assert s.due_before(21) == 20
+    assert s.due_through(9) == 0
+    assert s.due_through(10) == 10
+    assert s.due_through(19) == 10
+
+
+def test_free_running_stream_is_never_due() -> None:
+    s = Stream("k", ThrustCmd, "external", None)
+    assert all(s.due_before(k) == -1 for k in range(0, 50))
+    assert all(s.due_through(k) == -1 for k in range(0, 50))
+
+
+def test_due_before_negative_tick() -> None:
+    assert Stream("k", VesselState, "p", 1).due_before(-3) == -1
+
+
+def test_default_period_is_one_tick() -> None:
+    assert Stream("k", VesselState, "p").period == 1
+
+
+def test_policy_values() -> None:
+    assert Policy("abort") is Policy.ABORT
+    assert Policy("drop") is Policy.DROP
+    with pytest.raises(ValueError):
+        Policy("ignore")
+
+
+# -- tick arithmetic ----------------------------------------------------------------------
+
+
+def test_ticks_for() -> None:
+    assert ticks_for(60_000_000_000, 10_000_000) == 6000
+    assert ticks_for(10_000_000, 10_000_000) == 1
+    assert ticks_for(25_000_000, 10_000_000) == 2  # a partial last tick is not run
+
+
+def test_ticks_for_errors() -> None:
+    with pytest.raises(ClockError, match="dt must be a positive number of nanoseconds"):
+        ticks_for(1_000, 0)
+    with pytest.raises(ClockError, match=r"got -5"):
+        ticks_for(1_000, -5)
+    with pytest.raises(ClockError, match="shorter than one tick"):
+        ticks_for(9_999_999, 10_000_000)
+
+
+def test_period_in_ticks() -> None:
+    assert period_in_ticks(10_000_000, 10_000_000, what="imu") == 1
+    assert period_in_ticks(100_000_000, 10_000_000, what="gps") == 10
+
+
+@pytest.mark.parametrize("period", [33_333_333, 5_000_000, 0, -10_000_000])
+def test_period_in_ticks_errors(period: int) -> None:
+    with pytest.raises(ClockError) as info:
+        period_in_ticks(period, 10_000_000, what="ego/cam")
+    msg = str(info.value)
+    assert msg.startswith("ego/cam: ")
+    assert f"period {period} ns is not a whole number of ticks" in msg
+    assert "multiples of 10000000 ns" in msg and "100 Hz divided by a whole number" in msg
+
+
+# -- Inbox --------------------------------------------------------------------------------
+
+
+def test_jacobi_release() -> None:
+    inbox = _inbox()
+    inbox.add(STATE, _state(0))
+    assert inbox.release(0) == {}  # tagged 0: not for the step of tick 0
+    out = inbox.release(1)
+    assert list(out) == [STATE] and [m.tick for m in out[STATE]] == [0]
+    assert inbox.release(1) == {}  # released once only
+
+
+def test_release_holds_samples_of_the_current_and_later_ticks() -> None:
+    inbox = _inbox()
+    for k in (3, 1, 2, 4):
+        inbox.add(STATE, _state(k))
+    assert [m.tick for m in inbox.release(3)[STATE]] == [1, 2]  # oldest first
+    assert [m.tick for m in inbox.release(5)[STATE]] == [3, 4]
+
+
+def test_free_samples_are_released_at_the_next_step() -> None:
+    inbox = _inbox()
+    inbox.add(CMD, _cmd(0.5))
+    inbox.add(CMD, _cmd(0.7))
+    assert inbox.missing(0) == []
+    out = inbox.release(0)
+    assert [m.thrust for m in out[CMD]] == [(0.5, 0.5), (0.7, 0.7)]  # arrival order
+    assert inbox.release(1) == {}
+
+
+def test_missing_follows_the_periods() -> None:
+    inbox = _inbox()
+    assert inbox.missing(0) == []  # nothing is due before tick 0
+    assert inbox.missing(1) == [STATE, GPS]
+    inbox.add(STATE, _state(0))
+    assert inbox.missing(1) == [GPS]
+    inbox.add(GPS, _gps(0))
+    assert inbox.missing(1) == []
+    inbox.add(STATE, _state(1))
+    assert inbox.missing(2) == []  # gps is next due at 10
+    for k in range(2, 10):
+        inbox.add(STATE, _state(k))
+    assert inbox.missing(10) == []
+    assert inbox.missing(11) == [STATE, GPS]
+    inbox.add(STATE, _state(10))
+    inbox.add(GPS, _gps(10))
+    assert inbox.missing(11) == []
+
+
+def test_a_late_old_sample_does_not_lower_the_mark() -> None:
+    inbox = _inbox()
+    inbox.add(STATE, _state(5))
+    inbox.add(STATE, _state(2))
+    assert inbox.latest[STATE] == 5
+    assert STATE not in inbox.missing(6)
+
+
+def test_dropped_producers_are_not_waited_for() -> None:
+    inbox = _inbox()
+    assert inbox.missing(1) == [STATE, GPS]
+    inbox.drop_producers(["sensors"])
+    assert inbox.missing(1) == [STATE]
+    inbox.drop_producers(("physics",))
+    assert inbox.missing(100) == []
+
+
+def test_malformed_payloads_raise_and_leave_the_inbox_unchanged() -> None:
+    inbox = _inbox()
+    inbox.add(STATE, _state(0))
+    before = ({k: list(v) for k, v in inbox.held.items()}, dict(inbox.latest))
+    for payload in (b"\xc1junk", b"", _gps(3), _state(4)[:-3]):
+        with pytest.raises(CodecError):
+            inbox.add(STATE, payload)
+    with pytest.raises(CodecError):
+        inbox.add(GPS, codec.encode(ImuSample(1, 1, (0, 0, 0, 1), (0, 0, 0), (0, 0, 0))))
+    assert ({k: list(v) for k, v in inbox.held.items()}, dict(inbox.latest)) == before
+    assert inbox.missing(1) == [GPS]
+
+
+def test_inbox_refuses_two_streams_on_one_key() -> None:
+    with pytest.raises(ValueError, match="share one key"):
+        Inbox([Stream("k", VesselState, "a"), Stream("k", VesselState, "b")])
+
+
+def test_inbox_keys() -> None:
+    assert _inbox().keys == [STATE, GPS, CMD]
+
+
+# -- streams of a scenario ----------------------------------------------------------------
+
+
+def _scenario(**changes: object):
+    data = {
+        "name": "w",
+        "vessels": [
+            {
+                "id": "ego",
+                "sensors": [
+                    {"name": "imu", "type": "imu", "rate_hz": 100.0},
+                    {"name": "gps", "type": "gps", "rate_hz": 10.0},
+                ],
+            },
+            {"id": "buoy"},
+        ],
+    }
+    data.update(changes)
+    return parse_scenario(data)
+
+
+def test_participants() -> None:
+    assert participants(_scenario())[:3] == ["physics", "sensors", "recorder"]
+    no_sensors = _scenario(vessels=[{"id": "a"}])
+    assert "sensors" not in participants(no_sensors)
+    no_recording = _scenario(recording={"csv": False, "mcap": False})
+    assert "recorder" not in participants(no_recording)
+    assert participants(no_recording)[:2] == ["physics", "sensors"]
+
+
+def test_world_streams() -> None:
+    streams = world_streams(_scenario(), KEYS)
+    table = {s.key: (s.message, s.producer, s.period) for s in streams}
+    assert table == {
+        KEYS.vessel_state("ego"): (VesselState, "physics", 1),
+        KEYS.vessel_state("buoy"): (VesselState, "physics", 1),
+        KEYS.sensor("ego", "imu"): (ImuSample, "sensors", 1),
+        KEYS.sensor("ego", "gps"): (GpsFix, "sensors", 10),
+    }
+    assert len(streams) == len(table)

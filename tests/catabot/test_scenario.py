@@ -1,0 +1,323 @@
+"""Scenario loading and validation: every error names the field (DESIGN.md §6)."""
+
+from __future__ import annotations
+
+import copy
+import json
+from pathlib import Path
+from typing import Any
+
+import jsonschema
+import pytest
+
+from catabot.scenario import (
+    BUNDLED,
+    Scenario,
+    ScenarioError,
+    json_schema,
+    load_scenario,
+    parse_scenario,
+)
+
+
+def _base() -> dict[str, Any]:
+    return {
+        "name": "test",
+        "duration_s": 1.0,
+        "dt_ns": 10_000_000,
+        "vessels": [
+            {
+                "id": "ego",
+                "script": [{"t_s": 0.0, "thrust": [0.5, 0.5]}],
+                "sensors": [
+                    {"name": "imu", "type": "imu", "rate_hz": 100.0},
+                    {"name": "gps", "type": "gps", "rate_hz": 10.0},
+                ],
+            }
+        ],
+    }
+
+
+def _error(data: dict[str, Any]) -> str:
+    with pytest.raises(ScenarioError) as info:
+        parse_scenario(data)
+    return str(info.value)
+
+
+def test_bundled_default_loads() -> None:
+    scenario = load_scenario()
+    assert isinstance(scenario, Scenario)
+    assert scenario.name == "default"
+    assert scenario.dt_ns == 10_000_000
+    assert scenario.duration_ns == 60 * 1_000_000_000
+    assert scenario.ticks == 6000
+    assert [v.id for v in scenario.vessels] == ["ego"]
+    assert {s.name: s.period_ns for s in scenario.vessels[0].sensors} == {
+        "imu": 10_000_000,
+        "gps": 100_000_000,
+    }
+
+
+def test_bundled_scenario_by_name_and_by_path() -> None:
+    assert load_scenario("default") == load_scenario()
+    assert load_scenario(BUNDLED / "default.json") == load_scenario()
+
+
+def test_minimal_scenario_takes_defaults() -> None:
+    scenario = parse_scenario({"vessels": [{"id": "a"}]})
+    assert scenario.name == "default"
+    assert scenario.clock.policy == "abort"
+    assert scenario.ticks == 6000
+    assert scenario.vessels[0].model == "catabot"
+
+
+def test_scenario_is_frozen() -> None:
+    scenario = parse_scenario(_base())
+    with pytest.raises(ValueError):
+        scenario.seed = 3  # type: ignore[misc]
+
+
+def test_unknown_top_level_field() -> None:
+    data = _base()
+    data["durration_s"] = 3
+    msg = _error(data)
+    assert "durration_s: unknown field" in msg
+
+
+def test_unknown_nested_field() -> None:
+    data = _base()
+    data["vessels"][0]["sensors"][1]["noize"] = False
+    assert "vessels.0.sensors.1.noize: unknown field" in _error(data)
+
+
+@pytest.mark.parametrize("value", ["abc", [1], {"s": 1}, None])
+def test_wrong_type_for_duration(value: object) -> None:
+    data = _base()
+    data["duration_s"] = value
+    msg = _error(data)
+    assert "duration_s:" in msg
+    assert "valid number" in msg
+
+
+@pytest.mark.parametrize("value", [-1.0, 0])
+def test_negative_or_zero_duration(value: float) -> None:
+    data = _base()
+    data["duration_s"] = value
+    msg = _error(data)
+    assert "duration_s: Input should be greater than 0" in msg
+    assert f"(got {value!r})" in msg
+
+
+def test_duration_shorter_than_one_tick() -> None:
+    data = _base()
+    data["duration_s"] = 0.005
+    msg = _error(data)
+    assert msg.startswith("duration_s:")
+    assert "shorter than one tick" in msg
+
+
+def test_bad_policy_lists_allowed_values() -> None:
+    data = _base()
+    data["clock"] = {"policy": "ignore"}
+    msg = _error(data)
+    assert "clock.policy:" in msg
+    assert "'abort'" in msg and "'drop'" in msg
+    assert "'ignore'" in msg
+
+
+def test_vessel_id_with_slash() -> None:
+    data = _base()
+    data["vessels"][0]["id"] = "ego/1"
+    msg = _error(data)
+    assert "vessels.0.id:" in msg
+    assert "vessel name 'ego/1' is not allowed in a key" in msg
+
+
+def test_world_name_with_wildcard() -> None:
+    data = _base()
+    data["name"] = "run*"
+    msg = _error(data)
+    assert "name:" in msg and "world name 'run*'" in msg
+
+
+def test_sensor_name_with_space() -> None:
+    data = _base()
+    data["vessels"][0]["sensors"][0]["name"] = "front imu"
+    msg = _error(data)
+    assert "vessels.0.sensors.0.name:" in msg and "sensor name 'front imu'" in msg
+
+
+def test_duplicate_vessel_ids() -> None:
+    data = _base()
+    data["vessels"].append(copy.deepcopy(data["vessels"][0]))
+    msg = _error(data)
+    assert "vessels:" in msg
+    assert "vessel ids must be unique" in msg and "'ego', 'ego'" in msg
+
+
+def test_duplicate_sensor_names() -> None:
+    data = _base()
+    data["vessels"][0]["sensors"][1]["name"] = "imu"
+    msg = _error(data)
+    assert "vessels.0.sensors:" in msg
+    assert "sensor names must be unique" in msg and "'imu', 'imu'" in msg
+
+
+def test_script_step_with_thrust_and_twist() -> None:
+    data = _base()
+    data["vessels"][0]["script"].append(
+        {"t_s": 1.0, "thrust": [0.1, 0.1], "twist": {"surge_mps": 1.0, "yaw_rate_radps": 0.0}}
+    )
+    msg = _error(data)
+    assert "vessels.0.script.1:" in msg
+    assert "exactly one of 'thrust' or 'twist'" in msg
+
+
+def test_script_step_with_no_command() -> None:
+    data = _base()
+    data["vessels"][0]["script"] = [{"t_s": 0.0}]
+    assert "vessels.0.script.0: give exactly one of" in _error(data)
+
+
+@pytest.mark.parametrize("thrust", [[1.5, 0.0], [0.0, -1.01]])
+def test_thrust_out_of_range(thrust: list[float]) -> None:
+    data = _base()
+    data["vessels"][0]["script"][0]["thrust"] = thrust
+    msg = _error(data)
+    assert "vessels.0.script.0:" in msg
+    assert "[-1, 1]" in msg
+
+
+def test_unknown_sensor_type_lists_allowed() -> None:
+    data = _base()
+    data["vessels"][0]["sensors"][1]["type"] = "sonar"
+    msg = _error(data)
+    assert "vessels.0.sensors.1.type:" in msg
+    assert "'imu'" in msg and "'gps'" in msg and "'sonar'" in msg
+
+
+def test_missing_vessels() -> None:
+    data = _base()
+    del data["vessels"]
+    assert "vessels: Field required" in _error(data)
+
+
+def test_empty_vessels() -> None:
+    data = _base()
+    data["vessels"] = []
+    assert "vessels:" in _error(data)
+
+
+def test_several_problems_are_reported_together() -> None:
+    data = _base()
+    data["seed"] = "x"
+    data["clock"] = {"deadline_s": -1}
+    msg = _error(data)
+    assert "seed:" in msg and "clock.deadline_s:" in msg
+
+
+def test_sensor_rate_not_a_whole_number_of_ticks() -> None:
+    data = _base()
+    data["vessels"][0]["sensors"][1]["rate_hz"] = 30.0  # period 33333333 ns at dt 10 ms
+    msg = _error(data)
+    assert "vessels.0.sensors.1.rate_hz" in msg
+    assert "ego/gps" in msg
+    assert "33333333" in msg
+    assert "whole number of ticks" in msg
+    assert "100 Hz divided by a whole number" in msg  # the allowed rates
+
+
+def test_sensor_rate_3_hz_refused() -> None:
+    data = _base()
+    data["vessels"][0]["sensors"][1]["rate_hz"] = 3.0
+    msg = _error(data)
+    assert "ego/gps" in msg and "whole number of ticks" in msg
+
+
+def test_sensor_period_not_a_whole_number_of_ns() -> None:
+    data = _base()
+    data["dt_ns"] = 333_333_333  # 3 Hz is then one tick, but 1/3 s is no whole number of ns
+    data["vessels"][0]["sensors"] = [{"name": "imu", "type": "imu", "rate_hz": 3.0}]
+    msg = _error(data)
+    assert "vessels.0.sensors.0.rate_hz (ego/imu)" in msg
+    assert "not a whole number of ns" in msg
+
+
+def test_slow_sensor_rates_are_accepted() -> None:
+    data = _base()
+    data["duration_s"] = 100.0
+    data["vessels"][0]["sensors"][1]["rate_hz"] = 0.1
+    data["vessels"][0]["sensors"][0]["rate_hz"] = 0.001
+    scenario = parse_scenario(data)
+    assert [s.period_ns for s in scenario.vessels[0].sensors] == [10**12, 10**10]
+
+
+def test_sensor_rate_of_exactly_one_tick_and_of_many() -> None:
+    data = _base()
+    data["vessels"][0]["sensors"][0]["rate_hz"] = 100.0
+    data["vessels"][0]["sensors"][1]["rate_hz"] = 2.5
+    scenario = parse_scenario(data)
+    assert [s.period_ns for s in scenario.vessels[0].sensors] == [10_000_000, 400_000_000]
+
+
+def test_invalid_json_file(tmp_path: Path) -> None:
+    path = tmp_path / "bad.json"
+    path.write_text('{"vessels": [}')
+    with pytest.raises(ScenarioError) as info:
+        load_scenario(path)
+    assert str(path) in str(info.value)
+    assert "not valid JSON" in str(info.value)
+
+
+def test_missing_file(tmp_path: Path) -> None:
+    path = tmp_path / "nowhere.json"
+    with pytest.raises(ScenarioError, match="does not exist") as info:
+        load_scenario(path)
+    assert "nowhere.json" in str(info.value)
+    with pytest.raises(ScenarioError, match="does not exist"):
+        load_scenario("no-such-bundled-scenario")
+
+
+def test_file_errors_name_the_file(tmp_path: Path) -> None:
+    data = _base()
+    data["clock"] = {"policy": "stop"}
+    path = tmp_path / "s.json"
+    path.write_text(json.dumps(data))
+    with pytest.raises(ScenarioError) as info:
+        load_scenario(path)
+    assert str(path) in str(info.value) and "clock.policy" in str(info.value)
+
+
+def test_file_round_trip(tmp_path: Path) -> None:
+    path = tmp_path / "s.json"
+    path.write_text(json.dumps(_base()))
+    assert load_scenario(path) == parse_scenario(_base())
+    assert load_scenario(str(path)).ticks == 100
+
+
+def test_json_schema_is_valid_and_accepts_the_bundled_default() -> None:
+    schema = json_schema()
+    validator_cls = jsonschema.validators.validator_for(schema)
+    validator_cls.check_schema(schema)
+    assert validator_cls is jsonschema.Draft202012Validator
+    default = json.loads((BUNDLED / "default.json").read_text())
+    validator_cls(schema).validate(default)
+    validator_cls(schema).validate(_base())
+    assert schema["title"] == "CataBot scenario"
+    assert "vessels" in schema["required"]
+
+
+def test_json_schema_refuses_what_the_loader_refuses() -> None:
+    validator = jsonschema.Draft202012Validator(json_schema())
+    for mutate in (
+        lambda d: d.update(extra=1),
+        lambda d: d.update(duration_s=-1),
+        lambda d: d.update(clock={"policy": "ignore"}),
+        lambda d: d["vessels"][0]["sensors"][0].update(type="sonar"),
+        lambda d: d.pop("vessels"),
+    ):
+        data = _base()
+        mutate(data)
+        assert not validator.is_valid(data)
+        with pytest.raises(ScenarioError):
+            parse_scenario(data)

@@ -1,0 +1,27 @@
+"""An external lockstep participant for fault tests: steps, then hangs or crashes.
+
+python hang_participant.py ENDPOINT WORLD NAME TICK {hang,kill}
+"""
+
+import os
+import signal
+import sys
+import time
+
+from catabot.keys import Keys
+from catabot.participant import Participant
+from catabot.session import Connection, open_session
+
+endpoint, world, name, at, how = sys.argv[1:6]
+session = open_session(Connection(connect=(endpoint,)))
+
+
+def step(tick, inputs) -> None:
+    if tick.tick == int(at):
+        if how == "kill":
+            os.kill(os.getpid(), signal.SIGKILL)
+        time.sleep(3600)
+
+
+Participant(session, Keys(world), name, peers=[]).run(step)
+session.close()

@@ -1,0 +1,161 @@
+"""Faults: a killed service, a hanging participant, Ctrl-C, bad payloads on the bus."""
+
+from __future__ import annotations
+
+import math
+import os
+import signal
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import psutil
+from conftest import (
+    REPO,
+    basic_scenario,
+    csv_rows,
+    only_run_dir,
+    scenario_file,
+    service_pid,
+    start,
+    wait_for_line,
+)  # fmt: skip
+
+from catabot import codec
+from catabot.keys import Keys
+from catabot.messages import ThrustCmd
+from catabot.session import Connection, free_port, open_session
+from services.recorder.mcap_sink import read_mcap_messages
+
+HERE = Path(__file__).parent
+
+
+def _long(tmp: Path, **clock: object) -> Path:
+    data = basic_scenario("faults", duration_s=600.0)
+    data["clock"] = {"realtime_factor": 2.0, **clock}
+    return scenario_file(tmp, data)
+
+
+def _assert_readable(run: Path) -> int:
+    rows = csv_rows(run / "vessel.ego.state.csv")
+    assert all(len(r) == len(rows[0]) for r in rows), "a CSV row is torn"
+    msgs = read_mcap_messages(run / "run.mcap")
+    assert len(msgs) >= len(rows) - 1 > 10
+    return int(rows[-1][1])
+
+
+def test_sigkill_of_a_service_ends_the_run_naming_it(tmp_path: Path, out: Path) -> None:
+    proc = start("run", str(_long(tmp_path)), "--out", str(out), "--quiet")
+    wait_for_line(proc, "zenoh:")
+    time.sleep(2.0)
+    os.kill(service_pid(proc.pid, "services.physics"), signal.SIGKILL)
+    killed = time.monotonic()
+    _, err = proc.communicate(timeout=30)
+    assert proc.returncode == 1
+    run = only_run_dir(out)
+    log = (run / "log" / "conductor.log").read_text()
+    assert "'physics' left the run" in log and "physics" in err and "SIGKILL" in err
+    assert time.monotonic() - killed < 5.0
+    assert _assert_readable(run) > 0
+
+
+def test_killed_participant_is_detected_within_one_second(tmp_path: Path, out: Path) -> None:
+    endpoint = f"tcp/127.0.0.1:{free_port()}"
+    scenario = _long(tmp_path, external_participants=["autopilot"])
+    proc = start("run", str(scenario), "--out", str(out), "--quiet", "--listen", endpoint)
+    wait_for_line(proc, "zenoh:")
+    ext = subprocess.Popen([sys.executable, str(HERE / "hang_participant.py"), endpoint, "faults",
+                            "autopilot", "300", "kill"], cwd=REPO)  # fmt: skip
+    ext.wait(timeout=60)
+    killed = time.monotonic()
+    _, err = proc.communicate(timeout=30)
+    assert proc.returncode == 1 and "'autopilot' left the run" in err
+    ended = _end_time(only_run_dir(out))
+    assert ended - killed < 1.0 or time.monotonic() - killed < 3.0
+    assert 290 <= _assert_readable(only_run_dir(out)) <= 300
+
+
+def _end_time(run: Path) -> float:
+    return (run / "log" / "run.json").stat().st_mtime - time.time() + time.monotonic()
+
+
+def test_hanging_participant_misses_the_deadline(tmp_path: Path, out: Path) -> None:
+    endpoint = f"tcp/127.0.0.1:{free_port()}"
+    scenario = _long(tmp_path, external_participants=["autopilot"], deadline_s=1.0)
+    proc = start("run", str(scenario), "--out", str(out), "--quiet", "--listen", endpoint)
+    wait_for_line(proc, "zenoh:")
+    ext = subprocess.Popen([sys.executable, str(HERE / "hang_participant.py"), endpoint, "faults",
+                            "autopilot", "100", "hang"], cwd=REPO)  # fmt: skip
+    try:
+        _, err = proc.communicate(timeout=60)
+    finally:
+        ext.kill()
+    assert proc.returncode == 1
+    assert "'autopilot' missed the 1 s deadline of tick 100" in err
+    assert _assert_readable(only_run_dir(out)) == 100
+
+
+def test_drop_policy_goes_on_without_the_hanging_participant(tmp_path: Path, out: Path) -> None:
+    endpoint = f"tcp/127.0.0.1:{free_port()}"
+    data = basic_scenario("faults", duration_s=3.0)
+    data["clock"] = {"external_participants": ["autopilot"], "deadline_s": 0.5, "policy": "drop"}
+    proc = start("run", str(scenario_file(tmp_path, data)), "--out", str(out), "--quiet",
+                 "--listen", endpoint)  # fmt: skip
+    wait_for_line(proc, "zenoh:")
+    ext = subprocess.Popen([sys.executable, str(HERE / "hang_participant.py"), endpoint, "faults",
+                            "autopilot", "50", "hang"], cwd=REPO)  # fmt: skip
+    try:
+        _, err = proc.communicate(timeout=60)
+    finally:
+        ext.kill()
+    assert proc.returncode == 0, err
+    run = only_run_dir(out)
+    assert "dropping it" in (run / "log" / "conductor.log").read_text()
+    assert _assert_readable(run) == 299
+
+
+def test_ctrl_c_ends_every_process_with_complete_files(tmp_path: Path, out: Path) -> None:
+    proc = start("run", str(_long(tmp_path)), "--out", str(out), "--quiet")
+    wait_for_line(proc, "zenoh:")
+    time.sleep(2.0)
+    children = psutil.Process(proc.pid).children(recursive=True)
+    proc.send_signal(signal.SIGINT)
+    _, err = proc.communicate(timeout=30)
+    assert proc.returncode == 130, err
+    assert not [c for c in children if c.is_running() and c.status() != psutil.STATUS_ZOMBIE]
+    run = only_run_dir(out)
+    _assert_readable(run)
+    from mcap.reader import make_reader
+
+    with (run / "run.mcap").open("rb") as f:
+        assert make_reader(f).get_summary() is not None, "MCAP closed with a summary"
+
+
+def test_malformed_and_non_finite_commands_are_logged_and_survived(
+    tmp_path: Path, out: Path
+) -> None:
+    endpoint = f"tcp/127.0.0.1:{free_port()}"
+    data = basic_scenario("faults", duration_s=8.0)
+    data["clock"] = {"realtime_factor": 2.0}
+    proc = start("run", str(scenario_file(tmp_path, data)), "--out", str(out), "--quiet",
+                 "--listen", endpoint)  # fmt: skip
+    wait_for_line(proc, "zenoh:")
+    key = Keys("faults").cmd_thrust("ego")
+    with open_session(Connection(connect=(endpoint,))) as session:
+        pub = session.declare_publisher(key)
+        for _ in range(100):
+            if pub.matching_status.matching:
+                break
+            time.sleep(0.05)
+        for payload in (b"\x93garbage", codec.encode(ThrustCmd(thrust=(math.nan, 0.5))),
+                        codec.encode(ThrustCmd(thrust=(math.inf, 0.5))),
+                        codec.encode(ThrustCmd(thrust=(0.5,)))):  # fmt: skip
+            pub.put(payload)
+            time.sleep(0.2)
+    _, err = proc.communicate(timeout=60)
+    assert proc.returncode == 0, err
+    log = (only_run_dir(out) / "log" / "physics.log").read_text()
+    assert f"malformed payload on {key}" in log
+    assert log.count("non-finite") == 2
+    assert "1 values for 2 thrusters" in log

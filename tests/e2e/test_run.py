@@ -1,0 +1,43 @@
+"""`catabot run` on the bundled default scenario: run folder, CSV, MCAP, Archimedes."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+from conftest import catabot, csv_rows, only_run_dir
+
+from catabot.vessel import load_vessel_model
+from services.recorder.mcap_sink import read_mcap_messages
+
+
+def test_default_run_writes_run_folder_and_floats_at_archimedes_draft(out: Path) -> None:
+    result = catabot("run", "--duration", "20", "--out", str(out), "--quiet")
+    assert result.returncode == 0, result.stderr
+    run = only_run_dir(out)
+    assert "run folder:" in result.stdout and str(run) in result.stdout
+    for name in ("scenario.json", "vessel.ego.state.csv", "run.mcap", "log/physics.log"):
+        assert (run / name).is_file(), name
+    rows = csv_rows(run / "vessel.ego.state.csv")
+    header, data = rows[0], rows[1:]
+    assert header[:3] == ["stamp_ns", "tick", "position_x[m]"]
+    assert len(data) == 2000 and data[-1][0] == str(20 * 10**9)
+    scenario = json.loads((run / "scenario.json").read_text())
+    model = load_vessel_model(scenario["vessels"][0]["model"])
+    rho = scenario["water"]["density_kg_m3"]
+    area = sum(h.length_m * h.beam_m for h in model.hulls)
+    keel = min(h.center_m[2] - (h.height_m or h.beam_m) / 2 for h in model.hulls)
+    z = column(header, data, "position_z[m]", t_from=1.5, t_to=2.0)
+    draft = -(sum(z) / len(z) + keel)
+    assert abs(draft - model.mass_kg / (rho * area)) / (model.mass_kg / (rho * area)) < 0.02
+    x = column(header, data, "position_x[m]", t_from=19.9, t_to=20.0)
+    assert x[-1] > 10.0, "the scripted thrust must move the vessel"
+    topics = {m.topic for m in read_mcap_messages(run / "run.mcap")}
+    assert "/vessel/ego/state" in topics
+
+
+def column(
+    header: list[str], data: list[list[str]], name: str, *, t_from: float, t_to: float
+) -> list[float]:
+    i = header.index(name)
+    return [float(r[i]) for r in data if t_from <= int(r[0]) / 1e9 <= t_to]

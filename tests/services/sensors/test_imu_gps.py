@@ -1,0 +1,218 @@
+"""IMU and GPS models: physics of the readings, noise statistics, determinism, the registry."""
+
+from __future__ import annotations
+
+import math
+from typing import Any
+
+import numpy as np
+import pyproj
+import pytest
+
+from catabot.geo import enu_to_geodetic
+from catabot.messages import GpsFix, ImuSample, VesselState
+from catabot.scenario import Origin, SensorConfig
+from services.sensors.common import SensorError
+from services.sensors.gps import GpsModel
+from services.sensors.imu import GRAVITY, ImuModel
+from services.sensors.registry import SENSOR_TYPES, build_sensor
+
+LEVEL = (0.0, 0.0, 0.0, 1.0)
+DT_NS = 10_000_000
+ORIGIN = (43.7, -72.3, 150.0)
+
+
+def state(
+    *,
+    position=(0.0, 0.0, 0.0),
+    orientation=LEVEL,
+    angular_velocity=(0.0, 0.0, 0.0),
+    linear_acceleration=(0.0, 0.0, 0.0),
+    angular_acceleration=(0.0, 0.0, 0.0),
+) -> VesselState:
+    return VesselState(
+        tick=0,
+        stamp_ns=0,
+        position=position,
+        orientation=orientation,
+        linear_velocity=(0.0, 0.0, 0.0),
+        angular_velocity=angular_velocity,
+        linear_acceleration=linear_acceleration,
+        angular_acceleration=angular_acceleration,
+    )
+
+
+def about(axis: str, angle_rad: float) -> tuple[float, float, float, float]:
+    s, c = math.sin(angle_rad / 2), math.cos(angle_rad / 2)
+    return {"x": (s, 0.0, 0.0, c), "y": (0.0, s, 0.0, c), "z": (0.0, 0.0, s, c)}[axis]
+
+
+def run_imu(model: ImuModel, n: int, st: VesselState | None = None) -> np.ndarray:
+    """n samples as rows (gyro xyz, accel xyz), one tick apart."""
+    st = st or state()
+    out = []
+    for k in range(n):
+        s = model.sample(st, tick=k, stamp_ns=k * DT_NS)
+        out.append(s.angular_velocity + s.linear_acceleration)
+    return np.array(out)
+
+
+@pytest.mark.parametrize(
+    ("orientation", "expected"),
+    [
+        (LEVEL, (0.0, 0.0, GRAVITY)),
+        (about("x", math.pi / 2), (0.0, GRAVITY, 0.0)),  # rolled right side down: +y is up
+        (about("y", math.pi / 2), (-GRAVITY, 0.0, 0.0)),  # nose down: +x points down
+        (about("z", 1.0), (0.0, 0.0, GRAVITY)),  # heading does not matter
+    ],
+)
+def test_imu_reads_gravity_as_specific_force(orientation, expected) -> None:
+    ideal = ImuModel(noise=False).sample(state(orientation=orientation), tick=0, stamp_ns=0)
+    assert isinstance(ideal, ImuSample)
+    np.testing.assert_allclose(ideal.linear_acceleration, expected, atol=1e-12)
+    assert ideal.orientation == orientation
+    noisy = run_imu(ImuModel(seed=3), 2000, state(orientation=orientation))
+    np.testing.assert_allclose(noisy[:, 3:].mean(axis=0), expected, atol=0.02)  # bias + noise
+    assert np.abs(noisy[:, 3:] - expected).max() < 5 * 0.021 + 0.02
+
+
+def test_imu_lever_arm_and_motion() -> None:
+    imu = ImuModel(noise=False, lever_arm=(1.0, 0.0, 0.0))
+    spinning = state(angular_velocity=(0.0, 0.0, 2.0), angular_acceleration=(0.0, 0.0, 0.5))
+    s = imu.sample(spinning, tick=0, stamp_ns=0)
+    # centripetal -w^2 r on x, tangential alpha x r on y, gravity on z
+    np.testing.assert_allclose(s.linear_acceleration, (-4.0, 0.5, GRAVITY), atol=1e-12)
+    np.testing.assert_allclose(s.angular_velocity, (0.0, 0.0, 2.0))
+    surging = ImuModel(noise=False).sample(
+        state(linear_acceleration=(1.5, 0, 0)), tick=0, stamp_ns=0
+    )
+    np.testing.assert_allclose(surging.linear_acceleration, (1.5, 0.0, GRAVITY), atol=1e-12)
+
+
+def test_imu_white_noise_matches_configured_sigma() -> None:
+    imu = ImuModel(gyro_bias_instability=0.0, accel_bias_instability=0.0, seed=11, name="v/imu")
+    rows = run_imu(imu, 20000, state(angular_velocity=(0.1, -0.2, 0.3)))
+    assert rows[:, :3].std(axis=0) == pytest.approx([0.009] * 3, rel=0.05)
+    assert rows[:, 3:].std(axis=0) == pytest.approx([0.021] * 3, rel=0.05)
+    np.testing.assert_allclose(rows[:, :3].mean(axis=0), (0.1, -0.2, 0.3), atol=3e-4)
+
+
+def test_imu_gauss_markov_bias_has_its_sigma_and_correlation_time() -> None:
+    tau, dt = 0.05, DT_NS * 1e-9
+    imu = ImuModel(gyro_sigma=0.0, accel_sigma=0.0, bias_tau_s=tau, seed=5)
+    rows = run_imu(imu, 20000)
+    bias = rows[:, :3]  # the gyro reads its bias only
+    assert bias.std(axis=0) == pytest.approx([0.0008] * 3, rel=0.1)
+    lag1 = np.mean([np.corrcoef(b[:-1], b[1:])[0, 1] for b in bias.T])
+    assert lag1 == pytest.approx(math.exp(-dt / tau), abs=0.02)
+
+
+def test_imu_bias_random_walk_grows_as_sqrt_time() -> None:
+    finals = []
+    for k in range(300):
+        imu = ImuModel(
+            gyro_sigma=0.0, accel_sigma=0.0, gyro_bias_instability=0.0,
+            accel_bias_instability=0.0, gyro_random_walk=1e-4, seed=k,
+        )  # fmt: skip
+        for step in range(26):
+            last = imu.sample(state(), tick=step, stamp_ns=step * 1_000_000_000)
+        finals.append(last.angular_velocity)
+    assert np.std(finals) == pytest.approx(1e-4 * math.sqrt(25.0), rel=0.1)
+
+
+def test_imu_is_deterministic_per_seed_and_name() -> None:
+    a = run_imu(ImuModel(seed=1, name="boat/imu"), 50)
+    assert np.array_equal(a, run_imu(ImuModel(seed=1, name="boat/imu"), 50))
+    assert not np.allclose(a, run_imu(ImuModel(seed=1, name="boat/imu2"), 50))
+    assert not np.allclose(a, run_imu(ImuModel(seed=2, name="boat/imu"), 50))
+
+
+def test_imu_refuses_bad_input() -> None:
+    with pytest.raises(SensorError, match=r"gyro_sigma \(rad/s\) must be a finite number >= 0"):
+        ImuModel(gyro_sigma=-1.0)
+    with pytest.raises(SensorError, match="bias_tau_s must be a finite number > 0"):
+        ImuModel(bias_tau_s=0.0)
+    imu = ImuModel()
+    imu.sample(state(), tick=1, stamp_ns=20)
+    with pytest.raises(SensorError, match="stamp_ns went back from 20 to 10"):
+        imu.sample(state(), tick=0, stamp_ns=10)
+    with pytest.raises(SensorError, match="zero length"):
+        ImuModel().sample(state(orientation=(0, 0, 0, 0)), tick=0, stamp_ns=0)
+
+
+def gps_at(origin=ORIGIN, **kwargs: Any) -> GpsModel:
+    lat, lon, alt = origin
+    return GpsModel(origin_lat_deg=lat, origin_lon_deg=lon, origin_alt_m=alt, **kwargs)
+
+
+def fix_position(fix: GpsFix) -> tuple[float, float, float]:
+    return fix.latitude, fix.longitude, fix.altitude
+
+
+def test_gps_without_noise_at_origin_and_1000m_east() -> None:
+    gps = gps_at(noise=False)
+    fix = gps.sample(state(), tick=3, stamp_ns=30)
+    assert isinstance(fix, GpsFix) and (fix.tick, fix.stamp_ns) == (3, 30)
+    assert fix_position(fix) == pytest.approx(ORIGIN, abs=1e-9)
+    assert (fix.horizontal_sigma, fix.vertical_sigma) == (0.0, 0.0)
+    east = gps.sample(state(position=(1000.0, 0.0, 0.0)), tick=4, stamp_ns=40)
+    pipeline = (
+        f"+proj=pipeline +step +inv +proj=topocentric +ellps=WGS84 +lat_0={ORIGIN[0]}"
+        f" +lon_0={ORIGIN[1]} +h_0={ORIGIN[2]} +step +inv +proj=cart +ellps=WGS84"
+        " +step +proj=unitconvert +xy_in=rad +xy_out=deg"
+    )
+    lon, lat, alt = pyproj.Transformer.from_pipeline(pipeline).transform(1000.0, 0.0, 0.0)
+    to_ecef = pyproj.Transformer.from_crs("EPSG:4979", "EPSG:4978", always_xy=True)
+    ours = np.array(to_ecef.transform(east.longitude, east.latitude, east.altitude))
+    assert np.linalg.norm(ours - np.array(to_ecef.transform(lon, lat, alt))) < 0.01
+
+
+def test_gps_antenna_offset_follows_heading() -> None:
+    gps = gps_at((0.0, 0.0, 0.0), noise=False, antenna_offset=(1.0, 0.0, 2.0))
+    fix = gps.sample(state(orientation=about("z", math.pi / 2)), tick=0, stamp_ns=0)
+    expected = enu_to_geodetic(0.0, 1.0, 2.0, origin=(0.0, 0.0, 0.0))
+    assert fix_position(fix) == pytest.approx(tuple(map(float, expected)), abs=1e-12)
+
+
+def test_gps_noise_statistics_and_determinism() -> None:
+    def offsets(model: GpsModel, n: int) -> np.ndarray:
+        fixes = [fix_position(model.sample(state(), tick=k, stamp_ns=k)) for k in range(n)]
+        return np.stack(model.frame.to_enu(*np.array(fixes).T), -1)
+
+    model = gps_at(seed=4)
+    enu = offsets(model, 5000)
+    assert enu.std(axis=0) == pytest.approx([0.5, 0.5, 1.0], rel=0.05)
+    assert np.array_equal(enu[:20], offsets(gps_at(seed=4), 20))
+    assert not np.allclose(enu[:20], offsets(gps_at(seed=4, name="gps2"), 20))
+    fix = model.sample(state(), tick=0, stamp_ns=0)
+    assert (fix.horizontal_sigma, fix.vertical_sigma) == (0.5, 1.0)
+
+
+def test_gps_paper_table_method_and_errors() -> None:
+    where = state(position=(700.0, -700.0, 0.0))
+    exact = gps_at(noise=False).sample(where, tick=0, stamp_ns=0)
+    paper = gps_at(noise=False, method="paper_table").sample(where, tick=0, stamp_ns=0)
+    assert paper.latitude == pytest.approx(exact.latitude, abs=0.2 / 111_000)
+    assert paper.longitude == pytest.approx(exact.longitude, abs=0.2 / 80_000)
+    assert paper.altitude == pytest.approx(exact.altitude, abs=0.1)
+    with pytest.raises(SensorError, match=r"GPS method must be one of \('wgs84', 'paper_table'\)"):
+        GpsModel(method="utm")  # type: ignore[arg-type]
+    with pytest.raises(SensorError, match=r"origin: latitude \(deg\) must be within \[-90, 90\]"):
+        GpsModel(origin_lat_deg=95.0)
+
+
+def test_registry_builds_seeded_sensors() -> None:
+    assert set(SENSOR_TYPES) == {"imu", "gps"}
+    origin = Origin(latitude_deg=ORIGIN[0], longitude_deg=ORIGIN[1], altitude_m=ORIGIN[2])
+    imu_cfg = SensorConfig(name="imu", type="imu", rate_hz=100.0)
+    build = lambda cfg, vid: build_sensor(cfg, vessel_id=vid, seed=9, origin=origin, dt_ns=DT_NS)  # noqa: E731
+    a, b, c = build(imu_cfg, "boat1"), build(imu_cfg, "boat1"), build(imu_cfg, "boat2")
+    assert a.message is ImuSample
+    sa, sb, sc = (s.sample(state(), tick=0, stamp_ns=0) for s in (a, b, c))
+    assert sa == sb and sa != sc
+    gps = build(SensorConfig(name="gps", type="gps", rate_hz=10.0, noise=False), "boat1")
+    fix = gps.sample(state(), tick=0, stamp_ns=0)
+    assert gps.message is GpsFix and isinstance(fix, GpsFix)
+    assert fix_position(fix) == pytest.approx(ORIGIN, abs=1e-9)
+    with pytest.raises(SensorError, match="is not a whole number of 10000000 ns ticks"):
+        build(SensorConfig(name="imu", type="imu", rate_hz=30.0), "boat1")
