@@ -104,12 +104,11 @@ def run(opts: RunOptions) -> int:
         return 2
     run_dir = make_run_dir(opts.out, scenario)
     cond_flags, svc_flags = _endpoints(opts)
-    if not opts.quiet:
-        print(
-            f"run folder: {run_dir}\nzenoh: clients connect to {svc_flags[1]} (world "
-            f"{scenario.name!r}, keys catabot/{scenario.name}/...)",
-            flush=True,
-        )
+    print(
+        f"run folder: {run_dir}\nzenoh: clients connect to {svc_flags[1]} (world "
+        f"{scenario.name!r}, keys catabot/{scenario.name}/...)",
+        flush=True,
+    )
     scen = str(run_dir / "scenario.json")
     conductor = _spawn(
         ["catabot.conduct", "--scenario", scen, *cond_flags],

@@ -11,6 +11,8 @@ from typing import Any
 
 import pytest
 
+pytestmark = pytest.mark.timeout(120)
+
 REPO = Path(__file__).resolve().parents[2]
 
 

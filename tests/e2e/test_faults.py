@@ -8,6 +8,7 @@ import signal
 import subprocess
 import sys
 import time
+from datetime import datetime
 from pathlib import Path
 
 import psutil
@@ -68,16 +69,19 @@ def test_killed_participant_is_detected_within_one_second(tmp_path: Path, out: P
     ext = subprocess.Popen([sys.executable, str(HERE / "hang_participant.py"), endpoint, "faults",
                             "autopilot", "300", "kill"], cwd=REPO)  # fmt: skip
     ext.wait(timeout=60)
-    killed = time.monotonic()
+    killed = time.time()
     _, err = proc.communicate(timeout=30)
     assert proc.returncode == 1 and "'autopilot' left the run" in err
-    ended = _end_time(only_run_dir(out))
-    assert ended - killed < 1.0 or time.monotonic() - killed < 3.0
-    assert 290 <= _assert_readable(only_run_dir(out)) <= 300
+    run = only_run_dir(out)
+    assert _logged_at(run / "log" / "conductor.log", "run ended by a fault") - killed < 1.0
+    assert _assert_readable(run) == 299, "up to the last complete tick"
 
 
-def _end_time(run: Path) -> float:
-    return (run / "log" / "run.json").stat().st_mtime - time.time() + time.monotonic()
+def _logged_at(log: Path, needle: str) -> float:
+    """Wall time of the log line holding `needle` (logging's asctime, local time)."""
+    line = next(x for x in log.read_text().splitlines() if needle in x)
+    stamp = datetime.strptime(line[:23], "%Y-%m-%d %H:%M:%S,%f")
+    return stamp.timestamp()
 
 
 def test_hanging_participant_misses_the_deadline(tmp_path: Path, out: Path) -> None:
@@ -93,7 +97,7 @@ def test_hanging_participant_misses_the_deadline(tmp_path: Path, out: Path) -> N
         ext.kill()
     assert proc.returncode == 1
     assert "'autopilot' missed the 1 s deadline of tick 100" in err
-    assert _assert_readable(only_run_dir(out)) == 100
+    assert _assert_readable(only_run_dir(out)) == 99, "up to the last complete tick"
 
 
 def test_drop_policy_goes_on_without_the_hanging_participant(tmp_path: Path, out: Path) -> None:
@@ -148,6 +152,7 @@ def test_malformed_and_non_finite_commands_are_logged_and_survived(
             if pub.matching_status.matching:
                 break
             time.sleep(0.05)
+        time.sleep(0.5)  # matching means one subscriber (the recorder); let physics match too
         for payload in (b"\x93garbage", codec.encode(ThrustCmd(thrust=(math.nan, 0.5))),
                         codec.encode(ThrustCmd(thrust=(math.inf, 0.5))),
                         codec.encode(ThrustCmd(thrust=(0.5,)))):  # fmt: skip
