@@ -52,12 +52,14 @@ class RunResult:
     error: str = ""
     dropped: list[str] = field(default_factory=list)
     reason: str = "completed"
+    join_s: float = 0.0
 
 
 class Conductor:
     def __init__(self, session: zenoh.Session, keys: Keys, spec: ClockSpec) -> None:
         self.session, self.keys, self.spec = session, keys, spec
         self.run_id = uuid.uuid4().hex[:12]
+        self._created = time.monotonic()
         self.events: queue.SimpleQueue[tuple[str, str, bytes]] = queue.SimpleQueue()
         self.members: set[str] = set()
         self.dropped: list[str] = []
@@ -86,9 +88,11 @@ class Conductor:
     # -- run ---------------------------------------------------------------------------
 
     def run(self, on_progress: Callable[[Progress], None] | None = None) -> RunResult:
-        start = time.monotonic()
+        """Wait for every participant, tick to the end; wall time counts from tick 0."""
+        joined = start = time.monotonic()
         try:
             self._await_members()
+            joined = start = time.monotonic()
             self._tick_loop(on_progress, start)
             error = ""
         except ClockError as exc:
@@ -96,7 +100,8 @@ class Conductor:
         done = self._done  # complete ticks, also when a fault or a stop cut the run short
         reason = self._stop_reason or ("completed" if not error else "fault")
         self._end_pub.put(codec.encode(End(self.run_id, done - 1, reason, error)))
-        return RunResult(done, time.monotonic() - start, error, list(self.dropped), reason)
+        wall = time.monotonic() - start
+        return RunResult(done, wall, error, list(self.dropped), reason, joined - self._created)
 
     def _await_members(self) -> None:
         expected = set(self.spec.participants)

@@ -16,6 +16,7 @@ from typing import Any, Literal
 from pydantic import BaseModel, ConfigDict, Field, ValidationError, field_validator, model_validator
 
 from catabot.clock import NS_PER_S, ClockError, period_in_ticks, ticks_for
+from catabot.environment import CurrentConfig, WindConfig
 from catabot.keys import check_name
 
 BUNDLED = Path(__file__).parent / "data" / "scenarios"
@@ -112,6 +113,7 @@ class VesselConfig(_Model):
 
 class WaterConfig(_Model):
     density_kg_m3: float = Field(1025.0, gt=900, lt=1100)
+    current: CurrentConfig = CurrentConfig()
 
 
 class Origin(_Model):
@@ -135,6 +137,7 @@ class Scenario(_Model):
     clock: ClockConfig = ClockConfig()
     origin: Origin = Origin()
     water: WaterConfig = WaterConfig()
+    wind: WindConfig = WindConfig()
     vessels: list[VesselConfig] = Field(min_length=1)
     recording: RecordingConfig = RecordingConfig()
 

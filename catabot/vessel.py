@@ -56,6 +56,20 @@ Dof6 = Annotated[
     ],
     _length(6, " [X_u, Y_v, Z_w, K_p, M_q, N_r]"),
 ]
+AddedMass6 = Annotated[
+    tuple[
+        NonNegativeFloat,
+        NonNegativeFloat,
+        NonNegativeFloat,
+        NonNegativeFloat,
+        NonNegativeFloat,
+        NonNegativeFloat,
+    ],
+    _length(6, " [X_udot, Y_vdot, Z_wdot, K_pdot, M_qdot, N_rdot]"),
+]
+WindCoefficients3 = Annotated[
+    tuple[NonNegativeFloat, NonNegativeFloat, FiniteFloat], _length(3, " [C_x, C_y, C_n]")
+]
 
 
 class VesselModelError(ValueError):
@@ -137,6 +151,25 @@ class Thruster(_Strict):
     time_constant_s: NonNegativeFloat = 0.0
 
 
+class WindArea(_Strict):
+    """Above-water windage: areas and drag coefficients (Fossen 2011 §10.1, simplified).
+
+    With (u_a, v_a) the apparent wind (air velocity relative to the vessel, body frame),
+    rho_a the air density, V_a^2 = u_a^2 + v_a^2 and gamma = atan2(v_a, u_a):
+        X = 1/2 rho_a A_F C_x u_a |u_a|
+        Y = 1/2 rho_a A_L C_y v_a |v_a|
+        N = -1/2 rho_a A_L L C_n V_a^2 sin(2 gamma)   ( = -rho_a A_L L C_n u_a v_a )
+    i.e. VRX's wind law with its lumped coefficients split into 1/2 rho_a A C. C_n > 0 turns
+    the bow away from the wind (bow falls off downwind), as for a slender hull (Munk moment).
+    Applied at the body origin: no heeling moment.
+    """
+
+    frontal_area_m2: NonNegativeFloat
+    lateral_area_m2: NonNegativeFloat
+    coefficients: WindCoefficients3
+    length_m: PositiveFloat
+
+
 class VesselModel(_Strict):
     """One vessel model file. Inertia is about the centre of gravity, in body axes."""
 
@@ -148,6 +181,9 @@ class VesselModel(_Strict):
     hulls: Annotated[list[Hull], Field(min_length=1)]
     damping: Damping
     thrusters: list[Thruster] = Field(default_factory=list)
+    # Added mass magnitudes (>= 0, i.e. -X_udot ...), diagonal, about the body origin (kg, kg m^2).
+    added_mass: AddedMass6 = (0.0, 0.0, 0.0, 0.0, 0.0, 0.0)
+    wind: WindArea | None = None  # None: the wind exerts no force on this vessel
 
     @model_validator(mode="after")
     def _physical_inertia(self) -> VesselModel:

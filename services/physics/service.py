@@ -10,6 +10,7 @@ from __future__ import annotations
 import logging
 import sys
 
+from catabot.environment import CurrentField, WindField
 from catabot.inbox import Inputs
 from catabot.messages import Tick, VesselState
 from catabot.participant import Participant
@@ -36,6 +37,8 @@ class PhysicsService:
             ],
             dt_s=scenario.dt_ns / 1e9,
             water_density=scenario.water.density_kg_m3,
+            current=CurrentField.from_config(scenario.water.current),
+            wind=WindField(scenario.wind, seed=scenario.seed),
         )
         self.controllers = {
             vid: TwistController(m, dt_s=self.dt_ns / 1e9) for vid, m in models.items()

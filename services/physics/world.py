@@ -22,7 +22,11 @@ from dataclasses import dataclass
 import dartpy as dart
 import numpy as np
 
-from catabot.vessel import VesselModel
+from catabot.environment import CurrentField, WindField
+from catabot.terrain import Terrain
+from catabot.vessel import VesselModel, load_vessel_model
+from catabot.waves import WaveField
+from services.physics.grounding import Grounding
 from services.physics.hydro import (
     Array,
     ThrusterBank,
@@ -31,7 +35,9 @@ from services.physics.hydro import (
     damping_wrench,
     quat_from_rotvec,
     rot_from_quat,
+    water_height,
 )
+from services.physics.loads import EnvironmentLoads
 
 StartPose = tuple[float, float, float, float]  # x, y, z (m, map ENU), yaw (rad)
 
@@ -75,10 +81,18 @@ class PhysicsWorld:
         dt_s: float,
         water_density: float = 1025.0,
         gravity: float = 9.81,
+        waves: WaveField | None = None,
+        terrain: Terrain | None = None,
+        current: CurrentField | None = None,
+        wind: WindField | None = None,
+        buoys: Sequence[tuple[str, tuple[float, float]]] = (),
+        buoy_model: VesselModel | None = None,
     ) -> None:
+        self._n_vessels = len(vessels)  # buoys are extra bodies, rows after the vessels
+        vessels = [*vessels, *_buoy_bodies(buoys, buoy_model)]
         _check_setup(vessels, dt_s, water_density, gravity)
         self._ids = [vid for vid, _, _ in vessels]
-        self._index = {vid: i for i, vid in enumerate(self._ids)}
+        self._index = {vid: i for i, vid in enumerate(self._ids[: self._n_vessels])}
         models = [model for _, model, _ in vessels]
         self._dt, self._rho, self._g = float(dt_s), float(water_density), float(gravity)
         self._steps = 0
@@ -92,7 +106,18 @@ class PhysicsWorld:
         self._thrusters = ThrusterBank([m.thrusters for m in models], self._dt)
         self._lin = np.array([m.damping.linear for m in models], dtype=np.float64)
         self._quad = np.array([m.damping.quadratic for m in models], dtype=np.float64)
-        self._current_w = np.zeros((len(models), 3))  # water velocity, world frame (none yet)
+        self._current_w = np.zeros((len(models), 3))  # steady current, world frame
+        anchors = np.full((len(models), 2), np.nan)  # buoys are moored where they start
+        anchors[self._n_vessels :] = np.reshape([xy for _, xy in buoys], (-1, 2))
+        self._loads = EnvironmentLoads(
+            models, gravity=self._g, current=current, wind=wind, anchors=anchors
+        )
+        self._surface = waves.height if waves is not None else water_height  # eta(x, y, t)
+        self._waves = waves
+        # Bottom contact with the terrain (grounding.py); buoyancy knows nothing about it.
+        self._ground = (
+            Grounding(terrain, models, self._dt, self._skeletons) if terrain is not None else None
+        )
         self._read_state()
         self._acc_w = np.zeros((len(models), 6))
 
@@ -105,7 +130,12 @@ class PhysicsWorld:
 
     @property
     def vessel_ids(self) -> list[str]:
-        return list(self._ids)
+        return self._ids[: self._n_vessels]
+
+    @property
+    def buoy_ids(self) -> list[str]:
+        """Moored buoys, rows of `buoy_state_arrays()`."""
+        return self._ids[self._n_vessels :]
 
     def set_thrust(self, vessel_id: str, command: Sequence[float]) -> None:
         """Set a vessel's normalised thruster commands (-1 full reverse .. +1 full forward).
@@ -139,21 +169,33 @@ class PhysicsWorld:
         force_w = np.einsum("nij,nj->ni", self._rot, wrench_b[:, :3])
         moment_w = np.einsum("nij,nj->ni", self._rot, wrench_b[:, 3:])
         generalized = np.concatenate([moment_w, force_w], axis=1)
+        if self._ground is not None:
+            generalized += self._ground.generalized_forces(
+                self._rot, self._pos, self._vel_w, generalized
+            )
         for skel, tau in zip(self._skeletons, generalized, strict=True):
             skel.setForces(tau)
         vel_before = self._vel_w
         self._world.step()
         self._steps += 1
+        self._loads.advance(self._dt)  # gusts: one draw per step, whatever else happens
         self._read_state()
         self._acc_w = (self._vel_w - vel_before) / self._dt
 
     def state_arrays(self) -> KinematicsArrays:
         """Every vessel's state as stacked arrays (copies), rows in `vessel_ids` order."""
-        rot_t = self._rot.transpose(0, 2, 1)
-        to_body = lambda v: np.einsum("nij,nj->ni", rot_t, v)  # noqa: E731
+        return self._kinematics(slice(0, self._n_vessels))
+
+    def buoy_state_arrays(self) -> KinematicsArrays:
+        """Every buoy's state as stacked arrays (copies), rows in `buoy_ids` order."""
+        return self._kinematics(slice(self._n_vessels, None))
+
+    def _kinematics(self, rows: slice) -> KinematicsArrays:
+        rot_t = self._rot[rows].transpose(0, 2, 1)
+        to_body = lambda v: np.einsum("nij,nj->ni", rot_t, v[rows])  # noqa: E731
         return KinematicsArrays(
-            position=self._pos.copy(),
-            orientation=self._quat.copy(),
+            position=self._pos[rows].copy(),
+            orientation=self._quat[rows].copy(),
             linear_velocity=to_body(self._vel_w[:, 3:]),
             angular_velocity=to_body(self._vel_w[:, :3]),
             linear_acceleration=to_body(self._acc_w[:, 3:]),
@@ -172,8 +214,13 @@ class PhysicsWorld:
                 a.linear_acceleration[i],
                 a.angular_acceleration[i],
             )
-            for i, vid in enumerate(self._ids)
+            for i, vid in enumerate(self.vessel_ids)
         }
+
+    @property
+    def grounding(self) -> Grounding | None:
+        """Terrain contact (last step's penetration and force per vessel), None without terrain."""
+        return self._ground
 
     def thruster_forces(self, vessel_id: str) -> Array:
         """Delivered (lagged) force of each thruster of a vessel, newtons."""
@@ -200,8 +247,13 @@ class PhysicsWorld:
             ],
             axis=1,
         )
-        current_b = np.einsum("nij,nj->ni", rot_t, self._current_w)
-        return (
+        self._current_w = self._loads.current_world(self._pos)
+        water_w = self._current_w  # plus the waves' orbital velocity at each body origin:
+        if self._waves is not None:  # damping acts on motion relative to the water
+            x, y, z = self._pos.T
+            water_w = water_w + self._waves.velocity(x, y, z, self.time_s)
+        current_b = np.einsum("nij,nj->ni", rot_t, water_w)
+        base = (
             buoyancy_wrench(
                 self._columns,
                 self._rot,
@@ -209,10 +261,12 @@ class PhysicsWorld:
                 density=self._rho,
                 gravity=self._g,
                 time_s=self.time_s,
+                surface=self._surface,
             )
             + damping_wrench(nu, self._lin, self._quad, current_b)
             + self._thrusters.wrench()
-        )
+        )  # then wind, moorings and added mass (which needs every other load):
+        return self._loads.total(self._rot, self._pos, nu, self._current_w, base)
 
 
 def _check_setup(
@@ -237,6 +291,16 @@ def _check_setup(
         seen.add(vid)
         if len(pose) != 4 or not all(math.isfinite(v) for v in pose):
             raise ValueError(f"vessel {vid!r}: start pose must be 4 finite numbers (x, y, z, yaw)")
+
+
+def _buoy_bodies(
+    buoys: Sequence[tuple[str, tuple[float, float]]], model: VesselModel | None
+) -> list[tuple[str, VesselModel, StartPose]]:
+    """Buoys as bodies (bundled "buoy" model unless given), upright at their anchor points."""
+    if not buoys:
+        return []
+    buoy = model if model is not None else load_vessel_model("buoy")
+    return [(bid, buoy, (float(x), float(y), 0.0, 0.0)) for bid, (x, y) in buoys]
 
 
 def _make_skeleton(vessel_id: str, model: VesselModel, pose: StartPose) -> dart.dynamics.Skeleton:

@@ -183,7 +183,8 @@ def test_bad_vessel_model_names_the_field(
 
 
 def test_unknown_bundled_name_lists_bundled() -> None:
-    with pytest.raises(VesselModelError, match=r"unknown bundled name \(bundled: catabot, wamv\)"):
+    bundled = r"unknown bundled name \(bundled: buoy, catabot, monohull, wamv\)"
+    with pytest.raises(VesselModelError, match=bundled):
         load_vessel_model("titanic")
 
 

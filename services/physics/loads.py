@@ -1,0 +1,87 @@
+"""Environment loads for every body at once: current, wind, moorings and added mass.
+
+PhysicsWorld calls `current_world` (the current at each body, which damping acts against),
+then `total` with the sum of the other wrenches. Each part is skipped outright when it cannot act
+(no field, a calm wind, nil current, no added mass), so an empty environment costs nothing.
+
+Moorings: a moored body (a buoy) is held by a horizontal linear spring of zero rest length
+between its body origin (at the waterline) and its anchor's (x, y): F = -k (p_xy - anchor).
+A chain's catenary is stiffer with offset and pulls down too; a soft linear spring keeps the
+buoy on station without adding a stiff time scale, and acting at the waterline it does not
+heel the buoy.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+
+import numpy as np
+
+from catabot.environment import CurrentField, WindField
+from catabot.vessel import VesselModel
+from services.physics.added_mass import AddedMass
+from services.physics.hydro import Array
+from services.physics.wind import wind_gains, wind_wrench
+
+
+class EnvironmentLoads:
+    """Per-step environment forces; `advance` moves the fields' own state once per step."""
+
+    def __init__(
+        self,
+        models: Sequence[VesselModel],
+        *,
+        gravity: float,
+        current: CurrentField | None = None,
+        wind: WindField | None = None,
+        anchors: Array | None = None,
+        mooring_n_per_m: float = 100.0,
+    ) -> None:
+        n = len(models)
+        self.current = None if current is None or current.is_zero else current
+        self.wind = wind
+        self.wind_gains = wind_gains(models, wind.air_density) if wind is not None else None
+        self.added_mass = AddedMass(models, gravity)
+        anchor_xy = np.full((n, 2), np.nan) if anchors is None else np.asarray(anchors, float)
+        self.moored = np.flatnonzero(np.isfinite(anchor_xy).all(axis=1))
+        self.anchor_xy = anchor_xy[self.moored]
+        self.mooring_n_per_m = float(mooring_n_per_m)
+        self._zero_current = np.zeros((n, 3))
+
+    def current_world(self, pos: Array) -> Array:
+        """The steady current at each body origin, world frame (N, 3); zeros without one."""
+        if self.current is None:
+            return self._zero_current
+        out = np.zeros((len(pos), 3))
+        out[:, :2] = self.current.velocity_at(pos[:, 0], pos[:, 1])
+        return out
+
+    def total(self, rot: Array, pos: Array, nu: Array, current_w: Array, base: Array) -> Array:
+        """base + wind + moorings + added mass, body frame (N, 6).
+
+        current_w is `current_world(pos)`: the steady current only (wave orbital velocity is
+        not a uniform current and stays out of the added-mass terms).
+        """
+        total = base
+        if self.wind is not None and self.wind_gains is not None and not self.wind.is_calm:
+            wind_xy = self.wind.velocity_at(pos[:, 0], pos[:, 1])
+            total = total + wind_wrench(self.wind_gains, rot, wind_xy, nu)
+        if self.moored.size:
+            total = total + self._mooring(rot, pos)
+        if self.added_mass.active:
+            current_b = np.einsum("nji,nj->ni", rot, current_w)  # R^T v_c
+            total = total + self.added_mass.wrench(rot, nu, current_b, total)
+        return total
+
+    def advance(self, dt_s: float) -> None:
+        """Advance the fields' random state once per physics step."""
+        if self.wind is not None:
+            self.wind.advance(dt_s)
+
+    def _mooring(self, rot: Array, pos: Array) -> Array:
+        """Spring wrench of the moored bodies, zero rows elsewhere."""
+        out = np.zeros((len(pos), 6))
+        rows = self.moored
+        f = -self.mooring_n_per_m * (pos[rows, :2] - self.anchor_xy)  # world frame, (M, 2)
+        out[rows, :3] = f[:, 0:1] * rot[rows, 0, :] + f[:, 1:2] * rot[rows, 1, :]
+        return out
