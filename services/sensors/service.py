@@ -33,17 +33,28 @@ class SensorsService:
     def __init__(self, ctx: ServiceContext) -> None:
         scenario = ctx.scenario
         self.mounted = [
-            Mounted(v.id, ctx.keys.sensor(v.id, s.name), s.period_ns // scenario.dt_ns,
-                    build_sensor(s, vessel_id=v.id, seed=scenario.seed, origin=scenario.origin,
-                                 dt_ns=scenario.dt_ns))
-            for v in scenario.vessels for s in v.sensors
-        ]  # fmt: skip
+            Mounted(
+                v.id,
+                ctx.keys.sensor(v.id, s.name),
+                s.period_ns // scenario.dt_ns,
+                build_sensor(
+                    s,
+                    vessel_id=v.id,
+                    seed=scenario.seed,
+                    origin=scenario.origin,
+                    dt_ns=scenario.dt_ns,
+                ),
+            )
+            for v in scenario.vessels
+            for s in v.sensors
+        ]
         carriers = {m.vessel for m in self.mounted}
         self.states = {v.id: start_state(v) for v in scenario.vessels if v.id in carriers}
         self.state_key = {ctx.keys.vessel_state(vid): vid for vid in self.states}
         inputs = [s for s in state_streams(scenario, ctx.keys) if s.key in self.state_key]
-        self.participant = Participant(ctx.session, ctx.keys, ctx.name, inputs=inputs,
-                                       peers=ctx.peers)  # fmt: skip
+        self.participant = Participant(
+            ctx.session, ctx.keys, ctx.name, inputs=inputs, peers=ctx.peers
+        )
 
     def step(self, tick: Tick, inputs: Inputs) -> None:
         for key, msgs in inputs.items():

@@ -24,8 +24,13 @@ def _scenario(tmp: Path) -> Path:
         {"name": "imu", "type": "imu", "rate_hz": 50.0},
         {"name": "gps", "type": "gps", "rate_hz": 5.0},
     ]
-    data["vessels"].append({"id": "other", "pose": {"x_m": 20.0, "y_m": 5.0}, "script": [
-        {"t_s": 0.0, "twist": {"surge_mps": 0.8, "yaw_rate_radps": 0.1}}]})  # fmt: skip
+    data["vessels"].append(
+        {
+            "id": "other",
+            "pose": {"x_m": 20.0, "y_m": 5.0},
+            "script": [{"t_s": 0.0, "twist": {"surge_mps": 0.8, "yaw_rate_radps": 0.1}}],
+        }
+    )
     return scenario_file(tmp, data)
 
 

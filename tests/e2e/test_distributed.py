@@ -9,7 +9,6 @@ import sys
 from pathlib import Path
 
 import pytest
-
 from conftest import REPO, basic_scenario, catabot, files_of, only_run_dir, scenario_file
 
 
@@ -31,8 +30,12 @@ def test_two_hosts_record_the_same_bytes_as_one(tmp_path: Path, out: Path) -> No
     remote = tmp_path / "remote"
     result = subprocess.run(
         ["bash", str(REPO / "deploy" / "two-hosts.sh"), str(scenario), str(remote)],
-        capture_output=True, text=True, timeout=120, cwd=REPO, env={**os.environ, "PYTHON": sys.executable},
-    )  # fmt: skip
+        capture_output=True,
+        text=True,
+        timeout=120,
+        cwd=REPO,
+        env={**os.environ, "PYTHON": sys.executable},
+    )
     assert result.returncode == 0, result.stdout + result.stderr
     assert '"error": ""' in result.stdout
     assert files_of(remote) == files_of(only_run_dir(out))

@@ -21,7 +21,7 @@ from conftest import (
     service_pid,
     start,
     wait_for_line,
-)  # fmt: skip
+)
 
 from catabot import codec
 from catabot.keys import Keys
@@ -66,8 +66,18 @@ def test_killed_participant_is_detected_within_one_second(tmp_path: Path, out: P
     scenario = _long(tmp_path, external_participants=["autopilot"])
     proc = start("run", str(scenario), "--out", str(out), "--quiet", "--listen", endpoint)
     wait_for_line(proc, "zenoh:")
-    ext = subprocess.Popen([sys.executable, str(HERE / "hang_participant.py"), endpoint, "faults",
-                            "autopilot", "300", "kill"], cwd=REPO)  # fmt: skip
+    ext = subprocess.Popen(
+        [
+            sys.executable,
+            str(HERE / "hang_participant.py"),
+            endpoint,
+            "faults",
+            "autopilot",
+            "300",
+            "kill",
+        ],
+        cwd=REPO,
+    )
     ext.wait(timeout=60)
     killed = time.time()
     _, err = proc.communicate(timeout=30)
@@ -89,8 +99,18 @@ def test_hanging_participant_misses_the_deadline(tmp_path: Path, out: Path) -> N
     scenario = _long(tmp_path, external_participants=["autopilot"], deadline_s=1.0)
     proc = start("run", str(scenario), "--out", str(out), "--quiet", "--listen", endpoint)
     wait_for_line(proc, "zenoh:")
-    ext = subprocess.Popen([sys.executable, str(HERE / "hang_participant.py"), endpoint, "faults",
-                            "autopilot", "100", "hang"], cwd=REPO)  # fmt: skip
+    ext = subprocess.Popen(
+        [
+            sys.executable,
+            str(HERE / "hang_participant.py"),
+            endpoint,
+            "faults",
+            "autopilot",
+            "100",
+            "hang",
+        ],
+        cwd=REPO,
+    )
     try:
         _, err = proc.communicate(timeout=60)
     finally:
@@ -104,11 +124,28 @@ def test_drop_policy_goes_on_without_the_hanging_participant(tmp_path: Path, out
     endpoint = f"tcp/127.0.0.1:{free_port()}"
     data = basic_scenario("faults", duration_s=3.0)
     data["clock"] = {"external_participants": ["autopilot"], "deadline_s": 0.5, "policy": "drop"}
-    proc = start("run", str(scenario_file(tmp_path, data)), "--out", str(out), "--quiet",
-                 "--listen", endpoint)  # fmt: skip
+    proc = start(
+        "run",
+        str(scenario_file(tmp_path, data)),
+        "--out",
+        str(out),
+        "--quiet",
+        "--listen",
+        endpoint,
+    )
     wait_for_line(proc, "zenoh:")
-    ext = subprocess.Popen([sys.executable, str(HERE / "hang_participant.py"), endpoint, "faults",
-                            "autopilot", "50", "hang"], cwd=REPO)  # fmt: skip
+    ext = subprocess.Popen(
+        [
+            sys.executable,
+            str(HERE / "hang_participant.py"),
+            endpoint,
+            "faults",
+            "autopilot",
+            "50",
+            "hang",
+        ],
+        cwd=REPO,
+    )
     try:
         _, err = proc.communicate(timeout=60)
     finally:
@@ -142,8 +179,15 @@ def test_malformed_and_non_finite_commands_are_logged_and_survived(
     endpoint = f"tcp/127.0.0.1:{free_port()}"
     data = basic_scenario("faults", duration_s=8.0)
     data["clock"] = {"realtime_factor": 2.0}
-    proc = start("run", str(scenario_file(tmp_path, data)), "--out", str(out), "--quiet",
-                 "--listen", endpoint)  # fmt: skip
+    proc = start(
+        "run",
+        str(scenario_file(tmp_path, data)),
+        "--out",
+        str(out),
+        "--quiet",
+        "--listen",
+        endpoint,
+    )
     wait_for_line(proc, "zenoh:")
     key = Keys("faults").cmd_thrust("ego")
     with open_session(Connection(connect=(endpoint,))) as session:
@@ -153,9 +197,12 @@ def test_malformed_and_non_finite_commands_are_logged_and_survived(
                 break
             time.sleep(0.05)
         time.sleep(0.5)  # matching means one subscriber (the recorder); let physics match too
-        for payload in (b"\x93garbage", codec.encode(ThrustCmd(thrust=(math.nan, 0.5))),
-                        codec.encode(ThrustCmd(thrust=(math.inf, 0.5))),
-                        codec.encode(ThrustCmd(thrust=(0.5,)))):  # fmt: skip
+        for payload in (
+            b"\x93garbage",
+            codec.encode(ThrustCmd(thrust=(math.nan, 0.5))),
+            codec.encode(ThrustCmd(thrust=(math.inf, 0.5))),
+            codec.encode(ThrustCmd(thrust=(0.5,))),
+        ):
             pub.put(payload)
             time.sleep(0.2)
     _, err = proc.communicate(timeout=60)

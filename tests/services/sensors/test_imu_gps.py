@@ -111,9 +111,13 @@ def test_imu_bias_random_walk_grows_as_sqrt_time() -> None:
     finals = []
     for k in range(300):
         imu = ImuModel(
-            gyro_sigma=0.0, accel_sigma=0.0, gyro_bias_instability=0.0,
-            accel_bias_instability=0.0, gyro_random_walk=1e-4, seed=k,
-        )  # fmt: skip
+            gyro_sigma=0.0,
+            accel_sigma=0.0,
+            gyro_bias_instability=0.0,
+            accel_bias_instability=0.0,
+            gyro_random_walk=1e-4,
+            seed=k,
+        )
         for step in range(26):
             last = imu.sample(state(), tick=step, stamp_ns=step * 1_000_000_000)
         finals.append(last.angular_velocity)
