@@ -47,6 +47,7 @@ class Participant:
         self.present: set[str] = set()
         self.run_id = ""
         self._orphaned_at = 0.0
+        self._warned_tick = -1
         self._pubs: dict[str, zenoh.Publisher] = {}
         self._subs = [
             session.declare_subscriber(keys.tick(), self._push("tick")),
@@ -147,7 +148,8 @@ class Participant:
         missing = self.inbox.missing(tick.tick)
         if not missing and self.peers <= self.present:
             return True
-        if time.monotonic() - since > 5.0:
+        if time.monotonic() - since > 5.0 and self._warned_tick != tick.tick:
+            self._warned_tick = tick.tick
             log.warning(
                 "%s: tick %d still waits for %s (peers absent: %s)",
                 self.name,
