@@ -17,11 +17,12 @@ from dataclasses import dataclass
 from datetime import datetime
 from pathlib import Path
 
+from catabot.placement import resolve_poses
 from catabot.progress import ProgressBar
 from catabot.scenario import Scenario, ScenarioError, load_scenario
 from catabot.session import free_port
 from catabot.streams import services as needed_services
-from catabot.vessel import VesselModelError, load_vessel_model
+from catabot.vessel import VesselModelError
 
 SERVICE_MODULES = {
     "physics": "services.physics",
@@ -55,9 +56,7 @@ def prepare(opts: RunOptions) -> Scenario:
         data["clock"]["realtime_factor"] = opts.realtime
     from catabot.scenario import parse_scenario
 
-    scenario = parse_scenario(data, source="command line")
-    for vessel in scenario.vessels:
-        load_vessel_model(vessel.model)
+    scenario = resolve_poses(parse_scenario(data, source="command line"))
     for name in needed_services(scenario):
         if name not in SERVICE_MODULES:
             raise LaunchError(f"scenario needs service {name!r}, which this version does not have")

@@ -16,8 +16,10 @@ from typing import Any, Literal
 from pydantic import BaseModel, ConfigDict, Field, ValidationError, field_validator, model_validator
 
 from catabot.clock import NS_PER_S, ClockError, period_in_ticks, ticks_for
-from catabot.environment import CurrentConfig, WindConfig
+from catabot.environment.config import CurrentConfig, WindConfig
 from catabot.keys import check_name
+from catabot.terrain import TerrainConfig
+from catabot.waves import WaveConfig
 
 BUNDLED = Path(__file__).parent / "data" / "scenarios"
 
@@ -93,7 +95,7 @@ class SensorConfig(_Model):
 class VesselConfig(_Model):
     id: str
     model: str = "catabot"
-    pose: Pose = Pose()
+    pose: Pose | None = Field(None, description="null: open water near the terrain centre")
     script: list[ScriptStep] = []
     sensors: list[SensorConfig] = []
 
@@ -113,7 +115,21 @@ class VesselConfig(_Model):
 
 class WaterConfig(_Model):
     density_kg_m3: float = Field(1025.0, gt=900, lt=1100)
+    waves: WaveConfig = WaveConfig()
     current: CurrentConfig = CurrentConfig()
+
+
+class BuoyConfig(_Model):
+    """A floating buoy body (the bundled `buoy` model), free to drift and be hit."""
+
+    id: str
+    x_m: float
+    y_m: float
+
+    @field_validator("id")
+    @classmethod
+    def _key_safe(cls, v: str) -> str:
+        return check_name("buoy", v)
 
 
 class Origin(_Model):
@@ -138,6 +154,8 @@ class Scenario(_Model):
     origin: Origin = Origin()
     water: WaterConfig = WaterConfig()
     wind: WindConfig = WindConfig()
+    terrain: TerrainConfig | None = None
+    buoys: list[BuoyConfig] = []
     vessels: list[VesselConfig] = Field(min_length=1)
     recording: RecordingConfig = RecordingConfig()
 
@@ -207,7 +225,36 @@ def load_scenario(path: str | Path | None = None) -> Scenario:
         data = json.loads(file.read_text())
     except json.JSONDecodeError as exc:
         raise ScenarioError(f"scenario {file}: not valid JSON: {exc}") from None
-    return parse_scenario(data, source=str(file))
+    return parse_scenario(absolute_paths(data, file.parent.resolve()), source=str(file))
+
+
+def absolute_paths(data: Any, base: Path) -> Any:
+    """Input files named relative to the scenario become absolute, so the resolved copy in
+    the run folder (and every service reading it) finds the same files."""
+    if not isinstance(data, dict):
+        return data
+    data = json.loads(json.dumps(data))
+    _absolute(_node(data, "terrain"), "elevation_image", base)
+    _absolute(_node(data, "water", "current", "map"), "path", base)
+    vessels = data.get("vessels")
+    for vessel in vessels if isinstance(vessels, list) else []:
+        if isinstance(vessel, dict) and str(vessel.get("model", "")).endswith(".json"):
+            _absolute(vessel, "model", base)
+    return data
+
+
+def _node(data: dict[str, Any], *path: str) -> dict[str, Any]:
+    for key in path:
+        child = data.get(key)
+        if not isinstance(child, dict):
+            return {}
+        data = child
+    return data
+
+
+def _absolute(node: dict[str, Any], key: str, base: Path) -> None:
+    if isinstance(node.get(key), str):
+        node[key] = str(base / Path(node[key]).expanduser())
 
 
 def explain(exc: ValidationError) -> str:

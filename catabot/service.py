@@ -19,9 +19,11 @@ import zenoh
 from catabot.clock import ClockError
 from catabot.keys import Keys
 from catabot.participant import EndFn, Participant, StepFn
+from catabot.placement import resolve_poses
 from catabot.scenario import Scenario, ScenarioError, load_scenario
 from catabot.session import SessionError, add_connection_args, connection_from_args, open_session
 from catabot.streams import participants
+from catabot.vessel import VesselModelError
 
 log = logging.getLogger("catabot.service")
 
@@ -63,8 +65,10 @@ def run_service(name: str, build: BuildFn, argv: list[str] | None = None) -> int
     signal.signal(signal.SIGTERM, lambda *_: sys.exit(143))
     try:
         scenario = load_scenario(args.scenario)
+        if any(v.pose is None for v in scenario.vessels):
+            scenario = resolve_poses(scenario)  # deterministic: every service picks the same
         session = open_session(connection_from_args(args))
-    except (ScenarioError, SessionError) as exc:
+    except (ScenarioError, SessionError, VesselModelError) as exc:
         log.error("%s: %s", name, exc)
         return 2
     ctx = ServiceContext(

@@ -10,16 +10,14 @@ from __future__ import annotations
 import logging
 import sys
 
-from catabot.environment import CurrentField, WindField
 from catabot.inbox import Inputs
 from catabot.messages import Tick, VesselState
 from catabot.participant import Participant
 from catabot.service import Built, ServiceContext, run_service
 from catabot.streams import command_streams
-from catabot.vessel import load_vessel_model
 from services.physics.commands import CommandBook
 from services.physics.control import TwistController
-from services.physics.world import PhysicsWorld
+from services.physics.setup import build_world
 
 log = logging.getLogger("physics")
 
@@ -27,19 +25,9 @@ log = logging.getLogger("physics")
 class PhysicsService:
     def __init__(self, ctx: ServiceContext) -> None:
         scenario = ctx.scenario
-        models = {v.id: load_vessel_model(v.model) for v in scenario.vessels}
+        self.world, models = build_world(scenario)
         self.keys = ctx.keys
         self.dt_ns = scenario.dt_ns
-        self.world = PhysicsWorld(
-            [
-                (v.id, models[v.id], (v.pose.x_m, v.pose.y_m, 0.0, v.pose.yaw_rad))
-                for v in scenario.vessels
-            ],
-            dt_s=scenario.dt_ns / 1e9,
-            water_density=scenario.water.density_kg_m3,
-            current=CurrentField.from_config(scenario.water.current),
-            wind=WindField(scenario.wind, seed=scenario.seed),
-        )
         self.controllers = {
             vid: TwistController(m, dt_s=self.dt_ns / 1e9) for vid, m in models.items()
         }

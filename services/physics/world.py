@@ -5,8 +5,9 @@ generalized positions are [rotation vector (3), translation (3)] of the body fra
 its generalized velocities are [angular velocity (3), linear velocity of the body-frame origin
 (3)] both expressed in the WORLD frame (not the body frame), and its generalized forces are the
 matching [torque about the body origin, force at the body origin], world frame. State is read
-and forces are written through these per-skeleton vectors, which is much cheaper than querying
-body transforms one by one.
+and forces are written through these generalized vectors, which is much cheaper than querying
+body transforms one by one; all bodies are trees of one skeleton (fleet.py), so each is a
+single call for the whole fleet.
 
 The body node's frame is the vessel's body frame (FLU, origin at the waterline reference
 point); the centre of gravity is set as the body's local centre of mass, so reported positions
@@ -26,6 +27,7 @@ from catabot.environment import CurrentField, WindField
 from catabot.terrain import Terrain
 from catabot.vessel import VesselModel, load_vessel_model
 from catabot.waves import WaveField
+from services.physics.fleet import TreeView, make_fleet
 from services.physics.grounding import Grounding
 from services.physics.hydro import (
     Array,
@@ -99,9 +101,9 @@ class PhysicsWorld:
         self._world = dart.simulation.World()
         self._world.setGravity([0.0, 0.0, -self._g])
         self._world.setTimeStep(self._dt)
-        self._skeletons = [_make_skeleton(vid, m, p) for vid, m, p in vessels]
-        for skel in self._skeletons:
-            self._world.addSkeleton(skel)
+        self._fleet = make_fleet(vessels)  # body i: tree i, generalized entries 6i .. 6i+5
+        self._world.addSkeleton(self._fleet)
+        self._skeletons = [TreeView(self._fleet, i) for i in range(len(vessels))]
         self._columns = build_columns(models)
         self._thrusters = ThrusterBank([m.thrusters for m in models], self._dt)
         self._lin = np.array([m.damping.linear for m in models], dtype=np.float64)
@@ -173,8 +175,7 @@ class PhysicsWorld:
             generalized += self._ground.generalized_forces(
                 self._rot, self._pos, self._vel_w, generalized
             )
-        for skel, tau in zip(self._skeletons, generalized, strict=True):
-            skel.setForces(tau)
+        self._fleet.setForces(generalized.ravel())
         vel_before = self._vel_w
         self._world.step()
         self._steps += 1
@@ -231,8 +232,8 @@ class PhysicsWorld:
 
     def _read_state(self) -> None:
         """Cache pose and world-frame velocity of all vessels from the generalized vectors."""
-        q = np.array([s.getPositions() for s in self._skeletons], dtype=np.float64)
-        self._vel_w = np.array([s.getVelocities() for s in self._skeletons], dtype=np.float64)
+        q = self._fleet.getPositions().reshape(-1, 6)
+        self._vel_w = self._fleet.getVelocities().reshape(-1, 6)
         self._pos = q[:, 3:]
         self._quat = quat_from_rotvec(q[:, :3])
         self._rot = rot_from_quat(self._quat)
@@ -301,33 +302,3 @@ def _buoy_bodies(
         return []
     buoy = model if model is not None else load_vessel_model("buoy")
     return [(bid, buoy, (float(x), float(y), 0.0, 0.0)) for bid, (x, y) in buoys]
-
-
-def _make_skeleton(vessel_id: str, model: VesselModel, pose: StartPose) -> dart.dynamics.Skeleton:
-    """One free rigid body: mass and inertia at the COG, a box collision shape over the hulls."""
-    skel = dart.dynamics.Skeleton(vessel_id)
-    _, body = skel.createFreeJointAndBodyNodePair()
-    body.setName(vessel_id)
-    body.setMass(model.mass_kg)
-    ixx, iyy, izz = model.inertia_kgm2
-    body.setMomentOfInertia(ixx, iyy, izz, 0.0, 0.0, 0.0)
-    body.setLocalCOM(np.asarray(model.cog_m, dtype=np.float64))
-    lo, hi = _hull_bounds(model)
-    node = body.createShapeNode(dart.dynamics.BoxShape(hi - lo))
-    node.setRelativeTranslation((lo + hi) / 2)
-    node.createCollisionAspect()
-    node.createDynamicsAspect()
-    x, y, z, yaw = pose
-    skel.setPositions(np.array([0.0, 0.0, yaw, x, y, z]))
-    return skel
-
-
-def _hull_bounds(model: VesselModel) -> tuple[Array, Array]:
-    """Axis-aligned body-frame box around all hulls."""
-    lows, highs = [], []
-    for hull in model.hulls:
-        half = np.array([hull.length_m, hull.beam_m, hull.vertical_extent_m]) / 2
-        centre = np.asarray(hull.center_m, dtype=np.float64)
-        lows.append(centre - half)
-        highs.append(centre + half)
-    return np.min(lows, axis=0), np.max(highs, axis=0)

@@ -72,6 +72,7 @@ class SensorsService:
 def start_state(vessel: VesselConfig) -> VesselState:
     """The vessel at rest at its start pose, as physics creates it at t = 0."""
     p = vessel.pose
+    assert p is not None, "poses are resolved before services start"
     half = p.yaw_rad / 2
     zero = (0.0, 0.0, 0.0)
     quat = (0.0, 0.0, math.sin(half), math.cos(half))

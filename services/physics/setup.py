@@ -1,0 +1,31 @@
+"""A PhysicsWorld from a scenario: vessels at their resolved poses, and the environment."""
+
+from __future__ import annotations
+
+from catabot.environment.current import CurrentField
+from catabot.environment.wind import WindField
+from catabot.scenario import Scenario
+from catabot.terrain import load_terrain
+from catabot.vessel import VesselModel, load_vessel_model
+from catabot.waves import WaveField
+from services.physics.world import PhysicsWorld
+
+
+def build_world(scenario: Scenario) -> tuple[PhysicsWorld, dict[str, VesselModel]]:
+    models = {v.id: load_vessel_model(v.model) for v in scenario.vessels}
+    starts = []
+    for v in scenario.vessels:
+        assert v.pose is not None, "poses are resolved before physics starts"
+        starts.append((v.id, models[v.id], (v.pose.x_m, v.pose.y_m, 0.0, v.pose.yaw_rad)))
+    world = PhysicsWorld(
+        starts,
+        dt_s=scenario.dt_ns / 1e9,
+        water_density=scenario.water.density_kg_m3,
+        waves=WaveField(scenario.water.waves, scenario.seed),
+        terrain=load_terrain(scenario.terrain) if scenario.terrain is not None else None,
+        current=CurrentField.from_config(scenario.water.current),
+        wind=WindField(scenario.wind, seed=scenario.seed),
+        buoys=[(b.id, (b.x_m, b.y_m)) for b in scenario.buoys],
+        buoy_model=load_vessel_model("buoy") if scenario.buoys else None,
+    )
+    return world, models
