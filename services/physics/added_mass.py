@@ -77,6 +77,9 @@ class AddedMass:
         augmented = self.m_rb + np.einsum("ni,ij->nij", self.diag, np.eye(6))
         self.inverse = np.linalg.inv(augmented) if len(chosen) else augmented
         self.gravity = float(gravity)
+        self._lhs = np.empty((5, len(chosen), 3))  # stacked cross-product operands
+        self._rhs = np.empty((5, len(chosen), 3))
+        self._lhs[3] = self.cog
 
     @property
     def active(self) -> bool:
@@ -97,20 +100,39 @@ class AddedMass:
         return out
 
     def _solve(self, z_b: Array, nu: Array, nu_c: Array, other: Array) -> Array:
-        """tau_A for the chosen rows; z_b is the world up axis in body coordinates."""
-        v, w = nu[:, :3], nu[:, 3:]
-        a_lin = self.diag[:, :3]
-        p = np.einsum("nij,nj->ni", self.m_rb, nu)
-        v_r = v - nu_c
-        pa1, pa2 = self.coriolis_diag[:, :3] * v_r, self.coriolis_diag[:, 3:] * w
-        lhs = np.stack([w, v, w, w, v_r, w, self.cog, w])
-        rhs = np.stack([p[:, :3], p[:, :3], p[:, 3:], pa1, pa1, pa2, z_b, nu_c])
+        """tau_A for the chosen rows; z_b is the world up axis in body coordinates.
+
+        Written out component by component (C_A) and with one stacked cross product for the
+        rigid-body terms: at ~100 vessels numpy's per-call overhead, not arithmetic, is the
+        cost, so fewer, larger operations win.
+        """
+        p = np.einsum("nij,nj->ni", self.m_rb, nu)  # rigid-body momenta [p1, p2]
+        v_r = nu[:, :3] - nu_c
+        u_r, v_rel, w_r = v_r[:, 0], v_r[:, 1], v_r[:, 2]
+        rate_p, rate_q, rate_r = nu[:, 3], nu[:, 4], nu[:, 5]
+        a1, a2, a6 = self.coriolis_diag[:, 0], self.coriolis_diag[:, 1], self.coriolis_diag[:, 5]
+        m1, m2, m6 = a1 * u_r, a2 * v_rel, a6 * rate_r  # added-mass momenta (manoeuvring)
+        coriolis_a = np.stack(
+            [
+                -rate_r * m2,
+                rate_r * m1,
+                rate_p * m2 - rate_q * m1,
+                rate_q * m6 - w_r * m2,
+                w_r * m1 - rate_p * m6,
+                u_r * m2 - v_rel * m1,
+            ],
+            axis=1,
+        )
+        lhs, rhs = self._lhs, self._rhs  # pairs: w x p1, v x p1, w x p2, r_g x z_b, w x nu_c
+        lhs[0], lhs[1], lhs[2], lhs[4] = nu[:, 3:], nu[:, :3], nu[:, 3:], nu[:, 3:]
+        rhs[0], rhs[1], rhs[2], rhs[3], rhs[4] = p[:, :3], p[:, :3], p[:, 3:], z_b, nu_c
         c = cross(lhs, rhs)
-        coriolis_rb = np.concatenate([c[0], c[1] + c[2]], axis=1)
-        coriolis_a = np.concatenate([c[3], c[4] + c[5]], axis=1)
+        turning = self.diag[:, :3] * c[4]  # A_lin (w x nu_c): the current turning with the hull
         weight = -self.gravity * self.mass
-        gravity = np.concatenate([weight * z_b, weight * c[6]], axis=1)
-        turning = np.concatenate([a_lin * c[7], np.zeros_like(a_lin)], axis=1)  # M_A [w x nu_c]
-        total = other + gravity - coriolis_rb - coriolis_a - turning
+        total = other - coriolis_a
+        total[:, :3] += weight * z_b - c[0] - turning
+        total[:, 3:] += weight * c[3] - c[1] - c[2]
         nu_dot = np.einsum("nij,nj->ni", self.inverse, total)
-        return -self.diag * nu_dot - turning - coriolis_a
+        tau = -self.diag * nu_dot - coriolis_a
+        tau[:, :3] -= turning
+        return tau

@@ -1,0 +1,64 @@
+"""Terrain through `catabot run`: start poses checked before anything starts, auto placement."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import pytest
+from conftest import basic_scenario, catabot, csv_rows, only_run_dir, scenario_file
+
+from catabot.terrain import TerrainConfig, load_terrain
+
+SHARED = Path(__file__).resolve().parents[3] / "shared" / "data" / "elevation"
+RIVER = SHARED / "new-york-river.png"
+BAY = Path(__file__).resolve().parents[2] / "catabot" / "data" / "terrain" / "bay.png"
+
+
+def _bay(**vessel: object) -> dict[str, object]:
+    data = basic_scenario("terrain", duration_s=2.0)
+    data["terrain"] = {"elevation_image": str(BAY), "min_elevation_m": -15.0,
+                       "max_elevation_m": 25.0, "metres_per_pixel": 2.0}  # fmt: skip
+    data["vessels"][0].update(vessel)  # type: ignore[index]
+    return data
+
+
+def test_pose_on_land_is_refused_before_anything_starts(tmp_path: Path, out: Path) -> None:
+    data = _bay(pose={"x_m": 420.0, "y_m": 250.0})  # the island's summit
+    result = catabot("run", str(scenario_file(tmp_path, data)), "--out", str(out))
+    assert result.returncode == 2
+    assert "vessels.0.pose (ego)" in result.stderr and "on land" in result.stderr
+    assert list(out.iterdir()) == []
+
+
+def test_pose_in_too_shallow_water_is_refused(tmp_path: Path, out: Path) -> None:
+    data = _bay(pose={"x_m": 300.0, "y_m": 470.0})  # on the north shore's slope
+    result = catabot("run", str(scenario_file(tmp_path, data)), "--out", str(out))
+    assert result.returncode == 2
+    assert "vessels.0.pose (ego)" in result.stderr
+    assert "shallow" in result.stderr or "on land" in result.stderr
+
+
+def test_bundled_harbour_scenario_runs(out: Path) -> None:
+    result = catabot("run", "harbour", "--duration", "3", "--out", str(out), "--quiet")
+    assert result.returncode == 0, result.stderr
+    run = only_run_dir(out)
+    poses = [v["pose"] for v in json.loads((run / "scenario.json").read_text())["vessels"]]
+    assert all(p is not None for p in poses), "missing poses are resolved into the run folder"
+    assert (run / "vessel.wamv.state.csv").is_file()
+
+
+@pytest.mark.skipif(not RIVER.is_file(), reason="needs ../shared/data/elevation")
+def test_vessel_without_pose_starts_in_the_new_york_river(tmp_path: Path, out: Path) -> None:
+    data = basic_scenario("river", duration_s=2.0)
+    data["terrain"] = {"elevation_image": str(RIVER)}  # the original's defaults
+    result = catabot("run", str(scenario_file(tmp_path, data)), "--out", str(out), "--quiet")
+    assert result.returncode == 0, result.stderr
+    run = only_run_dir(out)
+    pose = json.loads((run / "scenario.json").read_text())["vessels"][0]["pose"]
+    terrain = load_terrain(TerrainConfig(elevation_image=str(RIVER)))
+    assert terrain.depth(pose["x_m"], pose["y_m"]) > 1.0
+    w, h = terrain.size_m
+    assert abs(pose["x_m"] - w / 2) < 400 and abs(pose["y_m"] - h / 2) < 400
+    rows = csv_rows(run / "vessel.ego.state.csv")
+    assert len(rows) == 201
