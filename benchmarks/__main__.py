@@ -8,6 +8,7 @@ import sys
 BENCHMARKS = {
     "lockstep": "benchmarks.lockstep",
     "physics": "benchmarks.physics",
+    "physics-env": "benchmarks.physics_env",
 }
 
 

@@ -108,8 +108,8 @@ def decode(payload: bytes | bytearray | memoryview, expect: type[M]) -> M:
 
 def _validated_fields(cls: type[Message], body: dict[str, Any]) -> dict[str, Any]:
     specs = _field_specs(cls)
-    unknown = sorted(set(body) - set(specs), key=repr)  # keys may mix str and bytes
-    if unknown:
+    if not body.keys() <= specs.keys():
+        unknown = sorted(set(body) - set(specs), key=repr)  # keys may mix str and bytes
         raise CodecError(f"{cls.TYPE}: unknown field(s) {unknown}; fields are {sorted(specs)}")
     out: dict[str, Any] = {}
     for name, (kind, length, required) in specs.items():
@@ -149,9 +149,11 @@ def _build_specs(cls: type[Message]) -> dict[str, tuple[str, int | None, bool]]:
 
 
 def _check(type_name: str, name: str, kind: str, length: int | None, value: Any) -> Any:
-    where = f"{type_name}.{name}"
-    if kind == "int" and type(value) is int:
+    """Validate one field; the common cases return before any message is formatted."""
+    simple = _SIMPLE.get(kind)
+    if simple is not None and type(value) is simple:
         return value
+    where = f"{type_name}.{name}"
     if kind == "str" and isinstance(value, str):
         return value
     if kind == "float" and type(value) in (int, float):
@@ -171,6 +173,9 @@ def _check(type_name: str, name: str, kind: str, length: int | None, value: Any)
     ):
         return tuple(value)
     raise CodecError(f"{where}: expected {kind}, got {type(value).__name__}")
+
+
+_SIMPLE = {"int": int, "str": str, "float": float}
 
 
 def finite(values: tuple[float, ...] | float) -> bool:

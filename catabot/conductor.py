@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import logging
 import queue
+import threading
 import time
 import uuid
 from collections.abc import Callable
@@ -68,13 +69,21 @@ class Conductor:
         self._tick_pub = session.declare_publisher(keys.tick(), congestion_control=BLOCK)
         self._end_pub = session.declare_publisher(keys.end(), congestion_control=BLOCK)
         self._token = session.liveliness().declare_token(keys.live(CONDUCTOR))
-        self._subs = [
-            session.declare_subscriber(keys.acks(), self._on_ack),
-            session.liveliness().declare_subscriber(keys.lives(), self._on_live, history=True),
-        ]
-
-    def _on_ack(self, sample: zenoh.Sample) -> None:
-        self.events.put(("ack", str(sample.key_expr), sample.payload.to_bytes()))
+        # Acks arrive on a FIFO channel (no Python callback per ack: the hot path); rare
+        # events (a participant leaving, a deadline passing, a stop) go to `events`, and the
+        # watchdog thread wakes the tick loop by publishing a poke on the conductor's own ack key.
+        self._acks = session.declare_subscriber(keys.acks(), zenoh.handlers.FifoChannel(4096))
+        self._poke_key = keys.ack(CONDUCTOR)
+        self._poke_pub = session.declare_publisher(self._poke_key)
+        self._live = session.liveliness().declare_subscriber(
+            keys.lives(), self._on_live, history=True
+        )
+        self._deadline: float | None = None
+        self._closed = threading.Event()
+        self._watchdog = threading.Thread(
+            target=self._watch, name="conductor-watchdog", daemon=True
+        )
+        self._watchdog.start()
 
     def _on_live(self, sample: zenoh.Sample) -> None:
         kind = "join" if sample.kind == zenoh.SampleKind.PUT else "leave"
@@ -84,6 +93,16 @@ class Conductor:
         """Ask the run to end at the next tick boundary (Ctrl-C, a signal)."""
         self._stop_reason = reason
         self.events.put(("stop", "", b""))
+
+    def _watch(self) -> None:
+        """Poke the tick loop when an event is pending or the tick's deadline has passed."""
+        poked_for: float | None = None
+        while not self._closed.wait(0.02):
+            deadline = self._deadline
+            late = deadline is not None and time.monotonic() > deadline and poked_for != deadline
+            if late or (deadline is not None and not self.events.empty()):
+                poked_for = deadline if late else poked_for
+                self._poke_pub.put(b"")
 
     # -- run ---------------------------------------------------------------------------
 
@@ -154,22 +173,34 @@ class Conductor:
     def _await_acks(self, k: int) -> bool:
         """Wait until every participant acked tick `k` or was dropped; False on a stop."""
         waiting = set(self.spec.participants) - set(self.dropped)
-        for name in sorted(waiting - self.members):
-            self._fault(name, f"left the run before tick {k}", waiting)
-        deadline = time.monotonic() + self.spec.deadline_s
-        while waiting:
-            kind, key, payload = self._next_event(deadline)
-            if kind == "ack":
-                self._take_ack(k, key, payload, waiting)
-            elif kind == "leave" and self.keys.participant_of(key) in waiting:
-                self._fault(self.keys.participant_of(key), f"left the run at tick {k}", waiting)
-            elif kind == "late":
-                for name in sorted(waiting):
-                    self._fault(
-                        name, f"missed the {self.spec.deadline_s:g} s deadline of tick {k}", waiting
-                    )
-            elif kind == "stop":
+        if not self._check_events(k, waiting):
+            return False
+        self._deadline = time.monotonic() + self.spec.deadline_s
+        try:
+            while waiting:
+                sample = self._acks.recv()
+                key = str(sample.key_expr)
+                if key != self._poke_key:
+                    self._take_ack(k, key, sample.payload.to_bytes(), waiting)
+                elif not self._check_events(k, waiting):
+                    return False
+        finally:
+            self._deadline = None
+        return True
+
+    def _check_events(self, k: int, waiting: set[str]) -> bool:
+        """Apply pending membership events and the deadline; False when a stop is asked."""
+        while not self.events.empty():
+            kind, _, _ = self._next_event(0.0)
+            if kind == "stop":
                 return False
+        for name in sorted(waiting - self.members):
+            self._fault(name, f"left the run at tick {k}", waiting)
+        if self._deadline is not None and time.monotonic() > self._deadline:
+            for name in sorted(waiting):
+                self._fault(
+                    name, f"missed the {self.spec.deadline_s:g} s deadline of tick {k}", waiting
+                )
         return True
 
     def _take_ack(self, k: int, key: str, payload: bytes, waiting: set[str]) -> None:
@@ -203,6 +234,8 @@ class Conductor:
         return event
 
     def close(self) -> None:
-        for sub in self._subs:
-            sub.undeclare()
+        self._closed.set()
+        self._watchdog.join()
+        self._acks.undeclare()
+        self._live.undeclare()
         self._token.undeclare()

@@ -120,7 +120,8 @@ class WaterConfig(_Model):
 
 
 class BuoyConfig(_Model):
-    """A floating buoy body (the bundled `buoy` model), free to drift and be hit."""
+    """A floating buoy body (the bundled `buoy` model), moored at (x_m, y_m) by a soft
+    horizontal spring (services/physics/loads.py): it bobs, heels, yields when hit, returns."""
 
     id: str
     x_m: float

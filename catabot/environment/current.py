@@ -82,7 +82,7 @@ class CurrentField:
         Gathers from the flattened grid with `take` (much cheaper than 2-D fancy indexing
         for a hundred points, which is the physics' use).
         """
-        assert self.grid is not None
+        assert self.grid is not None and self._flat is not None
         rows, cols = self.grid.shape[:2]
         fx = (x - self.origin[0]) / self.spacing
         fy = (y - self.origin[1]) / self.spacing

@@ -179,6 +179,9 @@ class ThrusterBank:
                     self.alpha[i, k] = -np.expm1(-dt_s / th.time_constant_s)
         self.command = np.zeros((n, t_max))
         self.force_n = np.zeros((n, t_max))
+        # Wrench per newton of each thruster, so that a step needs one contraction, no cross.
+        moment_arm = np.cross(self.position_m, self.direction)
+        self.unit_wrench = np.concatenate([self.direction, moment_arm], axis=2)  # (N, T, 6)
 
     def set_command(self, index: int, command: Array) -> None:
         """Store a validated, clamped command vector for vessel `index`."""
@@ -192,9 +195,7 @@ class ThrusterBank:
 
     def wrench(self) -> Array:
         """Body-frame wrench (N, 6) of the delivered thruster forces about the body origin."""
-        f = self.force_n[..., None] * self.direction
-        moment = np.cross(self.position_m, f)
-        return np.concatenate([f.sum(axis=1), moment.sum(axis=1)], axis=1)
+        return np.einsum("nt,ntk->nk", self.force_n, self.unit_wrench)
 
 
 # --- rotations --------------------------------------------------------------------------

@@ -6,8 +6,8 @@ its generalized velocities are [angular velocity (3), linear velocity of the bod
 (3)] both expressed in the WORLD frame (not the body frame), and its generalized forces are the
 matching [torque about the body origin, force at the body origin], world frame. State is read
 and forces are written through these generalized vectors, which is much cheaper than querying
-body transforms one by one; all bodies are trees of one skeleton (fleet.py), so each is a
-single call for the whole fleet.
+body transforms one by one; bodies are trees of a few shared skeletons (fleet.py), so a
+step makes a handful of such calls, not three per vessel.
 
 The body node's frame is the vessel's body frame (FLU, origin at the waterline reference
 point); the centre of gravity is set as the body's local centre of mass, so reported positions
@@ -25,9 +25,9 @@ import numpy as np
 
 from catabot.environment import CurrentField, WindField
 from catabot.terrain import Terrain
-from catabot.vessel import VesselModel, load_vessel_model
+from catabot.vessel import VesselModel
 from catabot.waves import WaveField
-from services.physics.fleet import TreeView, make_fleet
+from services.physics.fleet import Fleet, buoy_bodies
 from services.physics.grounding import Grounding
 from services.physics.hydro import (
     Array,
@@ -74,7 +74,11 @@ class KinematicsArrays:
 
 
 class PhysicsWorld:
-    """Vessels on calm water: buoyancy by columns, Fossen damping, lagged thrusters, DART."""
+    """Vessels and buoys: column buoyancy, Fossen damping, thrusters, environment loads, DART.
+
+    current / wind: fields that carry their own state (the wind's seeded gusts advance once
+    per step), so the world needs no seed. buoys: (id, (x, y)) moored at (x, y), see loads.py.
+    """
 
     def __init__(
         self,
@@ -91,7 +95,7 @@ class PhysicsWorld:
         buoy_model: VesselModel | None = None,
     ) -> None:
         self._n_vessels = len(vessels)  # buoys are extra bodies, rows after the vessels
-        vessels = [*vessels, *_buoy_bodies(buoys, buoy_model)]
+        vessels = [*vessels, *buoy_bodies(buoys, buoy_model)]
         _check_setup(vessels, dt_s, water_density, gravity)
         self._ids = [vid for vid, _, _ in vessels]
         self._index = {vid: i for i, vid in enumerate(self._ids[: self._n_vessels])}
@@ -101,9 +105,9 @@ class PhysicsWorld:
         self._world = dart.simulation.World()
         self._world.setGravity([0.0, 0.0, -self._g])
         self._world.setTimeStep(self._dt)
-        self._fleet = make_fleet(vessels)  # body i: tree i, generalized entries 6i .. 6i+5
-        self._world.addSkeleton(self._fleet)
-        self._skeletons = [TreeView(self._fleet, i) for i in range(len(vessels))]
+        self._fleet = Fleet(vessels)  # bodies as trees of a few skeletons (fleet.py)
+        self._fleet.add_to(self._world)
+        self._skeletons = self._fleet.views  # per-body, skeleton-like access
         self._columns = build_columns(models)
         self._thrusters = ThrusterBank([m.thrusters for m in models], self._dt)
         self._lin = np.array([m.damping.linear for m in models], dtype=np.float64)
@@ -175,7 +179,7 @@ class PhysicsWorld:
             generalized += self._ground.generalized_forces(
                 self._rot, self._pos, self._vel_w, generalized
             )
-        self._fleet.setForces(generalized.ravel())
+        self._fleet.set_forces(generalized)
         vel_before = self._vel_w
         self._world.step()
         self._steps += 1
@@ -232,8 +236,8 @@ class PhysicsWorld:
 
     def _read_state(self) -> None:
         """Cache pose and world-frame velocity of all vessels from the generalized vectors."""
-        q = self._fleet.getPositions().reshape(-1, 6)
-        self._vel_w = self._fleet.getVelocities().reshape(-1, 6)
+        q = self._fleet.positions()
+        self._vel_w = self._fleet.velocities()
         self._pos = q[:, 3:]
         self._quat = quat_from_rotvec(q[:, :3])
         self._rot = rot_from_quat(self._quat)
@@ -292,13 +296,3 @@ def _check_setup(
         seen.add(vid)
         if len(pose) != 4 or not all(math.isfinite(v) for v in pose):
             raise ValueError(f"vessel {vid!r}: start pose must be 4 finite numbers (x, y, z, yaw)")
-
-
-def _buoy_bodies(
-    buoys: Sequence[tuple[str, tuple[float, float]]], model: VesselModel | None
-) -> list[tuple[str, VesselModel, StartPose]]:
-    """Buoys as bodies (bundled "buoy" model unless given), upright at their anchor points."""
-    if not buoys:
-        return []
-    buoy = model if model is not None else load_vessel_model("buoy")
-    return [(bid, buoy, (float(x), float(y), 0.0, 0.0)) for bid, (x, y) in buoys]

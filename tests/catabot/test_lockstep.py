@@ -471,9 +471,10 @@ def test_stop_ends_the_run_at_the_tick_boundary(world: World) -> None:
     solo = world.member("solo", step)
     result = world.run(["solo"], 50, deadline_s=2.0, start_timeout_s=5.0)
     solo.join()
-    assert (result.error, result.reason, result.ticks_done) == ("", "interrupted", 5)
+    # the tick in progress is completed (everyone acked it), then the run stops
+    assert (result.error, result.reason, result.ticks_done) == ("", "interrupted", 6)
     assert solo.ticks == list(range(6))
-    assert solo.end is not None and (solo.end.reason, solo.end.tick) == ("interrupted", 4)
+    assert solo.end is not None and (solo.end.reason, solo.end.tick) == ("interrupted", 5)
 
 
 def test_realtime_factor_paces_the_clock(world: World) -> None:

@@ -5,6 +5,7 @@ from __future__ import annotations
 import math
 from typing import Any
 
+import dartpy as dart
 import numpy as np
 import pytest
 
@@ -12,6 +13,7 @@ from catabot.environment import CurrentField, WindConfig, WindField, WindZone
 from catabot.vessel import VesselModel, load_vessel_model
 from services.physics.added_mass import rigid_body_matrix
 from services.physics.control import TwistController
+from services.physics.fleet import GROUP
 from services.physics.hydro import rot_from_quat
 from services.physics.wind import wind_gains, wind_wrench
 from services.physics.world import PhysicsWorld
@@ -249,15 +251,23 @@ def test_twist_controller_output_is_clamped_and_turn_has_priority(catabot: Vesse
 # --- collisions and buoys -------------------------------------------------------------
 
 
-def test_vessels_driven_head_on_do_not_pass_through(catabot: VesselModel) -> None:
-    vessels = [("a", catabot, (0.0, 0.0, 0.0, 0.0)), ("b", catabot, (6.0, 0.0, 0.0, math.pi))]
+@pytest.mark.parametrize("idle", [0, GROUP], ids=["same-skeleton", "other-skeleton"])
+def test_vessels_driven_head_on_do_not_pass_through(catabot: VesselModel, idle: int) -> None:
+    """Contacts within one fleet skeleton and between two (idle vessels in between)."""
+    parked = [(f"p{i}", catabot, (100.0 + 10 * i, 50.0, 0.0, 0.0)) for i in range(idle)]
+    vessels = [
+        ("a", catabot, (0.0, 0.0, 0.0, 0.0)),
+        *parked,
+        ("b", catabot, (6.0, 0.0, 0.0, math.pi)),
+    ]
     world = PhysicsWorld(vessels, dt_s=DT)
     gap = []
     for _ in range(round(8.0 / DT)):
         world.set_thrust("a", [1.0, 1.0])
         world.set_thrust("b", [1.0, 1.0])
         world.step()
-        gap.append(np.diff(world.state_arrays().position[:, 0])[0])
+        x = world.state_arrays().position[:, 0]
+        gap.append(x[-1] - x[0])
     length = catabot.hulls[0].length_m
     assert min(gap) > length - 0.05  # bows meet, hulls do not overlap
     assert gap[-1] < length + 0.05  # and they are pressed together, not far apart
@@ -284,3 +294,34 @@ def test_buoy_floats_moored_and_stops_a_vessel(catabot: VesselModel) -> None:
     assert np.hypot(*(buoys.position[1, :2] - (20.0, 5.0))) < 0.5  # held by its mooring
     half = (catabot.hulls[0].length_m + buoy.hulls[0].length_m) / 2
     assert vessel.position[0, 0] < buoys.position[0, 0] - half + 0.1  # blocked by buoy b0
+
+
+def test_fleet_trees_behave_like_separate_skeletons(catabot: VesselModel) -> None:
+    """One multi-tree skeleton: row i is body i, and per-tree dynamics match a lone skeleton."""
+    monohull = load_vessel_model("monohull")
+    vessels = [
+        (f"v{i}", (catabot, monohull)[i % 2], (12.0 * i, -4.0 * i, 0.0, 0.3 * i))
+        for i in range(GROUP + 3)  # more than one skeleton's worth
+    ]
+    world = PhysicsWorld(vessels, dt_s=DT)
+    for i in range(1, len(vessels), 3):
+        world.set_thrust(f"v{i}", [1.0, 0.2])
+    run(world, 1.0)
+    s = world.state_arrays()
+    for i, (name, model, _) in enumerate(vessels):
+        view = world._skeletons[i]
+        body = view.getBodyNode(0)
+        assert body.getName() == view.getName() == name
+        assert np.allclose(body.getWorldTransform().translation(), s.position[i], atol=1e-12)
+        alone = dart.dynamics.Skeleton(name)
+        _, lone = alone.createFreeJointAndBodyNodePair()
+        lone.setMass(model.mass_kg)
+        lone.setMomentOfInertia(*model.inertia_kgm2, 0.0, 0.0, 0.0)
+        lone.setLocalCOM(np.asarray(model.cog_m))
+        alone.setGravity([0.0, 0.0, -9.81])
+        alone.setPositions(view.getPositions())
+        alone.setVelocities(view.getVelocities())
+        assert np.allclose(view.getMassMatrix(), alone.getMassMatrix(), rtol=1e-12)
+        assert np.allclose(
+            view.getCoriolisAndGravityForces(), alone.getCoriolisAndGravityForces(), rtol=1e-12
+        )
