@@ -13,11 +13,20 @@ import math
 from pathlib import Path
 from typing import Any, Literal
 
-from pydantic import BaseModel, ConfigDict, Field, ValidationError, field_validator, model_validator
+from pydantic import (
+    BaseModel,
+    ConfigDict,
+    Field,
+    ValidationError,
+    ValidationInfo,
+    field_validator,
+    model_validator,
+)
 
 from catabot.clock import NS_PER_S, ClockError, period_in_ticks, ticks_for
 from catabot.environment.config import CurrentConfig, WindConfig
 from catabot.keys import check_name
+from catabot.sensor_types import SENSOR_TYPES
 from catabot.terrain import TerrainConfig
 from catabot.waves import WaveConfig
 
@@ -78,14 +87,32 @@ class ScriptStep(_Model):
 
 class SensorConfig(_Model):
     name: str
-    type: Literal["imu", "gps"]
+    type: str = Field(description="a sensor type: see catabot/sensor_types.py")
     rate_hz: float = Field(gt=0)
     noise: bool = True
+    params: dict[str, Any] = Field({}, description="the type's parameters (defaults if empty)")
 
     @field_validator("name")
     @classmethod
     def _key_safe(cls, v: str) -> str:
         return check_name("sensor", v)
+
+    @field_validator("type")
+    @classmethod
+    def _known_type(cls, v: str) -> str:
+        if v not in SENSOR_TYPES:
+            raise ValueError(f"unknown sensor type {v!r}; allowed: {', '.join(map(repr, SENSOR_TYPES))}")
+        return v
+
+    @field_validator("params")
+    @classmethod
+    def _params(cls, v: dict[str, Any], info: ValidationInfo) -> dict[str, Any]:
+        kind = SENSOR_TYPES.get(info.data.get("type", ""))
+        return kind.params.model_validate(v).model_dump() if kind is not None else v
+
+    def typed_params(self) -> Any:
+        """The parameters as the type's own model (every default filled in)."""
+        return SENSOR_TYPES[self.type].params.model_validate(self.params)
 
     @property
     def period_ns(self) -> int:

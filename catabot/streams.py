@@ -8,10 +8,10 @@ from __future__ import annotations
 
 from catabot.clock import Stream, period_in_ticks
 from catabot.keys import Keys
-from catabot.messages import GpsFix, ImuSample, Message, ThrustCmd, TwistCmd, VesselState
+from catabot.messages import ThrustCmd, TwistCmd, VesselState
 from catabot.scenario import Scenario
+from catabot.sensor_types import SENSOR_TYPES
 
-SENSOR_MESSAGES: dict[str, type[Message]] = {"imu": ImuSample, "gps": GpsFix}
 EXTERNAL = "external"
 
 
@@ -23,7 +23,7 @@ def sensor_streams(scenario: Scenario, keys: Keys) -> list[Stream]:
     return [
         Stream(
             keys.sensor(v.id, s.name),
-            SENSOR_MESSAGES[s.type],
+            SENSOR_TYPES[s.type].message,
             "sensors",
             period_in_ticks(s.period_ns, scenario.dt_ns, what=f"{v.id}/{s.name}"),
         )

@@ -44,7 +44,8 @@ def source_name(vessel_id: str, config: SensorConfig) -> str:
 def _imu(
     config: SensorConfig, *, vessel_id: str, seed: int, origin: Origin, dt_ns: int
 ) -> ImuModel:
-    return ImuModel(noise=config.noise, seed=seed, name=source_name(vessel_id, config))
+    params = config.typed_params().model_dump()
+    return ImuModel(**params, noise=config.noise, seed=seed, name=source_name(vessel_id, config))
 
 
 def _gps(
@@ -54,6 +55,7 @@ def _gps(
         origin_lat_deg=origin.latitude_deg,
         origin_lon_deg=origin.longitude_deg,
         origin_alt_m=origin.altitude_m,
+        **config.typed_params().model_dump(),
         noise=config.noise,
         seed=seed,
         name=source_name(vessel_id, config),
