@@ -87,7 +87,10 @@ class ScriptStep(_Model):
 
 class SensorConfig(_Model):
     name: str
-    type: str = Field(description="a sensor type: see catabot/sensor_types.py")
+    type: str = Field(
+        description="a sensor type: see catabot/sensor_types.py",
+        json_schema_extra={"enum": list(SENSOR_TYPES)},
+    )
     rate_hz: float = Field(gt=0)
     noise: bool = True
     params: dict[str, Any] = Field({}, description="the type's parameters (defaults if empty)")
@@ -101,7 +104,8 @@ class SensorConfig(_Model):
     @classmethod
     def _known_type(cls, v: str) -> str:
         if v not in SENSOR_TYPES:
-            raise ValueError(f"unknown sensor type {v!r}; allowed: {', '.join(map(repr, SENSOR_TYPES))}")
+            allowed = ", ".join(map(repr, SENSOR_TYPES))
+            raise ValueError(f"unknown sensor type {v!r}; allowed: {allowed}")
         return v
 
     @field_validator("params")
