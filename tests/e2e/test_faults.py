@@ -94,63 +94,33 @@ def _logged_at(log: Path, needle: str) -> float:
     return stamp.timestamp()
 
 
-def test_hanging_participant_misses_the_deadline(tmp_path: Path, out: Path) -> None:
+def _with_external(scenario: Path, out: Path, *, at: int, how: str) -> tuple[int, str]:
+    """Run a scenario beside an external lockstep participant that hangs or dies at `at`."""
     endpoint = f"tcp/127.0.0.1:{free_port()}"
-    scenario = _long(tmp_path, external_participants=["autopilot"], deadline_s=1.0)
     proc = start("run", str(scenario), "--out", str(out), "--quiet", "--listen", endpoint)
     wait_for_line(proc, "zenoh:")
-    ext = subprocess.Popen(
-        [
-            sys.executable,
-            str(HERE / "hang_participant.py"),
-            endpoint,
-            "faults",
-            "autopilot",
-            "100",
-            "hang",
-        ],
-        cwd=REPO,
-    )
+    cmd = [sys.executable, str(HERE / "hang_participant.py"), endpoint, "faults", "autopilot"]
+    ext = subprocess.Popen([*cmd, str(at), how], cwd=REPO)
     try:
         _, err = proc.communicate(timeout=60)
     finally:
         ext.kill()
-    assert proc.returncode == 1
+    return proc.returncode, err
+
+
+def test_hanging_participant_misses_the_deadline(tmp_path: Path, out: Path) -> None:
+    scenario = _long(tmp_path, external_participants=["autopilot"], deadline_s=1.0)
+    code, err = _with_external(scenario, out, at=100, how="hang")
+    assert code == 1
     assert "'autopilot' missed the 1 s deadline of tick 100" in err
     assert _assert_readable(only_run_dir(out)) == 99, "up to the last complete tick"
 
 
 def test_drop_policy_goes_on_without_the_hanging_participant(tmp_path: Path, out: Path) -> None:
-    endpoint = f"tcp/127.0.0.1:{free_port()}"
     data = basic_scenario("faults", duration_s=3.0)
     data["clock"] = {"external_participants": ["autopilot"], "deadline_s": 0.5, "policy": "drop"}
-    proc = start(
-        "run",
-        str(scenario_file(tmp_path, data)),
-        "--out",
-        str(out),
-        "--quiet",
-        "--listen",
-        endpoint,
-    )
-    wait_for_line(proc, "zenoh:")
-    ext = subprocess.Popen(
-        [
-            sys.executable,
-            str(HERE / "hang_participant.py"),
-            endpoint,
-            "faults",
-            "autopilot",
-            "50",
-            "hang",
-        ],
-        cwd=REPO,
-    )
-    try:
-        _, err = proc.communicate(timeout=60)
-    finally:
-        ext.kill()
-    assert proc.returncode == 0, err
+    code, err = _with_external(scenario_file(tmp_path, data), out, at=50, how="hang")
+    assert code == 0, err
     run = only_run_dir(out)
     assert "dropping it" in (run / "log" / "conductor.log").read_text()
     assert _assert_readable(run) == 299
