@@ -8,7 +8,6 @@ import sys
 BENCHMARKS = {
     "lockstep": "benchmarks.lockstep",
     "physics": "benchmarks.physics",
-    "physics-env": "benchmarks.physics_env",
 }
 
 
