@@ -8,6 +8,9 @@ import sys
 BENCHMARKS = {
     "lockstep": "benchmarks.lockstep",
     "physics": "benchmarks.physics",
+    "sensors": "benchmarks.sensors",
+    "cameras": "benchmarks.cameras",
+    "table2": "benchmarks.table2",
 }
 
 

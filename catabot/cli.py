@@ -10,6 +10,7 @@ import time
 from pathlib import Path
 
 from catabot import launcher
+from catabot.generate import add_arguments as add_generate_arguments
 from catabot.scenario import ScenarioError, json_schema, load_scenario
 from catabot.session import Connection, SessionError, add_connection_args, open_session
 
@@ -67,6 +68,10 @@ def _scenario(args: argparse.Namespace) -> int:
         else:
             sys.stdout.write(text)
         return 0
+    if args.action == "generate":
+        from catabot.generate import generate
+
+        return generate(args)
     try:
         scenario = load_scenario(args.file)
     except ScenarioError as exc:
@@ -103,9 +108,10 @@ def parser() -> argparse.ArgumentParser:
     rtr = sub.add_parser("router", help="run a zenoh router for distributed runs")
     add_connection_args(rtr)
     scen = sub.add_parser("scenario", help="scenario tools")
-    scen.add_argument("action", choices=["schema", "validate"])
+    scen.add_argument("action", choices=["schema", "validate", "generate"])
     scen.add_argument("file", nargs="?", help="scenario to validate")
-    scen.add_argument("--output", "-o", help="write the schema here")
+    scen.add_argument("--output", "-o", help="write the schema (or generated scenario) here")
+    add_generate_arguments(scen)
     return p
 
 

@@ -22,11 +22,13 @@ from catabot.progress import ProgressBar
 from catabot.scenario import Scenario, ScenarioError, load_scenario
 from catabot.session import free_port
 from catabot.streams import services as needed_services
+from catabot.traffic_plan import plan_traffic
 from catabot.vessel import VesselModelError
 
 SERVICE_MODULES = {
     "physics": "services.physics",
     "sensors": "services.sensors",
+    "traffic": "services.traffic",
     "recorder": "services.recorder",
 }
 
@@ -57,6 +59,7 @@ def prepare(opts: RunOptions) -> Scenario:
     from catabot.scenario import parse_scenario
 
     scenario = resolve_poses(parse_scenario(data, source="command line"))
+    plan_traffic(scenario)  # boats that find no open water are refused here, not in a service
     for name in needed_services(scenario):
         if name not in SERVICE_MODULES:
             raise LaunchError(f"scenario needs service {name!r}, which this version does not have")

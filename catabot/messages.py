@@ -12,6 +12,8 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 from typing import Any, ClassVar
 
+import numpy as np
+
 SCHEMA_VERSION = 1
 
 XYZ = ("x", "y", "z")
@@ -107,6 +109,21 @@ class TwistCmd(Message):
 
 
 @dataclass(frozen=True)
+class WaypointsCmd(Message):
+    """A path for a vessel to follow (high-level control), or `mode="release"` to hand the
+    vessel back to its scenario behaviour. `points` is flat: x0, y0, x1, y1, ... in `map`;
+    `mode` is "loop", "back_and_forth" or "release" (no bool on the wire: any language)."""
+
+    TYPE: ClassVar[str] = "waypoints_cmd"
+    points: tuple[float, ...] = varvec("m")
+    speed: float = scalar("m/s")
+    tolerance: float = scalar("m")
+    mode: str = "back_and_forth"
+    tick: int = -1
+    stamp_ns: int = 0
+
+
+@dataclass(frozen=True)
 class ImuSample(Message):
     """Body-frame specific force (gravity included: +g on z at rest), rate, orientation."""
 
@@ -132,6 +149,94 @@ class GpsFix(Message):
     vertical_sigma: float = scalar("m")
 
 
+@dataclass(frozen=True)
+class RadarSweep(Message):
+    """The sector a marine radar swept in one sample: per-beam echo profiles and first returns.
+
+    Beam i points at `azimuth_start_rad - i * step` (body frame, counter-clockwise from the bow,
+    horizontal: the antenna is stabilised); the antenna turns clockwise seen from above, so
+    `azimuth_end_rad` < `azimuth_start_rad` (not wrapped). `heading_rad` (ENU yaw of the vessel)
+    turns the sector north-up. `intensity` is (beams, range_bins) uint8, bin j covers
+    [j, j + 1) * range_m / range_bins; `ranges` (beams,) float32 is the first return, inf if none.
+    """
+
+    TYPE: ClassVar[str] = "radar_sweep"
+    tick: int
+    stamp_ns: int
+    azimuth_start_rad: float = field(metadata={"unit": "rad"})
+    azimuth_end_rad: float = field(metadata={"unit": "rad"})
+    heading_rad: float = field(metadata={"unit": "rad"})
+    range_m: float = field(metadata={"unit": "m"})
+    beams: int = field(metadata={"unit": ""})
+    intensity: np.ndarray = field(metadata={"unit": ""})
+    ranges: np.ndarray = field(metadata={"unit": "m"})
+
+
+@dataclass(frozen=True)
+class CameraFrame(Message):
+    """One camera frame; outputs that are switched off are empty arrays.
+
+    Optical frame (ROS): z forward, x right, y down. `depth` (H, W) float32 is the distance
+    along z (inf: no hit); `normals` (H, W, 3) int8 are unit normals in the optical frame
+    times 127; `segmentation` (H, W) uint8 is the class (0 sky, 1 water, 2 terrain, 3 vessel,
+    4 buoy) and `instance` (H, W) uint16 the instance (0: none). `boxes` (K, 6) float32 rows
+    are [instance, class, x0, y0, x1, y1] in pixels (x1, y1 exclusive) and `box_flags` (K, 2)
+    uint8 [truncated, occluded].
+    """
+
+    TYPE: ClassVar[str] = "camera_frame"
+    tick: int
+    stamp_ns: int
+    width: int = field(metadata={"unit": "px"})
+    height: int = field(metadata={"unit": "px"})
+    hfov_rad: float = field(metadata={"unit": "rad"})
+    objects: int = field(metadata={"unit": ""})
+    color: np.ndarray = field(metadata={"unit": ""})
+    depth: np.ndarray = field(metadata={"unit": "m"})
+    normals: np.ndarray = field(metadata={"unit": ""})
+    segmentation: np.ndarray = field(metadata={"unit": ""})
+    instance: np.ndarray = field(metadata={"unit": ""})
+    boxes: np.ndarray = field(metadata={"unit": "px"})
+    box_flags: np.ndarray = field(metadata={"unit": ""})
+
+
+@dataclass(frozen=True)
+class LidarScan(Message):
+    """One LiDAR scan in the sensor frame (FLU at the mount), returns only, with labels.
+
+    Bulk fields are arrays, one entry per return: `points` (N, 3) float32 m, `intensity`
+    float32 (relative power, paper eq. 4), `ring` uint16 (channel, 0 = lowest beam), `cls` uint8
+    (services/sensors/scene.py CLASS_*; 0 for raindrops), `instance` int32, `is_rain` bool.
+    `range_image` (channels, columns) float32 m holds every beam, inf where nothing returned.
+    Its CSV row is a summary: the number of returns and of rain returns (catabot/tabular.py).
+    """
+
+    TYPE: ClassVar[str] = "lidar_scan"
+    tick: int
+    stamp_ns: int
+    points: np.ndarray = field(metadata={"unit": "m", "summary": ("returns", "len")})
+    intensity: np.ndarray = field(metadata={"unit": ""})
+    ring: np.ndarray = field(metadata={"unit": ""})
+    cls: np.ndarray = field(metadata={"unit": ""})
+    instance: np.ndarray = field(metadata={"unit": ""})
+    is_rain: np.ndarray = field(metadata={"unit": "", "summary": ("rain_returns", "count")})
+    range_image: np.ndarray = field(metadata={"unit": "m"})
+
+
 MESSAGE_TYPES: dict[str, type[Message]] = {
-    cls.TYPE: cls for cls in (Tick, Ack, End, VesselState, ThrustCmd, TwistCmd, ImuSample, GpsFix)
+    cls.TYPE: cls
+    for cls in (
+        Tick,
+        Ack,
+        End,
+        VesselState,
+        ThrustCmd,
+        TwistCmd,
+        WaypointsCmd,
+        ImuSample,
+        GpsFix,
+        RadarSweep,
+        CameraFrame,
+        LidarScan,
+    )
 }

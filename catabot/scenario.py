@@ -24,10 +24,11 @@ from pydantic import (
 )
 
 from catabot.clock import NS_PER_S, ClockError, period_in_ticks, ticks_for
-from catabot.environment.config import CurrentConfig, WindConfig
+from catabot.environment.config import CurrentConfig, RainConfig, WindConfig
 from catabot.keys import check_name
 from catabot.sensor_types import SENSOR_TYPES
 from catabot.terrain import TerrainConfig
+from catabot.traffic_config import TrafficConfig
 from catabot.waves import WaveConfig
 
 BUNDLED = Path(__file__).parent / "data" / "scenarios"
@@ -186,9 +187,11 @@ class Scenario(_Model):
     origin: Origin = Origin()
     water: WaterConfig = WaterConfig()
     wind: WindConfig = WindConfig()
+    rain: RainConfig = RainConfig()
     terrain: TerrainConfig | None = None
     buoys: list[BuoyConfig] = []
     vessels: list[VesselConfig] = Field(min_length=1)
+    traffic: TrafficConfig = TrafficConfig()
     recording: RecordingConfig = RecordingConfig()
 
     @field_validator("name")

@@ -41,7 +41,6 @@ STRING_KEYS = ("terrainPathToElevationFile",)
 KNOWN = set(BOOL_KEYS) | set(NUMBER_RANGES) | set(CHOICES) | set(STRING_KEYS)
 NOT_YET = {
     "radarActive": "marine radar",
-    "lidarActive": "LiDAR",
     "minimapActive": "the radar minimap",
     "screenshotsSaveToFile": "camera datasets",
     "terrainFromFile": "terrain from elevation images",
@@ -69,14 +68,26 @@ def map_settings_config(data: dict[str, Any], *, source: str) -> dict[str, Any]:
         [{"name": "imu", "type": "imu", "rate_hz": 100.0}] if data.get("imuActive", True) else []
     )
     sensors.append({"name": "gps", "type": "gps", "rate_hz": 10.0})
+    if data.get("lidarActive", True):  # the original's OS1-like LiDAR at about 5 Hz
+        sensors.append({"name": "lidar", "type": "lidar", "rate_hz": 5.0})
     return {
         "name": "settings-config",
         "origin": {
             "latitude_deg": data.get("gpsLatitude", 0.0),
             "longitude_deg": data.get("gpsLongitude", 0.0),
         },
+        "rain": {"rate_mm_h": data.get("rainIntensity", 0.0)},
         "vessels": [{"id": "robot_0", "model": "catabot", "sensors": sensors}],
+        "traffic": _traffic(data),
     }
+
+
+def _traffic(data: dict[str, Any]) -> dict[str, Any]:
+    """boatsNumberActive boats; Circles and Waypoints as in the original, `pose` (driven from
+    outside) as boats holding their spawn point until an external command takes them."""
+    kind = {"Circles": "circle", "Waypoints": "waypoints", "pose": "hold"}
+    behaviour = kind[data.get("boatControlType", "Circles")]
+    return {"count": int(data.get("boatsNumberActive", 0)), "behaviour_mix": {behaviour: 1.0}}
 
 
 def _check(data: dict[str, Any]) -> None:
@@ -114,7 +125,3 @@ def _warn_unsupported(data: dict[str, Any], source: str) -> None:
                 key,
                 feature,
             )
-    if data.get("rainIntensity", 0.0) > 0:
-        log.warning("%s: rainIntensity only affects LiDAR, not in this version; ignored", source)
-    if data.get("boatsNumberActive", 0) > 0:
-        log.warning("%s: boatsNumberActive needs the traffic service, not in this version", source)

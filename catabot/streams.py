@@ -8,15 +8,18 @@ from __future__ import annotations
 
 from catabot.clock import Stream, period_in_ticks
 from catabot.keys import Keys
-from catabot.messages import ThrustCmd, TwistCmd, VesselState
+from catabot.messages import ThrustCmd, TwistCmd, VesselState, WaypointsCmd
 from catabot.scenario import Scenario
 from catabot.sensor_types import SENSOR_TYPES
+from catabot.traffic_plan import all_buoys, all_vessels, plan_traffic
 
 EXTERNAL = "external"
 
 
 def state_streams(scenario: Scenario, keys: Keys) -> list[Stream]:
-    return [Stream(keys.vessel_state(v.id), VesselState, "physics") for v in scenario.vessels]
+    """Every body's state from physics: vessels (traffic included), then buoys."""
+    ids = [v.id for v in all_vessels(scenario)] + [b.id for b in all_buoys(scenario)]
+    return [Stream(keys.vessel_state(i), VesselState, "physics") for i in ids]
 
 
 def sensor_streams(scenario: Scenario, keys: Keys) -> list[Stream]:
@@ -33,12 +36,29 @@ def sensor_streams(scenario: Scenario, keys: Keys) -> list[Stream]:
 
 
 def command_streams(scenario: Scenario, keys: Keys) -> list[Stream]:
-    """Commands from outside the lockstep: applied at the next tick boundary."""
+    """Commands: from outside the lockstep (applied at the next tick boundary), and a
+    traffic boat's twist set-points, a lockstep stream of the traffic service on the same
+    key (an external twist on it still arrives as tick -1 and takes over the boat)."""
+    boats = traffic_boat_ids(scenario)
     out: list[Stream] = []
-    for v in scenario.vessels:
+    for v in all_vessels(scenario):
+        producer, period = ("traffic", 1) if v.id in boats else (EXTERNAL, None)
         out.append(Stream(keys.cmd_thrust(v.id), ThrustCmd, EXTERNAL, None))
-        out.append(Stream(keys.cmd_twist(v.id), TwistCmd, EXTERNAL, None))
+        out.append(Stream(keys.cmd_twist(v.id), TwistCmd, producer, period))
     return out
+
+
+def waypoint_streams(scenario: Scenario, keys: Keys) -> list[Stream]:
+    """High-level commands from outside: the traffic service follows them, physics only
+    learns from them that an external twist or thrust override has ended."""
+    return [
+        Stream(keys.cmd_waypoints(v.id), WaypointsCmd, EXTERNAL, None)
+        for v in all_vessels(scenario)
+    ]
+
+
+def traffic_boat_ids(scenario: Scenario) -> set[str]:
+    return {b.id for b in plan_traffic(scenario).boats}
 
 
 def world_streams(scenario: Scenario, keys: Keys) -> list[Stream]:
@@ -56,6 +76,8 @@ def services(scenario: Scenario) -> list[str]:
     names = ["physics"]
     if any(v.sensors for v in scenario.vessels):
         names.append("sensors")
+    if scenario.traffic.count > 0:
+        names.append("traffic")
     if scenario.recording.csv or scenario.recording.mcap:
         names.append("recorder")
     return names

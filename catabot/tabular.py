@@ -8,7 +8,10 @@ same scenario and seed must give byte-identical files.
 Layout: `stamp_ns`, `tick`, then every other field in declaration order. A vector field with
 axes expands to one column per axis (`position_x[m]`); a variable-length vector (axes None)
 to `name_0`, `name_1`, ... for a width taken from the first sample. Bulk NumPy arrays (point
-clouds, images) have no tabular form and are left out: they are recorded elsewhere.
+clouds, images) have no tabular form and are left out: they are recorded elsewhere. An array
+field whose metadata names a `summary` (column, "len" | "count") gets one column instead: its
+length, or its number of non-zero entries (a LiDAR scan's returns and rain returns), so a CSV
+of clouds still says per sample how much was seen.
 """
 
 from __future__ import annotations
@@ -32,6 +35,8 @@ class _Column:
     unit: str
     axes: tuple[str, ...] | None  # None: variable length; () : scalar
     skip: bool = False
+    field: str = ""  # the message field, when it differs from the column (a summary)
+    reduce: str = ""  # "len" or "count": a bulk array written as one number
 
 
 def _label(name: str, unit: str) -> str:
@@ -59,7 +64,11 @@ def _build_layout(cls: type[Message]) -> tuple[_Column, ...]:
         hint = hints[f.name]
         unit = str(f.metadata.get("unit", ""))
         if hint is np.ndarray:
-            by_name[f.name] = _Column(f.name, unit, (), skip=True)
+            summary = f.metadata.get("summary")
+            if summary is not None:
+                by_name[f.name] = _Column(summary[0], "", (), field=f.name, reduce=summary[1])
+            else:
+                by_name[f.name] = _Column(f.name, unit, (), skip=True)
         elif typing.get_origin(hint) is tuple:
             axes = f.metadata.get("axes")
             by_name[f.name] = _Column(f.name, unit, tuple(axes) if axes is not None else None)
@@ -112,8 +121,10 @@ def row(msg: Message) -> list[str]:
     """The cells of one sample, in the order of `columns(type(msg), width=...)`."""
     cells: list[str] = []
     for col in _layout(type(msg)):
-        value = getattr(msg, col.name)
-        if col.axes == ():
+        value = getattr(msg, col.field or col.name)
+        if col.reduce:
+            cells.append(str(len(value) if col.reduce == "len" else np.count_nonzero(value)))
+        elif col.axes == ():
             cells.append(fmt(value))
         else:
             cells.extend(fmt(v) for v in value)

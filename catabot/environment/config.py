@@ -129,3 +129,10 @@ class WindConfig(_Model):
             self.speed_mps * math.cos(self.toward_rad),
             self.speed_mps * math.sin(self.toward_rad),
         )
+
+
+class RainConfig(_Model):
+    """Rain in force over the whole world: the rate the LiDAR rain model (paper eq. 1) takes,
+    within the 0-50 mm/h the original simulator offered."""
+
+    rate_mm_h: Annotated[float, Field(ge=0.0, le=50.0)] = 0.0

@@ -3,6 +3,11 @@
 Scripted steps are applied at the first tick boundary at or after their time; a command
 from the bus replaces the scripted one from the next tick on and stays until another
 arrives (the vessel keeps the last order it was given, as a real autopilot does).
+
+Traffic boats: the traffic service's set-points arrive as lockstep twists (tick >= 0) on
+the boat's cmd/twist key. An external command (tick -1, twist or thrust) outranks them
+and holds the boat until a `WaypointsCmd` arrives for it (release, or a new path that
+the traffic service then steers): external > traffic set-point > script.
 """
 
 from __future__ import annotations
@@ -13,7 +18,7 @@ from dataclasses import dataclass
 
 from catabot import codec
 from catabot.clock import NS_PER_S
-from catabot.messages import Message, ThrustCmd, TwistCmd
+from catabot.messages import Message, ThrustCmd, TwistCmd, WaypointsCmd
 from catabot.scenario import ScriptStep, VesselConfig
 
 log = logging.getLogger("physics.commands")
@@ -35,17 +40,25 @@ class CommandBook:
             vid: [round(s.t_s * NS_PER_S) for s in steps] for vid, steps in self.scripts.items()
         }
         self.external: dict[str, Order] = {}
+        self.lockstep: dict[str, Order] = {}
 
     def order(self, vessel: str, stamp_ns: int) -> Order:
         if vessel in self.external:
             return self.external[vessel]
+        if vessel in self.lockstep:
+            return self.lockstep[vessel]
         index = bisect.bisect_right(self.times[vessel], stamp_ns) - 1
         return _from_step(self.scripts[vessel][index]) if index >= 0 else Order()
 
     def take(self, vessel: str, key: str, msgs: list[Message]) -> None:
         """Adopt the newest valid command from the bus; refuse non-finite ones loudly."""
         for msg in msgs:
-            if isinstance(msg, ThrustCmd) and len(msg.thrust) != self.thrusters[vessel]:
+            if isinstance(msg, WaypointsCmd):
+                self.external.pop(vessel, None)  # handed back (to traffic or the script)
+            elif isinstance(msg, TwistCmd) and msg.tick >= 0 and codec.finite(msg.surge):
+                if codec.finite(msg.yaw_rate):
+                    self.lockstep[vessel] = Order(twist=(msg.surge, msg.yaw_rate))
+            elif isinstance(msg, ThrustCmd) and len(msg.thrust) != self.thrusters[vessel]:
                 log.error(
                     "refused command on %s: %d values for %d thrusters",
                     key,

@@ -10,14 +10,18 @@ from __future__ import annotations
 import logging
 import sys
 
+import numpy as np
+
 from catabot.inbox import Inputs
 from catabot.messages import Tick, VesselState
 from catabot.participant import Participant
 from catabot.service import Built, ServiceContext, run_service
-from catabot.streams import command_streams
+from catabot.streams import command_streams, waypoint_streams
+from catabot.traffic_plan import all_vessels
 from services.physics.commands import CommandBook
-from services.physics.control import TwistController
+from services.physics.control import TwistControllerBank
 from services.physics.setup import build_world
+from services.physics.world import VesselKinematics
 
 log = logging.getLogger("physics")
 
@@ -28,13 +32,12 @@ class PhysicsService:
         self.world, models = build_world(scenario)
         self.keys = ctx.keys
         self.dt_ns = scenario.dt_ns
-        self.controllers = {
-            vid: TwistController(m, dt_s=self.dt_ns / 1e9) for vid, m in models.items()
-        }
+        ids = self.world.vessel_ids
+        self.controllers = TwistControllerBank([models[v] for v in ids], dt_s=self.dt_ns / 1e9)
         self.book = CommandBook(
-            scenario.vessels, {vid: len(m.thrusters) for vid, m in models.items()}
+            all_vessels(scenario), {vid: len(m.thrusters) for vid, m in models.items()}
         )
-        self.streams = command_streams(scenario, ctx.keys)
+        self.streams = command_streams(scenario, ctx.keys) + waypoint_streams(scenario, ctx.keys)
         self.vessel_of = {s.key: s.key.split("/")[-3] for s in self.streams}
         self.participant = Participant(
             ctx.session, ctx.keys, ctx.name, inputs=self.streams, peers=ctx.peers
@@ -48,15 +51,19 @@ class PhysicsService:
         self._publish(tick)
 
     def _apply_orders(self, stamp_ns: int) -> None:
-        states = self.world.states()
-        for vid in self.world.vessel_ids:
-            order = self.book.order(vid, stamp_ns)
-            if order.twist is not None:
-                s = states[vid]
-                measured = (float(s.linear_velocity[0]), float(s.angular_velocity[2]))
-                command = tuple(self.controllers[vid].command(order.twist, measured))
-            else:
-                command = order.thrust or ()
+        """Thrust orders as given; twist orders through one controller pass for all vessels."""
+        ids = self.world.vessel_ids
+        orders = [self.book.order(vid, stamp_ns) for vid in ids]
+        commands: list[tuple[float, ...]] = [o.thrust or () for o in orders]
+        rows = np.array([i for i, o in enumerate(orders) if o.twist is not None], dtype=np.intp)
+        if rows.size:
+            s = self.world.state_arrays()
+            measured = np.stack([s.linear_velocity[rows, 0], s.angular_velocity[rows, 2]], axis=1)
+            target = np.array([orders[i].twist for i in rows], dtype=np.float64)
+            out = self.controllers.command(rows, target, measured)
+            for j, i in enumerate(rows):
+                commands[i] = tuple(out[j, : self.controllers.count[i]])
+        for vid, command in zip(ids, commands, strict=True):
             if command:
                 try:
                     self.world.set_thrust(vid, command)
@@ -64,8 +71,9 @@ class PhysicsService:
                     log.error("vessel %s: refused thrust command: %s", vid, exc)
 
     def _publish(self, tick: Tick) -> None:
+        """Every vessel's state, then every buoy's (sensors see buoys, the recorder logs them)."""
         stamp = tick.stamp_ns + self.dt_ns
-        for vid, s in self.world.states().items():
+        for vid, s in self._body_states():
             self.participant.publish(
                 self.keys.vessel_state(vid),
                 VesselState(
@@ -79,6 +87,15 @@ class PhysicsService:
                     _t(s.angular_acceleration),
                 ),
             )
+
+    def _body_states(self) -> list[tuple[str, VesselKinematics]]:
+        out = list(self.world.states().items())
+        b = self.world.buoy_state_arrays()
+        for i, bid in enumerate(self.world.buoy_ids):
+            row = (b.position, b.orientation, b.linear_velocity, b.angular_velocity)
+            acc = (b.linear_acceleration, b.angular_acceleration)
+            out.append((bid, VesselKinematics(*(a[i] for a in (*row, *acc)))))
+        return out
 
 
 def _t(values: object) -> tuple[float, ...]:

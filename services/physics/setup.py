@@ -6,17 +6,20 @@ from catabot.environment.current import CurrentField
 from catabot.environment.wind import WindField
 from catabot.scenario import Scenario
 from catabot.terrain import load_terrain
+from catabot.traffic_plan import all_buoys, all_vessels
 from catabot.vessel import VesselModel, load_vessel_model
 from catabot.waves import WaveField
 from services.physics.world import PhysicsWorld
 
 
 def build_world(scenario: Scenario) -> tuple[PhysicsWorld, dict[str, VesselModel]]:
-    models = {v.id: load_vessel_model(v.model) for v in scenario.vessels}
+    vessels = all_vessels(scenario)  # the scenario's own, then the traffic boats
+    models = {v.id: load_vessel_model(v.model) for v in vessels}
     starts = []
-    for v in scenario.vessels:
+    for v in vessels:
         assert v.pose is not None, "poses are resolved before physics starts"
         starts.append((v.id, models[v.id], (v.pose.x_m, v.pose.y_m, 0.0, v.pose.yaw_rad)))
+    buoys = all_buoys(scenario)
     world = PhysicsWorld(
         starts,
         dt_s=scenario.dt_ns / 1e9,
@@ -25,7 +28,7 @@ def build_world(scenario: Scenario) -> tuple[PhysicsWorld, dict[str, VesselModel
         terrain=load_terrain(scenario.terrain) if scenario.terrain is not None else None,
         current=CurrentField.from_config(scenario.water.current),
         wind=WindField(scenario.wind, seed=scenario.seed),
-        buoys=[(b.id, (b.x_m, b.y_m)) for b in scenario.buoys],
-        buoy_model=load_vessel_model("buoy") if scenario.buoys else None,
+        buoys=[(b.id, (b.x_m, b.y_m)) for b in buoys],
+        buoy_model=load_vessel_model("buoy") if buoys else None,
     )
     return world, models

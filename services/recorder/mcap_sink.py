@@ -1,7 +1,7 @@
 """`run.mcap`: every stream as an MCAP channel (DESIGN.md §7).
 
-Vessel states are ROS 2 `nav_msgs/msg/Odometry` (CDR); every other message is JSON with a
-JSON Schema derived from its dataclass, so Foxglove Studio opens every channel.
+States are ROS 2 `nav_msgs/msg/Odometry`, LiDAR scans `sensor_msgs/msg/PointCloud2` (CDR); other
+messages are JSON with a JSON Schema from their dataclass, so Foxglove Studio opens every channel.
 
 Why it is written this way:
 - Unchunked records, and bytes reach the file only in `flush()` (once per tick): a recorder
@@ -32,11 +32,16 @@ from mcap.writer import LIBRARY_IDENTIFIER, CompressionType, Writer
 from mcap_ros2._dynamic import serialize_dynamic
 from mcap_ros2.decoder import DecoderFactory
 
-from catabot.messages import Message, VesselState
-from services.recorder import json_schemas, ros2_msgdefs
+from catabot.messages import CameraFrame, LidarScan, Message, VesselState
+from services.recorder import images, json_schemas, pointcloud, ros2_msgdefs
 from services.recorder.csv_sink import RecorderError
 
 _RECORD_HEAD = struct.Struct("<BQ")  # opcode, length of the record body
+_ROS2 = {  # messages written as ROS 2 types: (type name, msgdef)
+    VesselState: (ros2_msgdefs.ODOMETRY, ros2_msgdefs.ODOMETRY_MSGDEF),
+    LidarScan: (pointcloud.POINTCLOUD2, pointcloud.POINTCLOUD2_MSGDEF),
+    CameraFrame: (images.IMAGE, images.IMAGE_MSGDEF),  # one channel per output: images.py
+}
 
 
 class _TickBuffer(io.BufferedIOBase):
@@ -126,6 +131,10 @@ class McapSink:
         cls = type(msg)
         if cls is VesselState:
             encoding, encode = MessageEncoding.CDR, _odometry_encoder(_vessel_of(stream))
+        elif cls is LidarScan:
+            encoding, encode = MessageEncoding.CDR, pointcloud.pointcloud_encoder(stream)
+        elif cls is CameraFrame:
+            encoding, encode = MessageEncoding.CDR, images.image_encoder(stream)
         else:
             encoding, encode = MessageEncoding.JSON, _json_encoder
         topic = "/" + stream.strip("/")
@@ -136,9 +145,9 @@ class McapSink:
 
     def _schema(self, cls: type[Message]) -> int:
         if cls not in self._schemas:
-            if cls is VesselState:
-                text = ros2_msgdefs.ODOMETRY_MSGDEF.encode()
-                sid = self._writer.register_schema(ros2_msgdefs.ODOMETRY, SchemaEncoding.ROS2, text)
+            if cls in _ROS2:
+                name, msgdef = _ROS2[cls]
+                sid = self._writer.register_schema(name, SchemaEncoding.ROS2, msgdef.encode())
             else:
                 text = json.dumps(json_schemas.json_schema(cls), separators=(",", ":")).encode()
                 sid = self._writer.register_schema(

@@ -12,11 +12,13 @@ import logging
 import sys
 
 from catabot.inbox import Inputs
-from catabot.messages import End, Message, Tick
+from catabot.messages import CameraFrame, End, Message, Tick
 from catabot.participant import Participant
 from catabot.service import Built, ServiceContext, run_service
 from catabot.streams import command_streams, world_streams
+from services.recorder import images
 from services.recorder.csv_sink import CsvSink, RecorderError
+from services.recorder.dataset import Dataset
 from services.recorder.mcap_sink import McapSink
 
 log = logging.getLogger("recorder")
@@ -29,6 +31,7 @@ class Recorder:
         self.keys = ctx.keys
         self.csv = CsvSink(ctx.run_dir) if rec.csv else None
         self.mcap = McapSink(ctx.run_dir / "run.mcap") if rec.mcap else None
+        self.dataset = Dataset(ctx.run_dir / "dataset", ctx.scenario)
         streams = world_streams(ctx.scenario, ctx.keys) + command_streams(ctx.scenario, ctx.keys)
         self.participant = Participant(
             ctx.session, ctx.keys, ctx.name, inputs=streams, peers=ctx.peers
@@ -46,9 +49,20 @@ class Recorder:
             if self.csv is not None:
                 self.csv.write(stream, msg)
             if self.mcap is not None:
-                self.mcap.write(stream, msg, stamp_ns=int(getattr(msg, "stamp_ns", 0)))
-        except RecorderError as exc:
+                self._write_mcap(stream, msg)
+            self.dataset.write(stream, msg)
+        except (RecorderError, OSError, ValueError) as exc:
             log.error("not recorded: %s", exc)
+
+    def _write_mcap(self, stream: str, msg: Message) -> None:
+        """One channel per stream; a camera gets one Image channel per output instead."""
+        assert self.mcap is not None
+        stamp_ns = int(getattr(msg, "stamp_ns", 0))
+        if isinstance(msg, CameraFrame):
+            for output in images.outputs(msg):
+                self.mcap.write(f"{stream}/{output}", msg, stamp_ns=stamp_ns)
+        else:
+            self.mcap.write(stream, msg, stamp_ns=stamp_ns)
 
     def _flush(self) -> None:
         if self.csv is not None:

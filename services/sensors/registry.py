@@ -14,9 +14,13 @@ from typing import Protocol
 
 from catabot.messages import Message, VesselState
 from catabot.scenario import Origin, SensorConfig
+from services.sensors.camera import CameraModel
 from services.sensors.common import SensorError
 from services.sensors.gps import GpsModel
 from services.sensors.imu import ImuModel
+from services.sensors.lidar import LidarModel
+from services.sensors.radar import RadarModel
+from services.sensors.scene import Scene
 
 
 class Sensor(Protocol):
@@ -32,7 +36,14 @@ class SensorFactory(Protocol):
     """Builds a sensor of one type for one vessel."""
 
     def __call__(
-        self, config: SensorConfig, *, vessel_id: str, seed: int, origin: Origin, dt_ns: int
+        self,
+        config: SensorConfig,
+        *,
+        vessel_id: str,
+        seed: int,
+        origin: Origin,
+        dt_ns: int,
+        scene: Scene | None = None,
     ) -> Sensor: ...
 
 
@@ -42,14 +53,26 @@ def source_name(vessel_id: str, config: SensorConfig) -> str:
 
 
 def _imu(
-    config: SensorConfig, *, vessel_id: str, seed: int, origin: Origin, dt_ns: int
+    config: SensorConfig,
+    *,
+    vessel_id: str,
+    seed: int,
+    origin: Origin,
+    dt_ns: int,
+    scene: Scene | None = None,
 ) -> ImuModel:
     params = config.typed_params().model_dump()
     return ImuModel(**params, noise=config.noise, seed=seed, name=source_name(vessel_id, config))
 
 
 def _gps(
-    config: SensorConfig, *, vessel_id: str, seed: int, origin: Origin, dt_ns: int
+    config: SensorConfig,
+    *,
+    vessel_id: str,
+    seed: int,
+    origin: Origin,
+    dt_ns: int,
+    scene: Scene | None = None,
 ) -> GpsModel:
     return GpsModel(
         origin_lat_deg=origin.latitude_deg,
@@ -62,14 +85,70 @@ def _gps(
     )
 
 
+def _radar(
+    config: SensorConfig,
+    *,
+    vessel_id: str,
+    seed: int,
+    origin: Origin,
+    dt_ns: int,
+    scene: Scene | None = None,
+) -> RadarModel:
+    return RadarModel(
+        config.typed_params(),
+        scene=scene,
+        period_ns=config.period_ns,
+        noise=config.noise,
+        seed=seed,
+        name=source_name(vessel_id, config),
+    )
+
+
+def _camera(
+    config: SensorConfig,
+    *,
+    vessel_id: str,
+    seed: int,
+    origin: Origin,
+    dt_ns: int,
+    scene: Scene | None = None,
+) -> CameraModel:
+    return CameraModel(
+        config.typed_params(), scene=scene, seed=seed, name=source_name(vessel_id, config)
+    )
+
+
+def _lidar(
+    config: SensorConfig,
+    *,
+    vessel_id: str,
+    seed: int,
+    origin: Origin,
+    dt_ns: int,
+    scene: Scene | None = None,
+) -> LidarModel:
+    name = source_name(vessel_id, config)
+    params = config.typed_params()
+    return LidarModel(params, scene=scene, noise=config.noise, seed=seed, name=name)
+
+
 SENSOR_TYPES: dict[str, SensorFactory] = {
     "imu": _imu,
     "gps": _gps,
+    "lidar": _lidar,
+    "radar": _radar,
+    "camera": _camera,
 }
 
 
 def build_sensor(
-    config: SensorConfig, *, vessel_id: str, seed: int, origin: Origin, dt_ns: int
+    config: SensorConfig,
+    *,
+    vessel_id: str,
+    seed: int,
+    origin: Origin,
+    dt_ns: int,
+    scene: Scene | None = None,
 ) -> Sensor:
     """The model for one configured sensor; refuses unknown types and fractional periods."""
     where = f"vessel {vessel_id!r} sensor {config.name!r}"
@@ -81,4 +160,4 @@ def build_sensor(
             f"{where}: period {config.period_ns} ns ({config.rate_hz} Hz) is not a whole "
             f"number of {dt_ns} ns ticks"
         )
-    return factory(config, vessel_id=vessel_id, seed=seed, origin=origin, dt_ns=dt_ns)
+    return factory(config, vessel_id=vessel_id, seed=seed, origin=origin, dt_ns=dt_ns, scene=scene)

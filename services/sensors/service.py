@@ -3,7 +3,8 @@
 At tick k it samples from the newest vessel states (tagged k-1, stamped t_k: the state
 at the start of this tick) and publishes samples tagged k stamped t_k. At tick 0 no
 state has been published yet, so the scenario's start pose at rest stands in: it is
-exactly the state physics starts from.
+exactly the state physics starts from. Ray-casting sensors (LiDAR, radar, cameras) share one
+Scene, built once; it needs every body's pose, so then every vessel and buoy state is an input.
 """
 
 from __future__ import annotations
@@ -15,10 +16,16 @@ from dataclasses import dataclass
 from catabot.inbox import Inputs
 from catabot.messages import Tick, VesselState
 from catabot.participant import Participant
-from catabot.scenario import VesselConfig
+from catabot.scenario import Pose, Scenario, VesselConfig
 from catabot.service import Built, ServiceContext, run_service
 from catabot.streams import state_streams
+from catabot.terrain import load_terrain
+from catabot.traffic_plan import all_buoys, all_vessels
+from catabot.waves import WaveField
 from services.sensors.registry import Sensor, build_sensor
+from services.sensors.scene import Scene, bodies_for
+
+SCENE_SENSORS = ("lidar", "radar", "camera")  # types that cast rays into the shared Scene
 
 
 @dataclass
@@ -32,6 +39,7 @@ class Mounted:
 class SensorsService:
     def __init__(self, ctx: ServiceContext) -> None:
         scenario = ctx.scenario
+        self.scene = build_scene(scenario) if needs_scene(scenario) else None
         self.mounted = [
             Mounted(
                 v.id,
@@ -43,13 +51,17 @@ class SensorsService:
                     seed=scenario.seed,
                     origin=scenario.origin,
                     dt_ns=scenario.dt_ns,
+                    scene=self.scene,
                 ),
             )
             for v in scenario.vessels
             for s in v.sensors
         ]
         carriers = {m.vessel for m in self.mounted}
-        self.states = {v.id: start_state(v) for v in scenario.vessels if v.id in carriers}
+        if self.scene is None:  # no scene: only the carriers' own states matter
+            self.states = {v.id: start_state(v) for v in scenario.vessels if v.id in carriers}
+        else:  # the scene needs every vessel's and buoy's pose
+            self.states = start_states(scenario)
         self.state_key = {ctx.keys.vessel_state(vid): vid for vid in self.states}
         inputs = [s for s in state_streams(scenario, ctx.keys) if s.key in self.state_key]
         self.participant = Participant(
@@ -61,12 +73,38 @@ class SensorsService:
             state = msgs[-1]
             assert isinstance(state, VesselState)
             self.states[self.state_key[key]] = state
+        if self.scene is not None:
+            poses = {vid: (s.position, s.orientation) for vid, s in self.states.items()}
+            self.scene.update(poses, tick.stamp_ns / 1e9)
         for m in self.mounted:
             if tick.tick % m.period == 0:
                 sample = m.sensor.sample(
                     self.states[m.vessel], tick=tick.tick, stamp_ns=tick.stamp_ns
                 )
                 self.participant.publish(m.key, sample)
+
+
+def needs_scene(scenario: Scenario) -> bool:
+    return any(s.type in SCENE_SENSORS for v in scenario.vessels for s in v.sensors)
+
+
+def build_scene(scenario: Scenario) -> Scene:
+    """The ray-casting world, built once: terrain, the physics' waves, every body."""
+    terrain = load_terrain(scenario.terrain) if scenario.terrain is not None else None
+    return Scene(
+        terrain=terrain,
+        waves=WaveField(scenario.water.waves, scenario.seed),
+        bodies=bodies_for(scenario),
+        rain_rate_mm_h=scenario.rain.rate_mm_h,
+    )
+
+
+def start_states(scenario: Scenario) -> dict[str, VesselState]:
+    """Every vessel (traffic included) and buoy at rest at its start pose."""
+    states = {v.id: start_state(v) for v in all_vessels(scenario)}
+    for b in all_buoys(scenario):
+        states[b.id] = start_state(VesselConfig(id=b.id, pose=Pose(x_m=b.x_m, y_m=b.y_m)))
+    return states
 
 
 def start_state(vessel: VesselConfig) -> VesselState:

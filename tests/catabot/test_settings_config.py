@@ -63,7 +63,13 @@ def test_original_defaults_are_accepted_and_mapped() -> None:
     assert scenario.origin.longitude_deg == 0.0
     assert [v.id for v in scenario.vessels] == ["robot_0"]
     assert scenario.vessels[0].model == "catabot"
-    assert _sensor_types(ORIGINAL_DEFAULTS) == ["imu", "gps"]
+    assert _sensor_types(ORIGINAL_DEFAULTS) == ["imu", "gps", "lidar"]
+    assert scenario.rain.rate_mm_h == 0.0
+
+
+def test_lidar_and_rain_are_mapped() -> None:
+    assert "lidar" not in _sensor_types(_settings(lidarActive=False))
+    assert parse_scenario(_settings(rainIntensity=12.5)).rain.rate_mm_h == 12.5
 
 
 def test_gps_origin_is_mapped() -> None:
@@ -81,7 +87,7 @@ def test_imu_on_and_off() -> None:
 def test_a_partial_file_takes_the_original_defaults() -> None:
     scenario = parse_scenario({"gpsLatitude": 10.0})
     assert scenario.origin.latitude_deg == 10.0
-    assert _sensor_types({"gpsLatitude": 10.0}) == ["imu", "gps"]
+    assert _sensor_types({"gpsLatitude": 10.0}) == ["imu", "gps", "lidar"]
 
 
 def test_a_native_scenario_is_not_taken_for_a_settings_file() -> None:
@@ -143,8 +149,9 @@ def test_unsupported_features_are_warned_about(caplog: pytest.LogCaptureFixture)
         parse_scenario(ORIGINAL_DEFAULTS, source="SettingsConfig.json")
     text = "\n".join(r.getMessage() for r in caplog.records if r.name == LOGGER)
     assert all(r.levelno == logging.WARNING for r in caplog.records if r.name == LOGGER)
-    for key in ("radarActive", "lidarActive", "minimapActive"):
+    for key in ("radarActive", "minimapActive"):
         assert f"SettingsConfig.json: {key}=true" in text
+    assert "lidarActive" not in text  # LiDAR exists: mapped, not warned about
     for key in ("screenshotsSaveToFile", "terrainFromFile", "rainIntensity", "boatsNumber"):
         assert key not in text  # off in the defaults: nothing to warn about
 
@@ -162,10 +169,13 @@ def test_requested_datasets_rain_and_traffic_are_warned_about(
         boatsNumberActive=10,
     )
     with caplog.at_level(logging.WARNING, logger=LOGGER):
-        parse_scenario(data, source="S.json")
+        scenario = parse_scenario(data, source="S.json")
     text = "\n".join(r.getMessage() for r in caplog.records if r.name == LOGGER)
-    for key in ("screenshotsSaveToFile", "terrainFromFile", "rainIntensity", "boatsNumberActive"):
+    for key in ("screenshotsSaveToFile", "terrainFromFile"):
         assert key in text
+    assert "rainIntensity" not in text  # mapped to the scenario's rain
+    assert "boatsNumberActive" not in text  # mapped to the scenario's traffic
+    assert scenario.traffic.count == 10 and scenario.traffic.behaviour_mix == {"circle": 1.0}
     for key in ("radarActive", "lidarActive", "minimapActive"):
         assert key not in text
 

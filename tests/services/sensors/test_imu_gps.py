@@ -206,7 +206,9 @@ def test_gps_paper_table_method_and_errors() -> None:
 
 
 def test_registry_builds_seeded_sensors() -> None:
-    assert set(SENSOR_TYPES) == {"imu", "gps"}
+    from catabot.sensor_types import SENSOR_TYPES as SCENARIO_TYPES
+
+    assert set(SENSOR_TYPES) == set(SCENARIO_TYPES)  # every scenario type has a model
     origin = Origin(latitude_deg=ORIGIN[0], longitude_deg=ORIGIN[1], altitude_m=ORIGIN[2])
     imu_cfg = SensorConfig(name="imu", type="imu", rate_hz=100.0)
     build = lambda cfg, vid: build_sensor(cfg, vessel_id=vid, seed=9, origin=origin, dt_ns=DT_NS)  # noqa: E731

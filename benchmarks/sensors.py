@@ -1,0 +1,115 @@
+"""LiDAR scan cost (32 x 512, 100 m) on the shared ray-casting scene, with and without rain.
+
+The scene is the bundled harbour terrain (catabot/data/terrain/bay.png, 600 m square, as in
+the harbour scenario) plus 100 boats scattered over it, some within range, and one buoy.
+Measured per scan, median of REPEATS: the whole `LidarModel.sample` (ray rotation, cast,
+noise, rain, packing the message) on calm water and with the harbour's waves (Hs 0.3 m) and
+a heavy swell, at 0 and 50 mm/h; and the parts: the cast alone and the rain model alone.
+The scene build (terrain mesh into Embree) is paid once per run and reported apart.
+Target (issue "Sensor farm"): a scan with rain within 5 ms.
+"""
+
+from __future__ import annotations
+
+import math
+import os
+import statistics
+import time
+from collections.abc import Callable
+from pathlib import Path
+
+import numpy as np
+
+from catabot.messages import VesselState
+from catabot.sensor_types import LidarParams
+from catabot.terrain import TerrainConfig, load_terrain
+from catabot.waves import WaveConfig, WaveField
+from services.sensors.lidar import LidarModel
+from services.sensors.rain import RainParams, apply_rain
+from services.sensors.scene import CLASS_BUOY, CLASS_VESSEL, Body, Scene
+
+BAY = Path(__file__).resolve().parents[1] / "catabot" / "data" / "terrain" / "bay.png"
+TERRAIN = TerrainConfig(
+    elevation_image=str(BAY), min_elevation_m=-15.0, max_elevation_m=25.0, metres_per_pixel=2.0
+)
+BOATS = 100
+REPEATS = 30
+EGO = (290.0, 300.0)
+SEAS = {
+    "calm": WaveConfig(),
+    "harbour": WaveConfig(significant_height_m=0.3, peak_period_s=4.0, direction_rad=1.2),
+    "medium": WaveConfig(preset="medium"),
+}
+
+
+def scene_of(waves: WaveConfig, rain: float) -> tuple[Scene, float]:
+    """The harbour scene with 100 boats and a buoy, and its build time in seconds."""
+    start = time.perf_counter()
+    boat = ((-1.0, -0.6, -0.1), (1.0, 0.6, 0.3))
+    bodies = [Body("ego", CLASS_VESSEL, 1, *boat)]
+    bodies += [Body(f"v{i}", CLASS_VESSEL, 2 + i, *boat) for i in range(BOATS)]
+    bodies.append(Body("b1", CLASS_BUOY, 2 + BOATS, (-0.2, -0.2, -0.15), (0.2, 0.2, 0.85)))
+    scene = Scene(
+        terrain=load_terrain(TERRAIN), waves=WaveField(waves, 1), bodies=bodies, rain_rate_mm_h=rain
+    )
+    xy = np.random.default_rng(2).uniform(50.0, 550.0, (BOATS, 2))
+    poses = {f"v{i}": ((x, y, 0.0), _yaw(0.7 * i)) for i, (x, y) in enumerate(xy)}
+    poses["ego"] = ((*EGO, 0.0), _yaw(1.57))
+    poses["b1"] = ((320.0, 360.0, 0.0), _yaw(0.0))
+    scene.update(poses, 3.0)
+    scene.cast(np.array([*EGO, 1.0]), np.array([[1.0, 0.0, -1.0]]), 100.0)  # first cast builds
+    return scene, time.perf_counter() - start
+
+
+def _yaw(a: float) -> tuple[float, float, float, float]:
+    return (0.0, 0.0, math.sin(a / 2), math.cos(a / 2))
+
+
+def median_ms(fn: Callable[[], object]) -> float:
+    """Median of REPEATS calls, ms; on a busy machine the minimum says more (see main)."""
+    return statistics.median(times_ms(fn))
+
+
+def times_ms(fn: Callable[[], object]) -> list[float]:
+    fn()
+    times = []
+    for _ in range(REPEATS):
+        start = time.perf_counter()
+        fn()
+        times.append(1e3 * (time.perf_counter() - start))
+    return times
+
+
+def row(sea: str, rain: float) -> tuple[str, float, float, float, float, float, float, int]:
+    scene, build_s = scene_of(SEAS[sea], rain)
+    lidar = LidarModel(LidarParams(), scene=scene, seed=1, name="ego/lidar")
+    zero = (0.0, 0.0, 0.0)
+    state = VesselState(0, 0, (*EGO, 0.0), _yaw(1.57), zero, zero, zero, zero)
+    scans = times_ms(lambda: lidar.sample(state, tick=0, stamp_ns=0))
+    scan_ms, scan_min = statistics.median(scans), min(scans)
+    dirs = lidar.dirs @ lidar.mount_rot.T
+    origin = np.array([*EGO, 1.0])
+    cast_ms = median_ms(lambda: scene.cast(origin, dirs, 100.0))
+    ranges = scene.cast(origin, dirs, 100.0).range.astype(np.float64)
+    rng = np.random.default_rng(0)
+    rain_ms = median_ms(lambda: apply_rain(ranges, 100.0, rain, RainParams(), rng))
+    returns = len(lidar.sample(state, tick=0, stamp_ns=0).points)
+    return sea, rain, scan_ms, scan_min, cast_ms, rain_ms, build_s * 1e3, returns
+
+
+def main() -> None:
+    print(f"LiDAR 32 x 512, 100 m, bay.png terrain, {BOATS} boats + 1 buoy (median of {REPEATS})")
+    head = ("sea", "rain mm/h", "scan ms", "scan min", "cast ms", "rain ms", "build ms", "returns")
+    print("{:>8} {:>9} {:>8} {:>8} {:>8} {:>8} {:>9} {:>8}".format(*head))
+    for sea in SEAS:
+        for rain in (0.0, 50.0):
+            sea_, rate, scan, low, cast, rain_ms, build, n = row(sea, rain)
+            print(
+                f"{sea_:>8} {rate:>9.0f} {scan:>8.2f} {low:>8.2f} {cast:>8.2f} {rain_ms:>8.2f} "
+                f"{build:>9.0f} {n:>8d}"
+            )
+    print(f"load average during the run: {os.getloadavg()[0]:.1f} on {os.cpu_count()} CPUs")
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,123 @@
+"""The scenario's `traffic` section: how many boats, which models, which behaviours.
+
+Kept apart from scenario.py so the schema of traffic stays readable in one place; the
+plan (where each boat starts and what it does) is derived from it by traffic_plan.py,
+a pure function every process evaluates the same way.
+"""
+
+from __future__ import annotations
+
+from typing import Literal
+
+from pydantic import BaseModel, ConfigDict, Field, field_validator, model_validator
+
+BEHAVIOURS = ("circle", "waypoints", "hold")
+Behaviour = Literal["circle", "waypoints", "hold"]
+Point = tuple[float, float]
+
+
+class _Model(BaseModel):
+    model_config = ConfigDict(extra="forbid", frozen=True, allow_inf_nan=False)
+
+
+class Region(_Model):
+    """A square (or rectangle) in `map`: centre and size; null centre = terrain centre or origin."""
+
+    center_m: Point | None = None
+    size_m: Point = (500.0, 500.0)
+
+    @field_validator("size_m")
+    @classmethod
+    def _positive(cls, v: Point) -> Point:
+        if min(v) <= 0:
+            raise ValueError(f"both sizes must be > 0 m (got {v})")
+        return v
+
+
+class ModelWeight(_Model):
+    model: str = "monohull"
+    weight: float = Field(1.0, gt=0)
+
+
+class CircleParams(_Model):
+    """The original's Circles: 5 m/s at 15 deg/s, i.e. a radius of about 19 m."""
+
+    radius_m: Point = Field((19.1, 19.1), description="[min, max] radius drawn per boat")
+    speed_mps: float = Field(5.0, gt=0, le=20)
+    direction: Literal["ccw", "cw", "random"] = "ccw"
+
+    @field_validator("radius_m")
+    @classmethod
+    def _range(cls, v: Point) -> Point:
+        if not 1.0 <= v[0] <= v[1]:
+            raise ValueError(f"need 1 <= min <= max (got {v})")
+        return v
+
+
+class WaypointParams(_Model):
+    """The original's Waypoints: 5 random points in a 1000 m square, 5 m/s, back and forth."""
+
+    points: list[Point] | None = Field(None, description="explicit path; null: random per boat")
+    count: int = Field(5, ge=2, le=50)
+    region: Region = Region(size_m=(1000.0, 1000.0))
+    mode: Literal["loop", "back_and_forth"] = "back_and_forth"
+    speed_mps: float = Field(5.0, gt=0, le=20)
+    tolerance_m: float = Field(5.0, gt=0)
+    buoys: bool = True
+
+    @field_validator("points")
+    @classmethod
+    def _enough(cls, v: list[Point] | None) -> list[Point] | None:
+        if v is not None and len(v) < 2:
+            raise ValueError(f"a path needs at least 2 points (got {len(v)})")
+        return v
+
+
+class HoldParams(_Model):
+    gain: float = Field(0.5, gt=0, description="surge set-point per metre of error, 1/s")
+    max_speed_mps: float = Field(2.0, gt=0)
+
+
+class BoatOverride(_Model):
+    """Per-boat settings that replace the drawn ones (index = the boat's number)."""
+
+    index: int = Field(ge=0)
+    model: str | None = None
+    x_m: float | None = None
+    y_m: float | None = None
+    yaw_rad: float | None = None
+    behaviour: Behaviour | None = None
+    points: list[Point] | None = None
+
+
+class TrafficConfig(_Model):
+    count: int = Field(0, ge=0, le=500)
+    models: list[ModelWeight] = [ModelWeight()]
+    region: Region = Region()
+    seed: int | None = Field(None, description="null: the scenario's seed")
+    behaviour_mix: dict[Behaviour, float] = {"circle": 1.0}
+    circle: CircleParams = CircleParams()
+    waypoints: WaypointParams = WaypointParams()
+    hold: HoldParams = HoldParams()
+    boats: list[BoatOverride] = []
+
+    @field_validator("models")
+    @classmethod
+    def _some_model(cls, v: list[ModelWeight]) -> list[ModelWeight]:
+        if not v:
+            raise ValueError("give at least one vessel model")
+        return v
+
+    @field_validator("behaviour_mix")
+    @classmethod
+    def _weights(cls, v: dict[str, float]) -> dict[str, float]:
+        if not v or any(w < 0 for w in v.values()) or sum(v.values()) <= 0:
+            raise ValueError(f"weights must be >= 0 with a positive sum (got {v})")
+        return v
+
+    @model_validator(mode="after")
+    def _overrides_in_range(self) -> TrafficConfig:
+        for b in self.boats:
+            if b.index >= self.count:
+                raise ValueError(f"boats: index {b.index} is not below count {self.count}")
+        return self

@@ -1,0 +1,122 @@
+"""`dataset/` in the run folder: labelled camera frames and radar PPI images as PNG files.
+
+Layout (one folder per sensor, `<vessel>.<sensor>`):
+- cameras: `<tick>_color.png` (RGB), `<tick>_depth.png` (16-bit grey, millimetres along the
+  optical axis; 0 = no return or beyond 65.535 m), `<tick>_normals.png` (RGB = (n + 1) / 2 in
+  the optical frame z forward, x right, y down), `<tick>_class.png` (8-bit class ids, 0 sky,
+  1 water, 2 terrain, 3 vessel, 4 buoy) and `<tick>_instance.png` (16-bit), for the outputs
+  that are on, plus one `labels.jsonl` line per frame with its boxes;
+- radars: `ppi_<tick>.png`, the north-up PPI (services/sensors/ppi.py) once per antenna turn.
+PNGs are written with fixed settings and no time chunk, so the same run gives the same bytes.
+"""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+from PIL import Image
+
+from catabot.messages import CameraFrame, Message, RadarSweep
+from catabot.scenario import Scenario
+from catabot.sensor_types import RadarParams
+from services.sensors.ppi import Ppi
+
+CLASS_NAMES = ("none", "water", "terrain", "vessel", "buoy")
+PNG_LEVEL = 3  # zlib level: fast; fixed, so the same pixels give the same bytes
+
+
+def save_png(path: Path, pixels: np.ndarray) -> None:
+    """One PNG; uint16 grey becomes 16-bit, uint8 (H, W[, 3]) 8-bit grey or RGB."""
+    Image.fromarray(np.ascontiguousarray(pixels)).save(path, format="PNG", compress_level=PNG_LEVEL)
+
+
+def depth_mm(depth: np.ndarray) -> np.ndarray:
+    """Depth (m, inf = none) as uint16 millimetres, 0 where there is no or no storable return."""
+    mm = np.where(np.isfinite(depth), np.rint(depth * 1000.0), 0.0)
+    return np.where(mm <= 65535, mm, 0).astype(np.uint16)
+
+
+def labels(frame: CameraFrame, files: dict[str, str]) -> dict[str, Any]:
+    """The labels.jsonl record of one frame."""
+    objects = [
+        {
+            "instance": int(row[0]),
+            "class": CLASS_NAMES[int(row[1])]
+            if int(row[1]) < len(CLASS_NAMES)
+            else str(int(row[1])),
+            "box": [int(v) for v in row[2:6]],
+            "truncated": bool(flag[0]),
+            "occluded": bool(flag[1]),
+        }
+        for row, flag in zip(frame.boxes, frame.box_flags, strict=True)
+    ]
+    return {
+        "tick": frame.tick,
+        "stamp_ns": frame.stamp_ns,
+        "width": frame.width,
+        "height": frame.height,
+        "files": files,
+        "objects": objects,
+    }
+
+
+class Dataset:
+    """Writes the dataset of every camera and radar of a scenario under `root`."""
+
+    def __init__(self, root: Path, scenario: Scenario) -> None:
+        self.root = root
+        self.radar: dict[str, tuple[RadarParams, int]] = {
+            f"sensor/{v.id}/{s.name}": (s.typed_params(), s.period_ns)
+            for v in scenario.vessels
+            for s in v.sensors
+            if s.type == "radar"
+        }
+        self._ppi: dict[str, Ppi] = {}
+
+    def folder(self, stream: str) -> Path:
+        parts = stream.strip("/").split("/")
+        path = self.root / ".".join(parts[1:])
+        path.mkdir(parents=True, exist_ok=True)
+        return path
+
+    def write(self, stream: str, msg: Message) -> None:
+        if isinstance(msg, CameraFrame):
+            self._camera(stream, msg)
+        elif isinstance(msg, RadarSweep) and stream in self.radar:
+            self._radar(stream, msg)
+
+    def _camera(self, stream: str, frame: CameraFrame) -> None:
+        folder, stem = self.folder(stream), f"{frame.tick:08d}"
+        images = {
+            "color": frame.color,
+            "depth": depth_mm(frame.depth) if frame.depth.size else frame.depth,
+            "normals": np.rint((frame.normals.astype(np.float32) / 127.0 + 1.0) * 127.5)
+            .clip(0, 255)
+            .astype(np.uint8),
+            "class": frame.segmentation,
+            "instance": frame.instance.astype(np.uint16),
+        }
+        files = {}
+        for name, pixels in images.items():
+            if pixels.size:
+                files[name] = f"{stem}_{name}.png"
+                save_png(folder / files[name], pixels)
+        with open(folder / "labels.jsonl", "a", encoding="utf-8") as out:
+            out.write(json.dumps(labels(frame, files), separators=(",", ":")) + "\n")
+
+    def _radar(self, stream: str, sweep: RadarSweep) -> None:
+        """Paint the sweep; save the PPI when this sweep ends an antenna turn (the next one
+        starts a new turn), so a run of whole turns writes one image per turn."""
+        p, period_ns = self.radar[stream]
+        ppi = self._ppi.get(stream)
+        if ppi is None:
+            step = 2 * np.pi / max(1, round(720.0 / p.beam_width_deg))  # as radar.py spaces beams
+            ppi = Ppi(size_px=p.ppi_size_px, range_m=p.range_m, fade_s=p.fade_s, beam_step_rad=step)
+            self._ppi[stream] = ppi
+        ppi.add(sweep)
+        turn_ns = round(p.rotation_period_s * 1e9)
+        if (sweep.stamp_ns + period_ns) // turn_ns > sweep.stamp_ns // turn_ns:
+            save_png(self.folder(stream) / f"ppi_{sweep.tick:08d}.png", ppi.render(sweep.stamp_ns))

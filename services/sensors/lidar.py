@@ -1,0 +1,109 @@
+"""A spinning LiDAR: the scene's ray cast, range noise, then the paper's rain model.
+
+Beams are a (channels x columns) grid fixed in the sensor frame (FLU at the mount): channel c
+at elevation -fov/2 + c fov/(channels-1) (ring 0 is the lowest beam), column j at azimuth
+2 pi j / columns counter-clockwise from the sensor's forward axis. Their directions are
+computed once; a scan rotates them by the vessel's pose and the mount, casts them through the
+shared Scene (terrain, bodies, waves), adds Gaussian range noise to real returns, and passes
+every beam through services/sensors/rain.py. The whole scan is taken at one instant (no
+motion skew within the turn). The scan is published in the sensor frame with labels.
+
+Randomness: one generator per sensor (common.sensor_rng, `<vessel>/<sensor>`); each scan draws
+a fixed number of values (noise, Poisson, uniform per beam) whatever it sees, so a sensor's
+draws never depend on other sensors or on the scene.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from numpy.typing import NDArray
+
+from catabot.messages import LidarScan, VesselState
+from catabot.sensor_types import LidarParams
+from services.sensors.common import SensorError, rotation_from_quaternion, sensor_rng
+from services.sensors.rain import RainParams, apply_rain
+from services.sensors.scene import CLASS_NONE, Scene
+
+F64 = NDArray[np.float64]
+
+
+def beam_directions(channels: int, columns: int, vertical_fov_deg: float) -> F64:
+    """Unit directions (channels * columns, 3) in the sensor frame, channel-major."""
+    half = math.radians(vertical_fov_deg) / 2
+    elevation = np.linspace(-half, half, channels) if channels > 1 else np.zeros(1)
+    azimuth = 2.0 * math.pi * np.arange(columns) / columns
+    el, az = np.meshgrid(elevation, azimuth, indexing="ij")
+    dirs = np.stack([np.cos(el) * np.cos(az), np.cos(el) * np.sin(az), np.sin(el)], axis=-1)
+    return dirs.reshape(-1, 3)
+
+
+def mount_rotation(yaw_deg: float, pitch_deg: float) -> F64:
+    """Sensor-to-body rotation Rz(yaw) @ Ry(pitch); positive pitch tilts the sensor nose-down."""
+    y, p = math.radians(yaw_deg), math.radians(pitch_deg)
+    rz = np.array([[math.cos(y), -math.sin(y), 0.0], [math.sin(y), math.cos(y), 0.0], [0, 0, 1]])
+    ry = np.array(
+        [[math.cos(p), 0.0, math.sin(p)], [0.0, 1.0, 0.0], [-math.sin(p), 0, math.cos(p)]]
+    )
+    return rz @ ry
+
+
+class LidarModel:
+    """One LiDAR on one vessel; `sample` casts a full scan from the vessel's state."""
+
+    message = LidarScan
+
+    def __init__(
+        self,
+        params: LidarParams,
+        *,
+        scene: Scene | None,
+        noise: bool = True,
+        seed: int = 0,
+        name: str = "lidar",
+    ) -> None:
+        if scene is None:
+            raise SensorError(f"lidar {name!r} needs the ray-casting scene")
+        self.params, self.scene, self.noise = params, scene, noise
+        self.rain = RainParams(
+            drop_diameter_mm=params.drop_diameter_mm,
+            beam_radius_m=params.beam_radius_m,
+            detection_threshold=params.detection_threshold,
+            reflectivity=params.reflectivity,
+            q_ext=params.q_ext,
+            q_back=params.q_back,
+        )
+        self.shape = (params.channels, params.columns)
+        self.dirs = beam_directions(params.channels, params.columns, params.vertical_fov_deg)
+        self.mount_rot = mount_rotation(params.mount_yaw_deg, params.mount_pitch_deg)
+        self.mount_xyz = np.asarray(params.mount_xyz, dtype=np.float64)
+        self.ring = np.repeat(np.arange(params.channels, dtype=np.uint16), params.columns)
+        self.rng = sensor_rng(seed, name)
+
+    def sample(self, state: VesselState, *, tick: int, stamp_ns: int) -> LidarScan:
+        """One scan at the vessel's pose in `state`, stamped `stamp_ns`."""
+        p = self.params
+        body_rot = rotation_from_quaternion(state.orientation)
+        origin = np.asarray(state.position, dtype=np.float64) + body_rot @ self.mount_xyz
+        rot = body_rot @ self.mount_rot  # sensor -> map
+        hits = self.scene.cast(origin, self.dirs @ rot.T, p.max_range_m)
+        distance = hits.range.astype(np.float64)
+        noise = self.rng.normal(0.0, p.range_noise_sigma_m, distance.shape)
+        if self.noise:
+            distance = np.maximum(distance + noise, 0.0)  # inf stays inf
+        rain = apply_rain(distance, p.max_range_m, self.scene.rain_rate_mm_h, self.rain, self.rng)
+        keep = np.flatnonzero(np.isfinite(rain.range))
+        r = rain.range[keep]
+        rain_hit = rain.is_rain[keep]
+        return LidarScan(
+            tick=tick,
+            stamp_ns=stamp_ns,
+            points=(self.dirs[keep] * r[:, None]).astype(np.float32),
+            intensity=rain.intensity[keep].astype(np.float32),
+            ring=self.ring[keep],
+            cls=np.where(rain_hit, CLASS_NONE, hits.cls[keep]).astype(np.uint8),
+            instance=np.where(rain_hit, 0, hits.instance[keep]).astype(np.int32),
+            is_rain=rain_hit,
+            range_image=rain.range.reshape(self.shape).astype(np.float32),
+        )

@@ -1,0 +1,301 @@
+"""The ray-casting world shared by LiDAR, radar and cameras: terrain, moving bodies, water.
+
+Three kinds of geometry, each with the cheapest exact test for it:
+- Terrain: static, so it is one open3d `RaycastingScene` (Embree) built ONCE per run from
+  `Terrain.mesh()`; building costs ~0.27 s for 0.5 M triangles, a cast ~7 M rays/s.
+- Bodies (vessels, buoys): moving boxes (the union AABB of the model's hulls, in the body
+  frame). Moving them must not rebuild the terrain scene, so they are tested analytically:
+  bodies out of range of every ray origin are dropped, a bounding-sphere test over
+  (rays x remaining bodies) is two small matrix products and leaves a few (ray, body) pairs,
+  and only those pairs get the slab test in the body's own frame. 100 boats cost well under
+  a millisecond per 32 x 512 scan when few are in range (benchmarks/sensors.py).
+- Water: the same surface as physics, z = WaveField.height(x, y, t). Calm water is the plane
+  z = 0. With waves, each downward ray is bracketed between z = +A and z = -A (A = the sum of
+  the component amplitudes bounds |eta|), marched in a few samples to find the FIRST sign
+  change of f(t) = z(t) - eta(x(t), y(t)), then refined by Illinois false position: the hit is
+  on the surface within a millimetre. Its cost is (downward rays x samples x components)
+  cosines, a few ms per LiDAR scan in a heavy sea (see water.py).
+
+The nearest hit of the three wins. All work is vectorised over rays; no Python loop runs per
+ray, and loops over bodies run over no more than a handful of refinement steps.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass
+from typing import TYPE_CHECKING
+
+import numpy as np
+from numpy.typing import NDArray
+
+from catabot.terrain import Terrain
+from catabot.waves import WaveField
+from services.sensors.common import SensorError, rotation_from_quaternion
+from services.sensors.water import water_hits
+
+if TYPE_CHECKING:
+    from catabot.scenario import Scenario
+
+CLASS_NONE, CLASS_WATER, CLASS_TERRAIN, CLASS_VESSEL, CLASS_BUOY = 0, 1, 2, 3, 4
+F32 = NDArray[np.float32]
+F64 = NDArray[np.float64]
+Vec3 = tuple[float, float, float]
+
+
+class SceneError(SensorError):
+    """Rays or poses the scene cannot use (wrong shapes, non-finite values, unknown body)."""
+
+
+@dataclass(frozen=True)
+class Body:
+    """A moving box-shaped body: hull bounds `lo`..`hi` in its body frame (FLU)."""
+
+    id: str
+    cls: int
+    instance: int
+    lo: Vec3
+    hi: Vec3
+
+
+@dataclass
+class Hits:
+    """The first hit of each ray; inf range, zero normal and CLASS_NONE where none."""
+
+    range: F32  # (N,) metres along the (unit) ray direction
+    normal: F32  # (N, 3) world-frame unit normals
+    cls: NDArray[np.uint8]  # (N,)
+    instance: NDArray[np.int32]  # (N,)
+
+
+class Scene:
+    """Terrain (built once), bodies (posed by `update`) and the wave surface at `time_s`."""
+
+    def __init__(
+        self,
+        *,
+        terrain: Terrain | None,
+        waves: WaveField,
+        bodies: Sequence[Body],
+        rain_rate_mm_h: float = 0.0,
+    ) -> None:
+        self.rain_rate_mm_h = float(rain_rate_mm_h)  # the rain in force (LiDAR's rain model)
+        self._terrain = terrain.raycasting_scene() if terrain is not None else None
+        self._waves = waves
+        self._amplitude = float(np.sum(waves.amplitudes_m))
+        self.bodies = list(bodies)
+        self._index = {b.id: i for i, b in enumerate(self.bodies)}
+        if len(self._index) != len(self.bodies):
+            raise SceneError("body ids must be unique")
+        lo = np.array([b.lo for b in self.bodies], dtype=np.float64).reshape(-1, 3)
+        hi = np.array([b.hi for b in self.bodies], dtype=np.float64).reshape(-1, 3)
+        self._lo, self._hi = lo, hi
+        self._centre_b = (lo + hi) / 2  # box centre in the body frame
+        self._radius = np.linalg.norm(hi - lo, axis=1) / 2
+        self._cls = np.array([b.cls for b in self.bodies], dtype=np.uint8)
+        self._inst = np.array([b.instance for b in self.bodies], dtype=np.int32)
+        n = len(self.bodies)
+        self._pos = np.full((n, 3), np.nan)  # unposed bodies are not in the scene
+        self._rot = np.tile(np.eye(3), (n, 1, 1))
+        self.time_s = 0.0
+
+    def update(
+        self, poses: Mapping[str, tuple[Sequence[float], Sequence[float]]], time_s: float
+    ) -> None:
+        """Set the pose (position xyz, quaternion xyzw in `map`) of the named bodies and the
+        time of the wave surface; bodies not named keep their last pose."""
+        for body_id, (position, quaternion) in poses.items():
+            i = self._index.get(body_id)
+            if i is None:
+                raise SceneError(f"unknown body {body_id!r} (known: {sorted(self._index)})")
+            p = np.asarray(position, dtype=np.float64)
+            if p.shape != (3,) or not np.isfinite(p).all():
+                raise SceneError(f"body {body_id!r}: position must be 3 finite numbers")
+            self._pos[i], self._rot[i] = p, rotation_from_quaternion(quaternion)
+        self.time_s = float(time_s)
+
+    def corners(self) -> F64:
+        """(n, 8, 3) map-frame corners of every body's box, in `bodies` order (NaN where not
+        yet posed): a camera projects them to tell a truncated or occluded 2D box."""
+        sel = np.array([[i >> 2 & 1, i >> 1 & 1, i & 1] for i in range(8)], dtype=bool)
+        local = np.where(sel[None], self._hi[:, None, :], self._lo[:, None, :])
+        return np.einsum("nij,nkj->nki", self._rot, local) + self._pos[:, None, :]
+
+    def cast(
+        self,
+        origins: np.ndarray,
+        directions: np.ndarray,
+        max_range: float,
+        pairs: tuple[NDArray[np.intp], NDArray[np.intp]] | None = None,
+    ) -> Hits:
+        """First hit of each ray (origins (N,3) or (3,), directions (N,3), normalised here)
+        within `max_range` metres. `pairs` (ray indices, body indices into `bodies`), when
+        given, replaces the body cull: a caller that knows which rays can meet which body
+        (a camera projects each box into its image) saves the (rays x bodies) test; every
+        (ray, body) that can hit must be in it."""
+        o, d = _rays(origins, directions)
+        n = d.shape[0]
+        rng = np.full(n, np.inf)
+        normal = np.zeros((n, 3))
+        cls = np.zeros(n, dtype=np.uint8)
+        inst = np.zeros(n, dtype=np.int32)
+        self._cast_terrain(o, d, max_range, rng, normal, cls)
+        self._cast_bodies(o, d, max_range, rng, normal, cls, inst, pairs)
+        t, nw = water_hits(
+            self._waves, self._amplitude, o, d, np.minimum(rng, max_range), self.time_s
+        )
+        closer = t < rng
+        rng[closer], normal[closer], cls[closer], inst[closer] = (
+            t[closer],
+            nw[closer],
+            CLASS_WATER,
+            0,
+        )
+        rng[rng > max_range] = np.inf
+        miss = ~np.isfinite(rng)
+        normal[miss], cls[miss], inst[miss] = 0.0, CLASS_NONE, 0
+        return Hits(rng.astype(np.float32), normal.astype(np.float32), cls, inst)
+
+    def _cast_terrain(
+        self, o: F64, d: F64, max_range: float, rng: F64, normal: F64, cls: NDArray[np.uint8]
+    ) -> None:
+        if self._terrain is None:
+            return
+        import open3d as o3d
+
+        rays = np.empty((d.shape[0], 6), dtype=np.float32)
+        rays[:, :3], rays[:, 3:] = o, d
+        out = self._terrain.cast_rays(o3d.core.Tensor.from_numpy(rays))
+        t = out["t_hit"].numpy().astype(np.float64)
+        hit = t <= max_range
+        rng[hit] = t[hit]
+        normal[hit] = out["primitive_normals"].numpy()[hit]
+        cls[hit] = CLASS_TERRAIN
+
+    def _cast_bodies(
+        self,
+        o: F64,
+        d: F64,
+        max_range: float,
+        rng: F64,
+        normal: F64,
+        cls: NDArray[np.uint8],
+        inst: NDArray[np.int32],
+        pairs: tuple[NDArray[np.intp], NDArray[np.intp]] | None = None,
+    ) -> None:
+        ray_i, body_i = self._candidates(o, d, max_range) if pairs is None else pairs
+        if ray_i.size == 0:
+            return
+        rot = self._rot[body_i]  # (P, 3, 3) body -> map
+        ob = np.einsum("pji,pj->pi", rot, o[ray_i] - self._pos[body_i])  # R^T (o - p)
+        db = np.einsum("pji,pj->pi", rot, d[ray_i])
+        t, face_b = _slab(ob, db, self._lo[body_i], self._hi[body_i])
+        ok = (t <= max_range) & (t < rng[ray_i])
+        ray_i, body_i, t = ray_i[ok], body_i[ok], t[ok]
+        face = np.einsum("pij,pj->pi", rot[ok], face_b[ok])
+        order = np.lexsort((-t, ray_i))  # per ray, nearest last: fancy assignment keeps it
+        ray_i, body_i, t, face = ray_i[order], body_i[order], t[order], face[order]
+        rng[ray_i], normal[ray_i] = t, face
+        cls[ray_i], inst[ray_i] = self._cls[body_i], self._inst[body_i]
+
+    def _candidates(
+        self, o: F64, d: F64, max_range: float
+    ) -> tuple[NDArray[np.intp], NDArray[np.intp]]:
+        """(ray, body) pairs whose ray passes within the body's bounding sphere."""
+        posed = np.isfinite(self._pos[:, 0])
+        centre = self._pos + np.einsum("nij,nj->ni", self._rot, self._centre_b)
+        single = o.strides[0] == 0  # every ray from one origin
+        lo, hi = (o[0], o[0]) if single else (o.min(axis=0), o.max(axis=0))  # range cull box
+        gap = np.linalg.norm(np.maximum(np.maximum(lo - centre, centre - hi), 0.0), axis=1)
+        keep = np.flatnonzero(posed & (gap <= max_range + self._radius))
+        if keep.size == 0:
+            return np.empty(0, np.intp), np.empty(0, np.intp)
+        c, r = centre[keep], self._radius[keep]
+        # np.dot, not @: NumPy's matmul takes a ~100x slower loop for (N, 3) x (3, K)
+        if single:  # a LiDAR, a camera: one small product
+            oc = c - lo
+            dist = np.linalg.norm(oc, axis=1)
+            tc = np.dot(d, oc.T)  # along-ray distance of each centre, (rays, bodies)
+            cos_half = self._corner_cone(keep, lo, oc, dist)
+            ray_i, k = np.nonzero(tc >= cos_half * dist)  # in range: culled above; slab: exact
+            return ray_i, keep[k]
+        else:
+            tc = np.dot(d, c.T) - np.sum(d * o, axis=1)[:, None]
+            oc2 = (
+                np.sum(c * c, axis=1)[None, :]
+                - 2.0 * np.dot(o, c.T)
+                + np.sum(o * o, axis=1)[:, None]
+            )
+        near = (oc2 - tc * tc <= r * r) & (tc >= -r) & (tc - r <= max_range)
+        ray_i, k = np.nonzero(near)
+        return ray_i, keep[k]
+
+    def _corner_cone(self, keep: NDArray[np.intp], origin: F64, oc: F64, dist: F64) -> F64:
+        """cos of the half-angle of the cone from `origin` about each body's centre that holds
+        its 8 corners, so holds the box (-1: every direction, when that cone is not convex).
+        Tighter than the bounding sphere, and still a cull when the origin is inside the
+        sphere (a LiDAR above its own hull), where the sphere test passes every ray."""
+        rel = self.corners()[keep] - origin  # (K, 8, 3)
+        cos = np.einsum("kcj,kj->kc", rel, oc) / (
+            np.linalg.norm(rel, axis=2) * dist[:, None] + 1e-300
+        )
+        cos_half = cos.min(axis=1) - 1e-9
+        return np.where(cos_half > 0.0, cos_half, -1.0)
+
+
+def _rays(origins: np.ndarray, directions: np.ndarray) -> tuple[F64, F64]:
+    d = np.asarray(directions, dtype=np.float64)
+    if d.ndim != 2 or d.shape[1] != 3:
+        raise SceneError(f"directions must have shape (N, 3) (got {d.shape})")
+    raw = np.asarray(origins, dtype=np.float64)
+    o = np.broadcast_to(raw, d.shape)  # one shared origin stays a stride-0 view (cheap cull)
+    norm = np.linalg.norm(d, axis=1, keepdims=True)
+    if not (np.isfinite(raw).all() and np.isfinite(d).all() and (norm > 0).all()):
+        raise SceneError("rays need finite origins and finite, non-zero directions")
+    return o, d / norm
+
+
+def _slab(ob: F64, db: F64, lo: F64, hi: F64) -> tuple[F64, F64]:
+    """Entry distance of rays (body frame) into boxes lo..hi (inf if missed or behind), and
+    the outward normal of the entry face (body frame). A ray starting inside hits at 0."""
+    with np.errstate(divide="ignore", invalid="ignore"):
+        inv = 1.0 / db
+        t1, t2 = (lo - ob) * inv, (hi - ob) * inv
+    t1 = np.where(np.isnan(t1), -np.inf, t1)  # parallel ray on a face plane: not limiting
+    t2 = np.where(np.isnan(t2), np.inf, t2)
+    near, far = np.minimum(t1, t2), np.maximum(t1, t2)
+    axis = np.argmax(near, axis=1)
+    t_in = np.take_along_axis(near, axis[:, None], 1)[:, 0]
+    t_out = far.min(axis=1)
+    hit = (t_in <= t_out) & (t_out >= 0.0)
+    t = np.where(hit, np.maximum(t_in, 0.0), np.inf)
+    face = np.zeros_like(ob)
+    rows = np.arange(ob.shape[0])
+    face[rows, axis] = -np.sign(db[rows, axis])
+    return t, face
+
+
+def bodies_for(scenario: Scenario) -> list[Body]:
+    """Every vessel, traffic boats included (instance 1 + its index), then every buoy
+    (instances after the vessels), as a box: the union of its model's hull bounds."""
+    from catabot.traffic_plan import all_buoys, all_vessels
+    from catabot.vessel import load_vessel_model
+
+    vessels, buoys = all_vessels(scenario), all_buoys(scenario)
+    bounds = {m: _hull_bounds(load_vessel_model(m)) for m in {v.model for v in vessels}}
+    bodies = [Body(v.id, CLASS_VESSEL, 1 + i, *bounds[v.model]) for i, v in enumerate(vessels)]
+    if buoys:
+        lo, hi = _hull_bounds(load_vessel_model("buoy"))
+        first = 1 + len(vessels)
+        bodies += [Body(b.id, CLASS_BUOY, first + j, lo, hi) for j, b in enumerate(buoys)]
+    return bodies
+
+
+def _hull_bounds(model: object) -> tuple[Vec3, Vec3]:
+    from catabot.vessel import VesselModel
+
+    assert isinstance(model, VesselModel)
+    centre = np.array([h.center_m for h in model.hulls])
+    half = np.array([(h.length_m, h.beam_m, h.vertical_extent_m) for h in model.hulls]) / 2
+    lo, hi = (centre - half).min(axis=0), (centre + half).max(axis=0)
+    return (float(lo[0]), float(lo[1]), float(lo[2])), (float(hi[0]), float(hi[1]), float(hi[2]))

@@ -1,0 +1,5 @@
+import sys
+
+from services.traffic.service import main
+
+sys.exit(main())

@@ -1,0 +1,150 @@
+"""Traffic behaviours as guidance laws over all boats at once: pose in, twist set-point out.
+
+Every law returns (surge m/s, yaw rate rad/s) per boat for the physics service's
+TwistController, so traffic boats are driven by forces exactly like the ego vessel.
+They act on the course over ground (heading plus drift angle), not the heading, so a
+boat that slips sideways in a turn still holds its circle or its track.
+One NumPy pass per tick for 100-500 boats; the per-boat work is only index bookkeeping.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+
+import numpy as np
+from numpy.typing import NDArray
+
+from catabot.traffic_plan import Boat
+
+Array = NDArray[np.float64]
+CIRCLE, WAYPOINTS, HOLD = 0, 1, 2
+KINDS = {"circle": CIRCLE, "waypoints": WAYPOINTS, "hold": HOLD}
+YAW_GAIN = 1.0  # 1/s: yaw rate per radian of course error
+MAX_YAW_RATE = 0.35  # rad/s: what a 5 m/s traffic boat can turn (about 20 deg/s)
+CIRCLE_LOOKAHEAD_M = 8.0  # radial error at which the correction reaches 45 degrees
+HOLD_RADIUS_M = 3.0  # closer than this, hold the heading instead of turning to the point
+
+
+def wrap(angle: Array) -> Array:
+    return np.asarray((angle + np.pi) % (2 * np.pi) - np.pi)
+
+
+def course(yaw: Array, velocity_b: Array) -> Array:
+    """Course over ground: heading plus drift angle, the heading itself when nearly still."""
+    u, v = velocity_b[:, 0], velocity_b[:, 1]
+    moving = np.hypot(u, v) > 0.5
+    return np.where(moving, yaw + np.arctan2(v, np.where(moving, u, 1.0)), yaw)
+
+
+def circle_law(
+    pos: Array, chi: Array, centre: Array, radius: Array, direction: Array, speed: Array
+) -> tuple[Array, Array]:
+    """Feed-forward yaw rate U/R plus a turn towards the circle proportional to radial error."""
+    rel = pos - centre
+    theta = np.arctan2(rel[:, 1], rel[:, 0])
+    error = np.hypot(rel[:, 0], rel[:, 1]) - radius
+    desired = theta + direction * (np.pi / 2 + np.arctan(error / CIRCLE_LOOKAHEAD_M))
+    rate = direction * speed / radius + YAW_GAIN * wrap(desired - chi)
+    return speed.copy(), np.clip(rate, -MAX_YAW_RATE, MAX_YAW_RATE)
+
+
+def pursuit_law(pos: Array, chi: Array, target: Array, speed: Array) -> tuple[Array, Array]:
+    """Head for the target; slow down while the course error is large, so the boat turns
+    tightly enough not to orbit a point inside its turning circle."""
+    rel = target - pos
+    err = wrap(np.arctan2(rel[:, 1], rel[:, 0]) - chi)
+    surge = speed * np.clip(np.cos(err), 0.3, 1.0)
+    return surge, np.clip(YAW_GAIN * err, -MAX_YAW_RATE, MAX_YAW_RATE)
+
+
+def hold_law(
+    pos: Array, yaw: Array, target: Array, target_yaw: Array, gain: float, max_speed: Array
+) -> tuple[Array, Array]:
+    """Station keeping: P on the body-frame position error; face the point while far."""
+    rel = target - pos
+    ahead = rel[:, 0] * np.cos(yaw) + rel[:, 1] * np.sin(yaw)
+    far = np.hypot(rel[:, 0], rel[:, 1]) > HOLD_RADIUS_M
+    face = np.where(far, np.arctan2(rel[:, 1], rel[:, 0]), target_yaw)
+    surge = np.clip(gain * ahead, -max_speed / 2, max_speed)
+    return surge, np.clip(YAW_GAIN * wrap(face - yaw), -MAX_YAW_RATE, MAX_YAW_RATE)
+
+
+class Behaviours:
+    """Every boat's behaviour state; `command` gives all set-points for one tick."""
+
+    def __init__(self, boats: Sequence[Boat], *, hold_gain: float = 0.5) -> None:
+        n = len(boats)
+        self.boats = list(boats)
+        self.hold_gain = hold_gain
+        self.kind = np.array([KINDS[b.behaviour] for b in boats], dtype=np.int64)
+        self.speed = np.array([b.speed_mps for b in boats], dtype=np.float64)
+        self.centre = np.array([b.center for b in boats], dtype=np.float64).reshape(n, 2)
+        self.radius = np.array([max(b.radius_m, 1.0) for b in boats], dtype=np.float64)
+        self.direction = np.array([b.direction for b in boats], dtype=np.float64)
+        self.hold_yaw = np.array([b.pose.yaw_rad for b in boats], dtype=np.float64)
+        self.paths: list[Array] = [np.zeros((0, 2))] * n
+        self.index = np.zeros(n, dtype=np.int64)
+        self.step = np.ones(n, dtype=np.int64)
+        self.loop = np.zeros(n, dtype=bool)
+        self.tol = np.array([b.tolerance_m for b in boats], dtype=np.float64)
+        for i, b in enumerate(boats):
+            if b.behaviour == "waypoints":
+                self.set_path(i, np.array(b.path), b.speed_mps, loop=b.loop, tol=b.tolerance_m)
+
+    def set_path(self, i: int, points: Array, speed: float, *, loop: bool, tol: float) -> None:
+        """Boat i follows `points` (K, 2) from the first one on."""
+        self.kind[i], self.speed[i], self.loop[i], self.tol[i] = WAYPOINTS, speed, loop, tol
+        self.paths[i] = np.asarray(points, dtype=np.float64).reshape(-1, 2)
+        self.index[i], self.step[i] = 0, 1
+
+    def release(self, i: int) -> None:
+        """Boat i goes back to its scenario behaviour, from where it is now."""
+        b = self.boats[i]
+        self.kind[i], self.speed[i] = KINDS[b.behaviour], b.speed_mps
+        self.tol[i], self.loop[i] = b.tolerance_m, b.loop
+        self.paths[i] = np.array(b.path, dtype=np.float64).reshape(-1, 2)
+        self.index[i], self.step[i] = 0, 1
+
+    def command(self, pos: Array, yaw: Array, velocity_b: Array) -> tuple[Array, Array]:
+        """Set-points for every boat: pos (N, 2) m, yaw (N,), body velocity (N, >=2)."""
+        chi = course(yaw, velocity_b)
+        surge, rate = np.zeros(len(yaw)), np.zeros(len(yaw))
+        for kind, law in ((CIRCLE, self._circle), (WAYPOINTS, self._path), (HOLD, self._hold)):
+            rows = np.flatnonzero(self.kind == kind)
+            if rows.size:
+                surge[rows], rate[rows] = law(rows, pos[rows], yaw[rows], chi[rows])
+        return surge, rate
+
+    def _circle(
+        self, rows: NDArray[np.intp], pos: Array, _: Array, chi: Array
+    ) -> tuple[Array, Array]:
+        return circle_law(
+            pos, chi, self.centre[rows], self.radius[rows], self.direction[rows], self.speed[rows]
+        )
+
+    def _hold(
+        self, rows: NDArray[np.intp], pos: Array, yaw: Array, _: Array
+    ) -> tuple[Array, Array]:
+        target = self.centre[rows]
+        return hold_law(pos, yaw, target, self.hold_yaw[rows], self.hold_gain, self.speed[rows])
+
+    def _path(
+        self, rows: NDArray[np.intp], pos: Array, _: Array, chi: Array
+    ) -> tuple[Array, Array]:
+        target = np.array([self.paths[i][self.index[i]] for i in rows]).reshape(-1, 2)
+        reached = np.hypot(*(target - pos).T) < self.tol[rows]
+        for i in rows[reached]:
+            self._advance(int(i))
+        target = np.array([self.paths[i][self.index[i]] for i in rows]).reshape(-1, 2)
+        return pursuit_law(pos, chi, target, self.speed[rows])
+
+    def _advance(self, i: int) -> None:
+        """Next point: wrap round when looping, turn back at either end otherwise."""
+        k, n = self.index[i] + self.step[i], len(self.paths[i])
+        if self.loop[i]:
+            self.index[i] = k % n
+            return
+        if not 0 <= k < n:
+            self.step[i] = -self.step[i]
+            k = self.index[i] + self.step[i]
+        self.index[i] = k

@@ -1,0 +1,104 @@
+"""The traffic service: every tick, each boat's behaviour turns its state into a twist set-point.
+
+At tick k it reads the boats' states tagged k-1 (at t_k; the plan's start poses at rest at
+tick 0), runs the guidance laws for all boats at once and publishes each boat's set-point
+on `vessel/<boat>/cmd/twist` tagged k, which physics applies from tick k+1 (the one-tick
+delay of DESIGN.md §4). External control never fights these set-points: physics lets an
+external twist or thrust (tick -1) outrank them until a `WaypointsCmd` hands the boat
+back; a `WaypointsCmd` with a path makes this service steer that path instead, and
+`mode="release"` restores the scenario behaviour.
+"""
+
+from __future__ import annotations
+
+import logging
+import sys
+
+import numpy as np
+
+from catabot import codec
+from catabot.inbox import Inputs
+from catabot.messages import Tick, TwistCmd, VesselState, WaypointsCmd
+from catabot.participant import Participant
+from catabot.service import Built, ServiceContext, run_service
+from catabot.streams import state_streams, waypoint_streams
+from catabot.traffic_plan import plan_traffic
+from services.traffic.behaviours import Behaviours
+
+log = logging.getLogger("traffic")
+MODES = ("loop", "back_and_forth", "release")
+
+
+class TrafficService:
+    def __init__(self, ctx: ServiceContext) -> None:
+        boats = plan_traffic(ctx.scenario).boats
+        self.ids = [b.id for b in boats]
+        self.row = {vid: i for i, vid in enumerate(self.ids)}
+        self.keys = ctx.keys
+        self.behaviours = Behaviours(boats, hold_gain=ctx.scenario.traffic.hold.gain)
+        n = len(boats)
+        self.pos = np.array([(b.pose.x_m, b.pose.y_m) for b in boats], dtype=np.float64)
+        self.yaw = np.array([b.pose.yaw_rad for b in boats], dtype=np.float64)
+        self.vel = np.zeros((n, 2))
+        states = [s for s in state_streams(ctx.scenario, ctx.keys) if _vessel(s.key) in self.row]
+        waypoints = [
+            s for s in waypoint_streams(ctx.scenario, ctx.keys) if _vessel(s.key) in self.row
+        ]
+        self.twist_keys = [ctx.keys.cmd_twist(vid) for vid in self.ids]
+        self.participant = Participant(
+            ctx.session, ctx.keys, ctx.name, inputs=states + waypoints, peers=ctx.peers
+        )
+
+    def step(self, tick: Tick, inputs: Inputs) -> None:
+        for key, msgs in inputs.items():
+            i = self.row[_vessel(key)]
+            for msg in msgs:
+                if isinstance(msg, VesselState):
+                    self._take_state(i, msg)
+                elif isinstance(msg, WaypointsCmd):
+                    self._take_waypoints(i, key, msg)
+        surge, rate = self.behaviours.command(self.pos, self.yaw, self.vel)
+        for i, key in enumerate(self.twist_keys):
+            self.participant.publish(
+                key, TwistCmd(float(surge[i]), float(rate[i]), tick.tick, tick.stamp_ns)
+            )
+
+    def _take_state(self, i: int, msg: VesselState) -> None:
+        x, y, z, w = msg.orientation
+        self.pos[i] = msg.position[:2]
+        self.yaw[i] = np.arctan2(2 * (w * z + x * y), 1 - 2 * (y * y + z * z))
+        self.vel[i] = msg.linear_velocity[:2]
+
+    def _take_waypoints(self, i: int, key: str, msg: WaypointsCmd) -> None:
+        """Adopt a path from outside, or release the boat; refuse malformed ones loudly."""
+        if msg.mode == "release":
+            self.behaviours.release(i)
+            return
+        pts = msg.points
+        if msg.mode not in MODES or len(pts) < 2 or len(pts) % 2 or not codec.finite(pts):
+            log.error("refused waypoints on %s: need an even number of finite values "
+                      "x0, y0, x1, ... and mode in %s (got %s)", key, MODES, msg)  # fmt: skip
+            return
+        if not (codec.finite((msg.speed, msg.tolerance)) and msg.speed > 0 and msg.tolerance > 0):
+            log.error("refused waypoints on %s: speed and tolerance must be > 0", key)
+            return
+        points = np.array(pts, dtype=np.float64).reshape(-1, 2)
+        self.behaviours.set_path(i, points, msg.speed, loop=msg.mode == "loop", tol=msg.tolerance)
+
+
+def _vessel(key: str) -> str:
+    """The vessel id of a `catabot/<world>/vessel/<id>/...` key."""
+    return key.split("/")[3]
+
+
+def build(ctx: ServiceContext) -> Built:
+    service = TrafficService(ctx)
+    return service.participant, service.step, None
+
+
+def main(argv: list[str] | None = None) -> int:
+    return run_service("traffic", build, argv)
+
+
+if __name__ == "__main__":
+    sys.exit(main())

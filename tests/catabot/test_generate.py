@@ -1,0 +1,26 @@
+"""`catabot scenario generate`: a valid scenario with the asked traffic, or a clear refusal."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import pytest
+
+from catabot.cli import main
+from catabot.scenario import load_scenario
+from catabot.traffic_plan import plan_traffic
+
+
+def test_generated_scenario_is_valid_and_has_the_traffic(tmp_path: Path) -> None:
+    out = tmp_path / "gen.json"
+    argv = ["scenario", "generate", "--boats", "30", "--mix", "circle=0.5,waypoints=0.5"]
+    assert main([*argv, "--seed", "9", "-o", str(out)]) == 0
+    scenario = load_scenario(out)
+    assert scenario.seed == 9 and scenario.traffic.count == 30
+    kinds = {b.behaviour for b in plan_traffic(scenario).boats}
+    assert kinds == {"circle", "waypoints"}
+
+
+def test_an_unknown_behaviour_is_refused(capsys: pytest.CaptureFixture[str]) -> None:
+    assert main(["scenario", "generate", "--mix", "zigzag=1"]) == 2
+    assert "unknown behaviour 'zigzag'" in capsys.readouterr().err

@@ -1,0 +1,33 @@
+"""A LiDAR in the rain through `catabot run`: PointCloud2 in the MCAP, a summary CSV, buoys."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+from conftest import basic_scenario, catabot, csv_rows, only_run_dir, scenario_file
+
+from services.recorder.mcap_sink import read_mcap_messages
+
+
+def test_lidar_in_rain_is_recorded_as_point_clouds(tmp_path: Path, out: Path) -> None:
+    data = basic_scenario("lidar", duration_s=1.0, rain={"rate_mm_h": 25.0})
+    data["buoys"] = [{"id": "b1", "x_m": 8.0, "y_m": 0.0}]
+    data["vessels"][0]["sensors"] = [{"name": "lidar", "type": "lidar", "rate_hz": 10.0}]
+    result = catabot("run", str(scenario_file(tmp_path, data)), "--out", str(out), "--quiet")
+    assert result.returncode == 0, result.stderr
+    run = only_run_dir(out)
+    clouds = [m for m in read_mcap_messages(run / "run.mcap") if m.topic == "/sensor/ego/lidar"]
+    assert len(clouds) == 10
+    assert {m.schema_name for m in clouds} == {"sensor_msgs/msg/PointCloud2"}
+    cloud = clouds[0].decoded
+    assert cloud.header.frame_id == "ego/lidar" and cloud.point_step == 24
+    assert [f.name for f in cloud.fields][:4] == ["x", "y", "z", "intensity"]
+    assert cloud.width > 1000 and len(cloud.data) == cloud.width * 24
+    labels = np.frombuffer(bytes(cloud.data), dtype=np.uint8).reshape(-1, 24)[:, 18]
+    assert 4 in set(labels.tolist())  # the buoy is seen, with its class
+    rows = csv_rows(run / "sensor.ego.lidar.csv")
+    assert rows[0] == ["stamp_ns", "tick", "returns", "rain_returns"]
+    assert len(rows) == 11 and all(int(r[2]) > 1000 for r in rows[1:])
+    assert sum(int(r[3]) for r in rows[1:]) > 0  # 25 mm/h: some returns are raindrops
+    assert (run / "vessel.b1.state.csv").is_file()  # buoys are published and recorded

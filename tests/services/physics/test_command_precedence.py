@@ -1,0 +1,31 @@
+"""Who drives a vessel: external command > traffic set-point > script, and the release."""
+
+from __future__ import annotations
+
+from catabot.messages import ThrustCmd, TwistCmd, WaypointsCmd
+from catabot.scenario import VesselConfig
+from services.physics.commands import CommandBook, Order
+
+KEY = "catabot/w/vessel/boat_000/cmd/twist"
+
+
+def _book() -> CommandBook:
+    return CommandBook([VesselConfig(id="boat_000")], {"boat_000": 2})
+
+
+def test_traffic_set_points_drive_a_boat_until_an_external_command_takes_it() -> None:
+    book = _book()
+    book.take("boat_000", KEY, [TwistCmd(5.0, 0.26, tick=0)])
+    assert book.order("boat_000", 0) == Order(twist=(5.0, 0.26))
+    book.take("boat_000", KEY, [TwistCmd(1.0, 0.0, tick=-1), TwistCmd(5.0, 0.3, tick=1)])
+    assert book.order("boat_000", 0) == Order(twist=(1.0, 0.0))  # the set-point waits
+    book.take("boat_000", KEY, [ThrustCmd((0.2, 0.2))])
+    assert book.order("boat_000", 0) == Order(thrust=(0.2, 0.2))
+
+
+def test_a_waypoints_command_hands_the_boat_back() -> None:
+    book = _book()
+    book.take("boat_000", KEY, [TwistCmd(5.0, 0.26, tick=3), TwistCmd(0.0, 0.0, tick=-1)])
+    release = WaypointsCmd(points=(), speed=0.0, tolerance=0.0, mode="release")
+    book.take("boat_000", KEY.replace("twist", "waypoints"), [release])
+    assert book.order("boat_000", 0) == Order(twist=(5.0, 0.26))

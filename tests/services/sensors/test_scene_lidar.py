@@ -1,0 +1,126 @@
+"""The shared ray-casting scene and the LiDAR on it: ranges, surfaces, labels, determinism."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+from catabot.messages import LidarScan, VesselState
+from catabot.sensor_types import LidarParams
+from catabot.terrain import Terrain
+from catabot.waves import WaveConfig, WaveField
+from services.sensors.lidar import LidarModel, beam_directions
+from services.sensors.scene import (
+    CLASS_BUOY,
+    CLASS_NONE,
+    CLASS_TERRAIN,
+    CLASS_VESSEL,
+    CLASS_WATER,
+    Body,
+    Scene,
+    SceneError,
+)
+
+CALM = WaveField(WaveConfig(), 0)
+EGO = Body("ego", CLASS_VESSEL, 1, (-1.0, -0.5, -0.1), (1.0, 0.5, 0.2))
+BOAT = Body("boat", CLASS_VESSEL, 2, (-2.0, -1.0, -0.2), (2.0, 1.0, 1.0))
+BUOY = Body("buoy", CLASS_BUOY, 3, (-0.2, -0.2, -0.15), (0.2, 0.2, 0.85))
+LEVEL = LidarParams(channels=3, vertical_fov_deg=10.0, columns=360, mount_xyz=(0.0, 0.0, 0.5))
+
+
+def _quat(yaw: float) -> tuple[float, float, float, float]:
+    return (0.0, 0.0, math.sin(yaw / 2), math.cos(yaw / 2))
+
+
+def _state(x: float = 0.0, y: float = 0.0, yaw: float = 0.0) -> VesselState:
+    zero = (0.0, 0.0, 0.0)
+    return VesselState(0, 0, (x, y, 0.0), _quat(yaw), zero, zero, zero, zero)
+
+
+def _scene(waves: WaveField = CALM, rain: float = 0.0, **poses: tuple[float, ...]) -> Scene:
+    scene = Scene(terrain=None, waves=waves, bodies=[EGO, BOAT, BUOY], rain_rate_mm_h=rain)
+    scene.update({k: ((v[0], v[1], 0.0), _quat(v[2])) for k, v in poses.items()}, 0.0)
+    return scene
+
+
+def test_lidar_hits_a_posed_box_at_the_known_range() -> None:
+    scene = _scene(ego=(0, 0, 0), boat=(20.0, 0.0, 0.0), buoy=(0.0, -10.0, 0.0))
+    scan = LidarModel(LEVEL, scene=scene, noise=False).sample(_state(), tick=3, stamp_ns=7)
+    assert isinstance(scan, LidarScan) and (scan.tick, scan.stamp_ns) == (3, 7)
+    level = scan.range_image[1]  # channel 1 is level; column j looks at j degrees
+    assert level[0] == pytest.approx(18.0, abs=0.01)  # the boat's stern face at x = 18
+    assert level[270] == pytest.approx(9.8, abs=0.01)  # the buoy's north face at y = -9.8
+    front = np.flatnonzero((scan.ring == 1) & (np.abs(scan.points[:, 1]) < 0.5))
+    front = front[scan.points[front, 0] > 0]
+    assert set(scan.cls[front]) == {CLASS_VESSEL} and set(scan.instance[front]) == {2}
+    buoy = (scan.ring == 1) & (scan.points[:, 1] < -9.0) & (np.abs(scan.points[:, 0]) < 0.2)
+    assert set(scan.cls[buoy]) == {CLASS_BUOY} and set(scan.instance[buoy]) == {3}
+    down = scan.ring == 0  # 5 degrees down from 0.5 m: the calm sea at 5.7 m
+    water = down & (scan.cls == CLASS_WATER)
+    assert water.sum() > 300 and np.all(scan.instance[water] == 0)
+    assert np.allclose(scan.points[water, 2], -0.5, atol=1e-4)  # z = 0 in the sensor frame
+
+
+def test_a_turned_box_and_a_moving_sensor() -> None:
+    scene = _scene(ego=(5, 5, 0), boat=(25.0, 5.0, math.pi / 2))  # beam-on: 1 m half-width
+    scan = LidarModel(LEVEL, scene=scene, noise=False).sample(_state(5, 5), tick=0, stamp_ns=0)
+    assert scan.range_image[1, 0] == pytest.approx(19.0, abs=0.01)
+    turned = LidarModel(LEVEL, scene=scene, noise=False).sample(
+        _state(5, 5, math.pi / 2), tick=0, stamp_ns=0
+    )
+    assert turned.range_image[1, 270] == pytest.approx(19.0, abs=0.01)  # boat now to the right
+
+
+def test_water_hits_lie_on_the_wave_surface() -> None:
+    waves = WaveField(WaveConfig(preset="heavy"), 4)
+    scene = _scene(waves)
+    scene.update({}, 12.5)
+    d = beam_directions(32, 512, 45.0)
+    origin = np.array([10.0, -3.0, 2.5])
+    hits = scene.cast(origin, d, 100.0)
+    water = hits.cls == CLASS_WATER
+    assert water.sum() > 5000
+    p = origin + hits.range[water, None].astype(np.float64) * d[water]
+    assert np.abs(p[:, 2] - waves.height(p[:, 0], p[:, 1], 12.5)).max() < 0.01
+    assert np.allclose(hits.normal[water], waves.normal(p[:, 0], p[:, 1], 12.5), atol=1e-3)
+
+
+def test_terrain_hits_match_the_height_field() -> None:
+    x = np.arange(200) + 0.5
+    terrain = Terrain(np.add.outer(np.zeros(200), 2.0 + 0.05 * x + np.sin(x / 9)), 1.0)
+    scene = Scene(terrain=terrain, waves=CALM, bodies=[])
+    d = beam_directions(16, 64, 60.0) @ np.array([[1, 0, 0], [0, 1, 0], [0, 0, 1.0]]).T
+    d[:, 2] -= 1.5  # every ray well downward
+    origin = np.array([100.0, 100.0, 30.0])
+    hits = scene.cast(origin, d, 200.0)
+    assert np.all(hits.cls == CLASS_TERRAIN) and np.all(hits.instance == 0)
+    dn = d / np.linalg.norm(d, axis=1, keepdims=True)
+    p = origin + hits.range[:, None].astype(np.float64) * dn
+    assert np.abs(p[:, 2] - terrain.height(p[:, 0], p[:, 1])).max() < 0.05
+    assert np.all(hits.normal[:, 2] > 0.9)
+
+
+def test_nothing_in_range_is_none_and_culling_keeps_far_bodies_out() -> None:
+    far = [Body(f"b{i}", CLASS_VESSEL, 10 + i, (-1, -1, 0), (1, 1, 1)) for i in range(100)]
+    scene = Scene(terrain=None, waves=CALM, bodies=far)
+    scene.update({f"b{i}": ((500.0 + 10 * i, 0.0, 0.0), _quat(0.0)) for i in range(100)}, 0.0)
+    hits = scene.cast(np.array([0.0, 0.0, 1.0]), np.array([[1.0, 0.0, 0.0], [0, 0, 1.0]]), 100.0)
+    assert np.all(np.isinf(hits.range)) and np.all(hits.cls == CLASS_NONE)
+    assert np.all(hits.normal == 0)
+    with pytest.raises(SceneError, match="unknown body 'nope'"):
+        scene.update({"nope": ((0, 0, 0), (0, 0, 0, 1))}, 0.0)
+
+
+def test_scans_are_deterministic_and_rain_is_labelled() -> None:
+    scene = _scene(rain=50.0, ego=(0, 0, 0), boat=(30.0, 0.0, 0.0))
+    params = LidarParams(mount_xyz=(0.0, 0.0, 1.0))
+    a, b, c = (LidarModel(params, scene=scene, seed=s, name="ego/lidar") for s in (1, 1, 2))
+    sa, sb, sc = (m.sample(_state(), tick=0, stamp_ns=0) for m in (a, b, c))
+    for name in ("points", "intensity", "ring", "cls", "instance", "is_rain", "range_image"):
+        assert np.array_equal(getattr(sa, name), getattr(sb, name))
+    assert not np.array_equal(sa.range_image, sc.range_image)
+    assert sa.range_image.shape == (32, 512) and sa.points.dtype == np.float32
+    assert sa.is_rain.any() and np.all(sa.cls[sa.is_rain] == CLASS_NONE)
+    assert np.all(sa.instance[sa.is_rain] == 0)

@@ -1,0 +1,125 @@
+"""Traffic behaviours driving real PhysicsWorld boats, and the spawning plan."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+from catabot.placement import footprint_m
+from catabot.scenario import Pose, parse_scenario
+from catabot.terrain import Terrain
+from catabot.traffic_plan import Boat, Planner, plan_traffic
+from catabot.vessel import load_vessel_model
+from services.physics.control import TwistControllerBank
+from services.physics.world import PhysicsWorld
+from services.traffic.behaviours import Behaviours
+
+DT = 0.02
+
+
+def _simulate(boats: list[Boat], seconds: float) -> np.ndarray:
+    """Boats stepped in PhysicsWorld under their behaviours; returns positions (steps, N, 2)."""
+    model = load_vessel_model("monohull")
+    starts = [(b.id, model, (b.pose.x_m, b.pose.y_m, 0.0, b.pose.yaw_rad)) for b in boats]
+    world = PhysicsWorld(starts, dt_s=DT)
+    bank = TwistControllerBank([model] * len(boats), dt_s=DT)
+    behaviours = Behaviours(boats)
+    rows = np.arange(len(boats))
+    track = []
+    for _ in range(round(seconds / DT)):
+        s = world.state_arrays()
+        q = s.orientation
+        yaw = np.arctan2(
+            2 * (q[:, 3] * q[:, 2] + q[:, 0] * q[:, 1]), 1 - 2 * (q[:, 1] ** 2 + q[:, 2] ** 2)
+        )
+        surge, rate = behaviours.command(s.position[:, :2], yaw, s.linear_velocity)
+        measured = np.stack([s.linear_velocity[:, 0], s.angular_velocity[:, 2]], axis=1)
+        out = bank.command(rows, np.stack([surge, rate], axis=1), measured)
+        for i, b in enumerate(boats):
+            world.set_thrust(b.id, out[i])
+        world.step()
+        track.append(world.state_arrays().position[:, :2])
+    return np.array(track)
+
+
+def test_circling_boat_holds_its_radius_within_5_percent() -> None:
+    radius = 5.0 / math.radians(15.0)  # the original's 5 m/s at 15 deg/s
+    boat = Boat("b", "monohull", Pose(x_m=0.0, y_m=-radius), "circle", 5.0, (0.0, 0.0), radius, 1)
+    track = _simulate([boat], 60.0)
+    steady = track[len(track) // 2 :, 0]
+    r = np.hypot(steady[:, 0], steady[:, 1])
+    assert np.abs(r / radius - 1).max() < 0.05, (r.min(), r.max(), radius)
+    angle = np.unwrap(np.arctan2(steady[:, 1], steady[:, 0]))
+    assert angle[-1] > angle[0] + math.pi  # counter-clockwise, and really going round
+
+
+def test_waypoint_follower_passes_every_point_and_returns() -> None:
+    path = ((60.0, 0.0), (60.0, 60.0), (120.0, 60.0))
+    boat = Boat("b", "monohull", Pose(), "waypoints", 5.0, path=path, tolerance_m=5.0)
+    track = _simulate([boat], 110.0)[:, 0]
+    times: list[int] = []
+    for point in (*path, path[1], path[0]):  # out, then back along the same path
+        d = np.hypot(*(track - point).T)
+        start = times[-1] + 50 if times else 0  # the next visit, after the previous one
+        hit = np.flatnonzero(d[start:] < 5.0)
+        assert hit.size, f"never within 5 m of {point} after step {start}"
+        times.append(start + int(hit[0]))
+    assert times == sorted(times)
+
+
+def test_hold_position_brings_a_drifted_boat_back() -> None:
+    boat = Boat("b", "monohull", Pose(x_m=15.0, y_m=-10.0, yaw_rad=2.0), "hold", 2.0, (0.0, 0.0))
+    track = _simulate([boat], 60.0)[:, 0]
+    assert np.hypot(*track[-1]) < 2.0
+    assert np.hypot(*track[-250:].T).max() < 3.0
+
+
+def _scenario(count: int, **traffic: object) -> dict[str, object]:
+    mix = {"circle": 0.4, "waypoints": 0.3, "hold": 0.3}
+    return {
+        "seed": 7,
+        "vessels": [{"id": "ego", "pose": {"x_m": 0.0, "y_m": 0.0}}],
+        "traffic": {"count": count, "behaviour_mix": mix, **traffic},
+    }
+
+
+def test_same_seed_same_plan_and_another_seed_another() -> None:
+    a = plan_traffic(parse_scenario(_scenario(60)))
+    b = plan_traffic(parse_scenario(_scenario(60)))
+    c = plan_traffic(parse_scenario(_scenario(60, seed=8)))
+    assert a == b and a != c
+    assert [x.id for x in a.boats[:3]] == ["boat_000", "boat_001", "boat_002"]
+    assert len(a.buoys) == 5 * sum(x.behaviour == "waypoints" for x in a.boats)
+
+
+def test_no_boat_overlaps_another_or_the_ego() -> None:
+    plan = plan_traffic(parse_scenario(_scenario(200, region={"size_m": [300.0, 300.0]})))
+    xy = np.array([(0.0, 0.0)] + [(b.pose.x_m, b.pose.y_m) for b in plan.boats])
+    r = footprint_m(load_vessel_model("monohull"))
+    d = np.hypot(*(xy[:, None] - xy[None]).transpose(2, 0, 1)) + np.eye(len(xy)) * 1e9
+    assert d.min() > 2 * r
+
+
+def test_no_boat_starts_or_steers_on_land() -> None:
+    """Synthetic terrain: land on the west half, a deep bay on the east half."""
+    x = (np.arange(200) + 0.5) * 5.0
+    grid = np.where(x[None, :] < 500.0, 10.0, -20.0) * np.ones((200, 1))
+    terrain = Terrain(grid, 5.0)
+    data = _scenario(80, region={"center_m": [500.0, 500.0], "size_m": [1000.0, 1000.0]})
+    data["vessels"] = [{"id": "ego", "pose": {"x_m": 800.0, "y_m": 500.0}}]
+    plan = Planner(parse_scenario(data), terrain).plan()
+    for b in plan.boats:
+        assert terrain.depth(b.pose.x_m, b.pose.y_m) > 1.0, b
+        if b.behaviour == "circle":
+            assert b.center[0] - b.radius_m > 500.0, b
+        for px, _ in b.path:
+            assert px > 500.0, b
+
+
+def test_a_bad_mix_is_refused_naming_the_field() -> None:
+    from catabot.scenario import ScenarioError
+
+    with pytest.raises(ScenarioError, match=r"traffic\.behaviour_mix"):
+        parse_scenario(_scenario(3) | {"traffic": {"count": 3, "behaviour_mix": {"zigzag": 1}}})
