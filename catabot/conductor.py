@@ -142,8 +142,7 @@ class Conductor:
                 return k
             self._pace(k)
             self._publish_tick(k)
-            if not self._await_acks(k):
-                return k
+            self._await_acks(k)
             self._done = k + 1
             now = time.monotonic()
             if on_progress and now - last_report >= 0.25:
@@ -170,11 +169,14 @@ class Conductor:
         tick = Tick(self.run_id, k, k * self.spec.dt_ns, self.spec.dt_ns, tuple(self.dropped))
         self._tick_pub.put(codec.encode(tick))
 
-    def _await_acks(self, k: int) -> bool:
-        """Wait until every participant acked tick `k` or was dropped; False on a stop."""
+    def _await_acks(self, k: int) -> None:
+        """Wait until every participant acked tick `k` or was dropped.
+
+        A stop asked meanwhile does not cut the tick short: the tick completes (so every
+        participant has the same last tick) and the loop stops at the next boundary.
+        """
         waiting = set(self.spec.participants) - set(self.dropped)
-        if not self._check_events(k, waiting):
-            return False
+        self._check_events(k, waiting)
         self._deadline = time.monotonic() + self.spec.deadline_s
         try:
             while waiting:
@@ -182,18 +184,15 @@ class Conductor:
                 key = str(sample.key_expr)
                 if key != self._poke_key:
                     self._take_ack(k, key, sample.payload.to_bytes(), waiting)
-                elif not self._check_events(k, waiting):
-                    return False
+                else:
+                    self._check_events(k, waiting)
         finally:
             self._deadline = None
-        return True
 
-    def _check_events(self, k: int, waiting: set[str]) -> bool:
-        """Apply pending membership events and the deadline; False when a stop is asked."""
+    def _check_events(self, k: int, waiting: set[str]) -> None:
+        """Apply pending membership events (a stop is noted in `_stop_reason`) and the deadline."""
         while not self.events.empty():
-            kind, _, _ = self._next_event(0.0)
-            if kind == "stop":
-                return False
+            self._next_event(0.0)
         for name in sorted(waiting - self.members):
             self._fault(name, f"left the run at tick {k}", waiting)
         if self._deadline is not None and time.monotonic() > self._deadline:
@@ -201,7 +200,6 @@ class Conductor:
                 self._fault(
                     name, f"missed the {self.spec.deadline_s:g} s deadline of tick {k}", waiting
                 )
-        return True
 
     def _take_ack(self, k: int, key: str, payload: bytes, waiting: set[str]) -> None:
         try:

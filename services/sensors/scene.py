@@ -129,10 +129,9 @@ class Scene:
         pairs: tuple[NDArray[np.intp], NDArray[np.intp]] | None = None,
     ) -> Hits:
         """First hit of each ray (origins (N,3) or (3,), directions (N,3), normalised here)
-        within `max_range` metres. `pairs` (ray indices, body indices into `bodies`), when
-        given, replaces the body cull: a caller that knows which rays can meet which body
-        (a camera projects each box into its image) saves the (rays x bodies) test; every
-        (ray, body) that can hit must be in it."""
+        within `max_range` metres. `pairs` (ray, body index) replaces the body cull when the
+        caller knows which rays can meet which body (a camera projects each box into its
+        image); it must hold every pair that can hit."""
         o, d = _rays(origins, directions)
         n = d.shape[0]
         rng = np.full(n, np.inf)

@@ -1,0 +1,182 @@
+"""Hand-written little-endian CDR (XCDR1) encoders for the ROS 2 messages of `run.mcap`.
+
+Why not `mcap_ros2`'s dynamic serializer: it walks the message definition field by field for
+every message (~50-130 us an Odometry), which with 100+ vessels costs tens of milliseconds a
+tick. Every field of Odometry and everything of PointCloud2 but three integers and the data is
+fixed once the frame ids are known, so each encoder compiles one `struct.Struct` up front and
+packs a message in one call. The bytes are identical to the dynamic serializer's
+(tests/services/recorder/test_cdr.py), so readers and earlier recordings see no difference.
+
+CDR rules used here: a 4-byte encapsulation header (CDR_LE) precedes the data; alignment is
+relative to the start of the data after it; a primitive of size n is aligned to n; a string is
+a uint32 length counting its NUL, the UTF-8 bytes and the NUL; a sequence is a uint32 count and
+its items; fixed arrays (float64[36]) have no prefix.
+"""
+
+from __future__ import annotations
+
+import struct
+import typing
+from collections.abc import Iterable, Mapping
+
+from catabot.messages import VesselState
+
+ENCAPSULATION = b"\x00\x01\x00\x00"  # CDR_LE, options 0
+_NS_PER_S = 1_000_000_000
+_COVARIANCE = 36  # float64[36], all zero: the simulator knows the exact state
+_FLOAT64 = 8
+
+
+class _Layout:
+    """Builds a little-endian `struct` format while tracking the CDR offset for alignment.
+
+    The offset counts from the start of the data after the encapsulation header, which is the
+    CDR alignment origin; the header itself is the first `4s` of every format.
+    """
+
+    def __init__(self) -> None:
+        self.format = "<4s"
+        self.offset = 0
+
+    def align(self, size: int) -> None:
+        """Zero padding so the next field of `size` bytes starts on a multiple of `size`."""
+        pad = -self.offset % size
+        if pad:
+            self.format += f"{pad}x"
+            self.offset += pad
+
+    def add(self, code: str, size: int) -> None:
+        """One aligned primitive (`code` is its `struct` letter)."""
+        self.align(size)
+        self.format += code
+        self.offset += size
+
+    def raw(self, count: int) -> None:
+        """`count` bytes packed from one `bytes` argument, no alignment (string bodies)."""
+        self.format += f"{count}s"
+        self.offset += count
+
+    def zeros(self, count: int) -> None:
+        """`count` zero bytes that take no argument (zero covariance, already aligned)."""
+        if count:
+            self.format += f"{count}x"
+            self.offset += count
+
+    def string(self, text: str) -> tuple[int, bytes]:
+        """A string field; returns the two pack arguments (length with NUL, bytes with NUL)."""
+        data = text.encode("utf-8") + b"\0"
+        self.add("I", 4)
+        self.raw(len(data))
+        return len(data), data
+
+    def compile(self) -> struct.Struct:
+        return struct.Struct(self.format)
+
+
+def _stamp(stamp_ns: int) -> tuple[int, int]:
+    """builtin_interfaces/Time (sec, nanosec); floor division keeps nanosec >= 0, as
+    `ros2_msgdefs.stamp` does."""
+    return divmod(stamp_ns, _NS_PER_S)
+
+
+def _header(layout: _Layout, frame_id: str) -> tuple[int, bytes]:
+    """std_msgs/Header: the stamp (packed per message) and the constant frame id."""
+    layout.add("i", 4)  # stamp.sec
+    layout.add("I", 4)  # stamp.nanosec
+    return layout.string(frame_id)
+
+
+def _odometry_struct(frame_id: str, child_frame_id: str) -> tuple[struct.Struct, tuple[object, ...]]:
+    """The Odometry format for two frame ids and the constant pack arguments after the stamp."""
+    layout = _Layout()
+    frame = _header(layout, frame_id)
+    child = layout.string(child_frame_id)
+    for _ in range(7):  # pose.pose: position xyz, orientation xyzw
+        layout.add("d", _FLOAT64)
+    layout.zeros(_COVARIANCE * _FLOAT64)
+    for _ in range(6):  # twist.twist: linear xyz, angular xyz
+        layout.add("d", _FLOAT64)
+    layout.zeros(_COVARIANCE * _FLOAT64)
+    return layout.compile(), (*frame, *child)
+
+
+def odometry_encoder(
+    frame_id: str, child_frame_id: str
+) -> typing.Callable[[VesselState, int], bytes]:
+    """CDR encoder of `nav_msgs/msg/Odometry` for one pair of frame ids.
+
+    Pose in `frame_id`, twist in `child_frame_id`; the covariances are zero and the
+    accelerations have no place in Odometry (see `ros2_msgdefs.odometry`, the same mapping).
+    """
+    compiled, frames = _odometry_struct(frame_id, child_frame_id)
+    pack = compiled.pack
+
+    def encode(state: VesselState, stamp_ns: int) -> bytes:
+        sec, nanosec = _stamp(stamp_ns)
+        p, v, w = state.position, state.linear_velocity, state.angular_velocity
+        x, y, z, qw = state.orientation
+        return pack(
+            ENCAPSULATION, sec, nanosec, *frames,
+            p[0], p[1], p[2], x, y, z, qw,
+            v[0], v[1], v[2], w[0], w[1], w[2],
+        )  # fmt: skip
+
+    return encode
+
+
+def _point_fields(fields: Iterable[Mapping[str, typing.Any]]) -> bytes:
+    """`sensor_msgs/PointField[]` as CDR, from an offset that is a multiple of 4.
+
+    Every item starts with a 4-aligned string length and holds no 8-byte type, so the bytes
+    are the same at any 4-aligned offset and can be built once.
+    """
+    layout = _Layout()
+    items = list(fields)
+    args: list[object] = [ENCAPSULATION, len(items)]
+    layout.add("I", 4)  # sequence length
+    for item in items:
+        args.extend(layout.string(str(item["name"])))
+        layout.add("I", 4)  # offset
+        layout.add("B", 1)  # datatype
+        layout.add("I", 4)  # count
+        args.extend((int(item["offset"]), int(item["datatype"]), int(item["count"])))
+    return layout.compile().pack(*args)[len(ENCAPSULATION) :]
+
+
+def _pointcloud2_head(frame_id: str, fields_cdr: bytes) -> tuple[struct.Struct, tuple[object, ...]]:
+    """The PointCloud2 format from the header up to the data length, and its constant
+    arguments: frame, height 1, then (width), fields, is_bigendian False, point_step."""
+    layout = _Layout()
+    frame = _header(layout, frame_id)
+    layout.add("I", 4)  # height
+    layout.add("I", 4)  # width (per message)
+    layout.raw(len(fields_cdr))  # starts 4-aligned, which _point_fields needs
+    layout.add("B", 1)  # is_bigendian
+    layout.add("I", 4)  # point_step
+    layout.add("I", 4)  # row_step (per message)
+    layout.add("I", 4)  # data length (per message)
+    return layout.compile(), frame
+
+
+def pointcloud2_encoder(
+    frame_id: str, fields: Iterable[Mapping[str, typing.Any]], point_step: int
+) -> typing.Callable[[typing.Any, int, int], bytes]:
+    """CDR encoder of an unorganised (height 1), little-endian, dense `sensor_msgs/PointCloud2`.
+
+    The returned `encode(data, width, stamp_ns)` takes the point bytes (any contiguous buffer,
+    `width * point_step` bytes), so the bulk data is copied once, straight into the message.
+    """
+    fields_cdr = _point_fields(fields)
+    compiled, frame = _pointcloud2_head(frame_id, fields_cdr)
+    pack = compiled.pack
+
+    def encode(data: typing.Any, width: int, stamp_ns: int) -> bytes:
+        sec, nanosec = _stamp(stamp_ns)
+        view = memoryview(data).cast("B")
+        head = pack(
+            ENCAPSULATION, sec, nanosec, *frame, 1, width, fields_cdr,
+            False, point_step, point_step * width, len(view),
+        )  # fmt: skip
+        return b"".join((head, view, b"\x01"))  # data is one byte a row: no padding; is_dense
+
+    return encode
