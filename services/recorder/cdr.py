@@ -86,7 +86,9 @@ def _header(layout: _Layout, frame_id: str) -> tuple[int, bytes]:
     return layout.string(frame_id)
 
 
-def _odometry_struct(frame_id: str, child_frame_id: str) -> tuple[struct.Struct, tuple[object, ...]]:
+def _odometry_struct(
+    frame_id: str, child_frame_id: str
+) -> tuple[struct.Struct, tuple[object, ...]]:
     """The Odometry format for two frame ids and the constant pack arguments after the stamp."""
     layout = _Layout()
     frame = _header(layout, frame_id)

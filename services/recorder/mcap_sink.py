@@ -29,11 +29,10 @@ from mcap.records import Message as McapMessage
 from mcap.stream_reader import MAGIC_SIZE, StreamReader
 from mcap.well_known import MessageEncoding, SchemaEncoding
 from mcap.writer import LIBRARY_IDENTIFIER, CompressionType, Writer
-from mcap_ros2._dynamic import serialize_dynamic
 from mcap_ros2.decoder import DecoderFactory
 
 from catabot.messages import CameraFrame, LidarScan, Message, VesselState
-from services.recorder import images, json_schemas, pointcloud, ros2_msgdefs
+from services.recorder import cdr, images, json_schemas, pointcloud, ros2_msgdefs
 from services.recorder.csv_sink import RecorderError
 
 _RECORD_HEAD = struct.Struct("<BQ")  # opcode, length of the record body
@@ -188,14 +187,14 @@ def _vessel_of(stream: str) -> str:
 
 
 def _odometry_encoder(vessel: str) -> typing.Callable[[Message, int], bytes]:
-    """CDR encoder of one vessel's Odometry (mcap_ros2's writer always chunks, so we
-    use its serializer with our own unchunked writer)."""
-    defs = serialize_dynamic(ros2_msgdefs.ODOMETRY, ros2_msgdefs.ODOMETRY_MSGDEF)
-    serialize = defs[ros2_msgdefs.ODOMETRY]
+    """CDR encoder of one vessel's Odometry (mcap_ros2's writer always chunks, so we write
+    our own unchunked records; cdr.py packs the same bytes as mcap_ros2's dynamic serializer
+    at a fraction of its cost per message)."""
+    odometry = cdr.odometry_encoder(ros2_msgdefs.WORLD_FRAME, vessel)
 
     def encode(msg: Message, stamp_ns: int) -> bytes:
         assert isinstance(msg, VesselState)
-        return bytes(serialize(ros2_msgdefs.odometry(msg, vessel, stamp_ns)))
+        return odometry(msg, stamp_ns)
 
     return encode
 

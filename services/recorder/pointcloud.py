@@ -15,10 +15,9 @@ from __future__ import annotations
 import typing
 
 import numpy as np
-from mcap_ros2._dynamic import serialize_dynamic
 
 from catabot.messages import LidarScan, Message
-from services.recorder.ros2_msgdefs import stamp
+from services.recorder.cdr import pointcloud2_encoder
 
 POINTCLOUD2 = "sensor_msgs/msg/PointCloud2"
 _SEPARATOR = "=" * 80
@@ -96,27 +95,13 @@ def points(scan: LidarScan) -> np.ndarray:
 
 
 def pointcloud_encoder(stream: str) -> typing.Callable[[Message, int], bytes]:
-    """CDR encoder of the PointCloud2 of one LiDAR stream."""
-    frame = sensor_frame(stream)
-    serialize = serialize_dynamic(POINTCLOUD2, POINTCLOUD2_MSGDEF)[POINTCLOUD2]
+    """CDR encoder of the PointCloud2 of one LiDAR stream (cdr.py: the same bytes as
+    mcap_ros2's dynamic serializer, without walking the definition per message)."""
+    encode_cloud = pointcloud2_encoder(sensor_frame(stream), FIELDS, POINT.itemsize)
 
     def encode(msg: Message, stamp_ns: int) -> bytes:
         assert isinstance(msg, LidarScan)
         cloud = points(msg)
-        return bytes(
-            serialize(
-                {
-                    "header": {"stamp": stamp(stamp_ns), "frame_id": frame},
-                    "height": 1,
-                    "width": len(cloud),
-                    "fields": FIELDS,
-                    "is_bigendian": False,
-                    "point_step": POINT.itemsize,
-                    "row_step": POINT.itemsize * len(cloud),
-                    "data": cloud.tobytes(),
-                    "is_dense": True,
-                }
-            )
-        )
+        return encode_cloud(cloud, len(cloud), stamp_ns)
 
     return encode

@@ -248,10 +248,13 @@ def _rays(origins: np.ndarray, directions: np.ndarray) -> tuple[F64, F64]:
         raise SceneError(f"directions must have shape (N, 3) (got {d.shape})")
     raw = np.asarray(origins, dtype=np.float64)
     o = np.broadcast_to(raw, d.shape)  # one shared origin stays a stride-0 view (cheap cull)
-    norm = np.linalg.norm(d, axis=1, keepdims=True)
-    if not (np.isfinite(raw).all() and np.isfinite(d).all() and (norm > 0).all()):
+    norm = np.sqrt(np.einsum("ij,ij->i", d, d))  # a NaN or inf anywhere in d shows here too
+    if not (np.isfinite(raw).all() and np.isfinite(norm).all() and (norm > 0).all()):
         raise SceneError("rays need finite origins and finite, non-zero directions")
-    return o, d / norm
+    if d is directions:  # the caller's own array: never scale it in place
+        return o, d / norm[:, None]
+    d /= norm[:, None]  # a fresh float64 copy made above
+    return o, d
 
 
 def _slab(ob: F64, db: F64, lo: F64, hi: F64) -> tuple[F64, F64]:

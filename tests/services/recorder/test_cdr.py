@@ -1,0 +1,148 @@
+"""cdr.py packs exactly the bytes of mcap_ros2's dynamic serializer, and they decode back."""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import pytest
+from mcap.reader import make_reader
+from mcap_ros2._dynamic import serialize_dynamic
+from mcap_ros2.decoder import DecoderFactory
+
+from catabot.messages import LidarScan, VesselState
+from services.recorder import cdr, pointcloud, ros2_msgdefs
+from services.recorder.mcap_sink import McapSink
+
+# Lengths 0..8 with the NUL put every residue mod 4 and mod 8 before the float64s.
+FRAMES = ["", "a", "ab", "abc", "ego", "ego1", "vessel", "boat_007", "ümlaut", "x" * 33]
+STAMPS = [0, 10, 1_500_000_001, 1_700_000_000_123_456_789, -1]
+
+
+def _state(k: int) -> VesselState:
+    f = 0.1 * k + 0.25
+    return VesselState(
+        tick=k,
+        stamp_ns=k,
+        position=(f, -2.0 * f, 1e300),
+        orientation=(0.0, -0.0, 0.5 * f, np.float64(0.75)),
+        linear_velocity=(1, 2, 3),  # ints, as the dynamic serializer coerces them
+        angular_velocity=(float("inf"), -f, 5e-324),
+        linear_acceleration=(9.0, 9.0, 9.0),
+        angular_acceleration=(9.0, 9.0, 9.0),
+    )
+
+
+def _dynamic(schema: str, msgdef: str) -> Any:
+    return serialize_dynamic(schema, msgdef)[schema]
+
+
+@pytest.mark.parametrize("child", FRAMES)
+@pytest.mark.parametrize("frame", ["map", "", "odom_frame"])
+def test_odometry_bytes_match_dynamic_serializer(frame: str, child: str) -> None:
+    reference = _dynamic(ros2_msgdefs.ODOMETRY, ros2_msgdefs.ODOMETRY_MSGDEF)
+    encode = cdr.odometry_encoder(frame, child)
+    for k, stamp_ns in enumerate(STAMPS):
+        state = _state(k)
+        expected = ros2_msgdefs.odometry(state, child, stamp_ns)
+        expected["header"]["frame_id"] = frame
+        data = encode(state, stamp_ns)
+        assert data[:4] == b"\x00\x01\x00\x00"
+        assert data == bytes(reference(expected))
+
+
+def _scan(n: int, seed: int) -> LidarScan:
+    rng = np.random.default_rng(seed)
+    return LidarScan(
+        tick=seed,
+        stamp_ns=seed,
+        points=rng.normal(size=(n, 3)).astype(np.float32),
+        intensity=rng.random(n, dtype=np.float32),
+        ring=rng.integers(0, 64, n).astype(np.uint16),
+        cls=rng.integers(0, 9, n).astype(np.uint8),
+        instance=rng.integers(-1, 1000, n).astype(np.int32),
+        is_rain=rng.random(n) < 0.1,
+        range_image=np.zeros((4, 8), np.float32),
+    )
+
+
+def _dynamic_cloud(scan: LidarScan, frame: str, stamp_ns: int) -> bytes:
+    """PointCloud2 exactly as pointcloud.py built it before cdr.py."""
+    reference = _dynamic(pointcloud.POINTCLOUD2, pointcloud.POINTCLOUD2_MSGDEF)
+    cloud = pointcloud.points(scan)
+    msg = {
+        "header": {"stamp": ros2_msgdefs.stamp(stamp_ns), "frame_id": frame},
+        "height": 1,
+        "width": len(cloud),
+        "fields": pointcloud.FIELDS,
+        "is_bigendian": False,
+        "point_step": pointcloud.POINT.itemsize,
+        "row_step": pointcloud.POINT.itemsize * len(cloud),
+        "data": cloud.tobytes(),
+        "is_dense": True,
+    }
+    return bytes(reference(msg))
+
+
+@pytest.mark.parametrize("n", [0, 1, 7, 300])
+@pytest.mark.parametrize("sensor", ["l", "li", "lid", "lidar", "top_lidar"])
+def test_pointcloud2_bytes_match_dynamic_serializer(n: int, sensor: str) -> None:
+    encode = pointcloud.pointcloud_encoder(f"sensor/ego/{sensor}")
+    for stamp_ns in STAMPS[:4]:
+        scan = _scan(n, stamp_ns % 97)
+        assert encode(scan, stamp_ns) == _dynamic_cloud(scan, f"ego/{sensor}", stamp_ns)
+
+
+def _decoded(path: Path) -> list[tuple[str, bytes, Any]]:
+    """(topic, raw bytes, decoded message) of every message, via mcap_ros2's decoder."""
+    with open(path, "rb") as f:
+        reader = make_reader(f, decoder_factories=[DecoderFactory()])
+        return [
+            (channel.topic, bytes(message.data), decoded)
+            for _, channel, message, decoded in reader.iter_decoded_messages(log_time_order=False)
+        ]
+
+
+def test_odometry_decodes_from_mcap(tmp_path: Path) -> None:
+    reference = _dynamic(ros2_msgdefs.ODOMETRY, ros2_msgdefs.ODOMETRY_MSGDEF)
+    sent = [
+        (f"vessel/{child or 'x'}/state", _state(k), STAMPS[k % 4]) for k, child in enumerate(FRAMES)
+    ]
+    with McapSink(tmp_path / "run.mcap") as sink:
+        for stream, state, stamp_ns in sent:
+            sink.write(stream, state, stamp_ns=stamp_ns)
+            sink.flush()
+    got = _decoded(tmp_path / "run.mcap")
+    assert len(got) == len(sent)
+    for (stream, state, stamp_ns), (topic, data, msg) in zip(sent, got, strict=True):
+        child = stream.split("/")[1]
+        assert topic == "/" + stream
+        assert data == bytes(reference(ros2_msgdefs.odometry(state, child, stamp_ns)))
+        assert (msg.header.stamp.sec, msg.header.stamp.nanosec) == divmod(stamp_ns, 10**9)
+        assert (msg.header.frame_id, msg.child_frame_id) == ("map", child)
+        pose, twist = msg.pose.pose, msg.twist.twist
+        assert (pose.position.x, pose.position.y, pose.position.z) == state.position
+        o = pose.orientation
+        assert (o.x, o.y, o.z, o.w) == state.orientation
+        assert (twist.linear.x, twist.linear.y, twist.linear.z) == state.linear_velocity
+        assert (twist.angular.x, twist.angular.y, twist.angular.z) == state.angular_velocity
+        assert list(msg.pose.covariance) == [0.0] * 36 == list(msg.twist.covariance)
+
+
+def test_pointcloud2_decodes_from_mcap(tmp_path: Path) -> None:
+    scans = [("sensor/ego/lidar", _scan(0, 1)), ("sensor/b/top", _scan(50, 2))]
+    with McapSink(tmp_path / "run.mcap") as sink:
+        for stream, scan in scans:
+            sink.write(stream, scan, stamp_ns=123_456_789_012)
+    got = _decoded(tmp_path / "run.mcap")
+    for (stream, scan), (_, _, msg) in zip(scans, got, strict=True):
+        cloud = pointcloud.points(scan)
+        assert msg.header.frame_id == stream.removeprefix("sensor/")
+        assert (msg.header.stamp.sec, msg.header.stamp.nanosec) == (123, 456_789_012)
+        assert (msg.height, msg.width, msg.point_step) == (1, len(cloud), 24)
+        assert (msg.row_step, msg.is_bigendian, msg.is_dense) == (24 * len(cloud), False, True)
+        assert [(f.name, f.offset, f.datatype, f.count) for f in msg.fields] == [
+            (f["name"], f["offset"], f["datatype"], f["count"]) for f in pointcloud.FIELDS
+        ]
+        assert bytes(msg.data) == cloud.tobytes()
