@@ -66,6 +66,10 @@ class Keys:
     def vessel_states(self) -> str:
         return f"{self.prefix}/vessel/*/state"
 
+    def world_states(self) -> str:
+        """Every body's state in one `BodyStates` per tick (what lockstep services read)."""
+        return f"{self.prefix}/world/states"
+
     def cmd_thrust(self, vessel: str) -> str:
         return f"{self.prefix}/vessel/{check_name('vessel', vessel)}/cmd/thrust"
 

@@ -85,6 +85,51 @@ class VesselState(Message):
 
 
 @dataclass(frozen=True)
+class BodyStates(Message):
+    """Every body's state at one instant in one message: row i of each array is `ids[i]`.
+
+    Per-body messages cost a put, a callback and a decode each on every consumer, which
+    dominates a tick with hundreds of bodies; one batch of float64 arrays costs one. Rows:
+    every vessel (traffic boats included), then every buoy; frames as in `VesselState`.
+    `position` (N, 3) m, `orientation` (N, 4) quaternion x, y, z, w, velocities and
+    accelerations (N, 3) in the body frame.
+    """
+
+    TYPE: ClassVar[str] = "body_states"
+    tick: int
+    stamp_ns: int
+    ids: tuple[str, ...] = field(metadata={"unit": ""})
+    position: np.ndarray = field(metadata={"unit": "m"})
+    orientation: np.ndarray = field(metadata={"unit": ""})
+    linear_velocity: np.ndarray = field(metadata={"unit": "m/s"})
+    angular_velocity: np.ndarray = field(metadata={"unit": "rad/s"})
+    linear_acceleration: np.ndarray = field(metadata={"unit": "m/s^2"})
+    angular_acceleration: np.ndarray = field(metadata={"unit": "rad/s^2"})
+
+    def row(self, i: int) -> VesselState:
+        """Body i as a `VesselState` (python floats: recorded bytes match the per-body form)."""
+        return VesselState(
+            self.tick, self.stamp_ns, *(tuple(a[i].tolist()) for a in self._arrays())
+        )
+
+    def rows(self) -> list[VesselState]:
+        """Every body as a `VesselState`, in `ids` order; one `tolist` per array, not per row."""
+        cols = [a.tolist() for a in self._arrays()]
+        rows = zip(*cols, strict=True)
+        return [VesselState(self.tick, self.stamp_ns, *map(tuple, r)) for r in rows]
+
+    def _arrays(self) -> tuple[np.ndarray, ...]:
+        return (
+            self.position,
+            self.orientation,
+            self.linear_velocity,
+            self.angular_velocity,
+            self.linear_acceleration,
+            self.angular_acceleration,
+        )
+
+
+@dataclass(frozen=True)
 class ThrustCmd(Message):
     """Per-thruster command, normalised: -1 full reverse, +1 full forward.
 
@@ -230,6 +275,7 @@ MESSAGE_TYPES: dict[str, type[Message]] = {
         Ack,
         End,
         VesselState,
+        BodyStates,
         ThrustCmd,
         TwistCmd,
         WaypointsCmd,

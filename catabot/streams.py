@@ -8,7 +8,7 @@ from __future__ import annotations
 
 from catabot.clock import Stream, period_in_ticks
 from catabot.keys import Keys
-from catabot.messages import ThrustCmd, TwistCmd, VesselState, WaypointsCmd
+from catabot.messages import BodyStates, ThrustCmd, TwistCmd, VesselState, WaypointsCmd
 from catabot.scenario import Scenario
 from catabot.sensor_types import SENSOR_TYPES
 from catabot.traffic_plan import all_buoys, all_vessels, plan_traffic
@@ -16,10 +16,40 @@ from catabot.traffic_plan import all_buoys, all_vessels, plan_traffic
 EXTERNAL = "external"
 
 
+def body_ids(scenario: Scenario) -> tuple[str, ...]:
+    """The rows of `BodyStates`: vessels (traffic included), then buoys."""
+    return tuple(v.id for v in all_vessels(scenario)) + tuple(b.id for b in all_buoys(scenario))
+
+
+class BodyRows:
+    """Which row of a `BodyStates` holds which body: mapped once, at the first batch, then
+    only checked (a changed row order would silently swap bodies between consumers)."""
+
+    def __init__(self, expected: tuple[str, ...]) -> None:
+        self.expected = expected
+        self.row: dict[str, int] | None = None
+
+    def check(self, batch: BodyStates) -> dict[str, int]:
+        """The id -> row map; raises ValueError when the batch's ids are not the table's."""
+        if batch.ids != self.expected:
+            raise ValueError(
+                f"world/states at tick {batch.tick} lists bodies {list(batch.ids)[:8]}..., "
+                f"expected {list(self.expected)[:8]}... ({len(self.expected)} bodies)"
+            )
+        if self.row is None:
+            self.row = {vid: i for i, vid in enumerate(batch.ids)}
+        return self.row
+
+
+def states_stream(keys: Keys) -> Stream:
+    """Every body's state from physics in one batch per tick: what lockstep services read."""
+    return Stream(keys.world_states(), BodyStates, "physics")
+
+
 def state_streams(scenario: Scenario, keys: Keys) -> list[Stream]:
-    """Every body's state from physics: vessels (traffic included), then buoys."""
-    ids = [v.id for v in all_vessels(scenario)] + [b.id for b in all_buoys(scenario)]
-    return [Stream(keys.vessel_state(i), VesselState, "physics") for i in ids]
+    """Each vessel's own state (traffic included), for observers and external autonomy
+    stacks only: no lockstep participant waits for them (they read `states_stream`)."""
+    return [Stream(keys.vessel_state(v.id), VesselState, "physics") for v in all_vessels(scenario)]
 
 
 def sensor_streams(scenario: Scenario, keys: Keys) -> list[Stream]:
@@ -63,7 +93,7 @@ def traffic_boat_ids(scenario: Scenario) -> set[str]:
 
 def world_streams(scenario: Scenario, keys: Keys) -> list[Stream]:
     """Every lockstep stream of the world (what the recorder waits for)."""
-    return state_streams(scenario, keys) + sensor_streams(scenario, keys)
+    return [states_stream(keys), *sensor_streams(scenario, keys)]
 
 
 def participants(scenario: Scenario) -> list[str]:

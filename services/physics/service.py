@@ -1,7 +1,7 @@
 """The physics service: a DART world stepped once per tick, states published every tick.
 
 At tick k it applies the orders in force (scripted, or the latest from the bus, which
-arrived before tick k), advances t_k → t_(k+1) and publishes each vessel's state at
+arrived before tick k), advances t_k → t_(k+1) and publishes every body's state at
 t_(k+1) tagged k: consumers see it from tick k+1 on (DESIGN.md §4's one-tick delay).
 """
 
@@ -13,7 +13,7 @@ import sys
 import numpy as np
 
 from catabot.inbox import Inputs
-from catabot.messages import Tick, VesselState
+from catabot.messages import BodyStates, Tick, VesselState
 from catabot.participant import Participant
 from catabot.service import Built, ServiceContext, run_service
 from catabot.streams import command_streams, waypoint_streams
@@ -21,9 +21,16 @@ from catabot.traffic_plan import all_vessels
 from services.physics.commands import CommandBook
 from services.physics.control import TwistControllerBank
 from services.physics.setup import build_world
-from services.physics.world import VesselKinematics
 
 log = logging.getLogger("physics")
+FIELDS = (  # the KinematicsArrays fields, in BodyStates / VesselState order
+    "position",
+    "orientation",
+    "linear_velocity",
+    "angular_velocity",
+    "linear_acceleration",
+    "angular_acceleration",
+)
 
 
 class PhysicsService:
@@ -39,6 +46,8 @@ class PhysicsService:
         )
         self.streams = command_streams(scenario, ctx.keys) + waypoint_streams(scenario, ctx.keys)
         self.vessel_of = {s.key: s.key.split("/")[-3] for s in self.streams}
+        self.body_ids = (*ids, *self.world.buoy_ids)
+        self.state_keys = [ctx.keys.vessel_state(vid) for vid in ids]
         self.participant = Participant(
             ctx.session, ctx.keys, ctx.name, inputs=self.streams, peers=ctx.peers
         )
@@ -71,35 +80,17 @@ class PhysicsService:
                     log.error("vessel %s: refused thrust command: %s", vid, exc)
 
     def _publish(self, tick: Tick) -> None:
-        """Every vessel's state, then every buoy's (sensors see buoys, the recorder logs them)."""
+        """One batch of every body for the lockstep services, then each vessel's own state
+        for observers (buoys only in the batch: nobody outside follows a buoy)."""
         stamp = tick.stamp_ns + self.dt_ns
-        for vid, s in self._body_states():
-            self.participant.publish(
-                self.keys.vessel_state(vid),
-                VesselState(
-                    tick.tick,
-                    stamp,
-                    _t(s.position),
-                    _t(s.orientation),
-                    _t(s.linear_velocity),
-                    _t(s.angular_velocity),
-                    _t(s.linear_acceleration),
-                    _t(s.angular_acceleration),
-                ),
-            )
-
-    def _body_states(self) -> list[tuple[str, VesselKinematics]]:
-        out = list(self.world.states().items())
-        b = self.world.buoy_state_arrays()
-        for i, bid in enumerate(self.world.buoy_ids):
-            row = (b.position, b.orientation, b.linear_velocity, b.angular_velocity)
-            acc = (b.linear_acceleration, b.angular_acceleration)
-            out.append((bid, VesselKinematics(*(a[i] for a in (*row, *acc)))))
-        return out
-
-
-def _t(values: object) -> tuple[float, ...]:
-    return tuple(float(v) for v in values)  # type: ignore[attr-defined]
+        v, b = self.world.state_arrays(), self.world.buoy_state_arrays()
+        cols = [np.concatenate((getattr(v, f), getattr(b, f))) for f in FIELDS]
+        self.participant.publish(
+            self.keys.world_states(), BodyStates(tick.tick, stamp, self.body_ids, *cols)
+        )
+        rows = zip(*(getattr(v, f).tolist() for f in FIELDS), strict=True)
+        for key, row in zip(self.state_keys, rows, strict=True):
+            self.participant.publish(key, VesselState(tick.tick, stamp, *map(tuple, row)))
 
 
 def build(ctx: ServiceContext) -> Built:

@@ -12,10 +12,10 @@ import logging
 import sys
 
 from catabot.inbox import Inputs
-from catabot.messages import CameraFrame, End, Message, Tick
+from catabot.messages import BodyStates, CameraFrame, End, Message, Tick
 from catabot.participant import Participant
 from catabot.service import Built, ServiceContext, run_service
-from catabot.streams import command_streams, world_streams
+from catabot.streams import BodyRows, body_ids, command_streams, world_streams
 from services.recorder import images
 from services.recorder.csv_sink import CsvSink, RecorderError
 from services.recorder.dataset import Dataset
@@ -33,16 +33,23 @@ class Recorder:
         self.mcap = McapSink(ctx.run_dir / "run.mcap") if rec.mcap else None
         self.dataset = Dataset(ctx.run_dir / "dataset", ctx.scenario)
         streams = world_streams(ctx.scenario, ctx.keys) + command_streams(ctx.scenario, ctx.keys)
+        self.states_key = ctx.keys.world_states()
+        self.body_rows = BodyRows(body_ids(ctx.scenario))
+        self.state_keys = [ctx.keys.vessel_state(vid) for vid in self.body_rows.expected]
         self.participant = Participant(
             ctx.session, ctx.keys, ctx.name, inputs=streams, peers=ctx.peers
         )
 
     def step(self, tick: Tick, inputs: Inputs) -> None:
+        inputs = self._per_body(inputs)
         for key in sorted(inputs):
             stream = self.keys.relative(key)
             for msg in inputs[key]:
                 self._write(stream, _stamped(msg, tick))
         self._flush()
+
+    def _per_body(self, inputs: Inputs) -> Inputs:
+        return per_body(inputs, self.states_key, self.state_keys, self.body_rows)
 
     def _write(self, stream: str, msg: Message) -> None:
         try:
@@ -77,6 +84,22 @@ class Recorder:
         if self.mcap is not None:
             self.mcap.close()
         log.info("recorder closed its files after tick %d", end.tick)
+
+
+def per_body(inputs: Inputs, batch_key: str, state_keys: list[str], rows: BodyRows) -> Inputs:
+    """Each `BodyStates` row as the `VesselState` of `vessel/<id>/state` (buoys too): the
+    recorded files stay one CSV and one Odometry channel per body, as before the batch, and
+    the batch itself is not recorded. `state_keys[i]` is the key of row i."""
+    batches = inputs.get(batch_key)
+    if not batches:
+        return inputs
+    out = {k: v for k, v in inputs.items() if k != batch_key}
+    for batch in batches:
+        assert isinstance(batch, BodyStates)
+        rows.check(batch)
+        for key, state in zip(state_keys, batch.rows(), strict=True):
+            out.setdefault(key, []).append(state)
+    return out
 
 
 def _stamped(msg: Message, tick: Tick) -> Message:

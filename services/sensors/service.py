@@ -4,7 +4,8 @@ At tick k it samples from the newest vessel states (tagged k-1, stamped t_k: the
 at the start of this tick) and publishes samples tagged k stamped t_k. At tick 0 no
 state has been published yet, so the scenario's start pose at rest stands in: it is
 exactly the state physics starts from. Ray-casting sensors (LiDAR, radar, cameras) share one
-Scene, built once; it needs every body's pose, so then every vessel and buoy state is an input.
+Scene, built once; it needs every body's pose. Every state comes in one `BodyStates` per
+tick (`world/states`), whose rows are looked up by body id.
 """
 
 from __future__ import annotations
@@ -14,11 +15,11 @@ import sys
 from dataclasses import dataclass
 
 from catabot.inbox import Inputs
-from catabot.messages import Tick, VesselState
+from catabot.messages import BodyStates, Message, Tick, VesselState
 from catabot.participant import Participant
 from catabot.scenario import Pose, Scenario, VesselConfig
 from catabot.service import Built, ServiceContext, run_service
-from catabot.streams import state_streams
+from catabot.streams import BodyRows, body_ids, states_stream
 from catabot.terrain import load_terrain
 from catabot.traffic_plan import all_buoys, all_vessels
 from catabot.waves import WaveField
@@ -58,30 +59,38 @@ class SensorsService:
             for s in v.sensors
         ]
         carriers = {m.vessel for m in self.mounted}
-        if self.scene is None:  # no scene: only the carriers' own states matter
-            self.states = {v.id: start_state(v) for v in scenario.vessels if v.id in carriers}
-        else:  # the scene needs every vessel's and buoy's pose
-            self.states = start_states(scenario)
-        self.state_key = {ctx.keys.vessel_state(vid): vid for vid in self.states}
-        inputs = [s for s in state_streams(scenario, ctx.keys) if s.key in self.state_key]
+        self.states = {v.id: start_state(v) for v in scenario.vessels if v.id in carriers}
+        # the scene needs every vessel's and buoy's pose; at tick 0, the start poses at rest
+        self.poses = {vid: (s.position, s.orientation) for vid, s in start_states(scenario).items()}
+        self.states_key = ctx.keys.world_states()
+        self.rows = BodyRows(body_ids(scenario))
         self.participant = Participant(
-            ctx.session, ctx.keys, ctx.name, inputs=inputs, peers=ctx.peers
+            ctx.session, ctx.keys, ctx.name, inputs=[states_stream(ctx.keys)], peers=ctx.peers
         )
 
     def step(self, tick: Tick, inputs: Inputs) -> None:
-        for key, msgs in inputs.items():
-            state = msgs[-1]
-            assert isinstance(state, VesselState)
-            self.states[self.state_key[key]] = state
+        batches = inputs.get(self.states_key)
+        if batches:
+            self._take(batches[-1])
         if self.scene is not None:
-            poses = {vid: (s.position, s.orientation) for vid, s in self.states.items()}
-            self.scene.update(poses, tick.stamp_ns / 1e9)
+            self.scene.update(self.poses, tick.stamp_ns / 1e9)
         for m in self.mounted:
             if tick.tick % m.period == 0:
                 sample = m.sensor.sample(
                     self.states[m.vessel], tick=tick.tick, stamp_ns=tick.stamp_ns
                 )
                 self.participant.publish(m.key, sample)
+
+    def _take(self, batch: Message) -> None:
+        """The carriers' states as `VesselState` (what sensors sample) and, only when a
+        scene needs them, every body's pose straight from the batch's arrays."""
+        assert isinstance(batch, BodyStates)
+        row = self.rows.check(batch)
+        for vid in self.states:
+            self.states[vid] = batch.row(row[vid])
+        if self.scene is not None:
+            pos, quat = batch.position, batch.orientation
+            self.poses = {vid: (pos[i], quat[i]) for vid, i in row.items()}
 
 
 def needs_scene(scenario: Scenario) -> bool:

@@ -1,12 +1,12 @@
 """The traffic service: every tick, each boat's behaviour turns its state into a twist set-point.
 
-At tick k it reads the boats' states tagged k-1 (at t_k; the plan's start poses at rest at
-tick 0), runs the guidance laws for all boats at once and publishes each boat's set-point
-on `vessel/<boat>/cmd/twist` tagged k, which physics applies from tick k+1 (the one-tick
-delay of DESIGN.md §4). External control never fights these set-points: physics lets an
-external twist or thrust (tick -1) outrank them until a `WaypointsCmd` hands the boat
-back; a `WaypointsCmd` with a path makes this service steer that path instead, and
-`mode="release"` restores the scenario behaviour.
+At tick k it reads the boats' rows of the `BodyStates` tagged k-1 (at t_k; the plan's
+start poses at rest at tick 0), runs the guidance laws for all boats at once and publishes
+each boat's set-point on `vessel/<boat>/cmd/twist` tagged k, which physics applies from
+tick k+1 (the one-tick delay of DESIGN.md §4). External control never fights these
+set-points: physics lets an external twist or thrust (tick -1) outrank them until a
+`WaypointsCmd` hands the boat back; a `WaypointsCmd` with a path makes this service steer
+that path instead, and `mode="release"` restores the scenario behaviour.
 """
 
 from __future__ import annotations
@@ -18,10 +18,10 @@ import numpy as np
 
 from catabot import codec
 from catabot.inbox import Inputs
-from catabot.messages import Tick, TwistCmd, VesselState, WaypointsCmd
+from catabot.messages import BodyStates, Message, Tick, TwistCmd, WaypointsCmd
 from catabot.participant import Participant
 from catabot.service import Built, ServiceContext, run_service
-from catabot.streams import state_streams, waypoint_streams
+from catabot.streams import BodyRows, body_ids, states_stream, waypoint_streams
 from catabot.traffic_plan import plan_traffic
 from services.traffic.behaviours import Behaviours
 
@@ -40,22 +40,29 @@ class TrafficService:
         self.pos = np.array([(b.pose.x_m, b.pose.y_m) for b in boats], dtype=np.float64)
         self.yaw = np.array([b.pose.yaw_rad for b in boats], dtype=np.float64)
         self.vel = np.zeros((n, 2))
-        states = [s for s in state_streams(ctx.scenario, ctx.keys) if _vessel(s.key) in self.row]
+        self.states_key = ctx.keys.world_states()
+        self.body_rows = BodyRows(body_ids(ctx.scenario))
+        self.boat_rows: np.ndarray | None = None
         waypoints = [
             s for s in waypoint_streams(ctx.scenario, ctx.keys) if _vessel(s.key) in self.row
         ]
         self.twist_keys = [ctx.keys.cmd_twist(vid) for vid in self.ids]
         self.participant = Participant(
-            ctx.session, ctx.keys, ctx.name, inputs=states + waypoints, peers=ctx.peers
+            ctx.session,
+            ctx.keys,
+            ctx.name,
+            inputs=[states_stream(ctx.keys), *waypoints],
+            peers=ctx.peers,
         )
 
     def step(self, tick: Tick, inputs: Inputs) -> None:
         for key, msgs in inputs.items():
+            if key == self.states_key:
+                self._take_states(msgs[-1])
+                continue
             i = self.row[_vessel(key)]
             for msg in msgs:
-                if isinstance(msg, VesselState):
-                    self._take_state(i, msg)
-                elif isinstance(msg, WaypointsCmd):
+                if isinstance(msg, WaypointsCmd):
                     self._take_waypoints(i, key, msg)
         surge, rate = self.behaviours.command(self.pos, self.yaw, self.vel)
         for i, key in enumerate(self.twist_keys):
@@ -63,11 +70,17 @@ class TrafficService:
                 key, TwistCmd(float(surge[i]), float(rate[i]), tick.tick, tick.stamp_ns)
             )
 
-    def _take_state(self, i: int, msg: VesselState) -> None:
-        x, y, z, w = msg.orientation
-        self.pos[i] = msg.position[:2]
-        self.yaw[i] = np.arctan2(2 * (w * z + x * y), 1 - 2 * (y * y + z * z))
-        self.vel[i] = msg.linear_velocity[:2]
+    def _take_states(self, batch: Message) -> None:
+        """The boats' rows of the batch, all at once (rows mapped at the first batch)."""
+        assert isinstance(batch, BodyStates)
+        row = self.body_rows.check(batch)
+        if self.boat_rows is None:
+            self.boat_rows = np.array([row[vid] for vid in self.ids], dtype=np.intp)
+        rows = self.boat_rows
+        x, y, z, w = batch.orientation[rows].T
+        self.pos = batch.position[rows, :2].copy()
+        self.yaw = np.arctan2(2 * (w * z + x * y), 1 - 2 * (y * y + z * z))
+        self.vel = batch.linear_velocity[rows, :2].copy()
 
     def _take_waypoints(self, i: int, key: str, msg: WaypointsCmd) -> None:
         """Adopt a path from outside, or release the boat; refuse malformed ones loudly."""

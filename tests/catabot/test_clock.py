@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import numpy as np
 import pytest
 
 from catabot import codec
@@ -9,9 +10,9 @@ from catabot.clock import ClockError, Policy, Stream, period_in_ticks, ticks_for
 from catabot.codec import CodecError
 from catabot.inbox import Inbox
 from catabot.keys import Keys
-from catabot.messages import GpsFix, ImuSample, ThrustCmd, VesselState
+from catabot.messages import BodyStates, GpsFix, ImuSample, ThrustCmd, VesselState
 from catabot.scenario import parse_scenario
-from catabot.streams import participants, world_streams
+from catabot.streams import BodyRows, body_ids, participants, state_streams, world_streams
 
 KEYS = Keys("w")
 STATE = KEYS.vessel_state("ego")
@@ -247,9 +248,30 @@ def test_world_streams() -> None:
     streams = world_streams(_scenario(), KEYS)
     table = {s.key: (s.message, s.producer, s.period) for s in streams}
     assert table == {
-        KEYS.vessel_state("ego"): (VesselState, "physics", 1),
-        KEYS.vessel_state("buoy"): (VesselState, "physics", 1),
+        KEYS.world_states(): (BodyStates, "physics", 1),
         KEYS.sensor("ego", "imu"): (ImuSample, "sensors", 1),
         KEYS.sensor("ego", "gps"): (GpsFix, "sensors", 10),
     }
     assert len(streams) == len(table)
+
+
+def test_per_vessel_states_are_for_observers_only() -> None:
+    """Lockstep consumers wait for the one batch; per-vessel states stay off the table."""
+    scenario = _scenario()  # two vessels ("buoy" is a vessel's id here), no moored buoys
+    assert KEYS.world_states() == "catabot/w/world/states"
+    states = [s.key for s in state_streams(scenario, KEYS)]
+    assert states == [KEYS.vessel_state("ego"), KEYS.vessel_state("buoy")]
+    assert body_ids(scenario) == ("ego", "buoy")
+    lockstep = {s.key for s in world_streams(scenario, KEYS)}
+    assert not lockstep & {KEYS.vessel_state("ego"), KEYS.vessel_state("buoy")}
+
+
+def test_body_rows_refuse_a_changed_row_order() -> None:
+    def batch(ids: tuple[str, ...]) -> BodyStates:
+        z3, z4 = np.zeros((len(ids), 3)), np.zeros((len(ids), 4))
+        return BodyStates(0, 0, ids, z3, z4, z3, z3, z3, z3)
+
+    rows = BodyRows(("ego", "buoy"))
+    assert rows.check(batch(("ego", "buoy"))) == {"ego": 0, "buoy": 1}
+    with pytest.raises(ValueError, match="expected"):
+        rows.check(batch(("buoy", "ego")))

@@ -15,6 +15,7 @@ from catabot.messages import (
     MESSAGE_TYPES,
     SCHEMA_VERSION,
     Ack,
+    BodyStates,
     CameraFrame,
     End,
     GpsFix,
@@ -47,6 +48,17 @@ SAMPLES: dict[str, Message] = {
         angular_velocity=(0.0, 0.002, -0.2),
         linear_acceleration=(0.15, 0.0, -0.01),
         angular_acceleration=(0.0, 0.0, 1e-5),
+    ),
+    "body_states": BodyStates(
+        tick=120,
+        stamp_ns=1_200_000_000,
+        ids=("ego", "boat_000", "buoy_0"),
+        position=np.arange(9, dtype=np.float64).reshape(3, 3) / 3,
+        orientation=np.tile([0.0, 0.0, 0.3826834323650898, 0.9238795325112867], (3, 1)),
+        linear_velocity=np.full((3, 3), 1.42),
+        angular_velocity=np.zeros((3, 3)),
+        linear_acceleration=np.full((3, 3), -0.01),
+        angular_acceleration=np.full((3, 3), 1e-5),
     ),
     "thrust_cmd": ThrustCmd(thrust=(0.8, -0.35), tick=7, stamp_ns=70_000_000),
     "twist_cmd": TwistCmd(surge=1.5, yaw_rate=-0.2, tick=-1, stamp_ns=0),
@@ -158,6 +170,28 @@ def test_message_round_trip(wire: str) -> None:
     body = codec.unpack(payload)
     assert body["v"] == SCHEMA_VERSION
     assert body["type"] == wire
+
+
+def test_body_states_rows_are_the_vessel_states_of_each_body() -> None:
+    """A decoded batch keeps ids and float64 rows; a row is the per-body message, exactly."""
+    batch = SAMPLES["body_states"]
+    assert isinstance(batch, BodyStates)
+    back = codec.decode(codec.encode(batch), BodyStates)
+    assert back.ids == ("ego", "boat_000", "buoy_0")
+    assert back.position.dtype == np.float64 and back.orientation.shape == (3, 4)
+    row = back.row(1)
+    assert row == VesselState(
+        120,
+        1_200_000_000,
+        (1.0, 4 / 3, 5 / 3),
+        (0.0, 0.0, 0.3826834323650898, 0.9238795325112867),
+        (1.42, 1.42, 1.42),
+        (0.0, 0.0, 0.0),
+        (-0.01, -0.01, -0.01),
+        (1e-5, 1e-5, 1e-5),
+    )
+    assert all(type(v) is float for v in row.position)
+    assert back.rows() == [back.row(i) for i in range(3)]
 
 
 def test_decode_accepts_memoryview_and_bytearray() -> None:
