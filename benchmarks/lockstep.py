@@ -58,10 +58,10 @@ def raw_rate(n: int) -> float:
     procs = _spawn("raw", f"tcp/127.0.0.1:{port}", world, names)
     for _ in names:
         present.get(timeout=30)
-    time.sleep(0.3)  # let gossip finish the mesh, as the participant's peer wait does
     pub = session.declare_publisher(
         f"raw/{world}/tick", congestion_control=zenoh.CongestionControl.BLOCK
     )
+    _handshake(pub, acks, n)
     start = time.perf_counter()
     for k in range(TICKS):
         pub.put(k.to_bytes(4, "little"))
@@ -74,6 +74,23 @@ def raw_rate(n: int) -> float:
     live.undeclare()
     session.close()
     return rate
+
+
+def _handshake(pub: zenoh.Publisher, acks: zenoh.Subscriber, n: int) -> None:
+    """Repeat a warm-up tick until every peer has answered once, then drain: a tick sent
+    before a peer's subscription is routed would otherwise be lost and the loop would hang."""
+    seen: set[str] = set()
+    limit = time.monotonic() + 30
+    while len(seen) < n and time.monotonic() < limit:
+        pub.put(b"w")
+        time.sleep(0.05)
+        while (sample := acks.try_recv()) is not None:
+            seen.add(str(sample.key_expr))
+    time.sleep(0.1)
+    while acks.try_recv() is not None:
+        pass
+    if len(seen) < n:
+        raise RuntimeError(f"only {len(seen)} of {n} raw peers answered the warm-up")
 
 
 def main() -> None:

@@ -10,7 +10,9 @@ there as well, so that a typo is caught when the scenario is loaded.)
 
 from __future__ import annotations
 
-from typing import Protocol
+from collections.abc import Callable
+from dataclasses import dataclass
+from typing import Any, Protocol
 
 from catabot.messages import Message, VesselState
 from catabot.scenario import Origin, SensorConfig
@@ -32,104 +34,59 @@ class Sensor(Protocol):
     def sample(self, state: VesselState, *, tick: int, stamp_ns: int) -> Message: ...
 
 
-class SensorFactory(Protocol):
-    """Builds a sensor of one type for one vessel."""
+@dataclass(frozen=True)
+class Mount:
+    """Everything a factory may use to build one sensor on one vessel."""
 
-    def __call__(
-        self,
-        config: SensorConfig,
-        *,
-        vessel_id: str,
-        seed: int,
-        origin: Origin,
-        dt_ns: int,
-        scene: Scene | None = None,
-    ) -> Sensor: ...
+    config: SensorConfig
+    vessel_id: str
+    seed: int
+    origin: Origin
+    dt_ns: int
+    scene: Scene | None
 
+    @property
+    def name(self) -> str:
+        """The name the sensor's randomness is seeded with: `<vessel_id>/<sensor_name>`."""
+        return f"{self.vessel_id}/{self.config.name}"
 
-def source_name(vessel_id: str, config: SensorConfig) -> str:
-    """The name a sensor's randomness is seeded with."""
-    return f"{vessel_id}/{config.name}"
-
-
-def _imu(
-    config: SensorConfig,
-    *,
-    vessel_id: str,
-    seed: int,
-    origin: Origin,
-    dt_ns: int,
-    scene: Scene | None = None,
-) -> ImuModel:
-    params = config.typed_params().model_dump()
-    return ImuModel(**params, noise=config.noise, seed=seed, name=source_name(vessel_id, config))
+    def params(self) -> Any:
+        return self.config.typed_params()
 
 
-def _gps(
-    config: SensorConfig,
-    *,
-    vessel_id: str,
-    seed: int,
-    origin: Origin,
-    dt_ns: int,
-    scene: Scene | None = None,
-) -> GpsModel:
+SensorFactory = Callable[[Mount], Sensor]
+
+
+def _imu(m: Mount) -> ImuModel:
+    return ImuModel(**m.params().model_dump(), noise=m.config.noise, seed=m.seed, name=m.name)
+
+
+def _gps(m: Mount) -> GpsModel:
+    origin = m.origin
     return GpsModel(
         origin_lat_deg=origin.latitude_deg,
         origin_lon_deg=origin.longitude_deg,
         origin_alt_m=origin.altitude_m,
-        **config.typed_params().model_dump(),
-        noise=config.noise,
-        seed=seed,
-        name=source_name(vessel_id, config),
+        **m.params().model_dump(),
+        noise=m.config.noise,
+        seed=m.seed,
+        name=m.name,
     )
 
 
-def _radar(
-    config: SensorConfig,
-    *,
-    vessel_id: str,
-    seed: int,
-    origin: Origin,
-    dt_ns: int,
-    scene: Scene | None = None,
-) -> RadarModel:
+def _lidar(m: Mount) -> LidarModel:
+    return LidarModel(m.params(), scene=m.scene, noise=m.config.noise, seed=m.seed, name=m.name)
+
+
+def _radar(m: Mount) -> RadarModel:
+    period = m.config.period_ns
     return RadarModel(
-        config.typed_params(),
-        scene=scene,
-        period_ns=config.period_ns,
-        noise=config.noise,
-        seed=seed,
-        name=source_name(vessel_id, config),
+        m.params(), scene=m.scene, period_ns=period, noise=m.config.noise, seed=m.seed, name=m.name
     )
 
 
-def _camera(
-    config: SensorConfig,
-    *,
-    vessel_id: str,
-    seed: int,
-    origin: Origin,
-    dt_ns: int,
-    scene: Scene | None = None,
-) -> CameraModel:
-    return CameraModel(
-        config.typed_params(), scene=scene, seed=seed, name=source_name(vessel_id, config)
-    )
-
-
-def _lidar(
-    config: SensorConfig,
-    *,
-    vessel_id: str,
-    seed: int,
-    origin: Origin,
-    dt_ns: int,
-    scene: Scene | None = None,
-) -> LidarModel:
-    name = source_name(vessel_id, config)
-    params = config.typed_params()
-    return LidarModel(params, scene=scene, noise=config.noise, seed=seed, name=name)
+def _camera(m: Mount) -> CameraModel:
+    return CameraModel(m.params(), scene=m.scene, seed=m.seed, name=m.name)
 
 
 SENSOR_TYPES: dict[str, SensorFactory] = {
@@ -160,4 +117,4 @@ def build_sensor(
             f"{where}: period {config.period_ns} ns ({config.rate_hz} Hz) is not a whole "
             f"number of {dt_ns} ns ticks"
         )
-    return factory(config, vessel_id=vessel_id, seed=seed, origin=origin, dt_ns=dt_ns, scene=scene)
+    return factory(Mount(config, vessel_id, seed, origin, dt_ns, scene))
