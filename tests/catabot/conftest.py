@@ -1,0 +1,16 @@
+"""Fixtures shared by the library tests."""
+
+from collections.abc import Iterator
+
+import pytest
+
+from tests.catabot.lockstep_world import World
+
+
+@pytest.fixture
+def world() -> Iterator[World]:
+    w = World()
+    try:
+        yield w
+    finally:
+        w.close()

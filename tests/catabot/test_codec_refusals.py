@@ -1,0 +1,211 @@
+"""RefusalsThe msgpack codec: round trips, zero-copy arrays, and clear refusals (DESIGN.md §5)."""
+
+from __future__ import annotations
+
+import math
+
+import msgpack
+import pytest
+
+from catabot import codec
+from catabot.codec import ARRAY_EXT, CodecError
+from catabot.messages import (
+    MESSAGE_TYPES,
+    SCHEMA_VERSION,
+    Ack,
+    ImuSample,
+    ThrustCmd,
+    TwistCmd,
+    VesselState,
+)
+
+# -- refusals -----------------------------------------------------------------------------
+from tests.catabot.codec_samples import SAMPLES, _body, _payload
+
+
+def _ext(header: object, raw: bytes = b"", *, hlen: int | None = None) -> bytes:
+    head = msgpack.packb(header)
+    n = len(head) if hlen is None else hlen
+    return msgpack.packb({"a": msgpack.ExtType(ARRAY_EXT, bytes([n]) + head + raw)})
+
+
+@pytest.mark.parametrize(
+    ("payload", "words"),
+    [
+        (_ext(["<f4", [3]], b"\0" * 11), ["malformed array extension"]),
+        (_ext(["<f4", [2, 2]], b"\0" * 8), ["malformed array extension"]),
+        (_ext(["<f4", [-1]], b"\0" * 8), ["malformed array extension", "shape"]),
+        (_ext(["<f4", "2"], b"\0" * 8), ["malformed array extension", "shape"]),
+        (_ext(["<f4", [1.5]], b"\0" * 8), ["malformed array extension", "shape"]),
+        (_ext(["<f4"], b"\0" * 8), ["malformed array extension"]),
+        (_ext(["|O", [1]], b"\0" * 8), ["array dtype", "not allowed"]),
+        (_ext(["<U1", [1]], b"\0" * 4), ["array dtype", "not allowed"]),
+        (_ext([["<f4"], [1]], b"\0" * 4), ["malformed array extension"]),
+        (_ext(["<f4", [1]], b"\0" * 4, hlen=200), ["malformed array extension"]),
+        (msgpack.packb({"a": msgpack.ExtType(ARRAY_EXT, b"")}), ["malformed array extension"]),
+        (msgpack.packb({"a": msgpack.ExtType(5, b"xyz")}), ["unknown msgpack extension type 5"]),
+    ],
+    ids=[
+        "bytes-not-multiple-of-itemsize",
+        "shape-does-not-match-bytes",
+        "negative-dimension",
+        "shape-not-a-list",
+        "float-dimension",
+        "no-shape",
+        "object-dtype",
+        "str-dtype",
+        "dtype-not-a-string",
+        "header-length-past-end",
+        "empty-extension",
+        "other-extension-code",
+    ],
+)
+def test_malformed_array_extension(payload: bytes, words: list[str]) -> None:
+    with pytest.raises(CodecError) as info:
+        codec.unpack(payload)
+    for word in words:
+        assert word in str(info.value)
+
+
+def test_non_msgpack_bytes() -> None:
+    for junk in (b"\xc1", b"\xc1\xc1garbage", b""):
+        with pytest.raises(CodecError, match="not a msgpack payload"):
+            codec.decode(junk, Ack)
+
+
+def test_truncated_payload() -> None:
+    payload = codec.encode(SAMPLES["vessel_state"])
+    for cut in (1, len(payload) // 2, len(payload) - 1):
+        with pytest.raises(CodecError, match="not a msgpack payload"):
+            codec.decode(payload[:cut], VesselState)
+
+
+def test_trailing_bytes_are_refused() -> None:
+    with pytest.raises(CodecError, match="not a msgpack payload"):
+        codec.decode(codec.encode(SAMPLES["ack"]) + b"\x00", Ack)
+
+
+def test_not_a_map() -> None:
+    with pytest.raises(CodecError, match="payload is a list, expected a map"):
+        codec.decode(msgpack.packb([1, 2]), Ack)
+
+
+@pytest.mark.parametrize("version", [0, 2, None, "1"])
+def test_unknown_schema_version(version: object) -> None:
+    body = _body(SAMPLES["ack"])
+    if version is None:
+        del body["v"]
+    else:
+        body["v"] = version
+    with pytest.raises(CodecError) as info:
+        codec.decode(_payload(body), Ack)
+    assert f"schema version {version!r} is not supported" in str(info.value)
+    assert f"this is {SCHEMA_VERSION}" in str(info.value)
+
+
+def test_unknown_type() -> None:
+    body = _body(SAMPLES["ack"])
+    body["type"] = "lidar_scan"
+    with pytest.raises(CodecError) as info:
+        codec.decode(_payload(body), Ack)
+    msg = str(info.value)
+    assert "'lidar_scan'" in msg and "'ack' was expected" in msg
+    for wire in MESSAGE_TYPES:
+        assert wire in msg  # the known types are listed
+
+
+def test_wrong_type() -> None:
+    with pytest.raises(CodecError, match=r"message type 'gps' where 'imu' was expected"):
+        codec.decode(codec.encode(SAMPLES["gps"]), ImuSample)
+
+
+def test_missing_type() -> None:
+    body = _body(SAMPLES["ack"])
+    del body["type"]
+    with pytest.raises(CodecError, match="message type None where 'ack' was expected"):
+        codec.decode(_payload(body), Ack)
+
+
+def test_missing_field() -> None:
+    body = _body(SAMPLES["vessel_state"])
+    del body["orientation"]
+    with pytest.raises(CodecError, match=r"vessel_state: missing field 'orientation'"):
+        codec.decode(_payload(body), VesselState)
+
+
+def test_unknown_field() -> None:
+    body = _body(SAMPLES["ack"])
+    body["speed"] = 3.0
+    with pytest.raises(CodecError) as info:
+        codec.decode(_payload(body), Ack)
+    assert "ack: unknown field(s) ['speed']" in str(info.value)
+    assert "fields are ['run', 'tick']" in str(info.value)
+
+
+def test_unknown_fields_of_mixed_key_types() -> None:
+    """A bin key beside str keys must still give a CodecError, not a TypeError."""
+    body = _body(SAMPLES["ack"])
+    body[b"raw"] = 1
+    body["speed"] = 2
+    with pytest.raises(CodecError, match="unknown field"):
+        codec.decode(_payload(body), Ack)
+
+
+@pytest.mark.parametrize(
+    ("wire", "field", "value", "words"),
+    [
+        ("ack", "tick", "7", ["ack.tick: expected int, got str"]),
+        ("ack", "tick", 7.0, ["ack.tick: expected int, got float"]),
+        ("ack", "tick", True, ["ack.tick: expected int, got bool"]),
+        ("ack", "run", 5, ["ack.run: expected str, got int"]),
+        ("gps", "latitude", "40.7", ["gps.latitude: expected float, got str"]),
+        ("gps", "latitude", None, ["gps.latitude: expected float, got NoneType"]),
+        ("vessel_state", "position", 1.0, ["vessel_state.position: expected vector"]),
+        ("vessel_state", "position", [1.0, 2.0], ["vessel_state.position", "expected 3 numbers"]),
+        ("imu", "orientation", [0, 0, 1], ["imu.orientation", "expected 4 numbers, got 3"]),
+        ("imu", "angular_velocity", [0, "x", 1], ["imu.angular_velocity", "must be a number"]),
+        ("thrust_cmd", "thrust", [0.5, None], ["thrust_cmd.thrust", "must be a number"]),
+        ("thrust_cmd", "thrust", [True, 0.0], ["thrust_cmd.thrust", "must be a number"]),
+        ("tick", "dropped", ["a", 3], ["tick.dropped: expected names"]),
+    ],
+)
+def test_bad_field_values(wire: str, field: str, value: object, words: list[str]) -> None:
+    msg = SAMPLES[wire]
+    body = _body(msg)
+    body[field] = value
+    with pytest.raises(CodecError) as info:
+        codec.decode(_payload(body), type(msg))
+    for word in words:
+        assert word in str(info.value)
+
+
+def test_variable_length_vectors_accept_any_length() -> None:
+    for thrust in ([], [0.1], [0.1, 0.2, 0.3, 0.4]):
+        body = _body(SAMPLES["thrust_cmd"])
+        body["thrust"] = thrust
+        assert codec.decode(_payload(body), ThrustCmd).thrust == tuple(thrust)
+
+
+def test_codec_error_is_a_value_error() -> None:
+    assert issubclass(CodecError, ValueError)
+
+
+# -- finite -------------------------------------------------------------------------------
+
+
+def test_finite() -> None:
+    assert codec.finite(1.0)
+    assert codec.finite(0)
+    assert codec.finite((0.5, -1.0, 1e300))
+    assert codec.finite(())
+    assert not codec.finite(math.nan)
+    assert not codec.finite(math.inf)
+    assert not codec.finite(-math.inf)
+    assert not codec.finite((0.5, math.nan))
+    assert not codec.finite((math.inf, 0.0))
+
+
+def test_non_finite_values_survive_the_codec_for_finite_to_refuse() -> None:
+    cmd = codec.decode(codec.encode(TwistCmd(surge=math.nan, yaw_rate=math.inf)), TwistCmd)
+    assert math.isnan(cmd.surge) and cmd.yaw_rate == math.inf
+    assert not codec.finite((cmd.surge, cmd.yaw_rate))

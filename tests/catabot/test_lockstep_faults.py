@@ -1,0 +1,182 @@
+"""Faults in the real lockstep: deadline, drop policy, start timeout, crash, bad input."""
+
+from __future__ import annotations
+
+import logging
+import threading
+import time
+
+import pytest
+
+from catabot import codec
+from catabot.clock import Policy, Stream
+from catabot.inbox import Inputs
+from catabot.messages import Tick, VesselState
+from catabot.participant import Participant
+from tests.catabot.lockstep_world import Step, World, _fix, _state
+
+# -- (c) deadline -------------------------------------------------------------------------
+
+
+def test_a_step_past_the_deadline_ends_the_run_naming_it(world: World) -> None:
+    release = threading.Event()
+
+    def hang(tick: Tick, _inputs: Inputs) -> None:
+        if tick.tick == 3:
+            release.wait(5.0)
+
+    world.member("fast")
+    world.member("stuck", hang)
+    try:
+        result = world.run(["fast", "stuck"], 20, deadline_s=0.5, start_timeout_s=5.0)
+    finally:
+        release.set()
+    assert "'stuck'" in result.error
+    assert "deadline" in result.error and "tick 3" in result.error
+    assert "'fast'" not in result.error
+    assert result.reason == "fault"
+    assert result.ticks_done == 3  # ticks 0, 1 and 2 completed
+    fast = world.members["fast"]
+    fast.join()
+    assert fast.ticks == [0, 1, 2, 3]
+    assert fast.end is not None and fast.end.error == result.error
+    assert fast.end.tick == 2  # the last complete tick
+    world.members["stuck"].join()
+
+
+# -- (d) policy drop ----------------------------------------------------------------------
+
+
+def test_policy_drop_goes_on_without_the_hanging_participant(world: World) -> None:
+    release = threading.Event()
+    key = world.keys.vessel_state("ego")
+    names = ["hang", "cons", "other"]
+    holder: dict[str, Participant] = {}
+
+    def hang(tick: Tick, _inputs: Inputs) -> None:
+        if tick.tick == 5:
+            release.wait(5.0)
+        holder["p"].publish(key, _state(tick.tick))
+
+    holder["p"] = world.member("hang", hang, peers=names).participant
+    cons = world.member("cons", inputs=[Stream(key, VesselState, "hang", 1)], peers=names)
+    world.member("other", peers=names)
+    try:
+        result = world.run(names, 20, deadline_s=0.3, start_timeout_s=5.0, policy=Policy.DROP)
+    finally:
+        release.set()
+    assert result.error == ""
+    assert result.dropped == ["hang"]
+    assert result.ticks_done == 20
+    assert result.reason == "completed"
+    for m in world.members.values():
+        m.join()
+        assert m.error is None
+    assert cons.ticks == list(range(20))
+    assert world.members["other"].ticks == list(range(20))
+    for k in range(1, 6):  # before the drop, the consumer had every state
+        assert [m.tick for m in cons.released[k][key]] == [k - 1]
+
+
+# -- (e) start timeout --------------------------------------------------------------------
+
+
+def test_a_participant_that_never_joins_is_named(world: World) -> None:
+    world.member("here")
+    t0 = time.monotonic()
+    result = world.run(["here", "ghost"], 10, deadline_s=1.0, start_timeout_s=0.5)
+    assert time.monotonic() - t0 < 3.0
+    assert "never joined" in result.error
+    assert "ghost" in result.error and "here" not in result.error
+    assert "0.5 s" in result.error
+    assert result.ticks_done == 0
+    here = world.members["here"]
+    here.join()
+    assert here.ticks == []
+    assert here.end is not None and here.end.error == result.error
+
+
+# -- (f) a crash mid-run ------------------------------------------------------------------
+
+
+def _crash_at(world: World, tick: int, crashed_at: list[float]) -> Step:
+    def step(t: Tick, _inputs: Inputs) -> None:
+        if t.tick == tick:
+            crashed_at.append(time.monotonic())
+            world.members["crash"].session.close()
+
+    return step
+
+
+def test_a_participant_that_crashes_is_named_within_a_second(world: World) -> None:
+    crashed_at: list[float] = []
+    names = ["a", "b", "crash"]
+    world.member("a", peers=names)
+    world.member("b", peers=names)
+    world.member("crash", _crash_at(world, 10, crashed_at), peers=names)
+    result = world.run(names, 50, deadline_s=5.0, start_timeout_s=5.0)
+    assert crashed_at, "the crash never happened"
+    assert result.error == "participant 'crash' left the run at tick 10"
+    assert world.result_at - crashed_at[0] < 1.0
+    assert result.ticks_done == 10
+    for name in ("a", "b"):
+        m = world.members[name]
+        m.join()
+        assert m.error is None
+        assert m.end is not None and "crash" in m.end.error
+    world.members["crash"].join()
+
+
+def test_policy_drop_goes_on_without_a_crashed_participant(world: World) -> None:
+    crashed_at: list[float] = []
+    names = ["a", "b", "crash"]
+    world.member("a", peers=names)
+    world.member("b", peers=names)
+    world.member("crash", _crash_at(world, 10, crashed_at), peers=names)
+    result = world.run(names, 30, deadline_s=1.0, start_timeout_s=5.0, policy=Policy.DROP)
+    assert crashed_at
+    assert result.error == ""
+    assert result.dropped == ["crash"]
+    assert result.ticks_done == 30
+    for name in ("a", "b"):
+        m = world.members[name]
+        m.join()
+        assert m.error is None
+        assert m.ticks == list(range(30))
+    world.members["crash"].join()
+
+
+# -- (g) malformed input ------------------------------------------------------------------
+
+
+def test_malformed_input_is_logged_and_the_participant_goes_on(
+    world: World, caplog: pytest.LogCaptureFixture
+) -> None:
+    key = world.keys.vessel_state("ego")
+    names = ["inj", "cons"]
+    holder: dict[str, Participant] = {}
+
+    def inject(tick: Tick, _inputs: Inputs) -> None:
+        p = holder["p"]
+        if tick.tick == 3:
+            p.session.put(key, b"\xc1 not msgpack")
+            p.session.put(key, codec.encode(_fix(3)))  # a valid message of the wrong type
+        p.publish(key, _state(tick.tick))
+
+    holder["p"] = world.member("inj", inject, peers=names).participant
+    cons = world.member("cons", inputs=[Stream(key, VesselState, "inj", 1)], peers=names)
+    with caplog.at_level(logging.WARNING, logger="catabot.participant"):
+        result = world.run(names, 20, deadline_s=2.0, start_timeout_s=5.0)
+        for m in world.members.values():
+            m.join()
+            assert m.error is None
+    assert result.error == "" and result.ticks_done == 20
+    assert cons.ticks == list(range(20))
+    for k in range(1, 20):
+        assert [m.tick for m in cons.released[k][key]] == [k - 1]
+    warnings = [r.getMessage() for r in caplog.records if r.name == "catabot.participant"]
+    malformed = [w for w in warnings if "malformed" in w]
+    assert len(malformed) == 2, warnings
+    assert all(key in w and w.startswith("cons:") for w in malformed)
+    assert any("not a msgpack payload" in w for w in malformed)
+    assert any("'gps' where 'vessel_state' was expected" in w for w in malformed)
