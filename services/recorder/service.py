@@ -16,10 +16,12 @@ from catabot.messages import BodyStates, CameraFrame, End, Message, Tick
 from catabot.participant import Participant
 from catabot.service import Built, ServiceContext, run_service
 from catabot.streams import BodyRows, body_ids, command_streams, world_streams
+from catabot.traffic_plan import all_vessels
 from services.recorder import images
 from services.recorder.csv_sink import CsvSink, RecorderError
 from services.recorder.dataset import Dataset
 from services.recorder.mcap_sink import McapSink
+from services.recorder.metrics import Metrics
 
 log = logging.getLogger("recorder")
 
@@ -36,11 +38,16 @@ class Recorder:
         self.states_key = ctx.keys.world_states()
         self.body_rows = BodyRows(body_ids(ctx.scenario))
         self.state_keys = [ctx.keys.vessel_state(vid) for vid in self.body_rows.expected]
+        self.metrics = Metrics([v.id for v in all_vessels(ctx.scenario)])
+        self.run_dir = ctx.run_dir
         self.participant = Participant(
             ctx.session, ctx.keys, ctx.name, inputs=streams, peers=ctx.peers
         )
 
     def step(self, tick: Tick, inputs: Inputs) -> None:
+        for batch in inputs.get(self.states_key, []):
+            assert isinstance(batch, BodyStates)
+            self.metrics.add(batch)
         inputs = self._per_body(inputs)
         for key in sorted(inputs):
             stream = self.keys.relative(key)
@@ -83,6 +90,7 @@ class Recorder:
             self.csv.close()
         if self.mcap is not None:
             self.mcap.close()
+        self.metrics.write(self.run_dir / "metrics.json")
         log.info("recorder closed its files after tick %d", end.tick)
 
 

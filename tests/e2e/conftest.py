@@ -85,5 +85,7 @@ def out(tmp_path: Path) -> Path:
     return folder
 
 
-def files_of(run_dir: Path, patterns: Sequence[str] = ("*.csv", "*.mcap")) -> dict[str, bytes]:
+def files_of(
+    run_dir: Path, patterns: Sequence[str] = ("*.csv", "*.mcap", "metrics.json")
+) -> dict[str, bytes]:
     return {p.name: p.read_bytes() for pat in patterns for p in sorted(run_dir.glob(pat))}

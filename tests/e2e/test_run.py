@@ -16,7 +16,13 @@ def test_default_run_writes_run_folder_and_floats_at_archimedes_draft(out: Path)
     assert result.returncode == 0, result.stderr
     run = only_run_dir(out)
     assert "run folder:" in result.stdout and str(run) in result.stdout
-    for name in ("scenario.json", "vessel.ego.state.csv", "run.mcap", "log/physics.log"):
+    for name in (
+        "scenario.json",
+        "vessel.ego.state.csv",
+        "run.mcap",
+        "metrics.json",
+        "log/physics.log",
+    ):
         assert (run / name).is_file(), name
     rows = csv_rows(run / "vessel.ego.state.csv")
     header, data = rows[0], rows[1:]
@@ -32,6 +38,9 @@ def test_default_run_writes_run_folder_and_floats_at_archimedes_draft(out: Path)
     assert abs(draft - model.mass_kg / (rho * area)) / (model.mass_kg / (rho * area)) < 0.02
     x = column(header, data, "position_x[m]", t_from=19.9, t_to=20.0)
     assert x[-1] > 10.0, "the scripted thrust must move the vessel"
+    metrics = json.loads((run / "metrics.json").read_text())["vessels"]["ego"]
+    assert abs(metrics["final_position_m"][0] - float(data[-1][2])) < 1e-9
+    assert metrics["distance_m"] >= float(data[-1][2])
     topics = {m.topic for m in read_mcap_messages(run / "run.mcap")}
     assert "/vessel/ego/state" in topics
 
