@@ -13,11 +13,10 @@ import numpy as np
 from mcap_ros2._dynamic import serialize_dynamic
 
 from catabot.messages import CameraFrame, Message
-from services.recorder.ros2_msgdefs import stamp
+from services.recorder.ros2_msgdefs import HEADER_DEPENDENCIES, concatenated, stamp
 
 IMAGE = "sensor_msgs/msg/Image"
-_SEPARATOR = "=" * 80
-IMAGE_MSGDEF = f"""\
+_IMAGE_TEXT = """\
 std_msgs/Header header
 uint32 height
 uint32 width
@@ -25,15 +24,8 @@ string encoding
 uint8 is_bigendian
 uint32 step
 uint8[] data
-{_SEPARATOR}
-MSG: std_msgs/Header
-builtin_interfaces/Time stamp
-string frame_id
-{_SEPARATOR}
-MSG: builtin_interfaces/Time
-int32 sec
-uint32 nanosec
 """
+IMAGE_MSGDEF = concatenated(_IMAGE_TEXT, {**HEADER_DEPENDENCIES})
 ENCODINGS = {"color": "rgb8", "depth": "32FC1"}
 
 

@@ -18,10 +18,10 @@ import numpy as np
 
 from catabot.messages import LidarScan, Message
 from services.recorder.cdr import pointcloud2_encoder
+from services.recorder.ros2_msgdefs import HEADER_DEPENDENCIES, concatenated
 
 POINTCLOUD2 = "sensor_msgs/msg/PointCloud2"
-_SEPARATOR = "=" * 80
-POINTCLOUD2_MSGDEF = f"""\
+_POINTCLOUD2_TEXT = """\
 std_msgs/Header header
 uint32 height
 uint32 width
@@ -31,16 +31,8 @@ uint32 point_step
 uint32 row_step
 uint8[] data
 bool is_dense
-{_SEPARATOR}
-MSG: std_msgs/Header
-builtin_interfaces/Time stamp
-string frame_id
-{_SEPARATOR}
-MSG: builtin_interfaces/Time
-int32 sec
-uint32 nanosec
-{_SEPARATOR}
-MSG: sensor_msgs/PointField
+"""
+_POINTFIELD_TEXT = """\
 uint8 INT8    = 1
 uint8 UINT8   = 2
 uint8 INT16   = 3
@@ -54,6 +46,9 @@ uint32 offset
 uint8  datatype
 uint32 count
 """
+POINTCLOUD2_MSGDEF = concatenated(
+    _POINTCLOUD2_TEXT, {**HEADER_DEPENDENCIES, "sensor_msgs/PointField": _POINTFIELD_TEXT}
+)
 _LAYOUT = (  # name, NumPy type, sensor_msgs/PointField datatype
     ("x", "<f4", 7),
     ("y", "<f4", 7),

@@ -71,14 +71,17 @@ float64 z
 }
 
 
-def _concatenated(main: str, deps: dict[str, str]) -> str:
+def concatenated(main: str, deps: dict[str, str]) -> str:
+    """A message definition followed by its dependencies, in the format `mcap_ros2` parses."""
     parts = [main]
     for name, text in deps.items():
         parts.append(f"{_SEPARATOR}\nMSG: {name}\n{text}")
     return "\n".join(parts)
 
 
-ODOMETRY_MSGDEF = _concatenated(_ODOMETRY_TEXT, _DEPENDENCIES)
+ODOMETRY_MSGDEF = concatenated(_ODOMETRY_TEXT, _DEPENDENCIES)
+HEADER_DEPENDENCIES = {k: _DEPENDENCIES[k] for k in ("std_msgs/Header", "builtin_interfaces/Time")}
+"""What every stamped message (Image, PointCloud2) depends on."""
 """`nav_msgs/msg/Odometry` with its dependencies, in the format `mcap_ros2` parses."""
 
 _ZERO_COVARIANCE = [0.0] * 36  # unknown covariance; the simulator has the exact state
