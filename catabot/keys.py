@@ -98,6 +98,13 @@ class Keys:
             raise KeyError_(f"key {key!r} is not in world {self.world!r}")
         return key[len(head) :]
 
+    def vessel_of(self, key: str) -> str:
+        """The vessel id of a `vessel/<id>/...` or `sensor/<id>/...` key of this world."""
+        parts = self.relative(key).split("/")
+        if len(parts) < 3 or parts[0] not in ("vessel", "sensor"):
+            raise KeyError_(f"key {key!r} names no vessel")
+        return parts[1]
+
     def participant_of(self, key: str) -> str:
         """The participant named by the last chunk of an ack or liveliness key."""
         return key.rsplit("/", 1)[-1]

@@ -45,28 +45,16 @@ Vec3 = Annotated[tuple[FiniteFloat, FiniteFloat, FiniteFloat], _length(3, " [x, 
 Inertia3 = Annotated[
     tuple[PositiveFloat, PositiveFloat, PositiveFloat], _length(3, " [Ixx, Iyy, Izz]")
 ]
-Dof6 = Annotated[
-    tuple[
-        NonNegativeFloat,
-        NonNegativeFloat,
-        NonNegativeFloat,
-        NonNegativeFloat,
-        NonNegativeFloat,
-        NonNegativeFloat,
-    ],
-    _length(6, " [X_u, Y_v, Z_w, K_p, M_q, N_r]"),
+_Six = tuple[
+    NonNegativeFloat,
+    NonNegativeFloat,
+    NonNegativeFloat,
+    NonNegativeFloat,
+    NonNegativeFloat,
+    NonNegativeFloat,
 ]
-AddedMass6 = Annotated[
-    tuple[
-        NonNegativeFloat,
-        NonNegativeFloat,
-        NonNegativeFloat,
-        NonNegativeFloat,
-        NonNegativeFloat,
-        NonNegativeFloat,
-    ],
-    _length(6, " [X_udot, Y_vdot, Z_wdot, K_pdot, M_qdot, N_rdot]"),
-]
+Dof6 = Annotated[_Six, _length(6, " [X_u, Y_v, Z_w, K_p, M_q, N_r]")]
+AddedMass6 = Annotated[_Six, _length(6, " [X_udot, Y_vdot, Z_wdot, K_pdot, M_qdot, N_rdot]")]
 WindCoefficients3 = Annotated[
     tuple[NonNegativeFloat, NonNegativeFloat, FiniteFloat], _length(3, " [C_x, C_y, C_n]")
 ]

@@ -45,7 +45,7 @@ class PhysicsService:
             all_vessels(scenario), {vid: len(m.thrusters) for vid, m in models.items()}
         )
         self.streams = command_streams(scenario, ctx.keys) + waypoint_streams(scenario, ctx.keys)
-        self.vessel_of = {s.key: s.key.split("/")[-3] for s in self.streams}
+        self.vessel_of = {s.key: ctx.keys.vessel_of(s.key) for s in self.streams}
         self.body_ids = (*ids, *self.world.buoy_ids)
         self.state_keys = [ctx.keys.vessel_state(vid) for vid in ids]
         self.participant = Participant(

@@ -44,7 +44,9 @@ class TrafficService:
         self.body_rows = BodyRows(body_ids(ctx.scenario))
         self.boat_rows: np.ndarray | None = None
         waypoints = [
-            s for s in waypoint_streams(ctx.scenario, ctx.keys) if _vessel(s.key) in self.row
+            s
+            for s in waypoint_streams(ctx.scenario, ctx.keys)
+            if ctx.keys.vessel_of(s.key) in self.row
         ]
         self.twist_keys = [ctx.keys.cmd_twist(vid) for vid in self.ids]
         self.participant = Participant(
@@ -60,7 +62,7 @@ class TrafficService:
             if key == self.states_key:
                 self._take_states(msgs[-1])
                 continue
-            i = self.row[_vessel(key)]
+            i = self.row[self.keys.vessel_of(key)]
             for msg in msgs:
                 if isinstance(msg, WaypointsCmd):
                     self._take_waypoints(i, key, msg)
@@ -97,11 +99,6 @@ class TrafficService:
             return
         points = np.array(pts, dtype=np.float64).reshape(-1, 2)
         self.behaviours.set_path(i, points, msg.speed, loop=msg.mode == "loop", tol=msg.tolerance)
-
-
-def _vessel(key: str) -> str:
-    """The vessel id of a `catabot/<world>/vessel/<id>/...` key."""
-    return key.split("/")[3]
 
 
 def build(ctx: ServiceContext) -> Built:

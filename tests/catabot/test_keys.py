@@ -91,3 +91,11 @@ def test_participant_of() -> None:
     assert k.participant_of(k.ack("physics")) == "physics"
     assert k.participant_of(k.live("recorder")) == "recorder"
     assert k.participant_of(k.live("conductor")) == "conductor"
+
+
+def test_vessel_of_reads_the_vessel_id_back_from_a_key() -> None:
+    keys = Keys("w")
+    assert keys.vessel_of(keys.cmd_twist("boat_007")) == "boat_007"
+    assert keys.vessel_of(keys.sensor("ego", "lidar")) == "ego"
+    with pytest.raises(KeyError_, match="names no vessel"):
+        keys.vessel_of(keys.tick())
