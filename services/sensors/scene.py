@@ -32,7 +32,8 @@ from numpy.typing import NDArray
 from catabot.terrain import Terrain
 from catabot.waves import WaveField
 from services.sensors.common import SensorError, rotation_from_quaternion
-from services.sensors.water import water_hits
+from services.sensors.cull import cone_pairs, sphere_pairs
+from services.sensors.water import calm_hits, wave_hits
 
 if TYPE_CHECKING:
     from catabot.scenario import Scenario
@@ -41,6 +42,9 @@ CLASS_NONE, CLASS_WATER, CLASS_TERRAIN, CLASS_VESSEL, CLASS_BUOY = 0, 1, 2, 3, 4
 F32 = NDArray[np.float32]
 F64 = NDArray[np.float64]
 Vec3 = tuple[float, float, float]
+UP = np.array([0.0, 0.0, 1.0], dtype=np.float32)
+CORNER_BITS = np.array([[i >> 2 & 1, i >> 1 & 1, i & 1] for i in range(8)], dtype=bool)
+"""Corner i of a box takes hi on axis x, y, z where bit 2, 1, 0 of i is set."""
 
 
 class SceneError(SensorError):
@@ -98,6 +102,7 @@ class Scene:
         self._pos = np.full((n, 3), np.nan)  # unposed bodies are not in the scene
         self._rot = np.tile(np.eye(3), (n, 1, 1))
         self.time_s = 0.0
+        self._buffers: dict[int, F32] = {}
 
     def update(
         self, poses: Mapping[str, tuple[Sequence[float], Sequence[float]]], time_s: float
@@ -117,9 +122,11 @@ class Scene:
     def corners(self) -> F64:
         """(n, 8, 3) map-frame corners of every body's box, in `bodies` order (NaN where not
         yet posed): a camera projects them to tell a truncated or occluded 2D box."""
-        sel = np.array([[i >> 2 & 1, i >> 1 & 1, i & 1] for i in range(8)], dtype=bool)
-        local = np.where(sel[None], self._hi[:, None, :], self._lo[:, None, :])
-        return np.einsum("nij,nkj->nki", self._rot, local) + self._pos[:, None, :]
+        return self._corners_of(slice(None))
+
+    def _corners_of(self, rows: NDArray[np.intp] | slice) -> F64:
+        local = np.where(CORNER_BITS[None], self._hi[rows, None, :], self._lo[rows, None, :])
+        return np.einsum("nij,nkj->nki", self._rot[rows], local) + self._pos[rows, None, :]
 
     def cast(
         self,
@@ -133,43 +140,68 @@ class Scene:
         caller knows which rays can meet which body (a camera projects each box into its
         image); it must hold every pair that can hit."""
         o, d = _rays(origins, directions)
-        n = d.shape[0]
-        rng = np.full(n, np.inf)
-        normal = np.zeros((n, 3))
-        cls = np.zeros(n, dtype=np.uint8)
-        inst = np.zeros(n, dtype=np.int32)
-        self._cast_terrain(o, d, max_range, rng, normal, cls)
+        rng, normal, cls = self._cast_terrain(o, d, max_range)
+        inst = np.zeros(d.shape[0], dtype=np.int32)
         self._cast_bodies(o, d, max_range, rng, normal, cls, inst, pairs)
-        t, nw = water_hits(
-            self._waves, self._amplitude, o, d, np.minimum(rng, max_range), self.time_s
-        )
-        closer = t < rng
-        rng[closer], normal[closer], cls[closer], inst[closer] = (
-            t[closer],
-            nw[closer],
-            CLASS_WATER,
-            0,
-        )
-        rng[rng > max_range] = np.inf
-        miss = ~np.isfinite(rng)
-        normal[miss], cls[miss], inst[miss] = 0.0, CLASS_NONE, 0
-        return Hits(rng.astype(np.float32), normal.astype(np.float32), cls, inst)
+        self._cast_water(o, d, max_range, rng, normal, cls, inst)
+        return Hits(rng.astype(np.float32), normal, cls, inst)
 
-    def _cast_terrain(
-        self, o: F64, d: F64, max_range: float, rng: F64, normal: F64, cls: NDArray[np.uint8]
-    ) -> None:
+    def _cast_terrain(self, o: F64, d: F64, max_range: float) -> tuple[F64, F32, NDArray[np.uint8]]:
+        """Range (inf: none within max_range), float32 normal (zero: none) and class of the
+        terrain hit of each ray: Embree's own float32 outputs, copied as little as possible."""
+        n = d.shape[0]
         if self._terrain is None:
-            return
+            return np.full(n, np.inf), np.zeros((n, 3), np.float32), np.zeros(n, np.uint8)
         import open3d as o3d
 
-        rays = np.empty((d.shape[0], 6), dtype=np.float32)
-        rays[:, :3], rays[:, 3:] = o, d
+        rays = self._ray_buffer(n)
+        rays[:, :3] = o
+        rays[:, 3:] = d  # rounded to float32 as astype would
         out = self._terrain.cast_rays(o3d.core.Tensor.from_numpy(rays))
-        t = out["t_hit"].numpy().astype(np.float64)
-        hit = t <= max_range
-        rng[hit] = t[hit]
-        normal[hit] = out["primitive_normals"].numpy()[hit]
-        cls[hit] = CLASS_TERRAIN
+        t32 = out["t_hit"].numpy()
+        normal: F32 = out["primitive_normals"].numpy()  # Embree gives zero on a miss
+        far = t32 > max_range  # misses (inf) too
+        rng = t32.astype(np.float64)
+        if far.any():
+            rng[far] = np.inf
+            normal[far] = 0.0
+        cls = np.where(far, np.uint8(CLASS_NONE), np.uint8(CLASS_TERRAIN))
+        return rng, normal, cls
+
+    def _ray_buffer(self, n: int) -> F32:
+        """The (n, 6) float32 rays handed to Embree, reused across casts of the same size
+        (a fresh 7 MB array per camera frame costs ~1 ms of page faults)."""
+        buf = self._buffers.get(n)
+        if buf is None:
+            buf = self._buffers[n] = np.empty((n, 6), dtype=np.float32)
+            if len(self._buffers) > 8:  # sizes vary (radar sectors): keep a few
+                self._buffers.pop(next(iter(self._buffers)))
+        return buf
+
+    def _cast_water(
+        self,
+        o: F64,
+        d: F64,
+        max_range: float,
+        rng: F64,
+        normal: F32,
+        cls: NDArray[np.uint8],
+        inst: NDArray[np.int32],
+    ) -> None:
+        """Rays that meet the water before anything else get the water's hit."""
+        if self._waves.is_calm or self._amplitude <= 0.0:
+            t = calm_hits(o, d, max_range)
+            closer = t < rng
+            np.copyto(rng, t, where=closer)
+            np.copyto(normal, UP, where=closer[:, None])
+            np.copyto(cls, np.uint8(CLASS_WATER), where=closer)
+            np.copyto(inst, 0, where=closer)
+            return
+        limit = np.minimum(rng, max_range)
+        rows, t, nw = wave_hits(self._waves, self._amplitude, o, d, limit, self.time_s)
+        closer = t < rng[rows]
+        rows = rows[closer]
+        rng[rows], normal[rows], cls[rows], inst[rows] = t[closer], nw[closer], CLASS_WATER, 0
 
     def _cast_bodies(
         self,
@@ -177,7 +209,7 @@ class Scene:
         d: F64,
         max_range: float,
         rng: F64,
-        normal: F64,
+        normal: F32,
         cls: NDArray[np.uint8],
         inst: NDArray[np.int32],
         pairs: tuple[NDArray[np.intp], NDArray[np.intp]] | None = None,
@@ -200,7 +232,7 @@ class Scene:
     def _candidates(
         self, o: F64, d: F64, max_range: float
     ) -> tuple[NDArray[np.intp], NDArray[np.intp]]:
-        """(ray, body) pairs whose ray passes within the body's bounding sphere."""
+        """(ray, body) pairs whose ray may meet the body's box (services/sensors/cull.py)."""
         posed = np.isfinite(self._pos[:, 0])
         centre = self._pos + np.einsum("nij,nj->ni", self._rot, self._centre_b)
         single = o.strides[0] == 0  # every ray from one origin
@@ -210,23 +242,12 @@ class Scene:
         if keep.size == 0:
             return np.empty(0, np.intp), np.empty(0, np.intp)
         c, r = centre[keep], self._radius[keep]
-        # np.dot, not @: NumPy's matmul takes a ~100x slower loop for (N, 3) x (3, K)
-        if single:  # a LiDAR, a camera: one small product
+        if single:  # a LiDAR, a radar: cones from one point; in range: culled above
             oc = c - lo
             dist = np.linalg.norm(oc, axis=1)
-            tc = np.dot(d, oc.T)  # along-ray distance of each centre, (rays, bodies)
-            cos_half = self._corner_cone(keep, lo, oc, dist)
-            ray_i, k = np.nonzero(tc >= cos_half * dist)  # in range: culled above; slab: exact
-            return ray_i, keep[k]
+            ray_i, k = cone_pairs(d, oc, dist, self._corner_cone(keep, lo, oc, dist))
         else:
-            tc = np.dot(d, c.T) - np.sum(d * o, axis=1)[:, None]
-            oc2 = (
-                np.sum(c * c, axis=1)[None, :]
-                - 2.0 * np.dot(o, c.T)
-                + np.sum(o * o, axis=1)[:, None]
-            )
-        near = (oc2 - tc * tc <= r * r) & (tc >= -r) & (tc - r <= max_range)
-        ray_i, k = np.nonzero(near)
+            ray_i, k = sphere_pairs(o, d, c, r, max_range)
         return ray_i, keep[k]
 
     def _corner_cone(self, keep: NDArray[np.intp], origin: F64, oc: F64, dist: F64) -> F64:
@@ -234,7 +255,7 @@ class Scene:
         its 8 corners, so holds the box (-1: every direction, when that cone is not convex).
         Tighter than the bounding sphere, and still a cull when the origin is inside the
         sphere (a LiDAR above its own hull), where the sphere test passes every ray."""
-        rel = self.corners()[keep] - origin  # (K, 8, 3)
+        rel = self._corners_of(keep) - origin  # (K, 8, 3)
         cos = np.einsum("kcj,kj->kc", rel, oc) / (
             np.linalg.norm(rel, axis=2) * dist[:, None] + 1e-300
         )

@@ -25,34 +25,32 @@ REFINE_STEPS = 10
 TOLERANCE_M = 1e-4  # vertical distance to the surface at which a ray is done
 
 
-def water_hits(
+def calm_hits(o: F64, d: F64, max_range: float) -> F64:
+    """Distance along each unit ray to the plane z = 0 from above (inf: none within
+    `max_range`); the normal there is +z."""
+    with np.errstate(divide="ignore", invalid="ignore"):
+        t = -o[:, 2] / d[:, 2]
+    miss = ~((d[:, 2] < -1e-12) & (o[:, 2] >= 0.0) & (t <= max_range))
+    t[miss] = np.inf
+    return t
+
+
+def wave_hits(
     waves: WaveField, amplitude: float, o: F64, d: F64, limit: F64, time_s: float
-) -> tuple[F64, F64]:
-    """Distance to the water along each unit ray (inf if none before `limit`) and the
-    surface's unit normal there (world frame)."""
-    n = d.shape[0]
-    t = np.full(n, np.inf)
-    normal = np.zeros((n, 3))
+) -> tuple[NDArray[np.intp], F64, F64]:
+    """The rays that meet the wave surface before `limit`, their distances and the
+    surface's unit normals there (world frame)."""
     down = d[:, 2] < -1e-12
-    if waves.is_calm or amplitude <= 0.0:
-        with np.errstate(divide="ignore", invalid="ignore"):
-            tz = np.where(down & (o[:, 2] >= 0.0), -o[:, 2] / d[:, 2], np.inf)
-        hit = tz <= limit
-        t[hit] = tz[hit]
-        normal[hit, 2] = 1.0
-        return t, normal
     with np.errstate(divide="ignore", invalid="ignore"):
         t_top = np.maximum((amplitude - o[:, 2]) / d[:, 2], 0.0)
         t_bottom = np.minimum((-amplitude - o[:, 2]) / d[:, 2], limit)
     rows = np.flatnonzero(down & (t_top < t_bottom))
     if rows.size == 0:
-        return t, normal
+        return rows, np.empty(0), np.empty((0, 3))
     found, tr = _first_crossing(waves, o[rows], d[rows], t_top[rows], t_bottom[rows], time_s)
     rows, tr = rows[found], tr[found]
-    t[rows] = tr
     p = o[rows] + tr[:, None] * d[rows]
-    normal[rows] = waves.normal(p[:, 0], p[:, 1], time_s).reshape(-1, 3)
-    return t, normal
+    return rows, tr, waves.normal(p[:, 0], p[:, 1], time_s).reshape(-1, 3)
 
 
 def _gap(waves: WaveField, o: F64, d: F64, t: F64, time_s: float) -> F64:
