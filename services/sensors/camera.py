@@ -148,11 +148,14 @@ class CameraModel:
 
     def _color(self, hits: Hits, dirs: F32, origin_z: float) -> NDArray[np.uint8]:
         p = self.params
-        rgb = shade(hits.cls, hits.instance, hits.range, hits.normal, dirs, origin_z)
+        planes = shade(hits.cls, hits.instance, hits.range, hits.normal, dirs, origin_z)
         distance = np.minimum(hits.range, np.float32(p.max_range_m))
-        rgb = rain_veil(rgb, distance, self.scene.rain_rate_mm_h).reshape(p.height, p.width, 3)
-        rain_streaks(rgb, self.scene.rain_rate_mm_h, self._rng)
-        return np.clip(rgb, 0.0, 255.0).astype(np.uint8)
+        planes = rain_veil(planes, distance, self.scene.rain_rate_mm_h)
+        planes = planes.reshape(3, p.height, p.width)
+        rain_streaks(planes, self.scene.rain_rate_mm_h, self._rng)
+        rgb = np.empty((p.height, p.width, 3), dtype=np.uint8)
+        np.copyto(rgb.transpose(2, 0, 1), planes, casting="unsafe")  # all blends within 0..255
+        return rgb
 
     def _boxes(
         self, seg: NDArray[np.uint8], inst: NDArray[np.int32], origin: F64, rot: F64

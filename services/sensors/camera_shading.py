@@ -47,15 +47,16 @@ STREAKS_PER_MM_H = 15
 
 
 def sky(dz: F32) -> F32:
-    """Sky colour for rays of world elevation sine `dz` (below the horizon: horizon colour)."""
-    t = np.sqrt(np.clip(dz, 0.0, 1.0))[:, None]
-    return (HORIZON + t * (ZENITH - HORIZON)).astype(np.float32)
+    """(3, N) sky colour planes for rays of world elevation sine `dz` (below the horizon:
+    horizon colour)."""
+    t = np.sqrt(np.clip(dz, 0.0, 1.0))
+    return HORIZON[:, None] + t * (ZENITH - HORIZON)[:, None]
 
 
 def lambert(normal: F32) -> F32:
-    """Ambient plus diffuse light from the fixed sun, (N, 1)."""
-    light = 0.35 + 0.65 * np.clip(np.dot(normal, SUN), 0.0, 1.0)
-    return light[:, None].astype(np.float32)
+    """Ambient plus diffuse light from the fixed sun, (N,)."""
+    light: F32 = 0.35 + 0.65 * np.clip(np.dot(normal, SUN), 0.0, 1.0)
+    return light
 
 
 def shade(
@@ -66,61 +67,67 @@ def shade(
     dirs: F32,
     origin_z: float,
 ) -> F32:
-    """(N, 3) float colours 0..255 of N rays (world directions `dirs`, world hit normals).
+    """(3, N) float colour planes 0..255 of N rays (world directions `dirs`, world hit
+    normals). Planes, not (N, 3) pixels: NumPy runs an (N, 3) expression as N loops of 3,
+    several times slower than 3 loops of N.
 
-    Sky and water, most of a frame, are one pass over every pixel with no gather or
-    scatter (a sky pixel is water with Fresnel weight 1 and the unreflected ray); terrain
-    and bodies, the few remaining pixels, are gathered, shaded and put back."""
+    The sky is one pass over every pixel with no gather; water, terrain and bodies are
+    gathered (np.take), shaded and put back over it."""
     out = _sky_and_water(cls, normal, dirs)
     for c, fn in ((CLASS_TERRAIN, _terrain), (CLASS_VESSEL, _body), (CLASS_BUOY, _body)):
         idx = np.flatnonzero(cls == c)
         if idx.size:
-            out[idx] = fn(idx, instance, rng, normal, dirs, origin_z)
+            out[:, idx] = fn(idx, instance, rng, normal, dirs, origin_z)
     return out
 
 
 def _sky_and_water(cls: NDArray[np.uint8], n: F32, d: F32) -> F32:
-    """Water: its colour blended with the sky mirrored in the wave normal by Schlick's
-    Fresnel term; everything else: the sky along the ray."""
-    water = cls == CLASS_WATER
-    dot = d[:, 0] * n[:, 0] + d[:, 1] * n[:, 1] + d[:, 2] * n[:, 2]
+    """Everything: the sky along the ray; then the water (about half a frame) only: its
+    colour blended with the sky mirrored in the wave normal by Schlick's Fresnel term."""
+    out = sky(d[:, 2])
+    idx = np.flatnonzero(cls == CLASS_WATER)
+    if idx.size == 0:
+        return out
+    nw, dw = np.take(n, idx, axis=0), np.take(d, idx, axis=0)
+    dot = dw[:, 0] * nw[:, 0] + dw[:, 1] * nw[:, 1] + dw[:, 2] * nw[:, 2]
     grazing = 1.0 - np.clip(-dot, 0.0, 1.0)
     grazing2 = grazing * grazing
-    fresnel = np.where(water, 0.02 + 0.98 * grazing2 * grazing2 * grazing, 1.0)
-    seen_z = np.where(water, d[:, 2] - 2.0 * dot * n[:, 2], d[:, 2])
-    sky_rgb = sky(seen_z.astype(np.float32))
-    return (sky_rgb + (1.0 - fresnel[:, None]) * (WATER - sky_rgb)).astype(np.float32)
+    fresnel = 0.02 + 0.98 * grazing2 * grazing2 * grazing
+    mirrored = sky((dw[:, 2] - 2.0 * dot * nw[:, 2]).astype(np.float32))
+    mirrored += (1.0 - fresnel) * (WATER[:, None] - mirrored)
+    out[:, idx] = mirrored
+    return out
 
 
 def _terrain(
     idx: NDArray[np.intp], inst: NDArray[np.int32], r: F32, n: F32, d: F32, z: float
 ) -> F32:
-    height = z + r[idx] * d[idx, 2]
-    rgb = np.stack(
-        [np.interp(height, TERRAIN_HEIGHTS, TERRAIN_COLORS[:, k]) for k in range(3)], axis=1
-    )
-    return (rgb * lambert(n[idx])).astype(np.float32)
+    height = z + np.take(r, idx) * np.take(d[:, 2], idx)
+    rgb = np.stack([np.interp(height, TERRAIN_HEIGHTS, TERRAIN_COLORS[:, k]) for k in range(3)])
+    return (rgb * lambert(np.take(n, idx, axis=0))).astype(np.float32)
 
 
 def _body(idx: NDArray[np.intp], inst: NDArray[np.int32], r: F32, n: F32, d: F32, z: float) -> F32:
-    return PALETTE[inst[idx] % len(PALETTE)] * lambert(n[idx])
+    colour: F32 = PALETTE.T[:, np.take(inst, idx) % len(PALETTE)]
+    return colour * lambert(np.take(n, idx, axis=0))
 
 
 def rain_veil(color: F32, distance: F32, rate_mm_h: float) -> F32:
-    """Blend (N, 3) colours toward the grey veil by exp(-k R^a d); no-op without rain."""
+    """Blend (3, N) colour planes toward the grey veil by exp(-k R^a d); no-op without rain."""
     if rate_mm_h <= 0.0:
         return color
     beta = RAIN_K_PER_M * rate_mm_h**RAIN_EXPONENT
-    t = np.exp(-beta * distance)[:, None].astype(np.float32)
-    return t * color + (1.0 - t) * VEIL
+    t = np.exp(-beta * distance).astype(np.float32)
+    return t * color + (1.0 - t) * VEIL[:, None]
 
 
 def rain_streaks(image: F32, rate_mm_h: float, rng: np.random.Generator) -> None:
-    """Brighten short, slanted streaks in an (H, W, 3) image, in place (seeded, no loops)."""
+    """Brighten short, slanted streaks in (3, H, W) colour planes, in place (seeded, no
+    loops)."""
     count = int(rate_mm_h * STREAKS_PER_MM_H)
     if count <= 0:
         return
-    h, w = image.shape[:2]
+    h, w = image.shape[1:]
     start = rng.random((count, 2)) * (h, w)
     length = rng.integers(6, 20, size=count)
     steps = np.arange(20)
@@ -128,4 +135,4 @@ def rain_streaks(image: F32, rate_mm_h: float, rng: np.random.Generator) -> None
     cols = (start[:, 1:] + 0.25 * steps).astype(np.intp)
     ok = (steps < length[:, None]) & (rows < h) & (cols < w)
     rows, cols = rows[ok], cols[ok]
-    image[rows, cols] = 0.7 * image[rows, cols] + 0.3 * np.float32(235.0)
+    image[:, rows, cols] = 0.7 * image[:, rows, cols] + 0.3 * np.float32(235.0)

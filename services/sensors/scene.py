@@ -162,9 +162,8 @@ class Scene:
         normal: F32 = out["primitive_normals"].numpy()  # Embree gives zero on a miss
         far = t32 > max_range  # misses (inf) too
         rng = t32.astype(np.float64)
-        if far.any():
-            rng[far] = np.inf
-            normal[far] = 0.0
+        beyond = np.flatnonzero(far & (t32 < np.inf))  # hits past max_range: none of it
+        rng[beyond], normal[beyond] = np.inf, 0.0
         cls = np.where(far, np.uint8(CLASS_NONE), np.uint8(CLASS_TERRAIN))
         return rng, normal, cls
 
@@ -193,7 +192,8 @@ class Scene:
             t = calm_hits(o, d, max_range)
             closer = t < rng
             np.copyto(rng, t, where=closer)
-            np.copyto(normal, UP, where=closer[:, None])
+            for axis in range(3):  # per column: an (N, 3) masked copy is ~6x slower
+                np.copyto(normal[:, axis], UP[axis], where=closer)
             np.copyto(cls, np.uint8(CLASS_WATER), where=closer)
             np.copyto(inst, 0, where=closer)
             return
@@ -217,17 +217,19 @@ class Scene:
         ray_i, body_i = self._candidates(o, d, max_range) if pairs is None else pairs
         if ray_i.size == 0:
             return
-        rot = self._rot[body_i]  # (P, 3, 3) body -> map
-        ob = np.einsum("pji,pj->pi", rot, o[ray_i] - self._pos[body_i])  # R^T (o - p)
-        db = np.einsum("pji,pj->pi", rot, d[ray_i])
-        t, face_b = _slab(ob, db, self._lo[body_i], self._hi[body_i])
-        ok = (t <= max_range) & (t < rng[ray_i])
-        ray_i, body_i, t = ray_i[ok], body_i[ok], t[ok]
-        face = np.einsum("pij,pj->pi", rot[ok], face_b[ok])
+        take = np.take  # not fancy indexing: take is several times faster on (P, 3) rows
+        rot = take(self._rot, body_i, axis=0)  # (P, 3, 3) body -> map
+        rel = rows_of(o, ray_i) - take(self._pos, body_i, axis=0)
+        ob = np.einsum("pji,pj->pi", rot, rel)  # R^T (o - p)
+        db = np.einsum("pji,pj->pi", rot, take(d, ray_i, axis=0))
+        t, face_b = _slab(ob, db, take(self._lo, body_i, axis=0), take(self._hi, body_i, axis=0))
+        ok = np.flatnonzero((t <= max_range) & (t < take(rng, ray_i)))
+        ray_i, body_i, t = take(ray_i, ok), take(body_i, ok), take(t, ok)
+        face = np.einsum("pij,pj->pi", take(rot, ok, axis=0), take(face_b, ok, axis=0))
         order = np.lexsort((-t, ray_i))  # per ray, nearest last: fancy assignment keeps it
         ray_i, body_i, t, face = ray_i[order], body_i[order], t[order], face[order]
         rng[ray_i], normal[ray_i] = t, face
-        cls[ray_i], inst[ray_i] = self._cls[body_i], self._inst[body_i]
+        cls[ray_i], inst[ray_i] = take(self._cls, body_i), take(self._inst, body_i)
 
     def _candidates(
         self, o: F64, d: F64, max_range: float
@@ -276,6 +278,14 @@ def _rays(origins: np.ndarray, directions: np.ndarray) -> tuple[F64, F64]:
         return o, d / norm[:, None]
     d /= norm[:, None]  # a fresh float64 copy made above
     return o, d
+
+
+def rows_of(a: F64, rows: NDArray[np.intp]) -> F64:
+    """a[rows] of an (N, 3) array; a shared origin (stride 0) stays a view: np.take would
+    first copy the whole broadcast array."""
+    if a.strides[0] == 0:
+        return np.broadcast_to(a[0], (rows.size, a.shape[1]))
+    return np.take(a, rows, axis=0)
 
 
 def _slab(ob: F64, db: F64, lo: F64, hi: F64) -> tuple[F64, F64]:
