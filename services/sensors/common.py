@@ -73,6 +73,23 @@ def rotation_from_quaternion(q: Sequence[float]) -> Array:
     )
 
 
+def rotations_from_quaternions(q: Array) -> Array | None:
+    """(n, 3, 3) rotations of n quaternions (x, y, z, w), the same bits as
+    `rotation_from_quaternion` one by one (same operations in the same order), or None if
+    any is non-finite or of zero length (the caller then names it one by one)."""
+    x, y, z, w = np.asarray(q, dtype=np.float64).T
+    norm = np.sqrt(x * x + y * y + z * z + w * w)
+    if not (np.isfinite(norm).all() and (norm >= 1e-9).all()):
+        return None
+    x, y, z, w = x / norm, y / norm, z / norm, w / norm
+    rows = [
+        [1 - 2 * (y * y + z * z), 2 * (x * y - z * w), 2 * (x * z + y * w)],
+        [2 * (x * y + z * w), 1 - 2 * (x * x + z * z), 2 * (y * z - x * w)],
+        [2 * (x * z - y * w), 2 * (y * z + x * w), 1 - 2 * (x * x + y * y)],
+    ]
+    return np.stack([np.stack(r, axis=-1) for r in rows], axis=-2)
+
+
 def single_thread_blas() -> bool:
     """Run NumPy's OpenBLAS on one thread in this process; True if it could.
 

@@ -19,7 +19,7 @@ from numpy.typing import NDArray
 F64 = NDArray[np.float64]
 Pairs = tuple[NDArray[np.intp], NDArray[np.intp]]
 CHUNK = 16  # rays per bundle: a LiDAR bundle spans ~11 deg of azimuth at 512 columns
-MIN_RAYS = 4 * CHUNK  # fewer rays than this: test them all directly
+MIN_RAYS = 1024  # fewer rays (a radar's few beams): the full product is cheaper
 SLACK_RAD = 1e-6  # angles are compared with this margin for rounding
 
 
