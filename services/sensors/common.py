@@ -90,6 +90,14 @@ def rotations_from_quaternions(q: Array) -> Array | None:
     return np.stack([np.stack(r, axis=-1) for r in rows], axis=-2)
 
 
+def rows_of(a: Array, rows: NDArray[np.intp]) -> Array:
+    """a[rows] of an (N, 3) array; a shared origin (stride 0) stays a view: np.take would
+    first copy the whole broadcast array."""
+    if a.strides[0] == 0:
+        return np.broadcast_to(a[0], (rows.size, a.shape[1]))
+    return np.take(a, rows, axis=0)
+
+
 def single_thread_blas() -> bool:
     """Run NumPy's OpenBLAS on one thread in this process; True if it could.
 

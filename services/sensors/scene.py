@@ -35,6 +35,7 @@ from services.sensors.common import (
     SensorError,
     rotation_from_quaternion,
     rotations_from_quaternions,
+    rows_of,
 )
 from services.sensors.cull import cone_pairs, sphere_pairs
 from services.sensors.water import calm_hits, wave_hits
@@ -314,14 +315,6 @@ def _rays(origins: np.ndarray, directions: np.ndarray) -> tuple[F64, F64]:
         return o, d / norm[:, None]
     d /= norm[:, None]  # a fresh float64 copy made above
     return o, d
-
-
-def rows_of(a: F64, rows: NDArray[np.intp]) -> F64:
-    """a[rows] of an (N, 3) array; a shared origin (stride 0) stays a view: np.take would
-    first copy the whole broadcast array."""
-    if a.strides[0] == 0:
-        return np.broadcast_to(a[0], (rows.size, a.shape[1]))
-    return np.take(a, rows, axis=0)
 
 
 def _slab(ob: F64, db: F64, lo: F64, hi: F64) -> tuple[F64, F64]:
