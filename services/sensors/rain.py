@@ -103,9 +103,10 @@ def apply_rain(
     # step one
     n = rng.poisson(mean_drops(rate_mm_h, z, p)).astype(np.float64)  # (2), (3)
     u = rng.random(z.shape)
-    with np.errstate(divide="ignore"):
-        z_drop = z * (1.0 - u ** (1.0 / n))  # least of n uniforms in (0, Z]; n = 0: Z
-    z_drop = np.maximum(z_drop, 1e-6)
+    z_drop = z.copy()  # least of n uniforms in (0, Z]; n = 0: Z (what u ** inf gives)
+    some = np.flatnonzero(n > 0)  # the power, the costliest step, only where it matters
+    z_drop[some] = z[some] * (1.0 - u[some] ** (1.0 / n[some]))
+    np.maximum(z_drop, 1e-6, out=z_drop)
     # step two
     alpha_obj = n * p.q_ext * area / (beam * z)  # (6)
     rio = np.where(hit, rho / z**2 * np.exp(-2.0 * alpha_obj * z), 0.0)  # (4)
@@ -116,6 +117,8 @@ def apply_rain(
     object_wins = hit & ((n == 0) | (rio >= rird))
     show_object = object_wins & ((n == 0) | (rio > thr))
     show_drop = ~object_wins & (rird > thr)
-    out_range = np.where(show_object, z, np.where(show_drop, z_drop, np.inf))
-    intensity = np.where(show_object, rio, np.where(show_drop, rird, 0.0))
+    out_range, intensity = np.full(z.shape, np.inf), np.zeros(z.shape)
+    for out, obj, drop in ((out_range, z, z_drop), (intensity, rio, rird)):
+        np.copyto(out, obj, where=show_object)  # show_object and show_drop never overlap
+        np.copyto(out, drop, where=show_drop)
     return RainReturns(out_range, intensity, show_drop)
