@@ -76,6 +76,7 @@ class LidarModel:
         )
         self.shape = (params.channels, params.columns)
         self.dirs = beam_directions(params.channels, params.columns, params.vertical_fov_deg)
+        self.dirs_t = np.ascontiguousarray(self.dirs.T)  # (3, N): points are built per axis
         self.mount_rot = mount_rotation(params.mount_yaw_deg, params.mount_pitch_deg)
         self.mount_xyz = np.asarray(params.mount_xyz, dtype=np.float64)
         self.ring = np.repeat(np.arange(params.channels, dtype=np.uint16), params.columns)
@@ -94,16 +95,18 @@ class LidarModel:
             distance = np.maximum(distance + noise, 0.0)  # inf stays inf
         rain = apply_rain(distance, p.max_range_m, self.scene.rain_rate_mm_h, self.rain, self.rng)
         keep = np.flatnonzero(np.isfinite(rain.range))
-        r = rain.range[keep]
-        rain_hit = rain.is_rain[keep]
+        r = np.take(rain.range, keep)
+        rain_hit = np.take(rain.is_rain, keep)
+        points = np.empty((keep.size, 3), dtype=np.float32)
+        np.multiply(np.take(self.dirs_t, keep, axis=1), r, out=points.T, casting="same_kind")
         return LidarScan(
             tick=tick,
             stamp_ns=stamp_ns,
-            points=(self.dirs[keep] * r[:, None]).astype(np.float32),
-            intensity=rain.intensity[keep].astype(np.float32),
-            ring=self.ring[keep],
-            cls=np.where(rain_hit, CLASS_NONE, hits.cls[keep]).astype(np.uint8),
-            instance=np.where(rain_hit, 0, hits.instance[keep]).astype(np.int32),
+            points=points,
+            intensity=np.take(rain.intensity, keep).astype(np.float32),
+            ring=np.take(self.ring, keep),
+            cls=np.where(rain_hit, np.uint8(CLASS_NONE), np.take(hits.cls, keep)),
+            instance=np.where(rain_hit, np.int32(0), np.take(hits.instance, keep)),
             is_rain=rain_hit,
             range_image=rain.range.reshape(self.shape).astype(np.float32),
         )
