@@ -125,7 +125,8 @@ class CameraModel:
         normals = EMPTY
         if out.normals:
             cam_n = np.dot(hits.normal, rot.astype(np.float32))
-            normals = np.rint(cam_n * 127.0).astype(np.int8).reshape(h, w, 3)
+            np.multiply(cam_n, np.float32(127.0), out=cam_n)
+            normals = np.rint(cam_n, out=cam_n).astype(np.int8).reshape(h, w, 3)
         seg = hits.cls.reshape(h, w)
         inst = hits.instance.reshape(h, w)
         color = self._color(hits, dirs, float(origin[2])) if out.color else EMPTY
