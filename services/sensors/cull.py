@@ -1,8 +1,9 @@
 """Which (ray, body) pairs can meet: the cheap pre-test before the exact slab test.
 
 A pair left out here is a hit lost, so every test is conservative; a pair let through only
-costs a slab test. Rays from ONE origin (a LiDAR, a radar) are tested against each body's
-corner cone (the cone from the origin about the body's centre that holds its 8 corners).
+costs a slab test. Rays from ONE origin (a radar, any caller) are tested against each body's
+corner cone (the cone from the origin about the body's centre that holds its 8 corners); a
+LiDAR, whose beams are a fixed grid, gets its pairs from the cones alone (`grid_pairs`).
 Testing every ray against every body in range is a (rays x bodies) product, ~1 ms for a
 32 x 512 scan and 16 bodies in range, almost all of it spent on pairs that are far apart.
 So neighbouring rays (consecutive in the caller's order: a LiDAR channel's columns, a
@@ -56,6 +57,38 @@ def _bundle_pairs(d: F64, unit_axis: F64, cos_half: F64) -> Pairs:
     g, k = np.nonzero(keep)
     rays = (g[:, None] * CHUNK + np.arange(CHUNK)).ravel()
     return rays, np.repeat(k, CHUNK)
+
+
+def grid_pairs(unit_axis: F64, cos_half: F64, elevations: F64, columns: int) -> Pairs:
+    """(ray, body) pairs, sorted by ray then body, of a spinning sensor's grid (ray
+    c * columns + j at elevation elevations[c], azimuth 2 pi j / columns, in the frame of
+    `unit_axis`) that may lie in each body's cone, without a pass over the rays.
+
+    For a ray at elevation e and a cone axis at elevation e0, azimuth a0, the ray is inside
+    the cone where cos e cos e0 cos(a - a0) + sin e sin e0 >= cos_half: per channel, an
+    azimuth interval about a0 of half-width arccos(q). It is widened by SLACK_RAD and
+    rounded outward to whole columns; the slab test that follows is exact."""
+    e0 = np.arcsin(np.clip(unit_axis[:, 2], -1.0, 1.0))[:, None]  # (K, 1)
+    a0 = np.arctan2(unit_axis[:, 1], unit_axis[:, 0])[:, None]
+    e = np.asarray(elevations, dtype=np.float64)[None, :]  # (1, C)
+    scale, offset = np.cos(e) * np.cos(e0), np.sin(e) * np.sin(e0)  # (K, C)
+    low = cos_half[:, None] - offset  # needed: scale cos(a - a0) >= low
+    flat = scale <= 1e-12  # a vertical axis or channel: inside for every azimuth, or none
+    with np.errstate(divide="ignore", invalid="ignore"):
+        q = np.where(flat, 0.0, low / np.where(flat, 1.0, scale))
+    every = (cos_half[:, None] <= -1.0) | np.where(flat, low <= 1e-9, q <= -1.0)
+    none = ~every & (flat | (q > 1.0 + 1e-9))
+    width = np.where(every, np.pi, np.arccos(np.clip(q, -1.0, 1.0)) + SLACK_RAD)
+    width[none] = -1.0
+    step = 2.0 * np.pi / columns
+    first = np.floor((a0 - width) / step).astype(np.intp)
+    count = np.minimum(np.ceil((a0 + width) / step).astype(np.intp) - first + 1, columns)
+    count = np.where(width < 0.0, 0, count)
+    k, c = np.nonzero(count > 0)
+    n = count[k, c]
+    ramp = np.arange(n.sum()) - np.repeat(np.cumsum(n) - n, n)  # 0.. n-1 per (body, channel)
+    column = (np.repeat(first[k, c], n) + ramp) % columns
+    return _sorted(np.repeat(c, n) * columns + column, np.repeat(k, n))
 
 
 def sphere_pairs(o: F64, d: F64, centre: F64, radius: F64, max_range: float) -> Pairs:

@@ -23,16 +23,22 @@ from numpy.typing import NDArray
 from catabot.messages import LidarScan, VesselState
 from catabot.sensor_types import LidarParams
 from services.sensors.common import SensorError, rotation_from_quaternion, sensor_rng
+from services.sensors.cull import grid_pairs
 from services.sensors.rain import RainParams, apply_rain
 from services.sensors.scene import CLASS_NONE, Scene
 
 F64 = NDArray[np.float64]
 
 
+def beam_elevations(channels: int, vertical_fov_deg: float) -> F64:
+    """Elevation (rad) of each channel, lowest first."""
+    half = math.radians(vertical_fov_deg) / 2
+    return np.linspace(-half, half, channels) if channels > 1 else np.zeros(1)
+
+
 def beam_directions(channels: int, columns: int, vertical_fov_deg: float) -> F64:
     """Unit directions (channels * columns, 3) in the sensor frame, channel-major."""
-    half = math.radians(vertical_fov_deg) / 2
-    elevation = np.linspace(-half, half, channels) if channels > 1 else np.zeros(1)
+    elevation = beam_elevations(channels, vertical_fov_deg)
     azimuth = 2.0 * math.pi * np.arange(columns) / columns
     el, az = np.meshgrid(elevation, azimuth, indexing="ij")
     dirs = np.stack([np.cos(el) * np.cos(az), np.cos(el) * np.sin(az), np.sin(el)], axis=-1)
@@ -76,6 +82,7 @@ class LidarModel:
         )
         self.shape = (params.channels, params.columns)
         self.dirs = beam_directions(params.channels, params.columns, params.vertical_fov_deg)
+        self.elevations = beam_elevations(params.channels, params.vertical_fov_deg)
         self.dirs_t = np.ascontiguousarray(self.dirs.T)  # (3, N): points are built per axis
         self.mount_rot = mount_rotation(params.mount_yaw_deg, params.mount_pitch_deg)
         self.mount_xyz = np.asarray(params.mount_xyz, dtype=np.float64)
@@ -88,7 +95,11 @@ class LidarModel:
         body_rot = rotation_from_quaternion(state.orientation)
         origin = np.asarray(state.position, dtype=np.float64) + body_rot @ self.mount_xyz
         rot = body_rot @ self.mount_rot  # sensor -> map
-        hits = self.scene.cast(origin, self.dirs @ rot.T, p.max_range_m)
+        cones = self.scene.cones(origin, p.max_range_m)  # bodies: only the beams near each
+        unit = (cones.axis / cones.dist[:, None]) @ rot  # in the sensor frame
+        pairs = grid_pairs(unit, cones.cos_half, self.elevations, p.columns)
+        pairs = pairs[0], cones.body[pairs[1]]
+        hits = self.scene.cast(origin, self.dirs @ rot.T, p.max_range_m, pairs)
         distance = hits.range.astype(np.float64)
         noise = self.rng.normal(0.0, p.range_noise_sigma_m, distance.shape)
         if self.noise:

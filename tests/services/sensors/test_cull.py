@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from services.sensors.cull import CHUNK, MIN_RAYS, cone_pairs
+from services.sensors.cull import CHUNK, MIN_RAYS, cone_pairs, grid_pairs
 
 
 def _dense(d: np.ndarray, axis: np.ndarray, dist: np.ndarray, cos_half: np.ndarray) -> set:
@@ -33,3 +33,20 @@ def test_a_bundle_of_opposite_rays_keeps_its_pairs() -> None:
     ray, body = cone_pairs(d, axis, np.array([10.0, 10.0]), np.array([0.99, 0.99]))
     assert d.shape[0] >= MIN_RAYS and ray.size == d.shape[0]
     assert np.array_equal(body, (d[ray, 0] < 0).astype(np.intp))
+
+
+def test_grid_pairs_hold_every_ray_inside_each_cone() -> None:
+    rng = np.random.default_rng(4)
+    elevations, columns = np.radians(np.linspace(-15.0, 15.0, 32)), 512
+    el, az = np.meshgrid(elevations, 2 * np.pi * np.arange(columns) / columns, indexing="ij")
+    d = np.stack([np.cos(el) * np.cos(az), np.cos(el) * np.sin(az), np.sin(el)], -1)
+    axis = rng.normal(size=(60, 3)) * [30.0, 30.0, 3.0]
+    axis[:3] = [[0.0, 0.0, -1.0], [0.0, 0.0, 1.0], [5.0, 0.0, 0.0]]  # vertical, on a channel
+    unit = axis / np.linalg.norm(axis, axis=1, keepdims=True)
+    cos_half = np.cos(rng.uniform(0.001, 0.5, 60))
+    cos_half[:2] = [np.cos(np.radians(80.0)), -1.0]
+    ray, body = grid_pairs(unit, cos_half, elevations, columns)
+    inside = _dense(d.reshape(-1, 3), unit, np.ones(60), cos_half)
+    got = set(zip(ray.tolist(), body.tolist(), strict=True))
+    assert inside <= got and len(got) < 1.5 * len(inside) + 200
+    assert np.all(np.diff(ray * 60 + body) > 0)
