@@ -14,7 +14,7 @@ import sys
 from dataclasses import asdict
 
 from catabot.clock import Policy
-from catabot.conductor import ClockSpec, Conductor
+from catabot.conductor import ClockSpec, Conductor, Progress
 from catabot.keys import Keys
 from catabot.scenario import Scenario, ScenarioError, load_scenario
 from catabot.session import SessionError, add_connection_args, connection_from_args, open_session
@@ -36,8 +36,13 @@ def clock_spec(scenario: Scenario) -> ClockSpec:
     )
 
 
-def emit(kind: str, **fields: object) -> None:
-    print(json.dumps({"kind": kind, **fields}), flush=True)
+def emit(kind: str, **fields: object) -> bool:
+    """One JSON line on stdout; False once nobody reads it (the launcher is gone)."""
+    try:
+        print(json.dumps({"kind": kind, **fields}), flush=True)
+    except (BrokenPipeError, ValueError):  # ValueError: stdout already closed
+        return False
+    return True
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -55,7 +60,14 @@ def main(argv: list[str] | None = None) -> int:
     conductor = Conductor(session, Keys(scenario.name), clock_spec(scenario))
     for sig in (signal.SIGINT, signal.SIGTERM):
         signal.signal(sig, lambda *_: conductor.stop("interrupted"))
-    result = conductor.run(lambda p: emit("progress", **asdict(p)))
+
+    def progress(p: Progress) -> None:
+        # Without its launcher the run has no one to report to: end it cleanly (services
+        # flush and exit) rather than tick on as orphans.
+        if not emit("progress", **asdict(p)):
+            conductor.stop("interrupted")
+
+    result = conductor.run(progress)
     emit("result", **asdict(result))
     if result.error:
         log.error("run ended by a fault: %s", result.error)

@@ -70,6 +70,10 @@ class Keys:
         """Every body's state in one `BodyStates` per tick (what lockstep services read)."""
         return f"{self.prefix}/world/states"
 
+    def world_twists(self) -> str:
+        """Every traffic boat's twist set-point in one `TwistBatch` per tick (lockstep)."""
+        return f"{self.prefix}/world/cmd/twist"
+
     def cmd_thrust(self, vessel: str) -> str:
         return f"{self.prefix}/vessel/{check_name('vessel', vessel)}/cmd/thrust"
 

@@ -145,14 +145,19 @@ class Supervisor:
         self.result: dict[str, object] = {}
 
     def wait(self) -> int:
-        previous = signal.signal(
-            signal.SIGINT, lambda *_: self.conductor.send_signal(signal.SIGINT)
-        )
+        """Ctrl-C, SIGTERM and SIGHUP all end the run cleanly through the conductor: a
+        launcher killed by its shell or a process manager must not leave orphans ticking."""
+        stops = (signal.SIGINT, signal.SIGTERM, signal.SIGHUP)
+        previous = {
+            sig: signal.signal(sig, lambda *_: self.conductor.send_signal(signal.SIGINT))
+            for sig in stops
+        }
         try:
             self._read_conductor()
             self._reap_services(timeout_s=15.0)
         finally:
-            signal.signal(signal.SIGINT, previous)
+            for sig, handler in previous.items():
+                signal.signal(sig, handler)
         return self._summary()
 
     def _read_conductor(self) -> None:

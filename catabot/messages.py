@@ -108,17 +108,16 @@ class BodyStates(Message):
 
     def row(self, i: int) -> VesselState:
         """Body i as a `VesselState` (python floats: recorded bytes match the per-body form)."""
-        return VesselState(
-            self.tick, self.stamp_ns, *(tuple(a[i].tolist()) for a in self._arrays())
-        )
+        return VesselState(self.tick, self.stamp_ns, *(tuple(a[i].tolist()) for a in self.arrays()))
 
     def rows(self) -> list[VesselState]:
         """Every body as a `VesselState`, in `ids` order; one `tolist` per array, not per row."""
-        cols = [a.tolist() for a in self._arrays()]
+        cols = [a.tolist() for a in self.arrays()]
         rows = zip(*cols, strict=True)
         return [VesselState(self.tick, self.stamp_ns, *map(tuple, r)) for r in rows]
 
-    def _arrays(self) -> tuple[np.ndarray, ...]:
+    def arrays(self) -> tuple[np.ndarray, ...]:
+        """The six arrays in `VesselState` field order."""
         return (
             self.position,
             self.orientation,
@@ -151,6 +150,38 @@ class TwistCmd(Message):
     yaw_rate: float = scalar("rad/s")
     tick: int = -1
     stamp_ns: int = 0
+
+
+@dataclass(frozen=True)
+class TwistBatch(Message):
+    """Twist set-points of many vessels in one message: entry i of each array is `ids[i]`.
+
+    The traffic service steers every boat every tick; one `TwistCmd` per boat cost a put, a
+    callback and a decode each in physics and in the recorder (the reason `BodyStates`
+    exists, in the other direction). Lockstep only: outside control stays per vessel on
+    `vessel/<id>/cmd/twist`. `surge` (N,) m/s, `yaw_rate` (N,) rad/s, float64.
+    """
+
+    TYPE: ClassVar[str] = "twist_batch"
+    tick: int
+    stamp_ns: int
+    ids: tuple[str, ...] = field(metadata={"unit": ""})
+    surge: np.ndarray = field(metadata={"unit": "m/s"})
+    yaw_rate: np.ndarray = field(metadata={"unit": "rad/s"})
+
+    def check(self, expected: tuple[str, ...]) -> None:
+        """Refuse a batch for other vessels or with arrays of the wrong shape."""
+        n = len(expected)
+        if self.ids != expected:
+            raise ValueError(
+                f"twist batch at tick {self.tick} lists vessels {list(self.ids)[:8]}..., "
+                f"expected {list(expected)[:8]}... ({n} vessels)"
+            )
+        for name in ("surge", "yaw_rate"):
+            value = getattr(self, name)
+            if not isinstance(value, np.ndarray) or value.shape != (n,):
+                shape = getattr(value, "shape", type(value).__name__)
+                raise ValueError(f"twist batch at tick {self.tick}: {name} is {shape}, not ({n},)")
 
 
 @dataclass(frozen=True)
@@ -278,6 +309,7 @@ MESSAGE_TYPES: dict[str, type[Message]] = {
         BodyStates,
         ThrustCmd,
         TwistCmd,
+        TwistBatch,
         WaypointsCmd,
         ImuSample,
         GpsFix,

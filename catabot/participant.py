@@ -12,6 +12,7 @@ import logging
 import queue
 import time
 from collections.abc import Callable, Sequence
+from typing import Any
 
 import zenoh
 
@@ -49,6 +50,8 @@ class Participant:
         self._orphaned_at = 0.0
         self._warned_tick = -1
         self._pubs: dict[str, zenoh.Publisher] = {}
+        self._listeners: dict[str, Any] = {}
+        self._watched: set[str] = set()
         self._subs = [
             session.declare_subscriber(keys.tick(), self._push("tick")),
             session.declare_subscriber(keys.end(), self._push("end")),
@@ -72,10 +75,30 @@ class Participant:
 
     def publish(self, key: str, msg: Message) -> None:
         """Publish an output; lockstep data is never dropped under congestion."""
+        self._publisher(key).put(codec.encode(msg))
+
+    def watched(self, key: str) -> bool:
+        """Whether any subscriber matches `key` now: outputs only observers read can skip
+        their encoding while nobody looks. Kept current by a Zenoh matching listener per
+        key (asking Zenoh each tick cost ~25 us a key under load)."""
+        if key not in self._listeners:
+            self._listen(key)
+        return key in self._watched
+
+    def _listen(self, key: str) -> None:
+        pub = self._publisher(key)
+
+        def on_change(status: Any) -> None:
+            (self._watched.add if status.matching else self._watched.discard)(key)
+
+        self._listeners[key] = pub.declare_matching_listener(on_change)
+        on_change(pub.matching_status)  # the listener reports changes only
+
+    def _publisher(self, key: str) -> zenoh.Publisher:
         pub = self._pubs.get(key)
         if pub is None:
             pub = self._pubs[key] = self.session.declare_publisher(key, congestion_control=BLOCK)
-        pub.put(codec.encode(msg))
+        return pub
 
     # -- the loop ------------------------------------------------------------------------
 

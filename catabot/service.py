@@ -7,7 +7,9 @@ runs the lockstep loop, and turns faults into one clear log line and a non-zero 
 from __future__ import annotations
 
 import argparse
+import cProfile
 import logging
+import os
 import signal
 import sys
 from collections.abc import Callable
@@ -18,6 +20,7 @@ import zenoh
 
 from catabot.clock import ClockError
 from catabot.keys import Keys
+from catabot.messages import End
 from catabot.participant import EndFn, Participant, StepFn
 from catabot.placement import resolve_poses
 from catabot.scenario import Scenario, ScenarioError, load_scenario
@@ -58,6 +61,19 @@ def setup_logging() -> None:
     )
 
 
+def _profiled(name: str, run_dir: Path, run: Callable[[], End]) -> End:
+    """`CATABOT_PROFILE=1`: cProfile the stepping loop into `log/<service>.prof` (open with
+    `python -m pstats`); sampling profilers miss much of a process that mostly waits."""
+    if not os.environ.get("CATABOT_PROFILE"):
+        return run()
+    profile = cProfile.Profile()
+    try:
+        return profile.runcall(run)
+    finally:
+        (run_dir / "log").mkdir(parents=True, exist_ok=True)
+        profile.dump_stats(run_dir / "log" / f"{name}.prof")
+
+
 def run_service(name: str, build: BuildFn, argv: list[str] | None = None) -> int:
     """Run one stepping service to the end of the run; returns the process exit code."""
     args = service_parser(name).parse_args(argv)
@@ -76,7 +92,7 @@ def run_service(name: str, build: BuildFn, argv: list[str] | None = None) -> int
     )
     try:
         participant, step, on_end = build(ctx)
-        end = participant.run(step, on_end)
+        end = _profiled(name, ctx.run_dir, lambda: participant.run(step, on_end))
     except ClockError as exc:
         log.error("%s", exc)
         return 3

@@ -8,7 +8,14 @@ from __future__ import annotations
 
 from catabot.clock import Stream, period_in_ticks
 from catabot.keys import Keys
-from catabot.messages import BodyStates, ThrustCmd, TwistCmd, VesselState, WaypointsCmd
+from catabot.messages import (
+    BodyStates,
+    ThrustCmd,
+    TwistBatch,
+    TwistCmd,
+    VesselState,
+    WaypointsCmd,
+)
 from catabot.scenario import Scenario
 from catabot.sensor_types import SENSOR_TYPES
 from catabot.traffic_plan import all_buoys, all_vessels, plan_traffic
@@ -66,16 +73,21 @@ def sensor_streams(scenario: Scenario, keys: Keys) -> list[Stream]:
 
 
 def command_streams(scenario: Scenario, keys: Keys) -> list[Stream]:
-    """Commands: from outside the lockstep (applied at the next tick boundary), and a
-    traffic boat's twist set-points, a lockstep stream of the traffic service on the same
-    key (an external twist on it still arrives as tick -1 and takes over the boat)."""
-    boats = traffic_boat_ids(scenario)
+    """Each vessel's commands from outside the lockstep (tick -1, applied at the next tick
+    boundary): thrust and twist, traffic boats included (an outside twist takes a boat over)."""
     out: list[Stream] = []
     for v in all_vessels(scenario):
-        producer, period = ("traffic", 1) if v.id in boats else (EXTERNAL, None)
         out.append(Stream(keys.cmd_thrust(v.id), ThrustCmd, EXTERNAL, None))
-        out.append(Stream(keys.cmd_twist(v.id), TwistCmd, producer, period))
+        out.append(Stream(keys.cmd_twist(v.id), TwistCmd, EXTERNAL, None))
     return out
+
+
+def twist_batch_streams(scenario: Scenario, keys: Keys) -> list[Stream]:
+    """The traffic service's set-points for all its boats, one `TwistBatch` per tick (none
+    without traffic)."""
+    if scenario.traffic.count == 0:
+        return []
+    return [Stream(keys.world_twists(), TwistBatch, "traffic", 1)]
 
 
 def waypoint_streams(scenario: Scenario, keys: Keys) -> list[Stream]:
@@ -87,13 +99,18 @@ def waypoint_streams(scenario: Scenario, keys: Keys) -> list[Stream]:
     ]
 
 
-def traffic_boat_ids(scenario: Scenario) -> set[str]:
-    return {b.id for b in plan_traffic(scenario).boats}
+def traffic_boat_ids(scenario: Scenario) -> tuple[str, ...]:
+    """The traffic boats, in `TwistBatch` order."""
+    return tuple(b.id for b in plan_traffic(scenario).boats)
 
 
 def world_streams(scenario: Scenario, keys: Keys) -> list[Stream]:
     """Every lockstep stream of the world (what the recorder waits for)."""
-    return [states_stream(keys), *sensor_streams(scenario, keys)]
+    return [
+        states_stream(keys),
+        *sensor_streams(scenario, keys),
+        *twist_batch_streams(scenario, keys),
+    ]
 
 
 def participants(scenario: Scenario) -> list[str]:

@@ -104,14 +104,20 @@ def sample_columns(msg: Message) -> list[str]:
     return out
 
 
+FLOAT = "%.12g"
+
+
 def fmt(value: Any) -> str:
-    """One cell, byte-stable across runs: ints in decimal, floats via repr(float)."""
+    """One cell, byte-stable across runs: ints in decimal, floats with `FLOAT` (12
+    significant digits: a micrometre at 1000 km; the MCAP keeps every float64 exactly).
+    Not repr: shortest round-trip formatting costs 2.6x as much, and a tick with 100 boats
+    formats ~2500 floats."""
     if isinstance(value, bool | np.bool_):
         return "true" if value else "false"
     if isinstance(value, int | np.integer):
         return str(int(value))
     if isinstance(value, float | np.floating):
-        return repr(float(value))  # shortest round-trip; 'nan', 'inf', '-inf' as such
+        return FLOAT % float(value)  # 'nan', 'inf', '-inf' as such
     if isinstance(value, str):
         return value
     raise TypeError(f"cannot write a {type(value).__name__} to a CSV cell")
@@ -129,3 +135,13 @@ def row(msg: Message) -> list[str]:
         else:
             cells.extend(fmt(v) for v in value)
     return cells
+
+
+def block_lines(stamp_ns: int, tick: int, table: np.ndarray) -> list[str]:
+    """The CSV lines of N samples sharing a stamp and a tick whose other cells are the float
+    columns of `table` (N, C): byte for byte what `row` gives for each, in one format call
+    (as `fmt` writes them) instead of N x C Python calls."""
+    n, width = table.shape
+    line = f"{int(stamp_ns)},{int(tick)}," + ",".join([FLOAT] * width) + "\n"
+    text = (line * n) % tuple(table.ravel().tolist())
+    return text.splitlines(keepends=True)

@@ -4,8 +4,8 @@ Scripted steps are applied at the first tick boundary at or after their time; a 
 from the bus replaces the scripted one from the next tick on and stays until another
 arrives (the vessel keeps the last order it was given, as a real autopilot does).
 
-Traffic boats: the traffic service's set-points arrive as lockstep twists (tick >= 0) on
-the boat's cmd/twist key. An external command (tick -1, twist or thrust) outranks them
+Traffic boats: the traffic service's set-points arrive in one lockstep `TwistBatch` per
+tick on `world/cmd/twist`. An external command (tick -1, twist or thrust) outranks them
 and holds the boat until a `WaypointsCmd` arrives for it (release, or a new path that
 the traffic service then steers): external > traffic set-point > script.
 """
@@ -16,9 +16,11 @@ import bisect
 import logging
 from dataclasses import dataclass
 
+import numpy as np
+
 from catabot import codec
 from catabot.clock import NS_PER_S
-from catabot.messages import Message, ThrustCmd, TwistCmd, WaypointsCmd
+from catabot.messages import Message, ThrustCmd, TwistBatch, TwistCmd, WaypointsCmd
 from catabot.scenario import ScriptStep, VesselConfig
 
 log = logging.getLogger("physics.commands")
@@ -49,6 +51,21 @@ class CommandBook:
             return self.lockstep[vessel]
         index = bisect.bisect_right(self.times[vessel], stamp_ns) - 1
         return _from_step(self.scripts[vessel][index]) if index >= 0 else Order()
+
+    def take_batch(self, batch: TwistBatch, expected: tuple[str, ...]) -> None:
+        """The traffic service's set-points: every boat with finite values adopts its own."""
+        try:
+            batch.check(expected)
+        except ValueError as exc:
+            log.error("refused %s", exc)
+            return
+        surge, rate = batch.surge.tolist(), batch.yaw_rate.tolist()
+        ok = np.isfinite(batch.surge) & np.isfinite(batch.yaw_rate)
+        for i in np.flatnonzero(ok).tolist():
+            self.lockstep[expected[i]] = Order(twist=(surge[i], rate[i]))
+        if not ok.all():
+            bad = [expected[i] for i in np.flatnonzero(~ok)]
+            log.error("refused twist set-points at tick %d: non-finite for %s", batch.tick, bad)
 
     def take(self, vessel: str, key: str, msgs: list[Message]) -> None:
         """Adopt the newest valid command from the bus; refuse non-finite ones loudly."""

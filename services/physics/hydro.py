@@ -178,6 +178,7 @@ class ThrusterBank:
                 if th.time_constant_s > 0:
                     self.alpha[i, k] = -np.expm1(-dt_s / th.time_constant_s)
         self.command = np.zeros((n, t_max))
+        self._padding = np.arange(t_max)[None, :] >= np.array(self.count)[:, None]  # (N, T)
         self.force_n = np.zeros((n, t_max))
         # Wrench per newton of each thruster, so that a step needs one contraction, no cross.
         moment_arm = np.cross(self.position_m, self.direction)
@@ -186,6 +187,14 @@ class ThrusterBank:
     def set_command(self, index: int, command: Array) -> None:
         """Store a validated, clamped command vector for vessel `index`."""
         self.command[index, : self.count[index]] = command
+
+    def set_commands(self, rows: NDArray[np.intp], commands: Array) -> None:
+        """Commands for vessels `rows` at once; columns past a vessel's thrusters are zeroed."""
+        width = min(commands.shape[1], self.command.shape[1])
+        block = np.zeros((len(rows), self.command.shape[1]))
+        block[:, :width] = commands[:, :width]
+        block[self._padding[rows]] = 0.0
+        self.command[rows] = block
 
     def advance(self) -> None:
         """Move each delivered force one time step towards its commanded force."""

@@ -13,10 +13,15 @@ import sys
 import numpy as np
 
 from catabot.inbox import Inputs
-from catabot.messages import BodyStates, Tick, VesselState
+from catabot.messages import BodyStates, Message, Tick, TwistBatch, VesselState
 from catabot.participant import Participant
 from catabot.service import Built, ServiceContext, run_service
-from catabot.streams import command_streams, waypoint_streams
+from catabot.streams import (
+    command_streams,
+    traffic_boat_ids,
+    twist_batch_streams,
+    waypoint_streams,
+)
 from catabot.traffic_plan import all_vessels
 from services.physics.commands import CommandBook
 from services.physics.control import TwistControllerBank
@@ -46,6 +51,9 @@ class PhysicsService:
         )
         self.streams = command_streams(scenario, ctx.keys) + waypoint_streams(scenario, ctx.keys)
         self.vessel_of = {s.key: ctx.keys.vessel_of(s.key) for s in self.streams}
+        self.twists_key = ctx.keys.world_twists()
+        self.boats = traffic_boat_ids(scenario)
+        self.streams += twist_batch_streams(scenario, ctx.keys)
         self.body_ids = (*ids, *self.world.buoy_ids)
         self.state_keys = [ctx.keys.vessel_state(vid) for vid in ids]
         self.participant = Participant(
@@ -54,43 +62,53 @@ class PhysicsService:
 
     def step(self, tick: Tick, inputs: Inputs) -> None:
         for key, msgs in inputs.items():
-            self.book.take(self.vessel_of[key], key, msgs)
+            if key == self.twists_key:
+                self._take_twists(msgs[-1])
+            else:
+                self.book.take(self.vessel_of[key], key, msgs)
         self._apply_orders(tick.stamp_ns)
         self.world.step()
         self._publish(tick)
+
+    def _take_twists(self, batch: Message) -> None:
+        assert isinstance(batch, TwistBatch)  # the inbox decodes each stream as its type
+        self.book.take_batch(batch, self.boats)
 
     def _apply_orders(self, stamp_ns: int) -> None:
         """Thrust orders as given; twist orders through one controller pass for all vessels."""
         ids = self.world.vessel_ids
         orders = [self.book.order(vid, stamp_ns) for vid in ids]
-        commands: list[tuple[float, ...]] = [o.thrust or () for o in orders]
+        for vid, order in zip(ids, orders, strict=True):
+            if order.thrust:
+                try:
+                    self.world.set_thrust(vid, order.thrust)
+                except ValueError as exc:
+                    log.error("vessel %s: refused thrust command: %s", vid, exc)
         rows = np.array([i for i, o in enumerate(orders) if o.twist is not None], dtype=np.intp)
         if rows.size:
             s = self.world.state_arrays()
             measured = np.stack([s.linear_velocity[rows, 0], s.angular_velocity[rows, 2]], axis=1)
             target = np.array([orders[i].twist for i in rows], dtype=np.float64)
-            out = self.controllers.command(rows, target, measured)
-            for j, i in enumerate(rows):
-                commands[i] = tuple(out[j, : self.controllers.count[i]])
-        for vid, command in zip(ids, commands, strict=True):
-            if command:
-                try:
-                    self.world.set_thrust(vid, command)
-                except ValueError as exc:
-                    log.error("vessel %s: refused thrust command: %s", vid, exc)
+            try:
+                self.world.set_thrusts(rows, self.controllers.command(rows, target, measured))
+            except ValueError as exc:
+                log.error("refused controller output: %s", exc)
 
     def _publish(self, tick: Tick) -> None:
         """One batch of every body for the lockstep services, then each vessel's own state
-        for observers (buoys only in the batch: nobody outside follows a buoy)."""
+        for observers (buoys only in the batch: nobody outside follows a buoy). A vessel's
+        own state is encoded only while someone subscribes to it: with 100 boats and no
+        viewer that is 100 encodes a tick for nobody."""
         stamp = tick.stamp_ns + self.dt_ns
         v, b = self.world.state_arrays(), self.world.buoy_state_arrays()
         cols = [np.concatenate((getattr(v, f), getattr(b, f))) for f in FIELDS]
         self.participant.publish(
             self.keys.world_states(), BodyStates(tick.tick, stamp, self.body_ids, *cols)
         )
-        rows = zip(*(getattr(v, f).tolist() for f in FIELDS), strict=True)
-        for key, row in zip(self.state_keys, rows, strict=True):
-            self.participant.publish(key, VesselState(tick.tick, stamp, *map(tuple, row)))
+        watched = [i for i, key in enumerate(self.state_keys) if self.participant.watched(key)]
+        for i in watched:
+            row = (tuple(getattr(v, f)[i].tolist()) for f in FIELDS)
+            self.participant.publish(self.state_keys[i], VesselState(tick.tick, stamp, *row))
 
 
 def build(ctx: ServiceContext) -> Built:

@@ -22,6 +22,7 @@ from dataclasses import dataclass
 
 import dartpy as dart
 import numpy as np
+from numpy.typing import NDArray
 
 from catabot.environment import CurrentField, WindField
 from catabot.terrain import Terrain
@@ -166,6 +167,17 @@ class PhysicsWorld:
                 f"({values[bad[0]]})"
             )
         self._thrusters.set_command(index, np.clip(values, -1.0, 1.0))
+
+    def set_thrusts(self, rows: NDArray[np.intp], commands: Array) -> None:
+        """Commands for many vessels at once (a controller's output): rows index `vessel_ids`,
+        commands (len(rows), >= thrusters) normalised, padding columns ignored; non-finite
+        rows are refused (logged by the caller's ValueError), the others clamped to [-1, 1]."""
+        commands = np.asarray(commands, dtype=np.float64)
+        if commands.ndim != 2 or len(commands) != len(rows) or np.any(rows >= self._n_vessels):
+            raise ValueError(f"thrust commands of shape {commands.shape} for rows {rows}")
+        if not np.isfinite(commands).all():
+            raise ValueError("thrust commands: a value is not finite")
+        self._thrusters.set_commands(rows, np.clip(commands, -1.0, 1.0))
 
     def step(self) -> None:
         """Advance every vessel by dt: compute all forces vectorised, apply, step DART."""

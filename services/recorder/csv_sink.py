@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import csv
 import io
+from collections.abc import Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import TextIO
@@ -39,10 +40,14 @@ class _CsvFile:
     handle: TextIO
     cls: type[Message]
     width: int
-    pending: io.StringIO = field(default_factory=io.StringIO)
+    pending: list[str] = field(default_factory=list)
 
-    def __post_init__(self) -> None:
-        self.writer = csv.writer(self.pending, lineterminator="\n")
+
+def _line(cells: list[str]) -> str:
+    """One CSV line, quoted where a cell needs it (the csv module's rules)."""
+    buffer = io.StringIO()
+    csv.writer(buffer, lineterminator="\n").writerow(cells)
+    return buffer.getvalue()
 
 
 class CsvSink:
@@ -77,28 +82,42 @@ class CsvSink:
                 f"{stream}: sample has {len(cells)} columns but the header has {out.width} "
                 "(set by the first sample); not written"
             )
-        out.writer.writerow(cells)
+        out.pending.append(_line(cells))
+
+    def write_lines(self, streams: Sequence[str], cls: type[Message], lines: Sequence[str]) -> None:
+        """Queue `lines[i]` (a formatted row of `tabular.columns(cls)`) on `streams[i]`: the
+        batch path, which formats every row of a tick at once (`services/recorder/batches`)."""
+        if self._closed:
+            raise RecorderError(f"{streams[0] if streams else '?'}: the CSV sink is closed")
+        for stream, line in zip(streams, lines, strict=True):
+            out = self._files.get(stream) or self._open_for(stream, cls, tabular.columns(cls))
+            if out.cls is not cls:
+                raise RecorderError(
+                    f"{stream}: a {cls.__name__} sample on a stream of {out.cls.__name__}; "
+                    "not written"
+                )
+            out.pending.append(line)
 
     def _open(self, stream: str, msg: Message) -> _CsvFile:
+        return self._open_for(stream, type(msg), tabular.sample_columns(msg))
+
+    def _open_for(self, stream: str, cls: type[Message], header: list[str]) -> _CsvFile:
         path = self.path(stream)
         if any(o.handle.name == str(path) for o in self._files.values()):
             raise RecorderError(f"{stream}: file {path.name} is already used by another stream")
-        header = tabular.sample_columns(msg)
         handle = open(path, "w", newline="", encoding="utf-8")  # noqa: SIM115
-        out = _CsvFile(stream, handle, type(msg), len(header))
-        out.writer.writerow(header)
+        out = _CsvFile(stream, handle, cls, len(header))
+        handle.write(_line(header))
         self._files[stream] = out
         return out
 
     def flush(self) -> None:
         """Write the rows queued since the last call and flush every file (once per tick)."""
         for out in self._files.values():
-            text = out.pending.getvalue()
-            if text:
-                out.handle.write(text)
-                out.pending.seek(0)
-                out.pending.truncate()
-            out.handle.flush()
+            if out.pending:
+                out.handle.write("".join(out.pending))
+                out.pending.clear()
+                out.handle.flush()
 
     def close(self) -> None:
         """Flush and close every file; further writes are refused."""

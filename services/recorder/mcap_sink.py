@@ -17,10 +17,10 @@ import io
 import json
 import struct
 import typing
-from collections.abc import Iterator
+from collections.abc import Iterator, Sequence
 from dataclasses import dataclass
 from pathlib import Path
-from typing import IO, Any, BinaryIO
+from typing import Any, BinaryIO
 
 from mcap.exceptions import EndOfFile
 from mcap.opcode import Opcode
@@ -28,12 +28,13 @@ from mcap.records import Channel, Schema
 from mcap.records import Message as McapMessage
 from mcap.stream_reader import MAGIC_SIZE, StreamReader
 from mcap.well_known import MessageEncoding, SchemaEncoding
-from mcap.writer import LIBRARY_IDENTIFIER, CompressionType, Writer
+from mcap.writer import LIBRARY_IDENTIFIER
 from mcap_ros2.decoder import DecoderFactory
 
 from catabot.messages import CameraFrame, LidarScan, Message, VesselState
 from services.recorder import cdr, images, json_schemas, pointcloud, ros2_msgdefs
 from services.recorder.csv_sink import RecorderError
+from services.recorder.mcap_writer import McapWriter
 
 _RECORD_HEAD = struct.Struct("<BQ")  # opcode, length of the record body
 _ROS2 = {  # messages written as ROS 2 types: (type name, msgdef)
@@ -91,13 +92,10 @@ class McapSink:
 
     def __init__(self, path: Path) -> None:
         self._out = _TickBuffer(Path(path))
-        self._writer = Writer(
-            typing.cast(IO[Any], self._out),
-            compression=CompressionType.NONE,
-            use_chunking=False,
-        )
         # profile "": channels mix CDR and JSON. The file is valid from the first byte on.
-        self._writer.start(profile="", library=f"catabot {LIBRARY_IDENTIFIER}")
+        self._writer = McapWriter(
+            typing.cast(BinaryIO, self._out), profile="", library=f"catabot {LIBRARY_IDENTIFIER}"
+        )
         self._out.flush()
         self._schemas: dict[type[Message], int] = {}
         self._channels: dict[str, _Channel] = {}
@@ -105,29 +103,43 @@ class McapSink:
 
     def write(self, stream: str, msg: Message, *, stamp_ns: int) -> None:
         """Add one message to channel `/<stream>`, stamped with simulated time."""
-        if self._closed:
-            raise RecorderError(f"{stream}: the MCAP sink is closed")
-        chan = self._channels.get(stream) or self._register(stream, msg)
-        if type(msg) is not chan.cls:
-            raise RecorderError(
-                f"{stream}: a {type(msg).__name__} sample on a channel of {chan.cls.__name__}; "
-                "not written"
-            )
+        chan = self._channel(stream, type(msg))
         try:
             data = chan.encode(msg, stamp_ns)
         except (ValueError, TypeError, IndexError, struct.error) as exc:
             raise RecorderError(f"{stream}: cannot encode {type(msg).__name__}: {exc}") from exc
-        self._writer.add_message(
-            channel_id=chan.id,
-            log_time=stamp_ns,
-            publish_time=stamp_ns,
-            data=data,
-            sequence=chan.sequence,
-        )
+        self._writer.add_messages([chan.id], [chan.sequence], stamp_ns, [data])
         chan.sequence += 1
 
-    def _register(self, stream: str, msg: Message) -> _Channel:
-        cls = type(msg)
+    def write_block(
+        self,
+        streams: Sequence[str],
+        cls: type[Message],
+        payloads: Sequence[bytes],
+        *,
+        stamp_ns: int,
+    ) -> None:
+        """`payloads[i]`, already encoded as the channel of `cls` expects, on `streams[i]`:
+        the batch path (`services/recorder/batches.py`), one write for a whole tick."""
+        chans = [self._channel(stream, cls) for stream in streams]
+        self._writer.add_messages(
+            [c.id for c in chans], [c.sequence for c in chans], stamp_ns, payloads
+        )
+        for chan in chans:
+            chan.sequence += 1
+
+    def _channel(self, stream: str, cls: type[Message]) -> _Channel:
+        if self._closed:
+            raise RecorderError(f"{stream}: the MCAP sink is closed")
+        chan = self._channels.get(stream) or self._register(stream, cls)
+        if cls is not chan.cls:
+            raise RecorderError(
+                f"{stream}: a {cls.__name__} sample on a channel of {chan.cls.__name__}; "
+                "not written"
+            )
+        return chan
+
+    def _register(self, stream: str, cls: type[Message]) -> _Channel:
         if cls is VesselState:
             encoding, encode = MessageEncoding.CDR, _odometry_encoder(_vessel_of(stream))
         elif cls is LidarScan:
@@ -157,9 +169,8 @@ class McapSink:
 
     def flush(self) -> None:
         """Put every record written so far into the file (call once per tick)."""
-        # Unchunked, the writer hands each message (with the schema and channel registered
-        # just before it) to our buffer at once, so flushing the buffer is enough; this also
-        # avoids Writer.flush(), which only mcap >= 1.6 has.
+        # Unchunked, the writer hands each record to our buffer at once, so flushing the
+        # buffer is enough.
         if not self._closed:
             self._out.flush()
 

@@ -2,8 +2,8 @@
 
 At tick k it reads the boats' rows of the `BodyStates` tagged k-1 (at t_k; the plan's
 start poses at rest at tick 0), runs the guidance laws for all boats at once and publishes
-each boat's set-point on `vessel/<boat>/cmd/twist` tagged k, which physics applies from
-tick k+1 (the one-tick delay of DESIGN.md §4). External control never fights these
+every boat's set-point in one `TwistBatch` on `world/cmd/twist` tagged k, which physics
+applies from tick k+1 (the one-tick delay of DESIGN.md §4). External control never fights these
 set-points: physics lets an external twist or thrust (tick -1) outrank them until a
 `WaypointsCmd` hands the boat back; a `WaypointsCmd` with a path makes this service steer
 that path instead, and `mode="release"` restores the scenario behaviour.
@@ -18,7 +18,7 @@ import numpy as np
 
 from catabot import codec
 from catabot.inbox import Inputs
-from catabot.messages import BodyStates, Message, Tick, TwistCmd, WaypointsCmd
+from catabot.messages import BodyStates, Message, Tick, TwistBatch, WaypointsCmd
 from catabot.participant import Participant
 from catabot.service import Built, ServiceContext, run_service
 from catabot.streams import BodyRows, body_ids, states_stream, waypoint_streams
@@ -32,7 +32,7 @@ MODES = ("loop", "back_and_forth", "release")
 class TrafficService:
     def __init__(self, ctx: ServiceContext) -> None:
         boats = plan_traffic(ctx.scenario).boats
-        self.ids = [b.id for b in boats]
+        self.ids = tuple(b.id for b in boats)
         self.row = {vid: i for i, vid in enumerate(self.ids)}
         self.keys = ctx.keys
         self.behaviours = Behaviours(boats, hold_gain=ctx.scenario.traffic.hold.gain)
@@ -48,7 +48,7 @@ class TrafficService:
             for s in waypoint_streams(ctx.scenario, ctx.keys)
             if ctx.keys.vessel_of(s.key) in self.row
         ]
-        self.twist_keys = [ctx.keys.cmd_twist(vid) for vid in self.ids]
+        self.twists_key = ctx.keys.world_twists()
         self.participant = Participant(
             ctx.session,
             ctx.keys,
@@ -67,10 +67,8 @@ class TrafficService:
                 if isinstance(msg, WaypointsCmd):
                     self._take_waypoints(i, key, msg)
         surge, rate = self.behaviours.command(self.pos, self.yaw, self.vel)
-        for i, key in enumerate(self.twist_keys):
-            self.participant.publish(
-                key, TwistCmd(float(surge[i]), float(rate[i]), tick.tick, tick.stamp_ns)
-            )
+        batch = TwistBatch(tick.tick, tick.stamp_ns, self.ids, surge, rate)
+        self.participant.publish(self.twists_key, batch)
 
     def _take_states(self, batch: Message) -> None:
         """The boats' rows of the batch, all at once (rows mapped at the first batch)."""

@@ -20,6 +20,7 @@ from catabot.messages import (
     RadarSweep,
     ThrustCmd,
     Tick,
+    TwistBatch,
     TwistCmd,
     VesselState,
     WaypointsCmd,
@@ -43,6 +44,13 @@ SAMPLES: dict[str, Message] = {
         angular_velocity=(0.0, 0.002, -0.2),
         linear_acceleration=(0.15, 0.0, -0.01),
         angular_acceleration=(0.0, 0.0, 1e-5),
+    ),
+    "twist_batch": TwistBatch(
+        tick=7,
+        stamp_ns=70_000_000,
+        ids=("boat_000", "boat_001"),
+        surge=np.array([2.0, 1.5]),
+        yaw_rate=np.array([0.1, -0.05]),
     ),
     "body_states": BodyStates(
         tick=120,

@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import threading
 import time
+from collections.abc import Callable
 
 from catabot import codec
 from catabot.clock import Stream
@@ -160,3 +161,24 @@ def test_realtime_factor_paces_the_clock(world: World) -> None:
     solo.join()
     assert result.error == "" and result.ticks_done == 20
     assert result.wall_s >= 19 * DT_NS / 1e9 / 2.0  # tick 19 starts 95 ms after tick 0
+
+
+def test_watched_follows_subscribers_coming_and_going(world: World) -> None:
+    """Outputs for observers only are skipped while nobody subscribes (physics' per-vessel
+    states); the answer must follow a subscriber in another session within a moment."""
+    part = Participant(world.open(), world.keys, "physics")
+    key = world.keys.vessel_state("ego")
+    assert not part.watched(key)
+    sub = world.open().declare_subscriber(key, lambda _: None)
+    assert _eventually(lambda: part.watched(key))
+    sub.undeclare()
+    assert _eventually(lambda: not part.watched(key))
+
+
+def _eventually(check: Callable[[], bool], timeout_s: float = 3.0) -> bool:
+    limit = time.monotonic() + timeout_s
+    while not check():
+        if time.monotonic() > limit:
+            return False
+        time.sleep(0.01)
+    return True

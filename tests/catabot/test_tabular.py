@@ -57,7 +57,7 @@ def test_variable_length_vector_takes_width() -> None:
 def test_sample_columns_size_by_sample() -> None:
     cmd = ThrustCmd(thrust=(0.5, -0.5, 0.0), tick=3, stamp_ns=300)
     assert tabular.sample_columns(cmd) == tabular.columns(ThrustCmd, width=3)
-    assert tabular.row(cmd) == ["300", "3", "0.5", "-0.5", "0.0"]
+    assert tabular.row(cmd) == ["300", "3", "0.5", "-0.5", "0"]
 
 
 def test_scalars_with_units() -> None:
@@ -65,18 +65,18 @@ def test_scalars_with_units() -> None:
     assert tabular.row(TwistCmd(surge=2.0, yaw_rate=-0.1, tick=1, stamp_ns=10)) == [
         "10",
         "1",
-        "2.0",
+        "2",
         "-0.1",
     ]
 
 
-def test_row_matches_columns_and_round_trips() -> None:
+def test_row_matches_columns_to_twelve_digits() -> None:
     state = _state()
     cells = tabular.row(state)
     assert len(cells) == len(tabular.columns(VesselState))
     assert cells[:2] == ["700000000", "7"]
     assert cells[-1] == "1e-05"
-    assert float(cells[7]) == state.orientation[1 + 1]  # shortest repr round-trips exactly
+    assert float(cells[7]) == pytest.approx(state.orientation[2], rel=1e-11)  # 12 digits
 
 
 def test_message_without_stamp_or_tick_fields() -> None:
@@ -90,3 +90,17 @@ def test_formatting_is_deterministic_for_numpy_and_specials() -> None:
     assert tabular.fmt(float("nan")) == "nan"
     assert tabular.fmt(float("-inf")) == "-inf"
     assert tabular.fmt(True) == "true"
+
+
+def test_floats_have_twelve_significant_digits() -> None:
+    assert tabular.fmt(1 / 3) == "0.333333333333"
+    assert tabular.fmt(123456.789012345) == "123456.789012"
+    assert tabular.fmt(1e-7) == "1e-07"
+
+
+def test_block_lines_equal_row_by_row_formatting() -> None:
+    table = np.array([[0.1, -2.5e-9], [float("nan"), 1e12]])
+    lines = tabular.block_lines(5, 2, table)
+    assert lines == [
+        "5,2," + ",".join(tabular.fmt(v) for v in row) + "\n" for row in table.tolist()
+    ]

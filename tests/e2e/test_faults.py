@@ -12,6 +12,7 @@ from datetime import datetime
 from pathlib import Path
 
 import psutil
+import pytest
 from conftest import (
     REPO,
     basic_scenario,
@@ -126,12 +127,16 @@ def test_drop_policy_goes_on_without_the_hanging_participant(tmp_path: Path, out
     assert _assert_readable(run) == 299
 
 
-def test_ctrl_c_ends_every_process_with_complete_files(tmp_path: Path, out: Path) -> None:
+@pytest.mark.parametrize("sig", [signal.SIGINT, signal.SIGTERM])
+def test_ctrl_c_ends_every_process_with_complete_files(
+    tmp_path: Path, out: Path, sig: signal.Signals
+) -> None:
+    """Ctrl-C, and a SIGTERM from a shell or a process manager, end the run cleanly."""
     proc = start("run", str(_long(tmp_path)), "--out", str(out), "--quiet")
     wait_for_line(proc, "zenoh:")
     time.sleep(2.0)
     children = psutil.Process(proc.pid).children(recursive=True)
-    proc.send_signal(signal.SIGINT)
+    proc.send_signal(sig)
     _, err = proc.communicate(timeout=30)
     assert proc.returncode == 130, err
     assert not [c for c in children if c.is_running() and c.status() != psutil.STATUS_ZOMBIE]
@@ -141,6 +146,20 @@ def test_ctrl_c_ends_every_process_with_complete_files(tmp_path: Path, out: Path
 
     with (run / "run.mcap").open("rb") as f:
         assert make_reader(f).get_summary() is not None, "MCAP closed with a summary"
+
+
+def test_killed_launcher_leaves_no_orphans(tmp_path: Path, out: Path) -> None:
+    """SIGKILL of `catabot run` (no handler runs): the conductor finds its stdout gone at
+    the next progress line and ends the run, so every service flushes and exits."""
+    proc = start("run", str(_long(tmp_path)), "--out", str(out), "--quiet")
+    wait_for_line(proc, "zenoh:")
+    time.sleep(2.0)
+    children = psutil.Process(proc.pid).children(recursive=True)
+    proc.kill()
+    proc.communicate(timeout=10)
+    _, alive = psutil.wait_procs(children, timeout=30)
+    assert not alive, [c.cmdline()[2:4] for c in alive]
+    _assert_readable(only_run_dir(out))
 
 
 def test_malformed_and_non_finite_commands_are_logged_and_survived(

@@ -146,3 +146,18 @@ def test_pointcloud2_decodes_from_mcap(tmp_path: Path) -> None:
             (f["name"], f["offset"], f["datatype"], f["count"]) for f in pointcloud.FIELDS
         ]
         assert bytes(msg.data) == cloud.tobytes()
+
+
+def test_odometry_batch_equals_one_message_at_a_time() -> None:
+    children = ("ego", "boat_000", "b", "buoy_0001")  # three template lengths
+    rng = np.random.default_rng(3)
+    values = rng.normal(size=(len(children), 13))
+    batch = cdr.OdometryBatch("map", children).encode(1_234_567_890_123, values)
+    for i, child in enumerate(children):
+        one = cdr.odometry_packer("map", child)(1_234_567_890_123, values[i].tolist())
+        assert batch[i] == one
+
+
+def test_odometry_batch_refuses_a_wrong_shape() -> None:
+    with pytest.raises(ValueError, match=r"shape \(2, 12\), not \(2, 13\)"):
+        cdr.OdometryBatch("map", ("a", "b")).encode(0, np.zeros((2, 12)))

@@ -1,0 +1,72 @@
+"""Batches (`BodyStates`, `TwistBatch`) recorded as the per-vessel streams they stand for.
+
+The run folder keeps one `vessel.<id>.state.csv` and one `/vessel/<id>/state` Odometry
+channel per body, and one `vessel.<id>.cmd.twist.csv` / `/vessel/<id>/cmd/twist` channel per
+traffic boat, as if each row had been its own message. Formatting them one message at a time
+(a dataclass, a CSV writer call, an encoder call and an MCAP record each) was most of the
+recorder's time with 100 boats, so each batch is formatted here in a few array-wide calls.
+The bytes are exactly those of the per-message path (tests/services/recorder/test_batches.py).
+"""
+
+from __future__ import annotations
+
+import typing
+from dataclasses import dataclass
+
+import numpy as np
+
+from catabot import tabular
+from catabot.messages import BodyStates, Message, TwistBatch, TwistCmd, VesselState
+from services.recorder import cdr, ros2_msgdefs
+
+# json_schemas.encode of a TwistCmd, field by field: {"surge":..,"yaw_rate":..,"tick":..,..}
+# (JSON keeps repr: it is two floats a boat, and JSON readers expect round-trip values)
+_TWIST_JSON = '{"surge":%r,"yaw_rate":%r,"tick":%d,"stamp_ns":%d}'
+
+
+@dataclass(frozen=True)
+class Block:
+    """Row i of a batch as a sample of `streams[i]`: its CSV line and its MCAP payload
+    (None where the payload cannot be encoded: JSON has no NaN)."""
+
+    cls: type[Message]
+    stamp_ns: int
+    streams: tuple[str, ...]
+    lines: list[str]
+    payloads: list[bytes | None]
+
+
+class BatchFormatter:
+    """Knows, for one run, which stream and which encoder each row of a batch belongs to."""
+
+    def __init__(self, body_ids: tuple[str, ...], boat_ids: tuple[str, ...]) -> None:
+        self.body_ids, self.boat_ids = body_ids, boat_ids
+        self.state_streams = tuple(f"vessel/{b}/state" for b in body_ids)
+        self.twist_streams = tuple(f"vessel/{b}/cmd/twist" for b in boat_ids)
+        self._odometry = cdr.OdometryBatch(ros2_msgdefs.WORLD_FRAME, body_ids)
+
+    def states(self, batch: BodyStates) -> Block:
+        """Raises ValueError for a batch of other bodies (rows would land in wrong files)."""
+        if batch.ids != self.body_ids:
+            raise ValueError(
+                f"world/states at tick {batch.tick} lists bodies {list(batch.ids)[:8]}..., "
+                f"expected {list(self.body_ids)[:8]}..."
+            )
+        table = np.concatenate(batch.arrays(), axis=1)  # VesselState's columns, (N, 19)
+        lines = tabular.block_lines(batch.stamp_ns, batch.tick, table)
+        # position, orientation, linear and angular velocity: the Odometry fields
+        payloads = self._odometry.encode(batch.stamp_ns, table[:, :13])
+        return Block(VesselState, batch.stamp_ns, self.state_streams, lines, list(payloads))
+
+    def twists(self, batch: TwistBatch) -> Block:
+        """Raises ValueError for a batch of other boats or of the wrong shape."""
+        batch.check(self.boat_ids)
+        table = np.stack((batch.surge, batch.yaw_rate), axis=1).astype(np.float64)
+        lines = tabular.block_lines(batch.stamp_ns, batch.tick, table)
+        finite = typing.cast(list[bool], np.isfinite(table).all(axis=1).tolist())
+        tail = (batch.tick, batch.stamp_ns)
+        payloads = [
+            (_TWIST_JSON % (*row, *tail)).encode() if ok else None
+            for row, ok in zip(table.tolist(), finite, strict=True)
+        ]
+        return Block(TwistCmd, batch.stamp_ns, self.twist_streams, lines, payloads)

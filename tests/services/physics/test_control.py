@@ -1,0 +1,52 @@
+"""Controller output for many vessels goes into the world at once (physics service path)."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from catabot.messages import TwistBatch
+from catabot.scenario import VesselConfig
+from catabot.vessel import load_vessel_model
+from services.physics.commands import CommandBook, Order
+from services.physics.world import PhysicsWorld
+
+
+def _world() -> PhysicsWorld:
+    cat, wamv = load_vessel_model("catabot"), load_vessel_model("wamv")
+    return PhysicsWorld([("a", cat, (0, 0, 0, 0)), ("b", wamv, (20, 0, 0, 1))], dt_s=0.01)
+
+
+def test_set_thrusts_equals_one_vessel_at_a_time() -> None:
+    one, many = _world(), _world()
+    commands = np.array([[0.4, -0.2, 0.9], [1.7, 0.3, 0.0]])  # padding column, a clamp
+    one.set_thrust("a", commands[0, :2])
+    one.set_thrust("b", np.clip(commands[1, :2], -1, 1))
+    many.set_thrusts(np.array([0, 1]), commands)
+    for world in (one, many):
+        for _ in range(20):
+            world.step()
+    assert np.array_equal(one.state_arrays().position, many.state_arrays().position)
+
+
+def test_set_thrusts_refuses_non_finite_and_unknown_rows() -> None:
+    world = _world()
+    with pytest.raises(ValueError, match="not finite"):
+        world.set_thrusts(np.array([0]), np.array([[np.nan, 0.0]]))
+    with pytest.raises(ValueError, match="for rows"):
+        world.set_thrusts(np.array([5]), np.array([[0.0, 0.0]]))
+
+
+def test_twist_batch_sets_each_boats_order_and_skips_bad_entries(
+    caplog: pytest.LogCaptureFixture,
+) -> None:
+    boats = ("boat_000", "boat_001")
+    book = CommandBook([VesselConfig(id=b) for b in boats], {b: 2 for b in boats})
+    batch = TwistBatch(3, 30, boats, np.array([1.0, np.nan]), np.array([0.1, 0.2]))
+    book.take_batch(batch, boats)
+    assert book.order("boat_000", 40) == Order(twist=(1.0, 0.1))
+    assert book.order("boat_001", 40) == Order()  # non-finite: refused, nothing adopted
+    assert "non-finite for ['boat_001']" in caplog.text
+    book.take_batch(TwistBatch(4, 40, ("x", "y"), np.zeros(2), np.zeros(2)), boats)
+    assert "expected ['boat_000', 'boat_001']" in caplog.text
+    assert book.order("boat_000", 50) == Order(twist=(1.0, 0.1))

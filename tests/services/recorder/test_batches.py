@@ -1,0 +1,87 @@
+"""Batches are recorded as the per-vessel streams they stand for, byte for byte."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from catabot.messages import BodyStates, TwistBatch, TwistCmd, VesselState
+from services.recorder import cdr, json_schemas, ros2_msgdefs
+from services.recorder.batches import BatchFormatter
+from services.recorder.csv_sink import CsvSink, RecorderError
+
+IDS = ("ego", "boat_000", "buoy_0")
+BOATS = ("boat_000",)
+
+
+def _states(tick: int) -> BodyStates:
+    rng = np.random.default_rng(tick)
+    n = len(IDS)
+    arrays = [rng.normal(size=(n, 3)), rng.normal(size=(n, 4))]
+    arrays += [rng.normal(size=(n, 3)) * 1e-7 for _ in range(4)]  # small: exponents in repr
+    return BodyStates(tick, (tick + 1) * 10_000_000, IDS, *arrays)
+
+
+def _twists(tick: int, surge: float = 1.5) -> TwistBatch:
+    return TwistBatch(tick, tick * 10_000_000, BOATS, np.array([surge]), np.array([-0.1]))
+
+
+def _csv_by_message(tmp: Path, stream: str, msgs: list[VesselState] | list[TwistCmd]) -> str:
+    with CsvSink(tmp) as sink:
+        for msg in msgs:
+            sink.write(stream, msg)
+    return (tmp / (stream.replace("/", ".") + ".csv")).read_text()
+
+
+def test_states_block_equals_the_per_message_rows(tmp_path: Path) -> None:
+    fmt = BatchFormatter(IDS, BOATS)
+    batches = [_states(k) for k in range(3)]
+    with CsvSink(tmp_path / "block") as sink:
+        for batch in batches:
+            block = fmt.states(batch)
+            sink.write_lines(block.streams, block.cls, block.lines)
+    for i, vid in enumerate(IDS):
+        rows = [b.row(i) for b in batches]
+        expected = _csv_by_message(tmp_path / vid, f"vessel/{vid}/state", rows)
+        assert (tmp_path / "block" / f"vessel.{vid}.state.csv").read_text() == expected
+        odometry = cdr.odometry_encoder(ros2_msgdefs.WORLD_FRAME, vid)
+        assert fmt.states(batches[2]).payloads[i] == odometry(rows[2], batches[2].stamp_ns)
+
+
+def test_twist_block_equals_the_per_message_csv_and_json(tmp_path: Path) -> None:
+    fmt = BatchFormatter(IDS, BOATS)
+    block = fmt.twists(_twists(4))
+    msg = TwistCmd(1.5, -0.1, 4, 40_000_000)
+    assert block.streams == ("vessel/boat_000/cmd/twist",)
+    assert block.payloads == [json_schemas.encode(msg)]
+    with CsvSink(tmp_path / "block") as sink:
+        sink.write_lines(block.streams, block.cls, block.lines)
+    expected = _csv_by_message(tmp_path / "one", "vessel/boat_000/cmd/twist", [msg])
+    assert (tmp_path / "block" / "vessel.boat_000.cmd.twist.csv").read_text() == expected
+
+
+def test_non_finite_set_point_has_a_csv_row_but_no_json() -> None:
+    block = BatchFormatter(IDS, BOATS).twists(_twists(1, surge=float("nan")))
+    assert block.payloads == [None]
+    assert block.lines[0].split(",")[2] == "nan"
+
+
+def test_batches_of_other_vessels_are_refused() -> None:
+    fmt = BatchFormatter(IDS, BOATS)
+    moved = _states(0)
+    other = BodyStates(0, 0, ("a", "b", "c"), *moved.arrays())
+    with pytest.raises(ValueError, match="expected"):
+        fmt.states(other)
+    with pytest.raises(ValueError, match="expected"):
+        fmt.twists(TwistBatch(0, 0, ("x",), np.zeros(1), np.zeros(1)))
+    with pytest.raises(ValueError, match=r"surge is \(2,\), not \(1,\)"):
+        fmt.twists(TwistBatch(0, 0, BOATS, np.zeros(2), np.zeros(1)))
+
+
+def test_block_on_a_stream_of_another_type_is_refused(tmp_path: Path) -> None:
+    with CsvSink(tmp_path) as sink:
+        sink.write("vessel/ego/state", _states(0).row(0))
+        with pytest.raises(RecorderError, match="TwistCmd sample on a stream of VesselState"):
+            sink.write_lines(["vessel/ego/state"], TwistCmd, ["1,0,1.0,2.0\n"])

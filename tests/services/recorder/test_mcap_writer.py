@@ -1,0 +1,63 @@
+"""McapWriter writes files that the reference `mcap` reader accepts, CRCs and summary."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import pytest
+from mcap.reader import make_reader
+from mcap.stream_reader import CRCValidationError, StreamReader
+
+from services.recorder.mcap_writer import McapWriter
+
+
+def _write(path: Path) -> None:
+    with open(path, "wb") as f:
+        writer = McapWriter(f, profile="", library="test")
+        schema = writer.register_schema("s", "jsonschema", b"{}")
+        a = writer.register_channel("/a", "json", schema)
+        b = writer.register_channel("/b", "json", schema)
+        writer.add_messages([a, b], [0, 0], 100, [b'{"x":1}', b'{"y":2}'])
+        writer.add_messages([], [], 150, [])  # an empty tick writes nothing
+        writer.add_messages([a], [1], 200, [b'{"x":3}'])
+        writer.finish()
+
+
+def test_reader_sees_every_message_and_the_statistics(tmp_path: Path) -> None:
+    path = tmp_path / "t.mcap"
+    _write(path)
+    with open(path, "rb") as f:
+        reader = make_reader(f, validate_crcs=True)
+        summary = reader.get_summary()
+        assert summary is not None and summary.statistics is not None
+        stats = summary.statistics
+        assert (stats.message_count, stats.channel_count, stats.schema_count) == (3, 2, 1)
+        assert (stats.message_start_time, stats.message_end_time) == (100, 200)
+        assert stats.channel_message_counts == {1: 2, 2: 1}
+        got = [(c.topic, m.sequence, m.log_time, m.data) for _, c, m in reader.iter_messages()]
+    assert got == [
+        ("/a", 0, 100, b'{"x":1}'),
+        ("/b", 0, 100, b'{"y":2}'),
+        ("/a", 1, 200, b'{"x":3}'),
+    ]
+
+
+def test_crcs_are_checked_and_right(tmp_path: Path) -> None:
+    path = tmp_path / "t.mcap"
+    _write(path)
+    records = list(StreamReader(str(path), validate_crcs=True).records)  # raises on a bad CRC
+    assert type(records[-1]).__name__ == "Footer"
+    data = bytearray(path.read_bytes())
+    data[data.index(b'{"y":2}')] ^= 0xFF  # one flipped byte in the data section
+    path.write_bytes(bytes(data))
+    with pytest.raises(CRCValidationError, match="crc validation failed in DataEnd"):
+        list(StreamReader(str(path), validate_crcs=True).records)
+
+
+def test_mismatched_lengths_are_refused(tmp_path: Path) -> None:
+    with open(tmp_path / "t.mcap", "wb") as f:
+        writer = McapWriter(f, profile="", library="test")
+        with pytest.raises(ValueError, match="2 channels, 1 sequences and 2 payloads"):
+            writer.add_messages([1, 2], [0], 0, [b"", b""])
+        with pytest.raises(ValueError, match=r"no channel registered with id\(s\) \[7\]"):
+            writer.add_messages([7], [0], 0, [b""])
