@@ -11,7 +11,7 @@ The bytes are exactly those of the per-message path (tests/services/recorder/tes
 from __future__ import annotations
 
 import typing
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 
@@ -26,14 +26,16 @@ _TWIST_JSON = '{"surge":%r,"yaw_rate":%r,"tick":%d,"stamp_ns":%d}'
 
 @dataclass(frozen=True)
 class Block:
-    """Row i of a batch as a sample of `streams[i]`: its CSV line and its MCAP payload
-    (None where the payload cannot be encoded: JSON has no NaN)."""
+    """Row i of a batch as a sample of `streams[i]`: its CSV line and its MCAP payload,
+    either one by one (None where it cannot be encoded: JSON has no NaN) or, for payloads
+    built as byte matrices, as (rows, (len(rows), L) matrix) groups."""
 
     cls: type[Message]
     stamp_ns: int
     streams: tuple[str, ...]
     lines: list[str]
-    payloads: list[bytes | None]
+    payloads: list[bytes | None] = field(default_factory=list)
+    groups: list[tuple[np.ndarray, np.ndarray]] = field(default_factory=list)
 
 
 class BatchFormatter:
@@ -55,8 +57,8 @@ class BatchFormatter:
         table = np.concatenate(batch.arrays(), axis=1)  # VesselState's columns, (N, 19)
         lines = tabular.block_lines(batch.stamp_ns, batch.tick, table)
         # position, orientation, linear and angular velocity: the Odometry fields
-        payloads = self._odometry.encode(batch.stamp_ns, table[:, :13])
-        return Block(VesselState, batch.stamp_ns, self.state_streams, lines, list(payloads))
+        groups = self._odometry.encode_groups(batch.stamp_ns, table[:, :13])
+        return Block(VesselState, batch.stamp_ns, self.state_streams, lines, groups=groups)
 
     def twists(self, batch: TwistBatch) -> Block:
         """Raises ValueError for a batch of other boats or of the wrong shape."""

@@ -216,22 +216,32 @@ class OdometryBatch:
         ]  # fmt: skip
 
     def encode(self, stamp_ns: int, values: np.ndarray) -> list[bytes]:
-        """values (N, 13): position xyz, orientation xyzw, body linear xyz, body angular xyz."""
+        """values (N, 13): position xyz, orientation xyzw, body linear xyz, body angular xyz;
+        one payload per body, in body order."""
+        out: list[bytes] = [b""] * self.size
+        for rows, block in self.encode_groups(stamp_ns, values):
+            data, length = block.tobytes(), block.shape[1]
+            for j, i in enumerate(rows.tolist()):
+                out[i] = data[j * length : (j + 1) * length]
+        return out
+
+    def encode_groups(
+        self, stamp_ns: int, values: np.ndarray
+    ) -> list[tuple[np.ndarray, np.ndarray]]:
+        """The payloads as (rows, (len(rows), L) byte matrix) per payload length: what
+        `McapWriter.add_block` writes without touching a message on its own."""
         if values.shape != (self.size, 13):
             raise ValueError(f"odometry values of shape {values.shape}, not ({self.size}, 13)")
-        out: list[bytes] = [b""] * self.size
         stamp = np.frombuffer(_STAMP.pack(*_stamp(stamp_ns)), np.uint8)
+        out = []
         for rows, template in self._groups:
             block = template.copy()
-            length = block.shape[1]
-            pose = length - _ODOMETRY_TAIL
+            pose = block.shape[1] - _ODOMETRY_TAIL
             twist = pose + (7 + _COVARIANCE) * _FLOAT64
             block[:, 4:12] = stamp
             block[:, pose : pose + 56] = _bytes(values[rows, :7])
             block[:, twist : twist + 48] = _bytes(values[rows, 7:])
-            data = block.tobytes()
-            for j, i in enumerate(rows.tolist()):
-                out[i] = data[j * length : (j + 1) * length]
+            out.append((rows, block))
         return out
 
 

@@ -22,6 +22,7 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any, BinaryIO
 
+import numpy as np
 from mcap.exceptions import EndOfFile
 from mcap.opcode import Opcode
 from mcap.records import Channel, Schema
@@ -125,6 +126,18 @@ class McapSink:
         self._writer.add_messages(
             [c.id for c in chans], [c.sequence for c in chans], stamp_ns, payloads
         )
+        for chan in chans:
+            chan.sequence += 1
+
+    def write_matrix(
+        self, streams: Sequence[str], cls: type[Message], payloads: Any, *, stamp_ns: int
+    ) -> None:
+        """`payloads` (k, L) bytes, row i on `streams[i]`: equal-length payloads (Odometry
+        of bodies with equally long ids) go into the file as one block."""
+        chans = [self._channel(stream, cls) for stream in streams]
+        ids = np.fromiter((c.id for c in chans), np.uint16, len(chans))
+        seqs = np.fromiter((c.sequence for c in chans), np.uint32, len(chans))
+        self._writer.add_block(ids, seqs, stamp_ns, payloads)
         for chan in chans:
             chan.sequence += 1
 

@@ -80,6 +80,11 @@ class Recorder:
 
     def _write_payloads(self, block: Block) -> None:
         assert self.mcap is not None
+        for rows, matrix in block.groups:
+            streams = [block.streams[i] for i in rows.tolist()]
+            self.mcap.write_matrix(streams, block.cls, matrix, stamp_ns=block.stamp_ns)
+        if not block.payloads:
+            return
         ok = [i for i, p in enumerate(block.payloads) if p is not None]
         if len(ok) < len(block.payloads):
             bad = sorted(set(range(len(block.streams))) - set(ok))

@@ -9,7 +9,7 @@ import pytest
 
 from catabot.messages import BodyStates, TwistBatch, TwistCmd, VesselState
 from services.recorder import cdr, json_schemas, ros2_msgdefs
-from services.recorder.batches import BatchFormatter
+from services.recorder.batches import BatchFormatter, Block
 from services.recorder.csv_sink import CsvSink, RecorderError
 
 IDS = ("ego", "boat_000", "buoy_0")
@@ -47,7 +47,14 @@ def test_states_block_equals_the_per_message_rows(tmp_path: Path) -> None:
         expected = _csv_by_message(tmp_path / vid, f"vessel/{vid}/state", rows)
         assert (tmp_path / "block" / f"vessel.{vid}.state.csv").read_text() == expected
         odometry = cdr.odometry_encoder(ros2_msgdefs.WORLD_FRAME, vid)
-        assert fmt.states(batches[2]).payloads[i] == odometry(rows[2], batches[2].stamp_ns)
+        assert _payloads(fmt.states(batches[2]))[i] == odometry(rows[2], batches[2].stamp_ns)
+
+
+def _payloads(block: Block) -> dict[int, bytes]:
+    """Row -> payload, from the block's byte-matrix groups."""
+    return {
+        i: bytes(matrix[j]) for rows, matrix in block.groups for j, i in enumerate(rows.tolist())
+    }
 
 
 def test_twist_block_equals_the_per_message_csv_and_json(tmp_path: Path) -> None:

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 from pathlib import Path
 
+import numpy as np
 import pytest
 from mcap.reader import make_reader
 from mcap.stream_reader import CRCValidationError, StreamReader
@@ -61,3 +62,30 @@ def test_mismatched_lengths_are_refused(tmp_path: Path) -> None:
             writer.add_messages([1, 2], [0], 0, [b"", b""])
         with pytest.raises(ValueError, match=r"no channel registered with id\(s\) \[7\]"):
             writer.add_messages([7], [0], 0, [b""])
+        with pytest.raises(ValueError, match="1 channels and 2 sequences for 2"):
+            writer.add_block(np.array([1]), np.array([0, 1]), 0, np.zeros((2, 3), np.uint8))
+        with pytest.raises(ValueError, match=r"no channel registered with id\(s\) \[9\]"):
+            writer.add_block(np.array([9]), np.array([0]), 0, np.zeros((1, 3), np.uint8))
+
+
+def test_a_block_writes_the_same_bytes_as_one_message_at_a_time(tmp_path: Path) -> None:
+    payloads = np.arange(12, dtype=np.uint8).reshape(3, 4)
+    for name, add in (
+        ("one", lambda w: w.add_messages([1, 2, 1], [5, 0, 6], 70, [bytes(r) for r in payloads])),
+        ("block", lambda w: w.add_block(np.array([1, 2, 1]), np.array([5, 0, 6]), 70, payloads)),
+    ):
+        with open(tmp_path / name, "wb") as f:
+            writer = McapWriter(f, profile="", library="test")
+            schema = writer.register_schema("s", "jsonschema", b"{}")
+            writer.register_channel("/a", "json", schema)
+            writer.register_channel("/b", "json", schema)
+            add(writer)
+            writer.finish()
+    assert (tmp_path / "one").read_bytes() == (tmp_path / "block").read_bytes()
+    with open(tmp_path / "block", "rb") as f:
+        got = [(m.channel_id, m.sequence, m.data) for _, _, m in make_reader(f).iter_messages()]
+    assert got == [
+        (1, 5, bytes(payloads[0])),
+        (2, 0, bytes(payloads[1])),
+        (1, 6, bytes(payloads[2])),
+    ]
