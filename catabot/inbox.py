@@ -25,6 +25,11 @@ class Inbox:
         self.latest = {key: -1 for key in self.streams}
         self.held: dict[str, list[Message]] = {key: [] for key in self.streams}
         self.dropped: set[str] = set()
+        # Only clocked streams can be due (physics has ~300 free-running command keys with
+        # 100 boats); only keys holding samples need a look at release.
+        self._clocked = [s for s in self.streams.values() if s.period is not None]
+        self._holding: set[str] = set()
+        self._order = {key: i for i, key in enumerate(self.streams)}  # release in stream order
 
     @property
     def keys(self) -> list[str]:
@@ -36,6 +41,7 @@ class Inbox:
         msg = codec.decode(payload, stream.message)
         tick = _tick_of(msg)
         self.held[key].append(msg)
+        self._holding.add(key)
         if tick > self.latest[key]:
             self.latest[key] = tick
 
@@ -46,21 +52,22 @@ class Inbox:
     def missing(self, tick: int) -> list[str]:
         """Keys whose last sample due before `tick` has not arrived yet."""
         return [
-            key
-            for key, s in self.streams.items()
-            if s.producer not in self.dropped and self.latest[key] < s.due_before(tick)
+            s.key
+            for s in self._clocked
+            if s.producer not in self.dropped and self.latest[s.key] < s.due_before(tick)
         ]
 
     def release(self, tick: int) -> dict[str, list[Message]]:
         """Hand over every held sample produced before `tick`, oldest tick first."""
         out: dict[str, list[Message]] = {}
-        for key, held in self.held.items():
-            if not held:
-                continue
+        for key in sorted(self._holding, key=self._order.__getitem__):
+            held = self.held[key]
             ready = [m for m in held if _tick_of(m) < tick]
             if ready:
                 self.held[key] = [m for m in held if _tick_of(m) >= tick]
                 out[key] = sorted(ready, key=_tick_of)
+            if not self.held[key]:
+                self._holding.discard(key)
         return out
 
 

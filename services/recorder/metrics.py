@@ -41,12 +41,16 @@ class Metrics:
     def _closest(self, pos: np.ndarray, stamp_ns: int) -> None:
         if len(pos) < 2:
             return
-        gaps = np.linalg.norm(pos[:, None, :2] - pos[None, :, :2], axis=2)
-        gaps[np.diag_indices(len(pos))] = np.inf
-        i, j = np.unravel_index(int(np.argmin(gaps)), gaps.shape)
-        if gaps[i, j] < self.closest[0]:
+        dx = np.subtract.outer(pos[:, 0], pos[:, 0])
+        dy = np.subtract.outer(pos[:, 1], pos[:, 1])
+        gap2 = np.multiply(dx, dx, out=dx)
+        gap2 += np.multiply(dy, dy, out=dy)  # squared: one sqrt, of the minimum only
+        np.fill_diagonal(gap2, np.inf)
+        i, j = np.unravel_index(int(np.argmin(gap2)), gap2.shape)
+        gap = float(np.hypot(pos[i, 0] - pos[j, 0], pos[i, 1] - pos[j, 1]))
+        if gap < self.closest[0]:
             a, b = sorted((self.ids[i], self.ids[j]))
-            self.closest = (float(gaps[i, j]), a, b, stamp_ns)
+            self.closest = (gap, a, b, stamp_ns)
 
     def write(self, path: Path) -> None:
         vessels = {
