@@ -100,6 +100,7 @@ class McapSink:
         self._out.flush()
         self._schemas: dict[type[Message], int] = {}
         self._channels: dict[str, _Channel] = {}
+        self._groups: dict[tuple[str, ...], tuple[list[_Channel], Any]] = {}
         self._closed = False
 
     def write(self, stream: str, msg: Message, *, stamp_ns: int) -> None:
@@ -134,8 +135,15 @@ class McapSink:
     ) -> None:
         """`payloads` (k, L) bytes, row i on `streams[i]`: equal-length payloads (Odometry
         of bodies with equally long ids) go into the file as one block."""
-        chans = [self._channel(stream, cls) for stream in streams]
-        ids = np.fromiter((c.id for c in chans), np.uint16, len(chans))
+        group = tuple(streams)
+        if not group:
+            return
+        if group not in self._groups:  # the same streams every tick: look them up once
+            chans = [self._channel(stream, cls) for stream in streams]
+            self._groups[group] = (chans, np.array([c.id for c in chans], np.uint16))
+        chans, ids = self._groups[group]
+        if self._closed or chans[0].cls is not cls:
+            self._channel(streams[0], cls)  # raises the precise error
         seqs = np.fromiter((c.sequence for c in chans), np.uint32, len(chans))
         self._writer.add_block(ids, seqs, stamp_ns, payloads)
         for chan in chans:

@@ -11,6 +11,7 @@ from catabot.messages import BodyStates, TwistBatch, TwistCmd, VesselState
 from services.recorder import cdr, json_schemas, ros2_msgdefs
 from services.recorder.batches import BatchFormatter, Block
 from services.recorder.csv_sink import CsvSink, RecorderError
+from services.recorder.mcap_sink import McapSink, read_mcap_messages
 
 IDS = ("ego", "boat_000", "buoy_0")
 BOATS = ("boat_000",)
@@ -92,3 +93,20 @@ def test_block_on_a_stream_of_another_type_is_refused(tmp_path: Path) -> None:
         sink.write("vessel/ego/state", _states(0).row(0))
         with pytest.raises(RecorderError, match="TwistCmd sample on a stream of VesselState"):
             sink.write_lines(["vessel/ego/state"], TwistCmd, ["1,0,1.0,2.0\n"])
+
+
+def test_mcap_blocks_read_back_as_odometry_and_refuse_another_type(tmp_path: Path) -> None:
+    fmt = BatchFormatter(IDS, BOATS)
+    with McapSink(tmp_path / "run.mcap") as sink:
+        for tick in range(2):
+            block = fmt.states(_states(tick))
+            for rows, matrix in block.groups:
+                streams = [block.streams[i] for i in rows.tolist()]
+                sink.write_matrix(streams, VesselState, matrix, stamp_ns=block.stamp_ns)
+        with pytest.raises(RecorderError, match="TwistCmd sample on a channel of VesselState"):
+            sink.write_matrix(streams, TwistCmd, matrix, stamp_ns=0)
+    msgs = read_mcap_messages(tmp_path / "run.mcap")
+    assert len(msgs) == 2 * len(IDS)
+    ego = [m for m in msgs if m.topic == "/vessel/ego/state"]
+    assert [m.sequence for m in ego] == [0, 1]
+    assert ego[1].decoded.pose.pose.position.x == _states(1).position[0, 0]
