@@ -8,11 +8,16 @@ can pass over a trough and meet the next crest), then refined by Illinois false 
 which converges superlinearly on the smooth surface, until the point is within TOLERANCE_M
 (0.5 mm) of the surface. Rays pointing up or level never hit water from above.
 
-Cost: (downward rays in bracket) x (~7 on average: ~4.5 march samples, ~3 refinements)
-evaluations of the sum, each one float32 multiply-add and cosine per wave component along
-the ray (RaySurface), in blocks of BLOCK rays whose tables stay in cache; calm water costs
-nothing of the sort. On the benchmark's harbour chop (48 components) a 32 x 512 LiDAR scan
-spends ~8 ms here, a 640 x 480 camera frame ~120 ms.
+A ray steeper than the steepest possible surface (slope sum a k) meets it exactly once:
+it skips the march, and one evaluation where it crosses z = 0 brackets its root tightly
+(the root is within |f| / (its minimum descent rate) of there). Known signs are not
+evaluated: at z = +A the ray is above every crest, at z = -A below every trough.
+
+Cost: (downward rays in bracket) x (~7 evaluations for grazing rays: ~4.5 march samples and
+~3 refinements; ~4 for steep ones) of the sum, each one float32 multiply-add and cosine per
+wave component along the ray (RaySurface), in blocks of BLOCK rays whose tables stay in
+cache; calm water costs nothing of the sort. On the benchmark's harbour chop (48
+components) a 32 x 512 LiDAR scan spends ~8 ms here, a 640 x 480 camera frame ~100 ms.
 """
 
 from __future__ import annotations
@@ -49,7 +54,9 @@ def wave_hits(
     down = d[:, 2] < -1e-12
     with np.errstate(divide="ignore", invalid="ignore"):
         t_top = np.maximum((amplitude - o[:, 2]) / d[:, 2], 0.0)
-        t_bottom = np.minimum((-amplitude - o[:, 2]) / d[:, 2], limit)
+        t_under = (-amplitude - o[:, 2]) / d[:, 2]  # where the ray is below every trough
+    limited = limit < t_under
+    t_bottom = np.where(limited, limit, t_under)
     rows = np.flatnonzero(down & (t_top < t_bottom))
     if rows.size == 0:
         return rows, np.empty(0), np.empty((0, 3))
@@ -58,7 +65,8 @@ def wave_hits(
     for s in range(0, rows.size, BLOCK):  # a block's phase tables stay in cache
         blk = rows[s : s + BLOCK]
         along = RaySurface(waves, rows_of(o, blk), np.take(d, blk, axis=0), time_s)
-        hit, t = _first_crossing(along, np.take(t_top, blk), np.take(t_bottom, blk))
+        t0, t1 = np.take(t_top, blk), np.take(t_bottom, blk)
+        hit, t = _first_crossing(along, t0, t1, np.take(limited, blk))
         at = np.flatnonzero(hit)
         found[s : s + BLOCK], tr[s : s + BLOCK] = hit, t
         normal[s + at] = along.normal(at, t[at])
@@ -89,6 +97,10 @@ class RaySurface:
         self.amp = waves.amplitudes_m.astype(np.float32)
         self.slope = (waves.amplitudes_m * kxy).T.astype(np.float32)  # (M, 2): a kx, a ky
         self.oz, self.dz = np.ascontiguousarray(o[:, 2]), np.ascontiguousarray(d[:, 2])
+        # |grad eta| <= sum a k: a ray descending faster than that crosses the surface once
+        wave_slope = float(np.sum(waves.amplitudes_m * k)) * np.hypot(d[:, 0], d[:, 1])
+        self.steep = -self.dz > wave_slope * (1.0 + 1e-6)
+        self.descent = -self.dz - wave_slope  # df/dt <= -descent: > 0 on steep rays
 
     def gap(self, rows: NDArray[np.intp], t: F64) -> F64:
         """f at distances t (metres) along the rays `rows`: positive above the water."""
@@ -110,18 +122,32 @@ class RaySurface:
         return phase
 
 
-def _first_crossing(surface: RaySurface, t0: F64, t1: F64) -> tuple[NDArray[np.bool_], F64]:
-    """(found, t): the first root of f in [t0, t1] per ray, marched then refined. The march
-    goes sample by sample and drops a ray as soon as it is under the surface, so a ray costs
-    the samples up to its crossing, not all of them. f(t0) >= 0 where t0 > 0 (there the ray
-    is at z = +A, over every crest), so it is evaluated only where needed: rays starting
-    inside the wave band (t0 = 0) and rays that cross in the first step."""
-    m, step = t0.size, (t1 - t0) / MARCH_SAMPLES
-    a, fa, b, fb = t0.copy(), np.full(m, np.nan), t0.copy(), np.zeros(m)
-    inside = np.flatnonzero(t0 <= 0.0)
+def _first_crossing(
+    surface: RaySurface, t0: F64, t1: F64, limited: NDArray[np.bool_]
+) -> tuple[NDArray[np.bool_], F64]:
+    """(found, t): the first root of f in [t0, t1] per ray, marched then refined.
+
+    Known signs are not evaluated: where t0 > 0 the ray is at z = +A, over every crest, so
+    f(t0) >= 0, and where t1 is not `limited` (cut short by a nearer hit) it is at z = -A,
+    so f(t1) <= 0; there z itself stands in for f (the refinement needs only the signs).
+    A ray steeper than the steepest possible surface (RaySurface.steep) meets it at most
+    once: it goes straight to the refinement. The others are marched sample by sample and
+    dropped as soon as they are under the surface, so a ray costs the samples up to its
+    crossing, not all of them."""
+    m = t0.size
+    a, fa = t0.copy(), surface.oz + t0 * surface.dz
+    b, fb = t1.copy(), surface.oz + t1 * surface.dz
+    inside = np.flatnonzero(t0 <= 0.0)  # starting within the wave band: f(t0) unknown
     fa[inside] = surface.gap(inside, t0[inside])
     found = fa <= 0.0  # already under water at the top of the bracket: t0
-    live = np.flatnonzero(~found)
+    b[found], fb[found] = a[found], fa[found]
+    steep = surface.steep & ~found
+    check = np.flatnonzero(steep & limited)  # one crossing at most: is it before t1?
+    fb[check] = surface.gap(check, t1[check])
+    found |= steep & (fb <= 0.0)
+    _narrow(surface, np.flatnonzero(steep & found), a, fa, b, fb)
+    live = np.flatnonzero(~found & ~steep)
+    step = (t1 - t0) / MARCH_SAMPLES
     for k in range(1, MARCH_SAMPLES + 1):
         if live.size == 0:
             break
@@ -133,12 +159,32 @@ def _first_crossing(surface: RaySurface, t0: F64, t1: F64) -> tuple[NDArray[np.b
         above = live[~under]
         a[above], fa[above] = t[~under], f[~under]
         live = above
-    first = np.flatnonzero(np.isnan(fa) & found)  # crossed in the first step: f(t0) needed
-    fa[first] = surface.gap(first, t0[first])
     rows = np.flatnonzero(found)
     t_hit = np.full(m, np.inf)
     t_hit[rows] = _illinois(surface, rows, a[rows], b[rows], fa[rows], fb[rows])
     return found, t_hit
+
+
+def _narrow(surface: RaySurface, rows: NDArray[np.intp], a: F64, fa: F64, b: F64, fb: F64) -> None:
+    """Shrink the brackets of steep rays (one root in [a, b]) in place with one evaluation:
+    at z = 0, f = -eta there; f falls at least `descent` per metre, so the root lies within
+    |f| / descent of it, on the side f's sign gives. The far end gets the value f would
+    have if the surface were flat there (the sign is certain, the size a good guess)."""
+    if rows.size == 0:
+        return
+    ra, rb = a[rows], b[rows]
+    t = np.clip(-np.take(surface.oz, rows) / np.take(surface.dz, rows), ra, rb)
+    f = surface.gap(rows, t)
+    fall, sink = np.take(surface.descent, rows), -np.take(surface.dz, rows)
+    above = f > 0.0
+    reach = np.abs(f) / fall
+    far = np.where(above, np.minimum(t + reach, rb), np.maximum(t - reach, ra))
+    cut = np.where(above, far < rb, far > ra)  # else the old end (and its value) stays
+    guess = f - sink * (far - t)  # sign certain: <= 0 beyond, >= 0 before
+    a[rows] = np.where(above, t, np.where(cut, far, ra))
+    fa[rows] = np.where(above, f, np.where(cut, guess, fa[rows]))
+    b[rows] = np.where(above, np.where(cut, far, rb), t)
+    fb[rows] = np.where(above, np.where(cut, guess, fb[rows]), f)
 
 
 def _illinois(surface: RaySurface, rows: NDArray[np.intp], a: F64, b: F64, fa: F64, fb: F64) -> F64:

@@ -38,3 +38,18 @@ def test_hits_over_several_blocks_lie_on_the_surface() -> None:
     p = o[rows] + t[:, None] * d[rows]
     assert np.abs(p[:, 2] - SEA.height(p[:, 0], p[:, 1], 3.0)).max() < 1e-3
     assert np.abs(normal - SEA.normal(p[:, 0], p[:, 1], 3.0)).max() < 1e-5
+
+
+def test_steep_rays_meet_the_surface_once_where_dense_sampling_finds_it() -> None:
+    rng = np.random.default_rng(8)
+    el, az = rng.uniform(np.radians(20.0), np.radians(85.0), 300), rng.uniform(0, 6.3, 300)
+    d = np.stack([np.cos(el) * np.cos(az), np.cos(el) * np.sin(az), -np.sin(el)], axis=1)
+    o = np.broadcast_to(np.array([10.0, -20.0, 1.5]), d.shape)
+    rows, t, _ = wave_hits(SEA, float(SEA.amplitudes_m.sum()), o, d, np.full(300, 1e3), 4.0)
+    assert rows.size == 300
+    s = np.linspace(0.0, 4.0 / np.sin(el)[:, None], 4001, axis=1)[..., 0]  # (300, 4001)
+    p = o[:, None, :] + s[..., None] * d[:, None, :]
+    f = p[..., 2] - SEA.height(p[..., 0], p[..., 1], 4.0)
+    first = np.argmax(f <= 0.0, axis=1)  # the first sample under the surface
+    step = s[:, 1] - s[:, 0]
+    assert np.all(np.abs(t - s[np.arange(300), first]) <= step + 1e-3 / np.sin(el))
