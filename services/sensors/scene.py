@@ -219,7 +219,8 @@ class Scene:
 
     def _ray_buffer(self, n: int) -> F32:
         """The (n, 6) float32 rays handed to Embree, reused across casts of the same size
-        (a fresh 7 MB array per camera frame costs ~1 ms of page faults)."""
+        (a fresh 7 MB array per camera frame costs ~1 ms of page faults). One cast at a
+        time: a Scene is not shared between threads."""
         buf = self._buffers.get(n)
         if buf is None:
             buf = self._buffers[n] = np.empty((n, 6), dtype=np.float32)

@@ -39,10 +39,14 @@ BLOCK = 4096  # rays solved together: (rays x components) float32 tables of ~0.8
 def calm_hits(o: F64, d: F64, max_range: float) -> F64:
     """Distance along each unit ray to the plane z = 0 from above (inf: none within
     `max_range`); the normal there is +z."""
+    dz = np.ascontiguousarray(d[:, 2])
+    shared = o.strides[0] == 0  # one origin: a scalar height (a camera's 300 k rays)
+    oz = o[0, 2] if shared else o[:, 2]
     with np.errstate(divide="ignore", invalid="ignore"):
-        t = -o[:, 2] / d[:, 2]
-    miss = ~((d[:, 2] < -1e-12) & (o[:, 2] >= 0.0) & (t <= max_range))
-    t[miss] = np.inf
+        t = -oz / dz
+    hit = (dz < -1e-12) & (t <= max_range)
+    hit &= (oz >= 0.0) if not shared else bool(oz >= 0.0)
+    t[~hit] = np.inf
     return t
 
 
