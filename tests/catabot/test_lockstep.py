@@ -66,11 +66,14 @@ def test_ticks_carry_time(world: World) -> None:
 # -- (b) Jacobi inputs --------------------------------------------------------------------
 
 
-def _producer_consumer(world: World, produce: Step) -> tuple[str, Member]:
+def _producer_consumer(
+    world: World, produce: Step, consume: Step | None = None, *, sink: bool = False
+) -> tuple[str, Member]:
     key = world.keys.sensor("ego", "gps")
     names = ["prod", "cons"]
     world.member("prod", produce, peers=names)
-    cons = world.member("cons", inputs=[Stream(key, GpsFix, "prod", 2)], peers=names)
+    stream = Stream(key, GpsFix, "prod", 2)
+    cons = world.member("cons", consume, inputs=[stream], peers=names, sink=sink)
     return key, cons
 
 
@@ -182,3 +185,25 @@ def _eventually(check: Callable[[], bool], timeout_s: float = 3.0) -> bool:
             return False
         time.sleep(0.01)
     return True
+
+
+def test_a_sink_acks_first_and_lags_at_most_one_tick(world: World) -> None:
+    """The recorder's mode: its slow step overlaps the others' next tick, every sample
+    still reaches it in Jacobi order, and it never falls two ticks behind."""
+    participant: dict[str, Participant] = {}
+
+    def produce(tick: Tick, _inputs: Inputs) -> None:
+        if tick.tick % 2 == 0:
+            participant["p"].publish(key, _fix(tick.tick))
+
+    key, cons = _producer_consumer(world, produce, lambda t, i: time.sleep(0.02), sink=True)
+    participant["p"] = world.members["prod"].participant
+    result = world.run(["prod", "cons"], 20, deadline_s=2.0, start_timeout_s=5.0)
+    assert result.error == "" and result.ticks_done == 20
+    cons.join()
+    _check_jacobi(cons, key, 20)
+    order = {(what, who, t): i for i, (what, who, t) in enumerate(world.events)}
+    overlap = [order[("start", "prod", k + 1)] < order[("done", "cons", k)] for k in range(19)]
+    assert any(overlap), "the sink's step never overlapped the next tick"
+    lag = [order[("done", "cons", k)] < order[("start", "prod", k + 2)] for k in range(18)]
+    assert all(lag), "the sink fell two ticks behind"
