@@ -86,6 +86,13 @@ def cell(result: dict[str, Any], has_lidar: bool) -> str:
     return f"RTF {rtf:5.2f} {scans}"
 
 
+def cpu_per_tick(result: dict[str, Any]) -> str:
+    """Where the time goes: ms of CPU per tick per service (all its threads)."""
+    ticks = max(int(result.get("ticks", 0)), 1)
+    cpu = result.get("cpu_s") or {}
+    return ", ".join(f"{name} {1e3 * s / ticks:.2f} ms" for name, s in cpu.items()) or "n/a"
+
+
 def main(argv: list[str] | None = None) -> None:
     args = sys.argv[1:] if argv is None else argv
     numbers = [a for a in args if a.replace(".", "", 1).isdigit()]
@@ -98,6 +105,7 @@ def main(argv: list[str] | None = None) -> None:
     if len(columns) < 3:
         print("  columns skipped (no camera): " + ", ".join(COLUMNS[1:]))
     has_lidar = "lidar" in SENSOR_TYPES
+    usage: dict[int, str] = {}
     with tempfile.TemporaryDirectory(prefix="table2-") as tmp:
         for boats in BOATS:
             row = [f"{boats:4d} boats"]
@@ -105,7 +113,12 @@ def main(argv: list[str] | None = None) -> None:
                 result = run_once(scenario(boats, column, seconds), Path(tmp))
                 row.append(f"{COLUMNS[column]}: {cell(result, has_lidar)} "
                            f"(paper {PAPER[boats][column]} FPS)")  # fmt: skip
+                if column == 0:
+                    usage[boats] = cpu_per_tick(result)
             print(" | ".join(row), flush=True)
+    print("CPU per tick in each service's stepping loop (no perception column):")
+    for boats, text in usage.items():
+        print(f"  {boats:4d} boats: {text}")
 
 
 if __name__ == "__main__":

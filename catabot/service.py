@@ -8,10 +8,12 @@ from __future__ import annotations
 
 import argparse
 import cProfile
+import json
 import logging
 import os
 import signal
 import sys
+import time
 from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
@@ -74,6 +76,12 @@ def _profiled(name: str, run_dir: Path, run: Callable[[], End]) -> End:
         profile.dump_stats(run_dir / "log" / f"{name}.prof")
 
 
+def _write_usage(name: str, run_dir: Path, cpu_s: float) -> None:
+    """CPU seconds of the stepping loop (every thread, start-up excluded), for run.json."""
+    (run_dir / "log").mkdir(parents=True, exist_ok=True)
+    (run_dir / "log" / f"{name}.usage.json").write_text(json.dumps({"cpu_s": round(cpu_s, 3)}))
+
+
 def run_service(name: str, build: BuildFn, argv: list[str] | None = None) -> int:
     """Run one stepping service to the end of the run; returns the process exit code."""
     args = service_parser(name).parse_args(argv)
@@ -92,7 +100,9 @@ def run_service(name: str, build: BuildFn, argv: list[str] | None = None) -> int
     )
     try:
         participant, step, on_end = build(ctx)
+        cpu_start = time.process_time()
         end = _profiled(name, ctx.run_dir, lambda: participant.run(step, on_end))
+        _write_usage(name, ctx.run_dir, time.process_time() - cpu_start)
     except ClockError as exc:
         log.error("%s", exc)
         return 3

@@ -7,6 +7,7 @@ wall-clock time (DESIGN.md §7).
 
 from __future__ import annotations
 
+import contextlib
 import json
 import signal
 import sys
@@ -22,6 +23,16 @@ def describe_exit(code: int | None) -> str:
     if code < 0:
         return f"killed by {signal.Signals(-code).name}"
     return f"exit code {code}"
+
+
+def _usage(run_dir: Path, services: Mapping[str, object]) -> dict[str, float]:
+    """Each service's CPU seconds in its stepping loop (start-up excluded), where reported."""
+    out: dict[str, float] = {}
+    for name in services:
+        path = run_dir / "log" / f"{name}.usage.json"
+        with contextlib.suppress(OSError, ValueError, KeyError):
+            out[name] = float(json.loads(path.read_text())["cpu_s"])
+    return out
 
 
 def summarise(
@@ -47,6 +58,7 @@ def summarise(
         "error": error,
         "reason": result.get("reason", ""),
         "services": dict(service_codes),
+        "cpu_s": _usage(run_dir, service_codes),
     }
     (run_dir / "log" / "run.json").write_text(json.dumps(record, indent=2) + "\n")
     rtf = sim_s / wall if wall > 0 else 0.0
