@@ -22,13 +22,13 @@ from pathlib import Path
 
 import numpy as np
 
+from catabot.blas import single_thread_blas
 from catabot.messages import VesselState
 from catabot.sensor_types import CameraParams, RadarParams
 from catabot.terrain import TerrainConfig, load_terrain
 from catabot.waves import WaveConfig, WaveField
 from services.sensors.camera import CameraModel
 from services.sensors.camera_boxes import candidate_rays
-from services.sensors.common import single_thread_blas
 from services.sensors.radar import RadarModel
 from services.sensors.scene import CLASS_VESSEL, Body, Scene
 
@@ -132,7 +132,7 @@ def radar_row(world: Scene, sea: str) -> tuple[str, tuple[float, float, float]]:
 
 
 def main() -> None:
-    single_thread_blas()  # as the sensors service does (services/sensors/common.py)
+    single_thread_blas()  # as every service does (catabot/blas.py)
     print(f"camera and radar cost: bay terrain, {BOATS} boats in view, median of {REPEATS}")
     print(f"{'what':52} {'wall ms':>8} {'per s':>8} {'min ms':>8} {'CPU ms':>8}")
     for sea, waves in SEAS.items():

@@ -20,11 +20,11 @@ from pathlib import Path
 
 import numpy as np
 
+from catabot.blas import single_thread_blas
 from catabot.messages import VesselState
 from catabot.sensor_types import LidarParams
 from catabot.terrain import TerrainConfig, load_terrain
 from catabot.waves import WaveConfig, WaveField
-from services.sensors.common import single_thread_blas
 from services.sensors.lidar import LidarModel
 from services.sensors.rain import RainParams, apply_rain
 from services.sensors.scene import CLASS_BUOY, CLASS_VESSEL, Body, Scene
@@ -99,7 +99,7 @@ def row(sea: str, rain: float) -> tuple[str, float, float, float, float, float, 
 
 
 def main() -> None:
-    single_thread_blas()  # as the sensors service does (services/sensors/common.py)
+    single_thread_blas()  # as every service does (catabot/blas.py)
     print(f"LiDAR 32 x 512, 100 m, bay.png terrain, {BOATS} boats + 1 buoy (median of {REPEATS})")
     head = ("sea", "rain mm/h", "scan ms", "scan min", "cast ms", "rain ms", "build ms", "returns")
     print("{:>8} {:>9} {:>8} {:>8} {:>8} {:>8} {:>9} {:>8}".format(*head))

@@ -13,6 +13,7 @@ import signal
 import sys
 from dataclasses import asdict
 
+from catabot.blas import single_thread_blas
 from catabot.clock import Policy
 from catabot.conductor import ClockSpec, Conductor, Progress
 from catabot.keys import Keys
@@ -50,6 +51,7 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--scenario", help="scenario file (default: the bundled default)")
     add_connection_args(parser)
     args = parser.parse_args(argv)
+    single_thread_blas()
     logging.basicConfig(level=logging.INFO, format="%(asctime)s %(name)s %(levelname)s %(message)s")
     try:
         scenario = load_scenario(args.scenario)

@@ -20,6 +20,7 @@ from pathlib import Path
 
 import zenoh
 
+from catabot.blas import single_thread_blas
 from catabot.clock import ClockError
 from catabot.keys import Keys
 from catabot.messages import End
@@ -86,6 +87,7 @@ def run_service(name: str, build: BuildFn, argv: list[str] | None = None) -> int
     """Run one stepping service to the end of the run; returns the process exit code."""
     args = service_parser(name).parse_args(argv)
     setup_logging()
+    single_thread_blas()  # idle BLAS threads spin on the cores other services need
     signal.signal(signal.SIGTERM, lambda *_: sys.exit(143))
     try:
         scenario = load_scenario(args.scenario)

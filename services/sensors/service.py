@@ -23,7 +23,6 @@ from catabot.streams import BodyRows, body_ids, states_stream
 from catabot.terrain import load_terrain
 from catabot.traffic_plan import all_buoys, all_vessels
 from catabot.waves import WaveField
-from services.sensors.common import single_thread_blas
 from services.sensors.registry import Sensor, build_sensor
 from services.sensors.scene import Scene, bodies_for
 
@@ -133,7 +132,6 @@ def build(ctx: ServiceContext) -> Built:
 
 
 def main(argv: list[str] | None = None) -> int:
-    single_thread_blas()  # spinning BLAS threads would slow the ray casts (common.py)
     return run_service("sensors", build, argv)
 
 
