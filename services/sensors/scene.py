@@ -107,6 +107,8 @@ class Scene:
         self._amplitude = float(np.sum(waves.amplitudes_m))
         self.bodies = list(bodies)
         self._index = {b.id: i for i, b in enumerate(self.bodies)}
+        self._rows_ids: tuple[str, ...] = ()  # update_arrays' id list and its scene rows
+        self._rows = np.empty(0, np.intp)
         if len(self._index) != len(self.bodies):
             raise SceneError("body ids must be unique")
         lo = np.array([b.lo for b in self.bodies], dtype=np.float64).reshape(-1, 3)
@@ -132,6 +134,32 @@ class Scene:
         the one-by-one path."""
         if poses:
             self._set_poses(poses)
+        self.time_s = float(time_s)
+
+    def update_arrays(
+        self, ids: Sequence[str], position: np.ndarray, orientation: np.ndarray, time_s: float
+    ) -> None:
+        """Every body of a `BodyStates` batch at once, row i being `ids[i]`: the per-tick
+        path, with no per-body Python objects (rows are mapped once per id list); a bad
+        row goes through `update`, which names it."""
+        ids = tuple(ids)
+        if self._rows_ids != ids:
+            self._rows = np.array([self._index.get(b, -1) for b in ids], dtype=np.intp)
+            self._rows_ids = ids
+        n, rows = len(ids), self._rows
+        rot = rotations_from_quaternions(orientation) if orientation.shape == (n, 4) else None
+        if (
+            rot is None
+            or position.shape != (n, 3)
+            or not np.isfinite(position).all()
+            or (n and rows.min() < 0)
+        ):
+            self.update(
+                dict(zip(ids, zip(position, orientation, strict=False), strict=False)), time_s
+            )
+            return
+        self._pos[rows], self._rot[rows] = position, rot
+        self._posed = None
         self.time_s = float(time_s)
 
     def _set_poses(self, poses: Mapping[str, tuple[Sequence[float], Sequence[float]]]) -> None:

@@ -60,8 +60,10 @@ class SensorsService:
         ]
         carriers = {m.vessel for m in self.mounted}
         self.states = {v.id: start_state(v) for v in scenario.vessels if v.id in carriers}
-        # the scene needs every vessel's and buoy's pose; at tick 0, the start poses at rest
+        # the scene needs every vessel's and buoy's pose; at tick 0, the start poses at rest,
+        # then the newest batch's arrays
         self.poses = {vid: (s.position, s.orientation) for vid, s in start_states(scenario).items()}
+        self.batch: BodyStates | None = None
         self.states_key = ctx.keys.world_states()
         self.rows = BodyRows(body_ids(scenario))
         self.participant = Participant(
@@ -72,7 +74,10 @@ class SensorsService:
         batches = inputs.get(self.states_key)
         if batches:
             self._take(batches[-1])
-        if self.scene is not None:
+        if self.scene is not None and self.batch is not None:
+            b = self.batch
+            self.scene.update_arrays(b.ids, b.position, b.orientation, tick.stamp_ns / 1e9)
+        elif self.scene is not None:
             self.scene.update(self.poses, tick.stamp_ns / 1e9)
         for m in self.mounted:
             if tick.tick % m.period == 0:
@@ -82,15 +87,13 @@ class SensorsService:
                 self.participant.publish(m.key, sample)
 
     def _take(self, batch: Message) -> None:
-        """The carriers' states as `VesselState` (what sensors sample) and, only when a
-        scene needs them, every body's pose straight from the batch's arrays."""
+        """The carriers' states as `VesselState` (what sensors sample); the batch itself
+        for the scene, which takes every body's pose straight from its arrays."""
         assert isinstance(batch, BodyStates)
         row = self.rows.check(batch)
         for vid in self.states:
             self.states[vid] = batch.row(row[vid])
-        if self.scene is not None:
-            pos, quat = batch.position, batch.orientation
-            self.poses = {vid: (pos[i], quat[i]) for vid, i in row.items()}
+        self.batch = batch
 
 
 def needs_scene(scenario: Scenario) -> bool:

@@ -124,3 +124,23 @@ def test_scans_are_deterministic_and_rain_is_labelled() -> None:
     assert sa.range_image.shape == (32, 512) and sa.points.dtype == np.float32
     assert sa.is_rain.any() and np.all(sa.cls[sa.is_rain] == CLASS_NONE)
     assert np.all(sa.instance[sa.is_rain] == 0)
+
+
+def test_pose_arrays_from_a_batch_equal_the_named_poses() -> None:
+    """The sensors service's per-tick path (batch arrays) casts exactly like named poses;
+    a bad row is still named."""
+    ids = ("boat", "buoy", "ego")  # not the scene's order
+    pos = np.array([[20.0, 1.0, 0.0], [0.0, -10.0, 0.1], [0.0, 0.0, 0.0]])
+    quat = np.array([_quat(0.3), _quat(0.0), _quat(-0.2)])
+    named, arrays = _scene(), _scene()
+    named.update({b: (pos[i], quat[i]) for i, b in enumerate(ids)}, 2.0)
+    arrays.update_arrays(ids, pos, quat, 2.0)
+    scans = [
+        LidarModel(LEVEL, scene=s, noise=False).sample(_state(), tick=0, stamp_ns=0)
+        for s in (named, arrays)
+    ]
+    assert np.array_equal(scans[0].range_image, scans[1].range_image)
+    assert arrays.time_s == 2.0
+    pos[1, 0] = np.nan
+    with pytest.raises(SceneError, match="buoy"):
+        arrays.update_arrays(ids, pos, quat, 3.0)
