@@ -21,8 +21,10 @@ in metres in the cross-section pi D^2 / 4 of (6)-(7), so alpha is in 1/m and exp
 dimensionless. (The original code used millimetres there too, which makes any drop in the beam
 hide the object; the paper's Fig. 5 shows objects seen through rain.)
 
-Randomness: one Poisson and one uniform draw per beam, for every beam whatever its n, so a
-beam's draws do not depend on the other beams' outcomes (deterministic for a seeded generator).
+Randomness: one Poisson draw per beam, then one uniform per beam, for every beam whatever
+its n: the same scan from the same seeded generator gives the same bytes. NumPy's Poisson
+sampler consumes a varying amount of the stream per draw, so a change in one beam's range
+shifts the draws of the beams after it (the statistics are unchanged).
 """
 
 from __future__ import annotations
