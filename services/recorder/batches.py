@@ -1,8 +1,9 @@
 """Batches (`BodyStates`, `TwistBatch`) recorded as the per-vessel streams they stand for.
 
-The run folder keeps one `vessel.<id>.state.csv` and one `/vessel/<id>/state` Odometry
-channel per body, and one `vessel.<id>.cmd.twist.csv` / `/vessel/<id>/cmd/twist` channel per
-traffic boat, as if each row had been its own message. Formatting them one message at a time
+The run folder keeps one `vessel.<id>.state.csv` per body and one `/vessel/<id>/state`
+Odometry channel per vessel (every body's frame is on `/tf`, one TFMessage a tick), and one
+`vessel.<id>.cmd.twist.csv` / `/vessel/<id>/cmd/twist` channel per traffic boat, as if each
+row had been its own message. Formatting them one message at a time
 (a dataclass, a CSV writer call, an encoder call and an MCAP record each) was most of the
 recorder's time with 100 boats, so each batch is formatted here in a few array-wide calls.
 The bytes are exactly those of the per-message path (tests/services/recorder/test_batches.py).
@@ -36,16 +37,23 @@ class Block:
     lines: list[str]
     payloads: list[bytes | None] = field(default_factory=list)
     groups: list[tuple[np.ndarray, np.ndarray]] = field(default_factory=list)
+    tf: bytes | None = None  # every body's frame as one tf2_msgs/TFMessage, for `/tf`
 
 
 class BatchFormatter:
     """Knows, for one run, which stream and which encoder each row of a batch belongs to."""
 
-    def __init__(self, body_ids: tuple[str, ...], boat_ids: tuple[str, ...]) -> None:
-        self.body_ids, self.boat_ids = body_ids, boat_ids
+    def __init__(
+        self, body_ids: tuple[str, ...], boat_ids: tuple[str, ...], *, vessels: int
+    ) -> None:
+        """body_ids: the `BodyStates` rows, the first `vessels` of them vessels (the rest
+        buoys: a CSV each and a frame on `/tf`, but no Odometry channel, as on the bus)."""
+        self.body_ids, self.boat_ids, self.vessels = body_ids, boat_ids, vessels
         self.state_streams = tuple(f"vessel/{b}/state" for b in body_ids)
         self.twist_streams = tuple(f"vessel/{b}/cmd/twist" for b in boat_ids)
-        self._odometry = cdr.OdometryBatch(ros2_msgdefs.WORLD_FRAME, body_ids)
+        frame = ros2_msgdefs.WORLD_FRAME
+        self._odometry = cdr.OdometryBatch(frame, body_ids[:vessels])
+        self._tf = cdr.TfBatch(frame, body_ids)
 
     def states(self, batch: BodyStates) -> Block:
         """Raises ValueError for a batch of other bodies (rows would land in wrong files)."""
@@ -57,8 +65,9 @@ class BatchFormatter:
         table = np.concatenate(batch.arrays(), axis=1)  # VesselState's columns, (N, 19)
         lines = tabular.block_lines(batch.stamp_ns, batch.tick, table)
         # position, orientation, linear and angular velocity: the Odometry fields
-        groups = self._odometry.encode_groups(batch.stamp_ns, table[:, :13])
-        return Block(VesselState, batch.stamp_ns, self.state_streams, lines, groups=groups)
+        groups = self._odometry.encode_groups(batch.stamp_ns, table[: self.vessels, :13])
+        tf = self._tf.encode(batch.stamp_ns, batch.position, batch.orientation)
+        return Block(VesselState, batch.stamp_ns, self.state_streams, lines, groups=groups, tf=tf)
 
     def twists(self, batch: TwistBatch) -> Block:
         """Raises ValueError for a batch of other boats or of the wrong shape."""

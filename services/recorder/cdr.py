@@ -249,3 +249,42 @@ def _bytes(values: np.ndarray) -> np.ndarray:
     """Rows of little-endian float64 as rows of bytes."""
     rows = np.ascontiguousarray(values, dtype="<f8")
     return rows.view(np.uint8).reshape(len(rows), -1)
+
+
+class TfBatch:
+    """`tf2_msgs/msg/TFMessage` of many bodies (map -> body), filled array-wide: the frame
+    ids never change, so the message is a template whose stamps and poses sit at offsets
+    found once."""
+
+    def __init__(self, frame_id: str, child_frame_ids: typing.Sequence[str]) -> None:
+        layout, args = _Layout(), [ENCAPSULATION, len(child_frame_ids)]
+        layout.add("I", 4)  # sequence length
+        stamps, poses = [], []
+        for child in child_frame_ids:
+            layout.align(4)
+            stamps.append(layout.offset)
+            frame = _header(layout, frame_id)
+            name = layout.string(child)
+            layout.align(_FLOAT64)
+            poses.append(layout.offset)
+            for _ in range(7):  # translation xyz, rotation xyzw
+                layout.add("d", _FLOAT64)
+            args += [0, 0, *frame, *name, *([0.0] * 7)]
+        head = len(ENCAPSULATION)
+        self.size = len(child_frame_ids)
+        self._template = np.frombuffer(layout.compile().pack(*args), np.uint8)
+        self._stamp_at = (np.array(stamps, np.intp)[:, None] + head + np.arange(8)).ravel()
+        self._pose_at = (np.array(poses, np.intp)[:, None] + head + np.arange(56)).ravel()
+
+    def encode(self, stamp_ns: int, position: np.ndarray, orientation: np.ndarray) -> bytes:
+        """position (N, 3) and orientation (N, 4, x y z w) of the bodies, in `map`."""
+        if position.shape != (self.size, 3) or orientation.shape != (self.size, 4):
+            raise ValueError(
+                f"tf of {position.shape} positions and {orientation.shape} orientations "
+                f"for {self.size} bodies"
+            )
+        data = self._template.copy()
+        stamp = np.frombuffer(_STAMP.pack(*_stamp(stamp_ns)), np.uint8)
+        data[self._stamp_at] = np.tile(stamp, self.size)
+        data[self._pose_at] = _bytes(np.concatenate((position, orientation), axis=1)).ravel()
+        return data.tobytes()

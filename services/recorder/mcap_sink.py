@@ -101,6 +101,7 @@ class McapSink:
         self._schemas: dict[type[Message], int] = {}
         self._channels: dict[str, _Channel] = {}
         self._groups: dict[tuple[str, ...], tuple[list[_Channel], Any]] = {}
+        self._ros2_schemas: dict[str, int] = {}
         self._closed = False
 
     def write(self, stream: str, msg: Message, *, stamp_ns: int) -> None:
@@ -148,6 +149,28 @@ class McapSink:
         self._writer.add_block(ids, seqs, stamp_ns, payloads)
         for chan in chans:
             chan.sequence += 1
+
+    def write_ros2(
+        self, stream: str, type_name: str, msgdef: str, data: bytes, *, stamp_ns: int
+    ) -> None:
+        """A message already in CDR, of a ROS 2 type no bus message maps to (`/tf`)."""
+        if self._closed:
+            raise RecorderError(f"{stream}: the MCAP sink is closed")
+        chan = self._channels.get(stream)
+        if chan is None:
+            if type_name not in self._ros2_schemas:
+                self._ros2_schemas[type_name] = self._writer.register_schema(
+                    type_name, SchemaEncoding.ROS2, msgdef.encode()
+                )
+            topic = "/" + stream.strip("/")
+            cid = self._writer.register_channel(
+                topic, MessageEncoding.CDR, self._ros2_schemas[type_name]
+            )
+            chan = self._channels[stream] = _Channel(cid, Message, _json_encoder)
+        elif chan.cls is not Message:
+            raise RecorderError(f"{stream}: a {type_name} on a channel of {chan.cls.__name__}")
+        self._writer.add_messages([chan.id], [chan.sequence], stamp_ns, [data])
+        chan.sequence += 1
 
     def _channel(self, stream: str, cls: type[Message]) -> _Channel:
         if self._closed:

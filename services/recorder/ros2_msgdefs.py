@@ -84,6 +84,29 @@ HEADER_DEPENDENCIES = {k: _DEPENDENCIES[k] for k in ("std_msgs/Header", "builtin
 """What every stamped message (Image, PointCloud2) depends on."""
 """`nav_msgs/msg/Odometry` with its dependencies, in the format `mcap_ros2` parses."""
 
+TF_MESSAGE = "tf2_msgs/msg/TFMessage"
+_TF_TEXT = """\
+geometry_msgs/TransformStamped[] transforms
+"""
+TF_MSGDEF = concatenated(
+    _TF_TEXT,
+    {
+        "geometry_msgs/TransformStamped": """\
+std_msgs/Header header
+string child_frame_id
+Transform transform
+""",
+        **HEADER_DEPENDENCIES,
+        "geometry_msgs/Transform": """\
+Vector3 translation
+Quaternion rotation
+""",
+        "geometry_msgs/Vector3": _DEPENDENCIES["geometry_msgs/Vector3"],
+        "geometry_msgs/Quaternion": _DEPENDENCIES["geometry_msgs/Quaternion"],
+    },
+)
+"""`tf2_msgs/msg/TFMessage`: every body's frame in `map`, one message a tick on `/tf`."""
+
 _ZERO_COVARIANCE = [0.0] * 36  # unknown covariance; the simulator has the exact state
 
 

@@ -28,6 +28,7 @@ from services.recorder.csv_sink import CsvSink, RecorderError
 from services.recorder.dataset import Dataset
 from services.recorder.mcap_sink import McapSink
 from services.recorder.metrics import Metrics
+from services.recorder.ros2_msgdefs import TF_MESSAGE, TF_MSGDEF
 
 log = logging.getLogger("recorder")
 FLUSH_EVERY_S = 0.1
@@ -42,7 +43,11 @@ class Recorder:
         self.mcap = McapSink(ctx.run_dir / "run.mcap") if rec.mcap else None
         self.dataset = Dataset(ctx.run_dir / "dataset", ctx.scenario)
         streams = world_streams(ctx.scenario, ctx.keys) + command_streams(ctx.scenario, ctx.keys)
-        self.batches = BatchFormatter(body_ids(ctx.scenario), traffic_boat_ids(ctx.scenario))
+        self.batches = BatchFormatter(
+            body_ids(ctx.scenario),
+            traffic_boat_ids(ctx.scenario),
+            vessels=len(all_vessels(ctx.scenario)),
+        )
         self.metrics = Metrics([v.id for v in all_vessels(ctx.scenario)])
         self.run_dir = ctx.run_dir
         self._flushed_at = 0.0
@@ -80,6 +85,8 @@ class Recorder:
 
     def _write_payloads(self, block: Block) -> None:
         assert self.mcap is not None
+        if block.tf is not None:
+            self.mcap.write_ros2("tf", TF_MESSAGE, TF_MSGDEF, block.tf, stamp_ns=block.stamp_ns)
         for rows, matrix in block.groups:
             streams = [block.streams[i] for i in rows.tolist()]
             self.mcap.write_matrix(streams, block.cls, matrix, stamp_ns=block.stamp_ns)

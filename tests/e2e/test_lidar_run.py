@@ -17,7 +17,8 @@ def test_lidar_in_rain_is_recorded_as_point_clouds(tmp_path: Path, out: Path) ->
     result = catabot("run", str(scenario_file(tmp_path, data)), "--out", str(out), "--quiet")
     assert result.returncode == 0, result.stderr
     run = only_run_dir(out)
-    clouds = [m for m in read_mcap_messages(run / "run.mcap") if m.topic == "/sensor/ego/lidar"]
+    messages = read_mcap_messages(run / "run.mcap")
+    clouds = [m for m in messages if m.topic == "/sensor/ego/lidar"]
     assert len(clouds) == 10
     assert {m.schema_name for m in clouds} == {"sensor_msgs/msg/PointCloud2"}
     cloud = clouds[0].decoded
@@ -31,3 +32,8 @@ def test_lidar_in_rain_is_recorded_as_point_clouds(tmp_path: Path, out: Path) ->
     assert len(rows) == 11 and all(int(r[2]) > 1000 for r in rows[1:])
     assert sum(int(r[3]) for r in rows[1:]) > 0  # 25 mm/h: some returns are raindrops
     assert (run / "vessel.b1.state.csv").is_file()  # buoys are published and recorded
+    tf = [m for m in messages if m.topic == "/tf"]
+    assert len(tf) == len(rows[1:]) * 10 and tf[0].schema_name == "tf2_msgs/msg/TFMessage"
+    frames = [t.child_frame_id for t in tf[-1].decoded.transforms]
+    assert "ego" in frames and "b1" in frames  # every body's frame; buoys only there
+    assert "/vessel/b1/state" not in {m.topic for m in messages}

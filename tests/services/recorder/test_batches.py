@@ -37,7 +37,7 @@ def _csv_by_message(tmp: Path, stream: str, msgs: list[VesselState] | list[Twist
 
 
 def test_states_block_equals_the_per_message_rows(tmp_path: Path) -> None:
-    fmt = BatchFormatter(IDS, BOATS)
+    fmt = BatchFormatter(IDS, BOATS, vessels=2)
     batches = [_states(k) for k in range(3)]
     with CsvSink(tmp_path / "block") as sink:
         for batch in batches:
@@ -48,7 +48,12 @@ def test_states_block_equals_the_per_message_rows(tmp_path: Path) -> None:
         expected = _csv_by_message(tmp_path / vid, f"vessel/{vid}/state", rows)
         assert (tmp_path / "block" / f"vessel.{vid}.state.csv").read_text() == expected
         odometry = cdr.odometry_encoder(ros2_msgdefs.WORLD_FRAME, vid)
-        assert _payloads(fmt.states(batches[2]))[i] == odometry(rows[2], batches[2].stamp_ns)
+        payload = _payloads(fmt.states(batches[2])).get(i)
+        assert payload == (odometry(rows[2], batches[2].stamp_ns) if i < 2 else None)  # buoy: /tf
+    tf = cdr.TfBatch("map", IDS).encode(
+        batches[2].stamp_ns, batches[2].position, batches[2].orientation
+    )
+    assert fmt.states(batches[2]).tf == tf
 
 
 def _payloads(block: Block) -> dict[int, bytes]:
@@ -59,7 +64,7 @@ def _payloads(block: Block) -> dict[int, bytes]:
 
 
 def test_twist_block_equals_the_per_message_csv_and_json(tmp_path: Path) -> None:
-    fmt = BatchFormatter(IDS, BOATS)
+    fmt = BatchFormatter(IDS, BOATS, vessels=2)
     block = fmt.twists(_twists(4))
     msg = TwistCmd(1.5, -0.1, 4, 40_000_000)
     assert block.streams == ("vessel/boat_000/cmd/twist",)
@@ -71,13 +76,13 @@ def test_twist_block_equals_the_per_message_csv_and_json(tmp_path: Path) -> None
 
 
 def test_non_finite_set_point_has_a_csv_row_but_no_json() -> None:
-    block = BatchFormatter(IDS, BOATS).twists(_twists(1, surge=float("nan")))
+    block = BatchFormatter(IDS, BOATS, vessels=2).twists(_twists(1, surge=float("nan")))
     assert block.payloads == [None]
     assert block.lines[0].split(",")[2] == "nan"
 
 
 def test_batches_of_other_vessels_are_refused() -> None:
-    fmt = BatchFormatter(IDS, BOATS)
+    fmt = BatchFormatter(IDS, BOATS, vessels=2)
     moved = _states(0)
     other = BodyStates(0, 0, ("a", "b", "c"), *moved.arrays())
     with pytest.raises(ValueError, match="expected"):
@@ -96,7 +101,7 @@ def test_block_on_a_stream_of_another_type_is_refused(tmp_path: Path) -> None:
 
 
 def test_mcap_blocks_read_back_as_odometry_and_refuse_another_type(tmp_path: Path) -> None:
-    fmt = BatchFormatter(IDS, BOATS)
+    fmt = BatchFormatter(IDS, BOATS, vessels=2)
     with McapSink(tmp_path / "run.mcap") as sink:
         for tick in range(2):
             block = fmt.states(_states(tick))
@@ -105,8 +110,10 @@ def test_mcap_blocks_read_back_as_odometry_and_refuse_another_type(tmp_path: Pat
                 sink.write_matrix(streams, VesselState, matrix, stamp_ns=block.stamp_ns)
         with pytest.raises(RecorderError, match="TwistCmd sample on a channel of VesselState"):
             sink.write_matrix(streams, TwistCmd, matrix, stamp_ns=0)
+        with pytest.raises(RecorderError, match="a tf2_msgs/msg/TFMessage on a channel of"):
+            sink.write_ros2(streams[0], "tf2_msgs/msg/TFMessage", "", b"", stamp_ns=0)
     msgs = read_mcap_messages(tmp_path / "run.mcap")
-    assert len(msgs) == 2 * len(IDS)
+    assert len(msgs) == 2 * 2  # two vessels (the buoy has no Odometry channel)
     ego = [m for m in msgs if m.topic == "/vessel/ego/state"]
     assert [m.sequence for m in ego] == [0, 1]
     assert ego[1].decoded.pose.pose.position.x == _states(1).position[0, 0]

@@ -161,3 +161,30 @@ def test_odometry_batch_equals_one_message_at_a_time() -> None:
 def test_odometry_batch_refuses_a_wrong_shape() -> None:
     with pytest.raises(ValueError, match=r"shape \(2, 12\), not \(2, 13\)"):
         cdr.OdometryBatch("map", ("a", "b")).encode(0, np.zeros((2, 12)))
+
+
+def test_tf_batch_decodes_as_tf2_msgs_with_every_frame() -> None:
+    from mcap.records import Schema
+    from mcap_ros2.decoder import DecoderFactory
+
+    children = ("ego", "boat_000", "b")  # ids of three lengths: alignment differs per body
+    rng = np.random.default_rng(5)
+    pos, quat = rng.normal(size=(3, 3)), rng.normal(size=(3, 4))
+    data = cdr.TfBatch("map", children).encode(2_500_000_001, pos, quat)
+    schema = Schema(
+        id=1, name=ros2_msgdefs.TF_MESSAGE, encoding="ros2msg", data=ros2_msgdefs.TF_MSGDEF.encode()
+    )
+    decoded = DecoderFactory().decoder_for("cdr", schema)(data)  # type: ignore[misc]
+    assert [t.child_frame_id for t in decoded.transforms] == list(children)
+    for i, t in enumerate(decoded.transforms):
+        assert (t.header.frame_id, t.header.stamp.sec, t.header.stamp.nanosec) == (
+            "map",
+            2,
+            500_000_001,
+        )
+        got = t.transform.translation
+        assert (got.x, got.y, got.z) == tuple(pos[i])
+        r = t.transform.rotation
+        assert (r.x, r.y, r.z, r.w) == tuple(quat[i])
+    with pytest.raises(ValueError, match="for 3 bodies"):
+        cdr.TfBatch("map", children).encode(0, pos[:2], quat)
