@@ -29,6 +29,7 @@ from catabot.messages import ImuSample, Message, VesselState
 from services.sensors.common import (
     Array,
     SensorError,
+    cross3,
     finite_vector,
     non_negative,
     rotation_from_quaternion,
@@ -102,7 +103,7 @@ class ImuModel:
         alpha = finite_vector(state.angular_acceleration, "angular_acceleration (rad/s^2)")
         acc = finite_vector(state.linear_acceleration, "linear_acceleration (m/s^2)")
         r = self.lever_arm
-        acc_sensor = acc + np.cross(alpha, r) + np.cross(w, np.cross(w, r))
+        acc_sensor = acc + cross3(alpha, r) + cross3(w, cross3(w, r))
         return w, acc_sensor + self.gravity * (rot.T @ UP)  # f = a - g, g = -gravity * up
 
     def sample(
