@@ -39,6 +39,7 @@ from services.sensors.common import (
     rows_of,
 )
 from services.sensors.cull import cone_pairs, sphere_pairs
+from services.sensors.terrain_cast import TerrainCaster
 from services.sensors.water import calm_hits, wave_hits
 
 if TYPE_CHECKING:
@@ -102,7 +103,7 @@ class Scene:
         rain_rate_mm_h: float = 0.0,
     ) -> None:
         self.rain_rate_mm_h = float(rain_rate_mm_h)  # the rain in force (LiDAR's rain model)
-        self._terrain = terrain.raycasting_scene() if terrain is not None else None
+        self._terrain = TerrainCaster(terrain)
         self._waves = waves
         self._amplitude = float(np.sum(waves.amplitudes_m))
         self.bodies = list(bodies)
@@ -122,7 +123,6 @@ class Scene:
         self._pos = np.full((n, 3), np.nan)  # unposed bodies are not in the scene
         self._rot = np.tile(np.eye(3), (n, 1, 1))
         self.time_s = 0.0
-        self._buffers: dict[int, F32] = {}
         self._posed: tuple[F64, F64] | None = None  # (centres, corners) of the poses now
 
     def update(
@@ -218,43 +218,12 @@ class Scene:
         caller knows which rays can meet which body (a camera projects each box into its
         image); it must hold every pair that can hit."""
         o, d = _rays(origins, directions)
-        rng, normal, cls = self._cast_terrain(o, d, max_range)
+        rng, normal, hit = self._terrain.cast(o, d, max_range)
+        cls = np.where(hit, np.uint8(CLASS_TERRAIN), np.uint8(CLASS_NONE))
         inst = np.zeros(d.shape[0], dtype=np.int32)
         self._cast_bodies(o, d, max_range, rng, normal, cls, inst, pairs)
         self._cast_water(o, d, max_range, rng, normal, cls, inst)
         return Hits(rng.astype(np.float32), normal, cls, inst)
-
-    def _cast_terrain(self, o: F64, d: F64, max_range: float) -> tuple[F64, F32, NDArray[np.uint8]]:
-        """Range (inf: none within max_range), float32 normal (zero: none) and class of the
-        terrain hit of each ray: Embree's own float32 outputs, copied as little as possible."""
-        n = d.shape[0]
-        if self._terrain is None:
-            return np.full(n, np.inf), np.zeros((n, 3), np.float32), np.zeros(n, np.uint8)
-        import open3d as o3d
-
-        rays = self._ray_buffer(n)
-        rays[:, :3] = o
-        rays[:, 3:] = d  # rounded to float32 as astype would
-        out = self._terrain.cast_rays(o3d.core.Tensor.from_numpy(rays))
-        t32 = out["t_hit"].numpy()
-        normal: F32 = out["primitive_normals"].numpy()  # Embree gives zero on a miss
-        far = t32 > max_range  # misses (inf) too
-        rng = t32.astype(np.float64)
-        beyond = np.flatnonzero(far & (t32 < np.inf))  # hits past max_range: none of it
-        rng[beyond], normal[beyond] = np.inf, 0.0
-        cls = np.where(far, np.uint8(CLASS_NONE), np.uint8(CLASS_TERRAIN))
-        return rng, normal, cls
-
-    def _ray_buffer(self, n: int) -> F32:
-        """The (n, 6) float32 rays handed to Embree, reused across casts of the same size
-        (a fresh 7 MB array per camera frame costs ~1 ms of page faults). One cast at a
-        time: a Scene is not shared between threads."""
-        buf = self._buffers.get(n)
-        if buf is None:
-            buf = self._buffers[n] = np.empty((n, 6), dtype=np.float32)
-            if len(self._buffers) > 8:  # sizes vary (radar sectors): keep a few
-                self._buffers.pop(next(iter(self._buffers)))
-        return buf
 
     def _cast_water(
         self,
