@@ -60,21 +60,21 @@ class Recorder:
             stream = self.keys.relative(key)
             for msg in inputs[key]:
                 if isinstance(msg, BodyStates):
-                    self.metrics.add(msg)
-                    self._write_block(stream, msg, self.batches.states)
+                    if self._write_block(stream, msg, self.batches.states):
+                        self.metrics.add(msg)  # only batches of this run's bodies
                 elif isinstance(msg, TwistBatch):
                     self._write_block(stream, msg, self.batches.twists)
                 else:
                     self._write(stream, _stamped(msg, tick))
         self._flush()
 
-    def _write_block(self, stream: str, msg: Any, formatter: Callable[[Any], Block]) -> None:
-        """A batch as the per-vessel rows it stands for (`batches.py`)."""
+    def _write_block(self, stream: str, msg: Any, formatter: Callable[[Any], Block]) -> bool:
+        """A batch as the per-vessel rows it stands for (`batches.py`); False if refused."""
         try:
             block = formatter(msg)
         except ValueError as exc:
             log.error("not recorded: %s: %s", stream, exc)
-            return
+            return False
         try:
             if self.csv is not None:
                 self.csv.write_lines(block.streams, block.cls, block.lines)
@@ -82,6 +82,7 @@ class Recorder:
                 self._write_payloads(block)
         except (RecorderError, OSError) as exc:
             log.error("not recorded: %s", exc)
+        return True
 
     def _write_payloads(self, block: Block) -> None:
         assert self.mcap is not None
