@@ -79,6 +79,16 @@ class Hits:
     instance: NDArray[np.int32]  # (N,)
 
 
+@dataclass(frozen=True)
+class _Nearest:
+    """The nearest hit so far of each ray, updated in place by each kind of surface."""
+
+    rng: F64
+    normal: F32
+    cls: NDArray[np.uint8]
+    inst: NDArray[np.int32]
+
+
 @dataclass
 class Cones:
     """Per body in range (`body`: index in Scene.bodies): the vector from the origin to its
@@ -220,22 +230,14 @@ class Scene:
         o, d = _rays(origins, directions)
         rng, normal, hit = self._terrain.cast(o, d, max_range)
         cls = np.where(hit, np.uint8(CLASS_TERRAIN), np.uint8(CLASS_NONE))
-        inst = np.zeros(d.shape[0], dtype=np.int32)
-        self._cast_bodies(o, d, max_range, rng, normal, cls, inst, pairs)
-        self._cast_water(o, d, max_range, rng, normal, cls, inst)
-        return Hits(rng.astype(np.float32), normal, cls, inst)
+        near = _Nearest(rng, normal, cls, np.zeros(d.shape[0], dtype=np.int32))
+        self._cast_bodies(o, d, max_range, near, pairs)
+        self._cast_water(o, d, max_range, near)
+        return Hits(near.rng.astype(np.float32), near.normal, near.cls, near.inst)
 
-    def _cast_water(
-        self,
-        o: F64,
-        d: F64,
-        max_range: float,
-        rng: F64,
-        normal: F32,
-        cls: NDArray[np.uint8],
-        inst: NDArray[np.int32],
-    ) -> None:
+    def _cast_water(self, o: F64, d: F64, max_range: float, near: _Nearest) -> None:
         """Rays that meet the water before anything else get the water's hit."""
+        rng, normal, cls, inst = near.rng, near.normal, near.cls, near.inst
         if self._waves.is_calm or self._amplitude <= 0.0:
             t = calm_hits(o, d, max_range)
             closer = t < rng
@@ -256,12 +258,10 @@ class Scene:
         o: F64,
         d: F64,
         max_range: float,
-        rng: F64,
-        normal: F32,
-        cls: NDArray[np.uint8],
-        inst: NDArray[np.int32],
+        near: _Nearest,
         pairs: tuple[NDArray[np.intp], NDArray[np.intp]] | None = None,
     ) -> None:
+        rng, normal, cls, inst = near.rng, near.normal, near.cls, near.inst
         ray_i, body_i = self._candidates(o, d, max_range) if pairs is None else pairs
         if ray_i.size == 0:
             return
