@@ -57,6 +57,7 @@ class CsvSink:
         self._dir = Path(directory)
         self._dir.mkdir(parents=True, exist_ok=True)
         self._files: dict[str, _CsvFile] = {}
+        self._groups: dict[tuple[tuple[str, ...], type[Message]], list[_CsvFile]] = {}
         self._closed = False
 
     def path(self, stream: str) -> Path:
@@ -89,14 +90,22 @@ class CsvSink:
         batch path, which formats every row of a tick at once (`services/recorder/batches`)."""
         if self._closed:
             raise RecorderError(f"{streams[0] if streams else '?'}: the CSV sink is closed")
-        for stream, line in zip(streams, lines, strict=True):
-            out = self._files.get(stream) or self._open_for(stream, cls, tabular.columns(cls))
-            if out.cls is not cls:
-                raise RecorderError(
-                    f"{stream}: a {cls.__name__} sample on a stream of {out.cls.__name__}; "
-                    "not written"
-                )
+        group = (tuple(streams), cls)
+        files = self._groups.get(group)
+        if files is None:  # the same streams every tick: open and check them once
+            files = self._groups[group] = [self._file_for(stream, cls) for stream in streams]
+        if len(files) != len(lines):
+            raise RecorderError(f"{len(lines)} lines for {len(files)} streams; not written")
+        for out, line in zip(files, lines, strict=True):
             out.pending.append(line)
+
+    def _file_for(self, stream: str, cls: type[Message]) -> _CsvFile:
+        out = self._files.get(stream) or self._open_for(stream, cls, tabular.columns(cls))
+        if out.cls is not cls:
+            raise RecorderError(
+                f"{stream}: a {cls.__name__} sample on a stream of {out.cls.__name__}; not written"
+            )
+        return out
 
     def _open(self, stream: str, msg: Message) -> _CsvFile:
         return self._open_for(stream, type(msg), tabular.sample_columns(msg))

@@ -98,6 +98,8 @@ def test_block_on_a_stream_of_another_type_is_refused(tmp_path: Path) -> None:
         sink.write("vessel/ego/state", _states(0).row(0))
         with pytest.raises(RecorderError, match="TwistCmd sample on a stream of VesselState"):
             sink.write_lines(["vessel/ego/state"], TwistCmd, ["1,0,1.0,2.0\n"])
+        with pytest.raises(RecorderError, match="2 lines for 1 streams"):
+            sink.write_lines(["vessel/ego/state"], VesselState, ["a\n", "b\n"])
 
 
 def test_mcap_blocks_read_back_as_odometry_and_refuse_another_type(tmp_path: Path) -> None:
