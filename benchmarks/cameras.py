@@ -18,24 +18,20 @@ import os
 import statistics
 import time
 from collections.abc import Callable
-from pathlib import Path
 
 import numpy as np
 
+from benchmarks.sensors import TERRAIN
 from catabot.blas import single_thread_blas
 from catabot.messages import VesselState
 from catabot.sensor_types import CameraParams, RadarParams
-from catabot.terrain import TerrainConfig, load_terrain
+from catabot.terrain import load_terrain
 from catabot.waves import WaveConfig, WaveField
 from services.sensors.camera import CameraModel
 from services.sensors.camera_boxes import candidate_rays
 from services.sensors.radar import RadarModel
 from services.sensors.scene import CLASS_VESSEL, Body, Scene
 
-BAY = Path(__file__).resolve().parents[1] / "catabot" / "data" / "terrain" / "bay.png"
-TERRAIN = TerrainConfig(
-    elevation_image=str(BAY), min_elevation_m=-15.0, max_elevation_m=25.0, metres_per_pixel=2.0
-)
 BOATS = 20
 REPEATS = 15
 EGO = (290.0, 300.0)

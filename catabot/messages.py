@@ -84,6 +84,16 @@ class VesselState(Message):
     angular_acceleration: tuple[float, ...] = vec("rad/s^2", XYZ)
 
 
+def check_ids(what: str, tick: int, ids: tuple[str, ...], expected: tuple[str, ...]) -> None:
+    """Refuse a batch whose rows are not `expected`, in order: a consumer that mapped rows
+    to bodies once would otherwise silently write one body's data under another's name."""
+    if ids != expected:
+        raise ValueError(
+            f"{what} at tick {tick} lists {list(ids)[:8]}..., "
+            f"expected {list(expected)[:8]}... ({len(expected)} rows)"
+        )
+
+
 @dataclass(frozen=True)
 class BodyStates(Message):
     """Every body's state at one instant in one message: row i of each array is `ids[i]`.
@@ -171,12 +181,8 @@ class TwistBatch(Message):
 
     def check(self, expected: tuple[str, ...]) -> None:
         """Refuse a batch for other vessels or with arrays of the wrong shape."""
+        check_ids("twist batch", self.tick, self.ids, expected)
         n = len(expected)
-        if self.ids != expected:
-            raise ValueError(
-                f"twist batch at tick {self.tick} lists vessels {list(self.ids)[:8]}..., "
-                f"expected {list(expected)[:8]}... ({n} vessels)"
-            )
         for name in ("surge", "yaw_rate"):
             value = getattr(self, name)
             if not isinstance(value, np.ndarray) or value.shape != (n,):

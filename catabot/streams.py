@@ -15,6 +15,7 @@ from catabot.messages import (
     TwistCmd,
     VesselState,
     WaypointsCmd,
+    check_ids,
 )
 from catabot.scenario import Scenario
 from catabot.sensor_types import SENSOR_TYPES
@@ -38,11 +39,7 @@ class BodyRows:
 
     def check(self, batch: BodyStates) -> dict[str, int]:
         """The id -> row map; raises ValueError when the batch's ids are not the table's."""
-        if batch.ids != self.expected:
-            raise ValueError(
-                f"world/states at tick {batch.tick} lists bodies {list(batch.ids)[:8]}..., "
-                f"expected {list(self.expected)[:8]}... ({len(self.expected)} bodies)"
-            )
+        check_ids("world/states", batch.tick, batch.ids, self.expected)
         if self.row is None:
             self.row = {vid: i for i, vid in enumerate(batch.ids)}
         return self.row

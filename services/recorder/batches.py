@@ -17,7 +17,14 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from catabot import tabular
-from catabot.messages import BodyStates, Message, TwistBatch, TwistCmd, VesselState
+from catabot.messages import (
+    BodyStates,
+    Message,
+    TwistBatch,
+    TwistCmd,
+    VesselState,
+    check_ids,
+)
 from services.recorder import cdr, ros2_msgdefs
 
 # json_schemas.encode of a TwistCmd, field by field: {"surge":..,"yaw_rate":..,"tick":..,..}
@@ -57,11 +64,7 @@ class BatchFormatter:
 
     def states(self, batch: BodyStates) -> Block:
         """Raises ValueError for a batch of other bodies (rows would land in wrong files)."""
-        if batch.ids != self.body_ids:
-            raise ValueError(
-                f"world/states at tick {batch.tick} lists bodies {list(batch.ids)[:8]}..., "
-                f"expected {list(self.body_ids)[:8]}..."
-            )
+        check_ids("world/states", batch.tick, batch.ids, self.body_ids)
         table = np.concatenate(batch.arrays(), axis=1)  # VesselState's columns, (N, 19)
         lines = tabular.block_lines(batch.stamp_ns, batch.tick, table)
         # position, orientation, linear and angular velocity: the Odometry fields

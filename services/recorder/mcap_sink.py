@@ -98,10 +98,9 @@ class McapSink:
             typing.cast(BinaryIO, self._out), profile="", library=f"catabot {LIBRARY_IDENTIFIER}"
         )
         self._out.flush()
-        self._schemas: dict[type[Message], int] = {}
+        self._schemas: dict[type[Message] | str, int] = {}  # by message class or ROS 2 type
         self._channels: dict[str, _Channel] = {}
-        self._groups: dict[tuple[str, ...], tuple[list[_Channel], Any]] = {}
-        self._ros2_schemas: dict[str, int] = {}
+        self._groups: dict[tuple[tuple[str, ...], type[Message]], tuple[list[_Channel], Any]] = {}
         self._closed = False
 
     def write(self, stream: str, msg: Message, *, stamp_ns: int) -> None:
@@ -136,15 +135,15 @@ class McapSink:
     ) -> None:
         """`payloads` (k, L) bytes, row i on `streams[i]`: equal-length payloads (Odometry
         of bodies with equally long ids) go into the file as one block."""
-        group = tuple(streams)
-        if not group:
+        if not streams:
             return
+        if self._closed:
+            raise RecorderError(f"{streams[0]}: the MCAP sink is closed")
+        group = (tuple(streams), cls)
         if group not in self._groups:  # the same streams every tick: look them up once
             chans = [self._channel(stream, cls) for stream in streams]
             self._groups[group] = (chans, np.array([c.id for c in chans], np.uint16))
         chans, ids = self._groups[group]
-        if self._closed or chans[0].cls is not cls:
-            self._channel(streams[0], cls)  # raises the precise error
         seqs = np.fromiter((c.sequence for c in chans), np.uint32, len(chans))
         self._writer.add_block(ids, seqs, stamp_ns, payloads)
         for chan in chans:
@@ -158,16 +157,15 @@ class McapSink:
             raise RecorderError(f"{stream}: the MCAP sink is closed")
         chan = self._channels.get(stream)
         if chan is None:
-            if type_name not in self._ros2_schemas:
-                self._ros2_schemas[type_name] = self._writer.register_schema(
-                    type_name, SchemaEncoding.ROS2, msgdef.encode()
-                )
+            if type_name not in self._schemas:
+                sid = self._writer.register_schema(type_name, SchemaEncoding.ROS2, msgdef.encode())
+                self._schemas[type_name] = sid
             topic = "/" + stream.strip("/")
             cid = self._writer.register_channel(
-                topic, MessageEncoding.CDR, self._ros2_schemas[type_name]
+                topic, MessageEncoding.CDR, self._schemas[type_name]
             )
-            chan = self._channels[stream] = _Channel(cid, Message, _json_encoder)
-        elif chan.cls is not Message:
+            chan = self._channels[stream] = _Channel(cid, _Encoded, _already_encoded)
+        elif chan.cls is not _Encoded:
             raise RecorderError(f"{stream}: a {type_name} on a channel of {chan.cls.__name__}")
         self._writer.add_messages([chan.id], [chan.sequence], stamp_ns, [data])
         chan.sequence += 1
@@ -252,6 +250,14 @@ def _odometry_encoder(vessel: str) -> typing.Callable[[Message, int], bytes]:
         return odometry(msg, stamp_ns)
 
     return encode
+
+
+class _Encoded(Message):
+    """Marks a channel fed with bytes already in its encoding (`write_ros2`)."""
+
+
+def _already_encoded(msg: Message, stamp_ns: int) -> bytes:
+    raise RecorderError("this channel takes bytes already encoded (McapSink.write_ros2)")
 
 
 def _json_encoder(msg: Message, stamp_ns: int) -> bytes:

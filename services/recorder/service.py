@@ -12,7 +12,6 @@ import dataclasses
 import logging
 import sys
 import time
-import typing
 from collections.abc import Callable
 from typing import Any
 
@@ -93,12 +92,12 @@ class Recorder:
             self.mcap.write_matrix(streams, block.cls, matrix, stamp_ns=block.stamp_ns)
         if not block.payloads:
             return
-        ok = [i for i, p in enumerate(block.payloads) if p is not None]
-        if len(ok) < len(block.payloads):
-            bad = sorted(set(range(len(block.streams))) - set(ok))
-            log.error("not recorded in MCAP (non-finite): %s", [block.streams[i] for i in bad])
-        streams = [block.streams[i] for i in ok]
-        payloads = [typing.cast(bytes, block.payloads[i]) for i in ok]
+        pairs = list(zip(block.streams, block.payloads, strict=True))
+        bad = [stream for stream, payload in pairs if payload is None]
+        if bad:
+            log.error("not recorded in MCAP (non-finite): %s", bad)
+        good = [(stream, payload) for stream, payload in pairs if payload is not None]
+        streams, payloads = [s for s, _ in good], [p for _, p in good]
         self.mcap.write_block(streams, block.cls, payloads, stamp_ns=block.stamp_ns)
 
     def _write(self, stream: str, msg: Message) -> None:
