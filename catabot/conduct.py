@@ -34,6 +34,7 @@ def clock_spec(scenario: Scenario) -> ClockSpec:
         start_timeout_s=c.start_timeout_s,
         policy=Policy(c.policy),
         realtime_factor=c.realtime_factor,
+        window_ticks=c.window_ticks,
     )
 
 

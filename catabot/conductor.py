@@ -36,6 +36,13 @@ class ClockSpec:
     start_timeout_s: float = 60.0
     policy: Policy = Policy.ABORT
     realtime_factor: float | None = None
+    window_ticks: int = 1
+
+    @property
+    def ack_every(self) -> int:
+        """Participants ack every this many ticks (and at the end of a grant): half the
+        window, so the slowest one's ack extends the grant before the fastest runs dry."""
+        return max(1, self.window_ticks // 2)
 
 
 @dataclass
@@ -65,7 +72,10 @@ class Conductor:
         self.members: set[str] = set()
         self.dropped: list[str] = []
         self._stop_reason = ""
-        self._done = 0
+        self._done = 0  # ticks every active participant has acked
+        self._granted = -1  # the last tick granted
+        self._acked = {name: -1 for name in spec.participants}
+        self._t0 = self._created
         self._tick_pub = session.declare_publisher(keys.tick(), congestion_control=BLOCK)
         self._end_pub = session.declare_publisher(keys.end(), congestion_control=BLOCK)
         self._token = session.liveliness().declare_token(keys.live(CONDUCTOR))
@@ -135,88 +145,116 @@ class Conductor:
         missing = ", ".join(sorted(expected - self.members))
         return f"participant(s) never joined within {self.spec.start_timeout_s:g} s: {missing}"
 
-    def _tick_loop(self, on_progress: Callable[[Progress], None] | None, start: float) -> int:
-        last_report, k = start, 0
-        for k in range(self.spec.ticks):
-            if self._stop_reason:
-                return k
-            self._pace(k)
-            self._publish_tick(k)
-            self._await_acks(k)
-            self._done = k + 1
+    def _tick_loop(self, on_progress: Callable[[Progress], None] | None, start: float) -> None:
+        """Grant ticks while the window and the pace allow, take acks, report progress.
+
+        After a stop no more ticks are granted, but every granted tick completes, so every
+        participant ends on the same last tick.
+        """
+        last_report = self._t0 = start
+        self._deadline = None
+        while self._done < self.spec.ticks and not self._stop_reason:
+            self._grant(self._horizon())
+            self._await_progress()
             now = time.monotonic()
             if on_progress and now - last_report >= 0.25:
-                on_progress(self._progress(k, now - start))
+                on_progress(self._progress(self._done - 1, now - start))
                 last_report = now
+        while self._done <= self._granted:
+            self._await_progress()
         if on_progress:
-            on_progress(self._progress(self.spec.ticks - 1, time.monotonic() - start))
-        return self.spec.ticks
+            on_progress(self._progress(self._done - 1, time.monotonic() - start))
 
     def _progress(self, k: int, wall: float) -> Progress:
         sim_s = (k + 1) * self.spec.dt_ns / 1e9
         return Progress(k, (k + 1) * self.spec.dt_ns, (k + 1) / max(wall, 1e-9), sim_s / wall)
 
-    def _pace(self, k: int) -> None:
+    def _horizon(self) -> int:
+        """The last tick that may be stepped now: the window past the slowest participant,
+        the run's end, and (paced runs) the ticks whose wall-clock time has come."""
+        last = min(self._done - 1 + self.spec.window_ticks, self.spec.ticks - 1)
         factor = self.spec.realtime_factor
         if factor:
-            if not hasattr(self, "_t0"):
-                self._t0 = time.monotonic()
-            delay = self._t0 + k * self.spec.dt_ns / 1e9 / factor - time.monotonic()
-            if delay > 0:
-                time.sleep(delay)
+            due = (time.monotonic() - self._t0) * factor * 1e9 / self.spec.dt_ns
+            last = min(last, int(due))
+        return last
 
-    def _publish_tick(self, k: int) -> None:
-        tick = Tick(self.run_id, k, k * self.spec.dt_ns, self.spec.dt_ns, tuple(self.dropped))
+    def _pace_delay(self) -> float:
+        """Seconds until the next tick is due, when only the pace holds it back."""
+        factor = self.spec.realtime_factor
+        nxt = self._granted + 1
+        if not factor or nxt >= min(self._done + self.spec.window_ticks, self.spec.ticks):
+            return 0.0
+        return self._t0 + nxt * self.spec.dt_ns / 1e9 / factor - time.monotonic()
+
+    def _grant(self, last: int, *, again: bool = False) -> None:
+        """Publish a Tick granting every tick up to `last` (again: repeat it with a new
+        dropped list)."""
+        if last <= self._granted and not again:
+            return
+        if self._done > self._granted:  # work is outstanding from now on
+            self._deadline = time.monotonic() + self.spec.deadline_s
+        self._granted = max(last, self._granted)
+        k, dt = self._granted, self.spec.dt_ns
+        tick = Tick(self.run_id, k, k * dt, dt, tuple(self.dropped), self.spec.ack_every)
         self._tick_pub.put(codec.encode(tick))
 
-    def _await_acks(self, k: int) -> None:
-        """Wait until every participant acked tick `k` or was dropped.
+    def _await_progress(self) -> None:
+        """Take at least one ack or event, then every ack already queued; apply membership
+        and the deadline. A paced run polls instead (until the next tick is due, at most
+        2 ms), so that it grants each tick on time."""
+        if self.spec.realtime_factor:
+            time.sleep(min(max(self._pace_delay(), 0.0002), 0.002))
+        else:
+            self._take(self._acks.recv())  # some tick is outstanding: an ack or a poke comes
+        while (sample := self._acks.try_recv()) is not None:
+            self._take(sample)
+        self._check_events()
 
-        A stop asked meanwhile does not cut the tick short: the tick completes (so every
-        participant has the same last tick) and the loop stops at the next boundary.
-        """
-        waiting = set(self.spec.participants) - set(self.dropped)
-        self._check_events(k, waiting)
-        self._deadline = time.monotonic() + self.spec.deadline_s
+    def _take(self, sample: zenoh.Sample) -> None:
+        key = str(sample.key_expr)
+        if key == self._poke_key:
+            return
         try:
-            while waiting:
-                sample = self._acks.recv()
-                key = str(sample.key_expr)
-                if key != self._poke_key:
-                    self._take_ack(k, key, sample.payload.to_bytes(), waiting)
-                else:
-                    self._check_events(k, waiting)
-        finally:
-            self._deadline = None
-
-    def _check_events(self, k: int, waiting: set[str]) -> None:
-        """Apply pending membership events (a stop is noted in `_stop_reason`) and the deadline."""
-        while not self.events.empty():
-            self._next_event(0.0)
-        for name in sorted(waiting - self.members):
-            self._fault(name, f"left the run at tick {k}", waiting)
-        if self._deadline is not None and time.monotonic() > self._deadline:
-            for name in sorted(waiting):
-                self._fault(
-                    name, f"missed the {self.spec.deadline_s:g} s deadline of tick {k}", waiting
-                )
-
-    def _take_ack(self, k: int, key: str, payload: bytes, waiting: set[str]) -> None:
-        try:
-            ack = codec.decode(payload, Ack)
+            ack = codec.decode(sample.payload.to_bytes(), Ack)
         except codec.CodecError as exc:
             log.warning("malformed ack on %s: %s", key, exc)
             return
-        if ack.run == self.run_id and ack.tick == k:
-            waiting.discard(self.keys.participant_of(key))
+        name = self.keys.participant_of(key)
+        if ack.run == self.run_id and name in self._acked:
+            self._acked[name] = max(self._acked[name], min(ack.tick, self._granted))
+            self._advance()
 
-    def _fault(self, name: str, what: str, waiting: set[str]) -> None:
+    def _advance(self) -> None:
+        """Every active participant has acked up to `_done - 1`; restart the deadline on
+        progress."""
+        active = [t for name, t in self._acked.items() if name not in self.dropped]
+        done = min(active, default=self._granted) + 1
+        if done > self._done:
+            self._done = done
+            outstanding = done <= self._granted
+            self._deadline = time.monotonic() + self.spec.deadline_s if outstanding else None
+
+    def _check_events(self) -> None:
+        """Apply pending membership events (a stop is noted in `_stop_reason`) and the deadline."""
+        while not self.events.empty():
+            self._next_event(0.0)
+        active = [n for n in sorted(self._acked) if n not in self.dropped]
+        for name in [n for n in active if n not in self.members]:
+            self._fault(name, f"left the run at tick {self._acked[name] + 1}")
+        k = self._done
+        if self._deadline is not None and time.monotonic() > self._deadline:
+            for name in [n for n in active if self._acked[n] < k <= self._granted]:
+                self._fault(name, f"missed the {self.spec.deadline_s:g} s deadline of tick {k}")
+
+    def _fault(self, name: str, what: str) -> None:
         message = f"participant {name!r} {what}"
         if self.spec.policy is Policy.ABORT:
             raise ClockError(message)
         log.error("%s; dropping it and going on (policy drop)", message)
         self.dropped.append(name)
-        waiting.discard(name)
+        self._advance()
+        self._grant(self._horizon(), again=True)  # tell the others to stop waiting for it
 
     def _next_event(self, deadline: float) -> tuple[str, str, bytes]:
         """Wait for one event ("late" when the deadline passes); membership is tracked here."""

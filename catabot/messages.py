@@ -43,12 +43,17 @@ class Message:
 
 @dataclass(frozen=True)
 class Tick(Message):
+    """On `clock/tick`: every tick up to `tick` may be stepped (a grant; DESIGN.md §4), and
+    participants ack every `ack_every` ticks and at the grant's last tick. A service's step
+    receives one Tick per tick it steps."""
+
     TYPE: ClassVar[str] = "tick"
     run: str
     tick: int
     stamp_ns: int
     dt_ns: int
     dropped: tuple[str, ...] = ()
+    ack_every: int = 1
 
 
 @dataclass(frozen=True)

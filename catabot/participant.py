@@ -1,9 +1,11 @@
 """A stepping participant: joins the lockstep, waits for due inputs, steps, acks.
 
 Services write only a `step(tick, inputs)` function; this class owns the protocol of
-DESIGN.md §4: membership by a liveliness token, Jacobi input release (a sample tagged
-k is handed over at tick k+1, never earlier), waiting for due samples, malformed
-payloads logged with their key and dropped, and a clean end on `clock/end`.
+DESIGN.md §4: membership by a liveliness token, stepping every tick the conductor has
+granted as soon as its inputs are complete (so a fast participant runs ahead of a slow
+one, within the window), Jacobi input release (a sample tagged k is handed over at tick
+k+1, never earlier), acks every few ticks, malformed payloads logged with their key and
+dropped, and a clean end on `clock/end`.
 """
 
 from __future__ import annotations
@@ -39,17 +41,13 @@ class Participant:
         inputs: Sequence[Stream] = (),
         peers: Sequence[str] = (),
         drain_s: float = 5.0,
-        sink: bool = False,
     ) -> None:
-        """`sink`: the participant publishes nothing another participant waits for (the
-        recorder). It acks tick k as soon as its inputs for k are complete and steps after:
-        its step then overlaps the others' next tick instead of holding the clock, and it
-        still cannot fall more than one tick behind (it acks k+1 only after stepping k)."""
         self.session, self.keys, self.name = session, keys, name
         self.inbox = Inbox(inputs)
         self.peers = set(peers) - {name}
         self.drain_s = drain_s
-        self.sink = sink
+        self.next_tick = 0
+        self._grant: Tick | None = None
         self.events: queue.SimpleQueue[tuple[str, str, bytes]] = queue.SimpleQueue()
         self.present: set[str] = set()
         self.run_id = ""
@@ -109,28 +107,39 @@ class Participant:
     # -- the loop ------------------------------------------------------------------------
 
     def run(self, step: StepFn, on_end: EndFn | None = None) -> End:
-        """Step every tick until the conductor ends the run; returns the end message."""
-        pending: Tick | None = None
-        waiting_since = 0.0
+        """Step every granted tick until the conductor ends the run; returns the end message."""
+        since = time.monotonic()
         while True:
             kind, key, payload = self._next()
             if kind == "data":
                 self._take_data(key, payload)
             elif kind == "tick":
-                pending, waiting_since = self._take_tick(payload) or pending, time.monotonic()
+                self._take_tick(payload)
             elif kind == "end":
                 end = self._take_end(payload)
                 if end is not None:
                     return self._finish(end, on_end)
-            if pending is not None and self._ready(pending, waiting_since):
-                inputs = self.inbox.release(pending.tick)
-                ack = codec.encode(Ack(pending.run, pending.tick))
-                if self.sink:
-                    self._ack.put(ack)
-                step(pending, inputs)
-                if not self.sink:
-                    self._ack.put(ack)
-                pending = None
+            since = self._step_ready(step, since)
+
+    def _step_ready(self, step: StepFn, since: float) -> float:
+        """Step every granted tick whose inputs are complete, in order, acking every
+        `ack_every` ticks and at the grant's end; returns when waiting for the next began."""
+        grant = self._grant
+        while grant is not None and self.next_tick <= grant.tick:
+            k = self.next_tick
+            if not self._ready(k, since):
+                break
+            step(self._tick_of(grant, k), self.inbox.release(k))
+            self.next_tick = k + 1
+            if (k + 1) % grant.ack_every == 0 or k == grant.tick:
+                self._ack.put(codec.encode(Ack(grant.run, k)))
+            since = time.monotonic()
+        return since
+
+    @staticmethod
+    def _tick_of(grant: Tick, k: int) -> Tick:
+        stamp = grant.stamp_ns - (grant.tick - k) * grant.dt_ns
+        return Tick(grant.run, k, stamp, grant.dt_ns, grant.dropped, grant.ack_every)
 
     def _next(self) -> tuple[str, str, bytes]:
         """The next event; an End may trail the conductor's token, so allow it a grace."""
@@ -155,19 +164,20 @@ class Participant:
         except codec.CodecError as exc:
             log.warning("%s: dropped malformed payload on %s: %s", self.name, key, exc)
 
-    def _take_tick(self, payload: bytes) -> Tick | None:
+    def _take_tick(self, payload: bytes) -> None:
         try:
             tick = codec.decode(payload, Tick)
         except codec.CodecError as exc:
             log.warning("%s: malformed tick: %s", self.name, exc)
-            return None
+            return
         if not self.run_id:
             self.run_id = tick.run
         if tick.run != self.run_id:
-            return None
+            return
         self.inbox.drop_producers(tick.dropped)
         self.peers -= set(tick.dropped)  # a dropped peer that crashed will never be present
-        return tick
+        if self._grant is None or tick.tick >= self._grant.tick:
+            self._grant = tick  # grants only grow; a repeat carries a new dropped list
 
     def _take_end(self, payload: bytes) -> End | None:
         try:
@@ -177,17 +187,17 @@ class Participant:
             return None
         return end if not self.run_id or end.run == self.run_id else None
 
-    def _ready(self, tick: Tick, since: float) -> bool:
+    def _ready(self, tick: int, since: float) -> bool:
         """Peers seen (so they know our subscriptions) and every due input arrived."""
-        missing = self.inbox.missing(tick.tick)
+        missing = self.inbox.missing(tick)
         if not missing and self.peers <= self.present:
             return True
-        if time.monotonic() - since > 5.0 and self._warned_tick != tick.tick:
-            self._warned_tick = tick.tick
+        if time.monotonic() - since > 5.0 and self._warned_tick != tick:
+            self._warned_tick = tick
             log.warning(
                 "%s: tick %d still waits for %s (peers absent: %s)",
                 self.name,
-                tick.tick,
+                tick,
                 missing,
                 sorted(self.peers - self.present),
             )

@@ -47,6 +47,9 @@ class ClockConfig(_Model):
     start_timeout_s: float = Field(60.0, gt=0, description="time allowed for services to join")
     policy: Literal["abort", "drop"] = "abort"
     realtime_factor: float | None = Field(None, gt=0, description="1.0 = wall clock; null = AFAP")
+    window_ticks: int = Field(
+        10, ge=1, le=1000, description="how far a participant may step ahead of the slowest"
+    )
     external_participants: list[str] = Field(
         [], description="names of stepping participants started outside `catabot run`"
     )

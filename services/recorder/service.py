@@ -51,7 +51,7 @@ class Recorder:
         self.run_dir = ctx.run_dir
         self._flushed_at = 0.0
         self.participant = Participant(
-            ctx.session, ctx.keys, ctx.name, inputs=streams, peers=ctx.peers, sink=True
+            ctx.session, ctx.keys, ctx.name, inputs=streams, peers=ctx.peers
         )
 
     def step(self, tick: Tick, inputs: Inputs) -> None:

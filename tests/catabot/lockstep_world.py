@@ -52,12 +52,11 @@ class Member:
         step: Step | None,
         inputs: Sequence[Stream],
         peers: Sequence[str],
-        sink: bool = False,
     ) -> None:
         self.world, self.name, self.user_step = world, name, step
         self.session = world.open()
         self.participant = Participant(
-            self.session, world.keys, name, inputs=inputs, peers=peers, drain_s=1.0, sink=sink
+            self.session, world.keys, name, inputs=inputs, peers=peers, drain_s=1.0
         )
         self.ticks: list[int] = []
         self.released: dict[int, Inputs] = {}
@@ -120,9 +119,8 @@ class World:
         *,
         inputs: Sequence[Stream] = (),
         peers: Sequence[str] = (),
-        sink: bool = False,
     ) -> Member:
-        m = self.members[name] = Member(self, name, step, inputs, peers, sink)
+        m = self.members[name] = Member(self, name, step, inputs, peers)
         return m
 
     def run(self, participants: Sequence[str], ticks: int, **spec: Any) -> RunResult:

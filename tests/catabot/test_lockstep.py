@@ -15,7 +15,7 @@ from collections.abc import Callable
 from catabot import codec
 from catabot.clock import Stream
 from catabot.inbox import Inputs
-from catabot.messages import GpsFix, Tick
+from catabot.messages import Ack, GpsFix, Tick
 from catabot.participant import Participant
 from tests.catabot.lockstep_world import DT_NS, Member, Step, World, _fix
 
@@ -67,13 +67,13 @@ def test_ticks_carry_time(world: World) -> None:
 
 
 def _producer_consumer(
-    world: World, produce: Step, consume: Step | None = None, *, sink: bool = False
+    world: World, produce: Step, consume: Step | None = None
 ) -> tuple[str, Member]:
     key = world.keys.sensor("ego", "gps")
     names = ["prod", "cons"]
     world.member("prod", produce, peers=names)
     stream = Stream(key, GpsFix, "prod", 2)
-    cons = world.member("cons", consume, inputs=[stream], peers=names, sink=sink)
+    cons = world.member("cons", consume, inputs=[stream], peers=names)
     return key, cons
 
 
@@ -187,23 +187,80 @@ def _eventually(check: Callable[[], bool], timeout_s: float = 3.0) -> bool:
     return True
 
 
-def test_a_sink_acks_first_and_lags_at_most_one_tick(world: World) -> None:
-    """The recorder's mode: its slow step overlaps the others' next tick, every sample
-    still reaches it in Jacobi order, and it never falls two ticks behind."""
+# -- the window -----------------------------------------------------------------------------
+
+
+def _slow_consumer_run(world: World, window: int, ticks: int) -> tuple[str, Member]:
     participant: dict[str, Participant] = {}
 
     def produce(tick: Tick, _inputs: Inputs) -> None:
         if tick.tick % 2 == 0:
             participant["p"].publish(key, _fix(tick.tick))
 
-    key, cons = _producer_consumer(world, produce, lambda t, i: time.sleep(0.02), sink=True)
+    key, cons = _producer_consumer(world, produce, lambda t, i: time.sleep(0.01))
     participant["p"] = world.members["prod"].participant
-    result = world.run(["prod", "cons"], 20, deadline_s=2.0, start_timeout_s=5.0)
-    assert result.error == "" and result.ticks_done == 20
-    cons.join()
-    _check_jacobi(cons, key, 20)
+    result = world.run(
+        ["prod", "cons"], ticks, deadline_s=2.0, start_timeout_s=5.0, window_ticks=window
+    )
+    assert result.error == "" and result.ticks_done == ticks
+    for m in world.members.values():
+        m.join()
+        assert m.error is None
+    return key, cons
+
+
+def test_a_window_lets_the_fast_run_ahead_of_the_slow_but_no_further(world: World) -> None:
+    """Within the window a producer steps ahead of a slow consumer (their steps overlap),
+    never more than `window_ticks` ahead, and the consumer still gets exactly the samples
+    of earlier ticks."""
+    window, ticks = 4, 24
+    key, cons = _slow_consumer_run(world, window, ticks)
+    _check_jacobi(cons, key, ticks)
+    assert world.members["prod"].ticks == list(range(ticks))
     order = {(what, who, t): i for i, (what, who, t) in enumerate(world.events)}
-    overlap = [order[("start", "prod", k + 1)] < order[("done", "cons", k)] for k in range(19)]
-    assert any(overlap), "the sink's step never overlapped the next tick"
-    lag = [order[("done", "cons", k)] < order[("start", "prod", k + 2)] for k in range(18)]
-    assert all(lag), "the sink fell two ticks behind"
+    ahead = [order[("start", "prod", k + 1)] < order[("done", "cons", k)] for k in range(ticks - 1)]
+    assert any(ahead), "the producer never stepped ahead of the consumer"
+    for k in range(window, ticks):
+        assert order[("done", "cons", k - window)] < order[("start", "prod", k)], (
+            f"the producer started tick {k} before the consumer finished tick {k - window}"
+        )
+
+
+def test_a_window_of_one_is_strict_lockstep(world: World) -> None:
+    _key, _cons = _slow_consumer_run(world, 1, 10)
+    order = {(what, who, t): i for i, (what, who, t) in enumerate(world.events)}
+    for k in range(1, 10):
+        assert order[("done", "cons", k - 1)] < order[("start", "prod", k)]
+
+
+def test_a_stop_in_a_window_ends_everyone_on_the_same_tick(world: World) -> None:
+    def step(tick: Tick, _inputs: Inputs) -> None:
+        if tick.tick == 5:
+            assert world.conductor is not None
+            world.conductor.stop("interrupted")
+
+    names = ["a", "b"]
+    world.member("a", step, peers=names)
+    world.member("b", lambda t, i: time.sleep(0.005), peers=names)
+    result = world.run(names, 200, deadline_s=2.0, start_timeout_s=5.0, window_ticks=8)
+    assert result.error == "" and result.reason == "interrupted"
+    assert 6 <= result.ticks_done <= 6 + 8  # what was granted when the stop came completes
+    for name in names:
+        m = world.members[name]
+        m.join()
+        assert m.ticks == list(range(result.ticks_done))
+        assert m.end is not None and m.end.tick == result.ticks_done - 1
+
+
+def test_acks_come_every_half_window(world: World) -> None:
+    """Half the window between acks: a tenth of the acks a strict lockstep needs."""
+    acks: list[int] = []
+    sub = world.open().declare_subscriber(
+        world.keys.ack("solo"), lambda s: acks.append(codec.decode(s.payload.to_bytes(), Ack).tick)
+    )
+    world.member("solo")
+    result = world.run(["solo"], 100, deadline_s=2.0, start_timeout_s=5.0, window_ticks=20)
+    world.members["solo"].join()
+    sub.undeclare()
+    assert result.error == "" and result.ticks_done == 100
+    assert acks == list(range(9, 100, 10))

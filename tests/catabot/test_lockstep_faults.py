@@ -44,6 +44,30 @@ def test_a_step_past_the_deadline_ends_the_run_naming_it(world: World) -> None:
     world.members["stuck"].join()
 
 
+def test_a_participant_hanging_inside_a_window_is_named(world: World) -> None:
+    release = threading.Event()
+
+    def hang(tick: Tick, _inputs: Inputs) -> None:
+        if tick.tick == 13:
+            release.wait(5.0)
+
+    world.member("fast")
+    world.member("stuck", hang)
+    try:
+        result = world.run(
+            ["fast", "stuck"], 100, deadline_s=0.5, start_timeout_s=5.0, window_ticks=8
+        )
+    finally:
+        release.set()
+    assert result.error == "participant 'stuck' missed the 0.5 s deadline of tick 12"
+    assert result.ticks_done == 12  # acks every 4 ticks: 3, 7, 11
+    fast = world.members["fast"]
+    fast.join()
+    assert fast.end is not None and fast.end.tick == 11
+    assert fast.ticks[:12] == list(range(12))
+    world.members["stuck"].join()
+
+
 # -- (d) policy drop ----------------------------------------------------------------------
 
 

@@ -321,3 +321,10 @@ def test_json_schema_refuses_what_the_loader_refuses() -> None:
         assert not validator.is_valid(data)
         with pytest.raises(ScenarioError):
             parse_scenario(data)
+
+
+@pytest.mark.parametrize("window", [0, -3, 2.5, "ten"])
+def test_a_clock_window_that_is_not_a_positive_whole_number(window: object) -> None:
+    data = _base()
+    data["clock"] = {"window_ticks": window}
+    assert "clock.window_ticks:" in _error(data)

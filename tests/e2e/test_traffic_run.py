@@ -99,9 +99,12 @@ def test_a_hundred_boats_stay_afloat_in_the_bay(tmp_path: Path, out: Path) -> No
 
 
 def test_two_traffic_runs_record_identical_bytes(tmp_path: Path) -> None:
-    scenario = scenario_file(tmp_path, _traffic("trafficdet", 10))
+    """The second run is a strict barrier (a window of one tick): the window decides who
+    may run ahead, never what anybody computes."""
     recorded = []
-    for tag in ("a", "b"):
+    for tag, window in (("a", 10), ("b", 1)):
+        data = _traffic("trafficdet", 10, clock={"window_ticks": window})
+        scenario = scenario_file(tmp_path, data, f"{tag}.json")
         (tmp_path / tag).mkdir()
         result = catabot("run", str(scenario), "--out", str(tmp_path / tag), "--quiet")
         assert result.returncode == 0, result.stderr
