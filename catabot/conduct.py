@@ -18,6 +18,7 @@ from catabot.clock import Policy
 from catabot.conductor import ClockSpec, Conductor, Progress
 from catabot.keys import Keys
 from catabot.scenario import Scenario, ScenarioError, load_scenario
+from catabot.service import quiet_gc
 from catabot.session import SessionError, add_connection_args, connection_from_args, open_session
 from catabot.streams import participants
 
@@ -61,6 +62,7 @@ def main(argv: list[str] | None = None) -> int:
         emit("result", ticks=0, wall_s=0.0, error=str(exc), dropped=[])
         return 2
     conductor = Conductor(session, Keys(scenario.name), clock_spec(scenario))
+    quiet_gc()
     for sig in (signal.SIGINT, signal.SIGTERM):
         signal.signal(sig, lambda *_: conductor.stop("interrupted"))
 

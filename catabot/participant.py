@@ -89,6 +89,16 @@ class Participant:
             self._listen(key)
         return key in self._watched
 
+    def watched_among(self, keys: Sequence[str]) -> list[int]:
+        """Indices of the `keys` someone subscribes to now; one set test a tick while nobody
+        watches (asking key by key cost physics 0.17 ms a tick with 100 boats)."""
+        for key in keys:
+            if key not in self._listeners:
+                self._listen(key)
+        if not self._watched:
+            return []
+        return [i for i, key in enumerate(keys) if key in self._watched]
+
     def _listen(self, key: str) -> None:
         pub = self._publisher(key)
 

@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import argparse
 import cProfile
+import gc
 import json
 import logging
 import os
@@ -77,6 +78,15 @@ def _profiled(name: str, run_dir: Path, run: Callable[[], End]) -> End:
         profile.dump_stats(run_dir / "log" / f"{name}.prof")
 
 
+def quiet_gc() -> None:
+    """Freeze what start-up built and collect cycles 100x less often: a tick's garbage is
+    freed by reference counting, yet every 700 allocations the collector walked the young
+    objects (3 % of the physics process's CPU with one vessel)."""
+    gc.collect()
+    gc.freeze()
+    gc.set_threshold(70_000, 10, 10)
+
+
 def _write_usage(name: str, run_dir: Path, cpu_s: float) -> None:
     """CPU seconds of the stepping loop (every thread, start-up excluded), for run.json."""
     (run_dir / "log").mkdir(parents=True, exist_ok=True)
@@ -102,6 +112,7 @@ def run_service(name: str, build: BuildFn, argv: list[str] | None = None) -> int
     )
     try:
         participant, step, on_end = build(ctx)
+        quiet_gc()
         cpu_start = time.process_time()
         end = _profiled(name, ctx.run_dir, lambda: participant.run(step, on_end))
         _write_usage(name, ctx.run_dir, time.process_time() - cpu_start)

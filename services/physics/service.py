@@ -105,8 +105,7 @@ class PhysicsService:
         self.participant.publish(
             self.keys.world_states(), BodyStates(tick.tick, stamp, self.body_ids, *cols)
         )
-        watched = [i for i, key in enumerate(self.state_keys) if self.participant.watched(key)]
-        for i in watched:
+        for i in self.participant.watched_among(self.state_keys):
             row = (tuple(getattr(v, f)[i].tolist()) for f in FIELDS)
             self.participant.publish(self.state_keys[i], VesselState(tick.tick, stamp, *row))
 

@@ -171,11 +171,15 @@ def test_watched_follows_subscribers_coming_and_going(world: World) -> None:
     states); the answer must follow a subscriber in another session within a moment."""
     part = Participant(world.open(), world.keys, "physics")
     key = world.keys.vessel_state("ego")
+    other = world.keys.vessel_state("boat_000")
     assert not part.watched(key)
+    assert part.watched_among([other, key]) == []
     sub = world.open().declare_subscriber(key, lambda _: None)
     assert _eventually(lambda: part.watched(key))
+    assert part.watched_among([other, key]) == [1]
     sub.undeclare()
     assert _eventually(lambda: not part.watched(key))
+    assert part.watched_among([other, key]) == []
 
 
 def _eventually(check: Callable[[], bool], timeout_s: float = 3.0) -> bool:
