@@ -15,13 +15,17 @@ from __future__ import annotations
 import bisect
 import logging
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
+from numpy.typing import NDArray
 
 from catabot import codec
 from catabot.clock import NS_PER_S
 from catabot.messages import Message, ThrustCmd, TwistBatch, TwistCmd, WaypointsCmd
 from catabot.scenario import ScriptStep, VesselConfig
+
+Array = NDArray[np.float64]
 
 log = logging.getLogger("physics.commands")
 
@@ -35,22 +39,47 @@ class Order:
 
 
 class CommandBook:
+    """Orders of every vessel. Set-points from the lockstep (the traffic batch, or a lockstep
+    participant's twist) live in arrays, so `orders` costs a few array operations a tick
+    whatever the number of boats; external overrides and scripts, few, stay per vessel."""
+
     def __init__(self, vessels: list[VesselConfig], thrusters: dict[str, int]) -> None:
+        self.ids = tuple(v.id for v in vessels)
+        self.row = {vid: i for i, vid in enumerate(self.ids)}
         self.thrusters = thrusters
         self.scripts = {v.id: sorted(v.script, key=lambda s: s.t_s) for v in vessels}
         self.times = {
             vid: [round(s.t_s * NS_PER_S) for s in steps] for vid, steps in self.scripts.items()
         }
+        self.scripted = [v.id for v in vessels if v.script]
         self.external: dict[str, Order] = {}
-        self.lockstep: dict[str, Order] = {}
+        self.set_point = np.zeros((len(self.ids), 2))  # (surge m/s, yaw rate rad/s)
+        self.has_set_point = np.zeros(len(self.ids), dtype=bool)
+        self._batch_rows: tuple[tuple[str, ...], NDArray[np.intp]] = ((), np.zeros(0, np.intp))
 
     def order(self, vessel: str, stamp_ns: int) -> Order:
+        """One vessel's order now: external > lockstep set-point > script."""
         if vessel in self.external:
             return self.external[vessel]
-        if vessel in self.lockstep:
-            return self.lockstep[vessel]
+        i = self.row[vessel]
+        if self.has_set_point[i]:
+            surge, rate = self.set_point[i].tolist()
+            return Order(twist=(surge, rate))
         index = bisect.bisect_right(self.times[vessel], stamp_ns) - 1
         return _from_step(self.scripts[vessel][index]) if index >= 0 else Order()
+
+    def orders(self, stamp_ns: int) -> tuple[dict[int, tuple[float, ...]], NDArray[np.intp], Array]:
+        """Every vessel's order: thrust values by row, then the rows under velocity control
+        and their (surge, yaw rate) targets, rows in `ids` order."""
+        target, follow = self.set_point.copy(), self.has_set_point.copy()
+        thrust: dict[int, tuple[float, ...]] = {}
+        for vid in self.scripted:
+            if not follow[self.row[vid]]:
+                _place(self.order(vid, stamp_ns), self.row[vid], target, follow, thrust)
+        for vid, order in self.external.items():
+            _place(order, self.row[vid], target, follow, thrust)
+        rows = np.flatnonzero(follow)
+        return thrust, rows, target[rows]
 
     def take_batch(self, batch: TwistBatch, expected: tuple[str, ...]) -> None:
         """The traffic service's set-points: every boat with finite values adopts its own."""
@@ -59,13 +88,19 @@ class CommandBook:
         except ValueError as exc:
             log.error("refused %s", exc)
             return
-        surge, rate = batch.surge.tolist(), batch.yaw_rate.tolist()
+        rows = self._rows_of(expected)
         ok = np.isfinite(batch.surge) & np.isfinite(batch.yaw_rate)
-        for i in np.flatnonzero(ok).tolist():
-            self.lockstep[expected[i]] = Order(twist=(surge[i], rate[i]))
+        self.set_point[rows[ok], 0] = batch.surge[ok]
+        self.set_point[rows[ok], 1] = batch.yaw_rate[ok]
+        self.has_set_point[rows[ok]] = True
         if not ok.all():
             bad = [expected[i] for i in np.flatnonzero(~ok)]
             log.error("refused twist set-points at tick %d: non-finite for %s", batch.tick, bad)
+
+    def _rows_of(self, boats: tuple[str, ...]) -> NDArray[np.intp]:
+        if self._batch_rows[0] != boats:
+            self._batch_rows = (boats, np.array([self.row[b] for b in boats], dtype=np.intp))
+        return self._batch_rows[1]
 
     def take(self, vessel: str, key: str, msgs: list[Message]) -> None:
         """Adopt the newest valid command from the bus; refuse non-finite ones loudly."""
@@ -74,7 +109,8 @@ class CommandBook:
                 self.external.pop(vessel, None)  # handed back (to traffic or the script)
             elif isinstance(msg, TwistCmd) and msg.tick >= 0 and codec.finite(msg.surge):
                 if codec.finite(msg.yaw_rate):
-                    self.lockstep[vessel] = Order(twist=(msg.surge, msg.yaw_rate))
+                    self.set_point[self.row[vessel]] = (msg.surge, msg.yaw_rate)
+                    self.has_set_point[self.row[vessel]] = True
             elif isinstance(msg, ThrustCmd) and len(msg.thrust) != self.thrusters[vessel]:
                 log.error(
                     "refused command on %s: %d values for %d thrusters",
@@ -88,6 +124,17 @@ class CommandBook:
                 self.external[vessel] = Order(twist=(msg.surge, msg.yaw_rate))
             else:
                 log.error("refused command on %s: non-finite value in %s", key, msg)
+
+
+def _place(
+    order: Order, row: int, target: Array, follow: NDArray[np.bool_], thrust: dict[int, Any]
+) -> None:
+    """Write one vessel's order into the arrays `orders` returns."""
+    follow[row] = order.twist is not None
+    if order.twist is not None:
+        target[row] = order.twist
+    elif order.thrust is not None:
+        thrust[row] = order.thrust
 
 
 def _from_step(step: ScriptStep) -> Order:

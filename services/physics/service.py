@@ -49,6 +49,7 @@ class PhysicsService:
         self.book = CommandBook(
             all_vessels(scenario), {vid: len(m.thrusters) for vid, m in models.items()}
         )
+        assert self.book.ids == tuple(ids), "the command book's rows are the world's rows"
         self.streams = command_streams(scenario, ctx.keys) + waypoint_streams(scenario, ctx.keys)
         self.vessel_of = {s.key: ctx.keys.vessel_of(s.key) for s in self.streams}
         self.twists_key = ctx.keys.world_twists()
@@ -76,19 +77,15 @@ class PhysicsService:
 
     def _apply_orders(self, stamp_ns: int) -> None:
         """Thrust orders as given; twist orders through one controller pass for all vessels."""
-        ids = self.world.vessel_ids
-        orders = [self.book.order(vid, stamp_ns) for vid in ids]
-        for vid, order in zip(ids, orders, strict=True):
-            if order.thrust:
-                try:
-                    self.world.set_thrust(vid, order.thrust)
-                except ValueError as exc:
-                    log.error("vessel %s: refused thrust command: %s", vid, exc)
-        rows = np.array([i for i, o in enumerate(orders) if o.twist is not None], dtype=np.intp)
+        thrust, rows, target = self.book.orders(stamp_ns)
+        for row, values in thrust.items():
+            try:
+                self.world.set_thrust(self.world.vessel_ids[row], values)
+            except ValueError as exc:
+                log.error("vessel %s: refused thrust command: %s", self.world.vessel_ids[row], exc)
         if rows.size:
             s = self.world.state_arrays()
             measured = np.stack([s.linear_velocity[rows, 0], s.angular_velocity[rows, 2]], axis=1)
-            target = np.array([orders[i].twist for i in rows], dtype=np.float64)
             try:
                 self.world.set_thrusts(rows, self.controllers.command(rows, target, measured))
             except ValueError as exc:

@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from catabot.messages import TwistBatch
+from catabot.messages import ThrustCmd, TwistBatch, TwistCmd
 from catabot.scenario import VesselConfig
 from catabot.vessel import load_vessel_model
 from services.physics.commands import CommandBook, Order
@@ -50,3 +50,33 @@ def test_twist_batch_sets_each_boats_order_and_skips_bad_entries(
     book.take_batch(TwistBatch(4, 40, ("x", "y"), np.zeros(2), np.zeros(2)), boats)
     assert "expected ['boat_000', 'boat_001']" in caplog.text
     assert book.order("boat_000", 50) == Order(twist=(1.0, 0.1))
+
+
+def test_orders_gathers_every_vessel_in_world_rows() -> None:
+    """Script, lockstep set-point, external override: `orders` agrees with `order` vessel by
+    vessel and hands the velocity-controlled rows over as arrays."""
+    ego = VesselConfig.model_validate(
+        {
+            "id": "ego",
+            "script": [
+                {"t_s": 0.0, "thrust": [0.5, 0.5]},
+                {"t_s": 1.0, "twist": {"surge_mps": 2.0, "yaw_rate_radps": 0.0}},
+            ],
+        }
+    )
+    boats = ("boat_000", "boat_001", "boat_002")
+    book = CommandBook([ego, *(VesselConfig(id=b) for b in boats)], {v: 2 for v in ("ego", *boats)})
+    book.take_batch(TwistBatch(0, 10, boats, np.array([1.0, 2.0, 3.0]), np.zeros(3)), boats)
+    book.take("boat_001", "k", [TwistCmd(0.5, 0.1, tick=-1)])
+    book.take("boat_002", "k", [ThrustCmd((0.1, -0.1))])
+    thrust, rows, target = book.orders(0)
+    assert thrust == {0: (0.5, 0.5), 3: (0.1, -0.1)}
+    assert rows.tolist() == [1, 2] and target.tolist() == [[1.0, 0.0], [0.5, 0.1]]
+    thrust, rows, target = book.orders(2_000_000_000)  # the script's twist step
+    assert thrust == {3: (0.1, -0.1)} and rows.tolist() == [0, 1, 2]
+    assert target[0].tolist() == [2.0, 0.0]
+    for vid in ("ego", *boats):
+        order = book.order(vid, 2_000_000_000)
+        row = book.row[vid]
+        assert order.thrust == thrust.get(row)
+        assert order.twist == (tuple(target[rows.tolist().index(row)]) if row in rows else None)
