@@ -3,8 +3,10 @@
 Each cell is one `catabot run --quiet` (real processes, the recorder on): physics at
 100 Hz, the ego with a 32 x 512 LiDAR at 10 Hz in rain, a radar, an IMU at 100 Hz and a
 GPS, plus N traffic boats; then with a segmentation camera, then with all four camera
-outputs. It prints the real-time factor and LiDAR scans per wall-clock second (from each
-run's log/run.json) beside the paper's frames per second. The paper's FPS is the Unity
+outputs. The boats circle, the original's default (`boatControlType` "Circles"); a last
+row runs 100 boats half of them on waypoint paths, with a floating buoy at each of their
+255 waypoints. It prints the real-time factor and LiDAR scans per wall-clock second (from
+each run's log/run.json) beside the paper's frames per second. The paper's FPS is the Unity
 frame rate; our nearest figure is the LiDAR scan rate, and the real-time factor says
 whether the run kept up with the clock at all. Sensor types not registered in
 catabot/sensor_types.py are left out, and the table says which.
@@ -31,6 +33,8 @@ PAPER = {  # Table II: FPS without perception / segmentation recording / four ou
     20: (51, 29, 13.5), 50: (36, 28, 13), 100: (32, 24, 12),
 }  # fmt: skip
 COLUMNS = ("no perception", "segmentation", "four outputs")
+CIRCLES = {"circle": 1.0}
+MIX = {"circle": 0.5, "waypoints": 0.5}
 
 
 def sensors(column: int) -> list[dict[str, Any]]:
@@ -50,14 +54,16 @@ def sensors(column: int) -> list[dict[str, Any]]:
     return [s for s in out if s["type"] in SENSOR_TYPES]
 
 
-def scenario(boats: int, column: int, seconds: float) -> dict[str, Any]:
+def scenario(
+    boats: int, column: int, seconds: float, mix: dict[str, float] = CIRCLES
+) -> dict[str, Any]:
     return {
-        "name": f"table2_{boats}_{column}",
+        "name": f"table2_{boats}_{column}_{len(mix)}",
         "seed": 1,
         "duration_s": seconds,
         "rain": {"rate_mm_h": 10.0},
         "vessels": [{"id": "ego", "pose": {"x_m": 0.0, "y_m": 0.0}, "sensors": sensors(column)}],
-        "traffic": {"count": boats, "behaviour_mix": {"circle": 0.5, "waypoints": 0.5}},
+        "traffic": {"count": boats, "behaviour_mix": mix},
     }
 
 
@@ -105,20 +111,26 @@ def main(argv: list[str] | None = None) -> None:
     if len(columns) < 3:
         print("  columns skipped (no camera): " + ", ".join(COLUMNS[1:]))
     has_lidar = "lidar" in SENSOR_TYPES
-    usage: dict[int, str] = {}
+    usage: dict[str, str] = {}
+    rtf: dict[int, float] = {}
     with tempfile.TemporaryDirectory(prefix="table2-") as tmp:
-        for boats in BOATS:
-            row = [f"{boats:4d} boats"]
+        for boats, mix in [(b, CIRCLES) for b in BOATS] + [(100, MIX)]:
+            label = f"{boats:4d} boats" + (" (half on waypoints, 255 buoys)" if mix is MIX else "")
+            row = [label]
             for column in columns:
-                result = run_once(scenario(boats, column, seconds), Path(tmp))
+                result = run_once(scenario(boats, column, seconds, mix), Path(tmp))
                 row.append(f"{COLUMNS[column]}: {cell(result, has_lidar)} "
                            f"(paper {PAPER[boats][column]} FPS)")  # fmt: skip
                 if column == 0:
-                    usage[boats] = cpu_per_tick(result)
+                    usage[label] = cpu_per_tick(result)
+                    if mix is CIRCLES and result.get("wall_s"):
+                        rtf[boats] = result["sim_s"] / result["wall_s"]
             print(" | ".join(row), flush=True)
+    if rtf.get(0) and 100 in rtf:
+        print(f"100 boats / 0 boats, no perception: {rtf[100] / rtf[0]:.2f} (paper 32/55 = 0.58)")
     print("CPU per tick in each service's stepping loop (no perception column):")
-    for boats, text in usage.items():
-        print(f"  {boats:4d} boats: {text}")
+    for label, text in usage.items():
+        print(f"  {label}: {text}")
 
 
 if __name__ == "__main__":
