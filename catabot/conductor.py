@@ -179,13 +179,13 @@ class Conductor:
             last = min(last, int(due))
         return last
 
-    def _pace_delay(self) -> float:
-        """Seconds until the next tick is due, when only the pace holds it back."""
+    def _pace_wait(self) -> float | None:
+        """Seconds until the next tick is due when only the pace holds it back, else None."""
         factor = self.spec.realtime_factor
         nxt = self._granted + 1
         if not factor or nxt >= min(self._done + self.spec.window_ticks, self.spec.ticks):
-            return 0.0
-        return self._t0 + nxt * self.spec.dt_ns / 1e9 / factor - time.monotonic()
+            return None
+        return max(self._t0 + nxt * self.spec.dt_ns / 1e9 / factor - time.monotonic(), 0.0)
 
     def _grant(self, last: int, *, again: bool = False) -> None:
         """Publish a Tick granting every tick up to `last` (again: repeat it with a new
@@ -200,13 +200,13 @@ class Conductor:
         self._tick_pub.put(codec.encode(tick))
 
     def _await_progress(self) -> None:
-        """Take at least one ack or event, then every ack already queued; apply membership
-        and the deadline. A paced run polls instead (until the next tick is due, at most
-        2 ms), so that it grants each tick on time."""
-        if self.spec.realtime_factor:
-            time.sleep(min(max(self._pace_delay(), 0.0002), 0.002))
-        else:
+        """Wait for an ack or an event, or (paced runs) until the next tick is due, then take
+        every ack queued; apply membership and the deadline."""
+        wait = self._pace_wait()
+        if wait is None:
             self._take(self._acks.recv())  # some tick is outstanding: an ack or a poke comes
+        elif wait > 0:
+            time.sleep(wait)
         while (sample := self._acks.try_recv()) is not None:
             self._take(sample)
         self._check_events()

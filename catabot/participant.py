@@ -48,6 +48,7 @@ class Participant:
         self.drain_s = drain_s
         self.next_tick = 0
         self._grant: Tick | None = None
+        self._waiting_since = time.monotonic()  # for the warning about a long wait
         self.events: queue.SimpleQueue[tuple[str, str, bytes]] = queue.SimpleQueue()
         self.present: set[str] = set()
         self.run_id = ""
@@ -118,7 +119,6 @@ class Participant:
 
     def run(self, step: StepFn, on_end: EndFn | None = None) -> End:
         """Step every granted tick until the conductor ends the run; returns the end message."""
-        since = time.monotonic()
         while True:
             kind, key, payload = self._next()
             if kind == "data":
@@ -129,22 +129,21 @@ class Participant:
                 end = self._take_end(payload)
                 if end is not None:
                     return self._finish(end, on_end)
-            since = self._step_ready(step, since)
+            self._step_ready(step)
 
-    def _step_ready(self, step: StepFn, since: float) -> float:
+    def _step_ready(self, step: StepFn) -> None:
         """Step every granted tick whose inputs are complete, in order, acking every
-        `ack_every` ticks and at the grant's end; returns when waiting for the next began."""
+        `ack_every` ticks and at the grant's end."""
         grant = self._grant
         while grant is not None and self.next_tick <= grant.tick:
             k = self.next_tick
-            if not self._ready(k, since):
+            if not self._ready(k):
                 break
             step(self._tick_of(grant, k), self.inbox.release(k))
             self.next_tick = k + 1
             if (k + 1) % grant.ack_every == 0 or k == grant.tick:
                 self._ack.put(codec.encode(Ack(grant.run, k)))
-            since = time.monotonic()
-        return since
+            self._waiting_since = time.monotonic()
 
     @staticmethod
     def _tick_of(grant: Tick, k: int) -> Tick:
@@ -187,6 +186,8 @@ class Participant:
         self.inbox.drop_producers(tick.dropped)
         self.peers -= set(tick.dropped)  # a dropped peer that crashed will never be present
         if self._grant is None or tick.tick >= self._grant.tick:
+            if self._grant is None or self.next_tick > self._grant.tick:
+                self._waiting_since = time.monotonic()  # it had run dry: a wait begins
             self._grant = tick  # grants only grow; a repeat carries a new dropped list
 
     def _take_end(self, payload: bytes) -> End | None:
@@ -197,12 +198,12 @@ class Participant:
             return None
         return end if not self.run_id or end.run == self.run_id else None
 
-    def _ready(self, tick: int, since: float) -> bool:
+    def _ready(self, tick: int) -> bool:
         """Peers seen (so they know our subscriptions) and every due input arrived."""
         missing = self.inbox.missing(tick)
         if not missing and self.peers <= self.present:
             return True
-        if time.monotonic() - since > 5.0 and self._warned_tick != tick:
+        if time.monotonic() - self._waiting_since > 5.0 and self._warned_tick != tick:
             self._warned_tick = tick
             log.warning(
                 "%s: tick %d still waits for %s (peers absent: %s)",

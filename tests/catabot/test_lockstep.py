@@ -12,6 +12,8 @@ import threading
 import time
 from collections.abc import Callable
 
+import pytest
+
 from catabot import codec
 from catabot.clock import Stream
 from catabot.inbox import Inputs
@@ -158,12 +160,18 @@ def test_stop_ends_the_run_at_the_tick_boundary(world: World) -> None:
     assert solo.end is not None and (solo.end.reason, solo.end.tick) == ("interrupted", 5)
 
 
-def test_realtime_factor_paces_the_clock(world: World) -> None:
-    solo = world.member("solo")
-    result = world.run(["solo"], 20, deadline_s=2.0, start_timeout_s=5.0, realtime_factor=2.0)
+@pytest.mark.parametrize("window", [1, 8])
+def test_realtime_factor_paces_the_clock(world: World, window: int) -> None:
+    started: dict[int, float] = {}
+    solo = world.member("solo", lambda t, _i: started.setdefault(t.tick, time.monotonic()))
+    result = world.run(
+        ["solo"], 20, deadline_s=2.0, start_timeout_s=5.0, realtime_factor=2.0, window_ticks=window
+    )
     solo.join()
     assert result.error == "" and result.ticks_done == 20
     assert result.wall_s >= 19 * DT_NS / 1e9 / 2.0  # tick 19 starts 95 ms after tick 0
+    for k in range(1, 20):  # a window never lets a paced tick start before its time
+        assert started[k] - started[0] >= k * DT_NS / 1e9 / 2.0 - 0.01, k  # tick 0 was late
 
 
 def test_watched_follows_subscribers_coming_and_going(world: World) -> None:

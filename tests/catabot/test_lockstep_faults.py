@@ -18,53 +18,37 @@ from tests.catabot.lockstep_world import Step, World, _fix, _state
 # -- (c) deadline -------------------------------------------------------------------------
 
 
-def test_a_step_past_the_deadline_ends_the_run_naming_it(world: World) -> None:
+@pytest.mark.parametrize(
+    ("window", "hang_at", "done"),
+    [(1, 3, 3), (8, 13, 12)],  # a window of 8 acks every 4 ticks: 3, 7, 11
+    ids=["barrier", "window"],
+)
+def test_a_step_past_the_deadline_ends_the_run_naming_it(
+    world: World, window: int, hang_at: int, done: int
+) -> None:
+    """The fault names the participant holding the oldest unacknowledged tick."""
     release = threading.Event()
 
     def hang(tick: Tick, _inputs: Inputs) -> None:
-        if tick.tick == 3:
-            release.wait(5.0)
-
-    world.member("fast")
-    world.member("stuck", hang)
-    try:
-        result = world.run(["fast", "stuck"], 20, deadline_s=0.5, start_timeout_s=5.0)
-    finally:
-        release.set()
-    assert "'stuck'" in result.error
-    assert "deadline" in result.error and "tick 3" in result.error
-    assert "'fast'" not in result.error
-    assert result.reason == "fault"
-    assert result.ticks_done == 3  # ticks 0, 1 and 2 completed
-    fast = world.members["fast"]
-    fast.join()
-    assert fast.ticks == [0, 1, 2, 3]
-    assert fast.end is not None and fast.end.error == result.error
-    assert fast.end.tick == 2  # the last complete tick
-    world.members["stuck"].join()
-
-
-def test_a_participant_hanging_inside_a_window_is_named(world: World) -> None:
-    release = threading.Event()
-
-    def hang(tick: Tick, _inputs: Inputs) -> None:
-        if tick.tick == 13:
+        if tick.tick == hang_at:
             release.wait(5.0)
 
     world.member("fast")
     world.member("stuck", hang)
     try:
         result = world.run(
-            ["fast", "stuck"], 100, deadline_s=0.5, start_timeout_s=5.0, window_ticks=8
+            ["fast", "stuck"], 100, deadline_s=0.5, start_timeout_s=5.0, window_ticks=window
         )
     finally:
         release.set()
-    assert result.error == "participant 'stuck' missed the 0.5 s deadline of tick 12"
-    assert result.ticks_done == 12  # acks every 4 ticks: 3, 7, 11
+    assert result.error == f"participant 'stuck' missed the 0.5 s deadline of tick {done}"
+    assert (result.reason, result.ticks_done) == ("fault", done)
     fast = world.members["fast"]
     fast.join()
-    assert fast.end is not None and fast.end.tick == 11
-    assert fast.ticks[:12] == list(range(12))
+    assert fast.ticks[: done + 1] == list(range(done + 1))
+    assert len(fast.ticks) <= done + window  # never past the window
+    assert fast.end is not None and fast.end.error == result.error
+    assert fast.end.tick == done - 1  # the last complete tick
     world.members["stuck"].join()
 
 
