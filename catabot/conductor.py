@@ -172,18 +172,22 @@ class Conductor:
     def _horizon(self) -> int:
         """The last tick that may be stepped now: the window past the slowest participant,
         the run's end, and (paced runs) the ticks whose wall-clock time has come."""
-        last = min(self._done - 1 + self.spec.window_ticks, self.spec.ticks - 1)
+        last = self._window_end()
         factor = self.spec.realtime_factor
         if factor:
             due = (time.monotonic() - self._t0) * factor * 1e9 / self.spec.dt_ns
             last = min(last, int(due))
         return last
 
+    def _window_end(self) -> int:
+        """The last tick the window and the run's length allow, whatever the pace."""
+        return min(self._done - 1 + self.spec.window_ticks, self.spec.ticks - 1)
+
     def _pace_wait(self) -> float | None:
         """Seconds until the next tick is due when only the pace holds it back, else None."""
         factor = self.spec.realtime_factor
         nxt = self._granted + 1
-        if not factor or nxt >= min(self._done + self.spec.window_ticks, self.spec.ticks):
+        if not factor or nxt > self._window_end():
             return None
         return max(self._t0 + nxt * self.spec.dt_ns / 1e9 / factor - time.monotonic(), 0.0)
 
@@ -192,9 +196,10 @@ class Conductor:
         dropped list)."""
         if last <= self._granted and not again:
             return
-        if self._done > self._granted:  # work is outstanding from now on
-            self._deadline = time.monotonic() + self.spec.deadline_s
+        was_idle = self._done > self._granted
         self._granted = max(last, self._granted)
+        if was_idle:  # work is outstanding from now on
+            self._restart_deadline()
         k, dt = self._granted, self.spec.dt_ns
         tick = Tick(self.run_id, k, k * dt, dt, tuple(self.dropped), self.spec.ack_every)
         self._tick_pub.put(codec.encode(tick))
@@ -228,18 +233,24 @@ class Conductor:
     def _advance(self) -> None:
         """Every active participant has acked up to `_done - 1`; restart the deadline on
         progress."""
-        active = [t for name, t in self._acked.items() if name not in self.dropped]
-        done = min(active, default=self._granted) + 1
+        done = min((self._acked[n] for n in self._active()), default=self._granted) + 1
         if done > self._done:
             self._done = done
-            outstanding = done <= self._granted
-            self._deadline = time.monotonic() + self.spec.deadline_s if outstanding else None
+            self._restart_deadline()
+
+    def _restart_deadline(self) -> None:
+        """`deadline_s` from now while a granted tick is outstanding; none otherwise."""
+        outstanding = self._done <= self._granted
+        self._deadline = time.monotonic() + self.spec.deadline_s if outstanding else None
+
+    def _active(self) -> list[str]:
+        return [n for n in sorted(self._acked) if n not in self.dropped]
 
     def _check_events(self) -> None:
         """Apply pending membership events (a stop is noted in `_stop_reason`) and the deadline."""
         while not self.events.empty():
             self._next_event(0.0)
-        active = [n for n in sorted(self._acked) if n not in self.dropped]
+        active = self._active()
         for name in [n for n in active if n not in self.members]:
             self._fault(name, f"left the run at tick {self._acked[name] + 1}")
         k = self._done

@@ -86,9 +86,7 @@ class Participant:
         """Whether any subscriber matches `key` now: outputs only observers read can skip
         their encoding while nobody looks. Kept current by a Zenoh matching listener per
         key (asking Zenoh each tick cost ~25 us a key under load)."""
-        if key not in self._listeners:
-            self._listen(key)
-        return key in self._watched
+        return bool(self.watched_among([key]))
 
     def watched_among(self, keys: Sequence[str]) -> list[int]:
         """Indices of the `keys` someone subscribes to now; one set test a tick while nobody

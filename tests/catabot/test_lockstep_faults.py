@@ -116,12 +116,18 @@ def _crash_at(world: World, tick: int, crashed_at: list[float]) -> Step:
     return step
 
 
-def test_a_participant_that_crashes_is_named_within_a_second(world: World) -> None:
+def _with_a_crash_at_tick_10(world: World) -> tuple[list[str], list[float]]:
+    """Members a, b and one that closes its session at tick 10; when it did is recorded."""
     crashed_at: list[float] = []
     names = ["a", "b", "crash"]
     world.member("a", peers=names)
     world.member("b", peers=names)
     world.member("crash", _crash_at(world, 10, crashed_at), peers=names)
+    return names, crashed_at
+
+
+def test_a_participant_that_crashes_is_named_within_a_second(world: World) -> None:
+    names, crashed_at = _with_a_crash_at_tick_10(world)
     result = world.run(names, 50, deadline_s=5.0, start_timeout_s=5.0)
     assert crashed_at, "the crash never happened"
     assert result.error == "participant 'crash' left the run at tick 10"
@@ -136,11 +142,7 @@ def test_a_participant_that_crashes_is_named_within_a_second(world: World) -> No
 
 
 def test_policy_drop_goes_on_without_a_crashed_participant(world: World) -> None:
-    crashed_at: list[float] = []
-    names = ["a", "b", "crash"]
-    world.member("a", peers=names)
-    world.member("b", peers=names)
-    world.member("crash", _crash_at(world, 10, crashed_at), peers=names)
+    names, crashed_at = _with_a_crash_at_tick_10(world)
     result = world.run(names, 30, deadline_s=1.0, start_timeout_s=5.0, policy=Policy.DROP)
     assert crashed_at
     assert result.error == ""
