@@ -4,7 +4,7 @@ Both use real processes and the same embedded peer mesh on loopback; the raw loo
 the floor cost of one broadcast plus N acks, so the ratio is what the protocol
 (codec, Jacobi inbox, deadline bookkeeping) costs on top of Zenoh itself. The ratio is
 for a window of one tick (a barrier per tick, like the raw loop); the last column is the
-default window of 10 ticks (a grant every 5 ticks and acks every 5).
+scenario's default window (`clock.window_ticks`: a grant and acks every half window).
 """
 
 from __future__ import annotations
@@ -18,6 +18,7 @@ import zenoh
 
 from catabot.conductor import ClockSpec, Conductor
 from catabot.keys import Keys
+from catabot.scenario import ClockConfig
 from catabot.session import Connection, free_port, open_session
 
 TICKS = 3000
@@ -99,11 +100,18 @@ def _handshake(pub: zenoh.Publisher, acks: zenoh.Subscriber, n: int) -> None:
 
 def main() -> None:
     print("\nLockstep empty-tick rate (real processes, loopback peer mesh)")
-    head = ("participants", "catabot ticks/s", "raw zenoh ticks/s", "ratio", "window 10 ticks/s")
+    window = ClockConfig().window_ticks
+    head = (
+        "participants",
+        "catabot ticks/s",
+        "raw zenoh ticks/s",
+        "ratio",
+        f"window {window} ticks/s",
+    )
     print(" | ".join(head))
     print("-|-".join("-" * len(h) for h in head))
     for n in PEERS:
-        ours, raw, windowed = catabot_rate(n), raw_rate(n), catabot_rate(n, 10)
+        ours, raw, windowed = catabot_rate(n), raw_rate(n), catabot_rate(n, window)
         cells = (f"{n}", f"{ours:.0f}", f"{raw:.0f}", f"{ours / raw:.2f}", f"{windowed:.0f}")
         print(" | ".join(c.rjust(len(h)) for c, h in zip(cells, head, strict=True)))
 

@@ -48,7 +48,7 @@ class ClockConfig(_Model):
     policy: Literal["abort", "drop"] = "abort"
     realtime_factor: float | None = Field(None, gt=0, description="1.0 = wall clock; null = AFAP")
     window_ticks: int = Field(
-        10, ge=1, le=1000, description="how far a participant may step ahead of the slowest"
+        40, ge=1, le=1000, description="how far a participant may step ahead of the slowest"
     )
     external_participants: list[str] = Field(
         [], description="names of stepping participants started outside `catabot run`"

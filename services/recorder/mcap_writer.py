@@ -39,7 +39,7 @@ class McapWriter:
         self._crc = 0
         self._schemas: list[Schema] = []
         self._channels: list[Channel] = []
-        self._counts: dict[int, int] = {}
+        self._counts = np.zeros(1, np.int64)  # messages by channel id (ids start at 1)
         self._first = self._last = -1
         self._messages = 0
         self._write(MAGIC)
@@ -60,7 +60,7 @@ class McapWriter:
             metadata={},
         )
         self._channels.append(channel)
-        self._counts[channel.id] = 0
+        self._counts = np.append(self._counts, 0)
         self._record(channel)
         return channel.id
 
@@ -77,20 +77,25 @@ class McapWriter:
                 f"{len(channels)} channels, {len(sequences)} sequences and {len(payloads)} "
                 "payloads: one of each per message"
             )
-        unknown = set(channels) - self._counts.keys()
-        if unknown:
-            raise ValueError(f"no channel registered with id(s) {sorted(unknown)}")
         if not payloads:
             return
+        self._count(np.asarray(channels))
         pack = _MESSAGE_HEAD.pack
         parts: list[Any] = []
         for chan, seq, data in zip(channels, sequences, payloads, strict=True):
             parts.append(pack(Opcode.MESSAGE, _MESSAGE_FIXED + len(data), chan, seq,
                               log_time, log_time))  # fmt: skip
             parts.append(data)
-            self._counts[chan] += 1
         self._note_times(log_time, len(payloads))
         self._write(b"".join(parts))
+
+    def _count(self, channels: NDArray[np.integer]) -> None:
+        """One more message on each of `channels` (ids may repeat); unknown ids refused
+        before anything is counted or written."""
+        unknown = channels[(channels < 1) | (channels >= len(self._counts))]
+        if len(unknown):
+            raise ValueError(f"no channel registered with id(s) {sorted(set(unknown.tolist()))}")
+        np.add.at(self._counts, channels, 1)
 
     def _note_times(self, log_time: int, count: int) -> None:
         self._first = log_time if self._messages == 0 else min(self._first, log_time)
@@ -106,12 +111,9 @@ class McapWriter:
         k, length = payloads.shape
         if len(channels) != k or len(sequences) != k:
             raise ValueError(f"{len(channels)} channels and {len(sequences)} sequences for {k}")
-        ids, counts = np.unique(channels, return_counts=True)
-        unknown = set(ids.tolist()) - self._counts.keys()
-        if unknown:
-            raise ValueError(f"no channel registered with id(s) {sorted(unknown)}")
         if k == 0:
             return
+        self._count(channels)
         head = np.empty(k, _HEAD_DTYPE)
         head["opcode"], head["length"] = Opcode.MESSAGE, _MESSAGE_FIXED + length
         head["channel"], head["sequence"] = channels, sequences
@@ -119,8 +121,6 @@ class McapWriter:
         records = np.empty((k, _MESSAGE_HEAD.size + length), np.uint8)
         records[:, : _MESSAGE_HEAD.size] = head.view(np.uint8).reshape(k, -1)
         records[:, _MESSAGE_HEAD.size :] = payloads
-        for chan, count in zip(ids.tolist(), counts.tolist(), strict=True):
-            self._counts[chan] += count
         self._note_times(log_time, k)
         self._write(records.tobytes())
 
@@ -162,7 +162,7 @@ class McapWriter:
             chunk_count=0,
             message_start_time=max(self._first, 0),
             message_end_time=max(self._last, 0),
-            channel_message_counts=dict(self._counts),
+            channel_message_counts={c.id: int(self._counts[c.id]) for c in self._channels},
         )
 
     def _record(self, record: Any) -> None:

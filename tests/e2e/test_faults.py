@@ -27,6 +27,7 @@ from conftest import (
 from catabot import codec
 from catabot.keys import Keys
 from catabot.messages import ThrustCmd
+from catabot.scenario import ClockConfig
 from catabot.session import Connection, free_port, open_session
 from services.recorder.mcap_sink import read_mcap_messages
 
@@ -88,7 +89,7 @@ def test_killed_participant_is_detected_within_one_second(tmp_path: Path, out: P
     _assert_recorded_through(run, 299)
 
 
-WINDOW = 10  # the default clock.window_ticks
+WINDOW = ClockConfig().window_ticks  # the default
 
 
 def _assert_recorded_through(run: Path, last_complete: int) -> None:
