@@ -5,6 +5,9 @@ samples produced in ticks < k, publishes what it produced (tagged k), then acks 
 A stream has a period in ticks and is produced at ticks k with k % period == 0; a
 consumer steps tick k only once the last due sample of each stream it reads has
 arrived. That rule, not message ordering, makes runs deterministic across routes.
+A consumer may read a stream with a lag of L ticks (a sample tagged j reaches step k
+only when j < k - L): a fixed transport delay, the same on every run, that lets the
+consumer step up to L ticks ahead of the producer instead of waiting for it every tick.
 """
 
 from __future__ import annotations
@@ -30,18 +33,31 @@ class Policy(StrEnum):
 
 @dataclass(frozen=True)
 class Stream:
-    """A key with one producer and a period in ticks; `period=None` is free-running."""
+    """A key with one producer and a period in ticks; `period=None` is free-running.
+    `lag`: this consumer's fixed delay in ticks on top of the one tick (clocked only)."""
 
     key: str
     message: type[Message]
     producer: str
     period: int | None = 1
+    lag: int = 0
+
+    def __post_init__(self) -> None:
+        if self.lag < 0 or (self.lag and self.period is None):
+            raise ValueError(
+                f"{self.key}: a lag must be >= 0, on a clocked stream (got {self.lag})"
+            )
 
     def due_before(self, tick: int) -> int:
-        """The last tick < `tick` at which a sample is due; -1 if none is due yet."""
+        """The last tick < `tick` - lag at which a sample is due; -1 if none is due yet."""
+        tick -= self.lag
         if self.period is None or tick <= 0:
             return -1
         return ((tick - 1) // self.period) * self.period
+
+    def released_before(self, tick: int) -> int:
+        """Samples tagged below this tick are handed to the step of `tick`."""
+        return tick - self.lag
 
     def due_through(self, tick: int) -> int:
         """The last tick <= `tick` at which a sample is due (used at run end)."""

@@ -1,6 +1,7 @@
 """Samples a participant has received, released in Jacobi order.
 
-A sample tagged tick j is released to the step of tick k only when j < k; free-running
+A sample tagged tick j is released to the step of tick k only when j < k (j < k - lag
+for a stream read with a lag: `Stream.released_before`); free-running
 samples (tick -1, from clients outside the lockstep) are released at the next step
 after they arrive. Releasing by tick rather than by arrival is what keeps a run
 deterministic when producers race each other on different routes.
@@ -61,10 +62,10 @@ class Inbox:
         """Hand over every held sample produced before `tick`, oldest tick first."""
         out: dict[str, list[Message]] = {}
         for key in sorted(self._holding, key=self._order.__getitem__):
-            held = self.held[key]
-            ready = [m for m in held if _tick_of(m) < tick]
+            held, before = self.held[key], self.streams[key].released_before(tick)
+            ready = [m for m in held if _tick_of(m) < before]
             if ready:
-                self.held[key] = [m for m in held if _tick_of(m) >= tick]
+                self.held[key] = [m for m in held if _tick_of(m) >= before]
                 out[key] = sorted(ready, key=_tick_of)
             if not self.held[key]:
                 self._holding.discard(key)

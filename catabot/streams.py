@@ -79,12 +79,12 @@ def command_streams(scenario: Scenario, keys: Keys) -> list[Stream]:
     return out
 
 
-def twist_batch_streams(scenario: Scenario, keys: Keys) -> list[Stream]:
+def twist_batch_streams(scenario: Scenario, keys: Keys, *, lag: int = 0) -> list[Stream]:
     """The traffic service's set-points for all its boats, one `TwistBatch` per tick (none
-    without traffic)."""
+    without traffic); physics reads them `traffic.setpoint_delay_ticks` late."""
     if scenario.traffic.count == 0:
         return []
-    return [Stream(keys.world_twists(), TwistBatch, "traffic", 1)]
+    return [Stream(keys.world_twists(), TwistBatch, "traffic", 1, lag)]
 
 
 def waypoint_streams(scenario: Scenario, keys: Keys) -> list[Stream]:

@@ -100,6 +100,13 @@ class TrafficConfig(_Model):
     waypoints: WaypointParams = WaypointParams()
     hold: HoldParams = HoldParams()
     boats: list[BoatOverride] = []
+    setpoint_delay_ticks: int = Field(
+        4,
+        ge=0,
+        le=1000,
+        description="extra ticks before physics applies a boat's set-point (autopilot latency); "
+        "lets physics step ahead of the traffic service; 0 = the one-tick minimum",
+    )
 
     @field_validator("models")
     @classmethod

@@ -54,7 +54,8 @@ class PhysicsService:
         self.vessel_of = {s.key: ctx.keys.vessel_of(s.key) for s in self.streams}
         self.twists_key = ctx.keys.world_twists()
         self.boats = traffic_boat_ids(scenario)
-        self.streams += twist_batch_streams(scenario, ctx.keys)
+        delay = scenario.traffic.setpoint_delay_ticks  # lets physics step ahead of traffic
+        self.streams += twist_batch_streams(scenario, ctx.keys, lag=delay)
         self.body_ids = (*ids, *self.world.buoy_ids)
         self.state_keys = [ctx.keys.vessel_state(vid) for vid in ids]
         self.participant = Participant(

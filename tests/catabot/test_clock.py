@@ -175,6 +175,25 @@ def test_missing_follows_the_periods() -> None:
     assert inbox.missing(11) == []
 
 
+def test_a_lagged_stream_is_due_and_released_lag_ticks_later() -> None:
+    lagged = Stream(STATE, VesselState, "physics", 1, lag=3)
+    assert [lagged.due_before(k) for k in (0, 3, 4, 5, 10)] == [-1, -1, 0, 1, 6]
+    inbox = Inbox([lagged])
+    assert inbox.missing(3) == []  # nothing due yet: the consumer steps ahead of physics
+    assert inbox.missing(4) == [STATE]
+    for k in range(6):
+        inbox.add(STATE, _state(k))
+    assert inbox.release(3) == {}
+    assert [m.tick for m in inbox.release(5)[STATE]] == [0, 1]  # tagged < 5 - 3
+    assert [m.tick for m in inbox.release(9)[STATE]] == [2, 3, 4, 5]
+
+
+@pytest.mark.parametrize("lag, period", [(-1, 1), (2, None)])
+def test_a_lag_must_be_non_negative_and_on_a_clocked_stream(lag: int, period: int | None) -> None:
+    with pytest.raises(ValueError, match="lag"):
+        Stream(STATE, VesselState, "physics", period, lag=lag)
+
+
 def test_a_late_old_sample_does_not_lower_the_mark() -> None:
     inbox = _inbox()
     inbox.add(STATE, _state(5))

@@ -328,3 +328,10 @@ def test_a_clock_window_that_is_not_a_positive_whole_number(window: object) -> N
     data = _base()
     data["clock"] = {"window_ticks": window}
     assert "clock.window_ticks:" in _error(data)
+
+
+@pytest.mark.parametrize("delay", [-1, 2.5, "eight", 1001])
+def test_a_setpoint_delay_that_is_not_a_whole_number_of_ticks(delay: object) -> None:
+    data = _base()
+    data["traffic"] = {"count": 2, "setpoint_delay_ticks": delay}
+    assert "traffic.setpoint_delay_ticks:" in _error(data)

@@ -13,7 +13,7 @@ from conftest import catabot, files_of, only_run_dir, scenario_file, start, wait
 from catabot import codec
 from catabot.keys import Keys
 from catabot.messages import TwistCmd, WaypointsCmd
-from catabot.scenario import load_scenario
+from catabot.scenario import ClockConfig, load_scenario
 from catabot.session import Connection, free_port, open_session
 from catabot.terrain import load_terrain
 from catabot.traffic_plan import plan_traffic
@@ -102,7 +102,7 @@ def test_two_traffic_runs_record_identical_bytes(tmp_path: Path) -> None:
     """The second run is a strict barrier (a window of one tick): the window decides who
     may run ahead, never what anybody computes."""
     recorded = []
-    for tag, window in (("a", 10), ("b", 1)):
+    for tag, window in (("a", ClockConfig().window_ticks), ("b", 1)):
         data = _traffic("trafficdet", 10, clock={"window_ticks": window})
         scenario = scenario_file(tmp_path, data, f"{tag}.json")
         (tmp_path / tag).mkdir()
@@ -111,3 +111,17 @@ def test_two_traffic_runs_record_identical_bytes(tmp_path: Path) -> None:
         recorded.append(files_of(only_run_dir(tmp_path / tag)))
     assert "vessel.boat_009.state.csv" in recorded[0] and "run.mcap" in recorded[0]
     assert recorded[0] == recorded[1]
+
+
+def test_a_setpoint_reaches_its_boat_after_the_configured_delay(tmp_path: Path) -> None:
+    """Physics applies the traffic set-point tagged j at tick j + 1 + delay: a boat at rest
+    in calm water first moves in the state of tick 1 + delay."""
+    for delay in (0, 5):
+        data = _traffic(f"delay{delay}", 1, duration_s=0.3, recording={"mcap": False})
+        data["traffic"] |= {"behaviour_mix": {"circle": 1.0}, "setpoint_delay_ticks": delay}
+        out = tmp_path / str(delay)
+        result = catabot("run", str(scenario_file(tmp_path, data)), "--out", str(out), "--quiet")
+        assert result.returncode == 0, result.stderr
+        states = _states(only_run_dir(out), "boat_000")
+        moving = np.flatnonzero(states[:, 9] > 1e-4)  # linear_velocity_x
+        assert moving[0] == 1 + delay and (states[moving[0] :, 9] > 1e-4).all(), moving[:3]
