@@ -101,7 +101,7 @@ class TrafficConfig(_Model):
     hold: HoldParams = HoldParams()
     boats: list[BoatOverride] = []
     setpoint_delay_ticks: int = Field(
-        4,
+        0,
         ge=0,
         le=1000,
         description="extra ticks before physics applies a boat's set-point (autopilot latency); "
