@@ -220,21 +220,34 @@ class Scenario(_Model):
 
 
 def check_rates(scenario: Scenario) -> None:
-    """Refuse sensor rates that are not a whole number of ticks (DESIGN.md §4)."""
+    """Refuse sensor and guidance rates that are not a whole number of ticks (DESIGN.md §4)."""
     for v_index, vessel in enumerate(scenario.vessels):
         for s_index, sensor in enumerate(vessel.sensors):
             where = f"vessels.{v_index}.sensors.{s_index}.rate_hz ({vessel.id}/{sensor.name})"
-            try:  # first, so that e.g. 30 Hz at 10 ms names the allowed rates
-                period_in_ticks(sensor.period_ns, scenario.dt_ns, what=where)
-            except ClockError as exc:
-                raise ScenarioError(str(exc)) from None
-            exact = NS_PER_S / sensor.rate_hz
-            if not math.isclose(exact, round(exact), rel_tol=1e-12, abs_tol=1e-6):
-                raise ScenarioError(f"{where}: {sensor.rate_hz} Hz is not a whole number of ns")
+            rate_in_ticks(sensor.rate_hz, scenario.dt_ns, where=where)
+    if scenario.traffic.count:
+        guidance_period_ticks(scenario)
     try:
         scenario.ticks  # noqa: B018 - validates duration against dt
     except ClockError as exc:
         raise ScenarioError(f"duration_s: {exc}") from None
+
+
+def rate_in_ticks(rate_hz: float, dt_ns: int, *, where: str) -> int:
+    """The period of a rate in ticks; ScenarioError naming `where` unless it is whole."""
+    try:  # first, so that e.g. 30 Hz at 10 ms names the allowed rates
+        ticks = period_in_ticks(round(NS_PER_S / rate_hz), dt_ns, what=where)
+    except ClockError as exc:
+        raise ScenarioError(str(exc)) from None
+    exact = NS_PER_S / rate_hz
+    if not math.isclose(exact, round(exact), rel_tol=1e-12, abs_tol=1e-6):
+        raise ScenarioError(f"{where}: {rate_hz} Hz is not a whole number of ns")
+    return ticks
+
+
+def guidance_period_ticks(scenario: Scenario) -> int:
+    """Ticks between two rounds of traffic set-points (`traffic.guidance_hz`)."""
+    return rate_in_ticks(scenario.traffic.guidance_hz, scenario.dt_ns, where="traffic.guidance_hz")
 
 
 def parse_scenario(data: Any, *, source: str = "<data>") -> Scenario:

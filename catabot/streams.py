@@ -17,7 +17,7 @@ from catabot.messages import (
     WaypointsCmd,
     check_ids,
 )
-from catabot.scenario import Scenario
+from catabot.scenario import Scenario, guidance_period_ticks
 from catabot.sensor_types import SENSOR_TYPES
 from catabot.traffic_plan import all_buoys, all_vessels, plan_traffic
 
@@ -80,11 +80,12 @@ def command_streams(scenario: Scenario, keys: Keys) -> list[Stream]:
 
 
 def twist_batch_streams(scenario: Scenario, keys: Keys, *, lag: int = 0) -> list[Stream]:
-    """The traffic service's set-points for all its boats, one `TwistBatch` per tick (none
-    without traffic); physics reads them `traffic.setpoint_delay_ticks` late."""
+    """The traffic service's set-points for all its boats, one `TwistBatch` every guidance
+    period (none without traffic); physics reads them `traffic.setpoint_delay_ticks` late."""
     if scenario.traffic.count == 0:
         return []
-    return [Stream(keys.world_twists(), TwistBatch, "traffic", 1, lag)]
+    period = guidance_period_ticks(scenario)
+    return [Stream(keys.world_twists(), TwistBatch, "traffic", period, lag)]
 
 
 def waypoint_streams(scenario: Scenario, keys: Keys) -> list[Stream]:

@@ -100,6 +100,14 @@ class TrafficConfig(_Model):
     waypoints: WaypointParams = WaypointParams()
     hold: HoldParams = HoldParams()
     boats: list[BoatOverride] = []
+    guidance_hz: float = Field(
+        10.0,
+        gt=0,
+        le=1000,
+        description="how often the boats' guidance (their autopilots' outer loop) computes new "
+        "set-points; physics holds each one and runs the velocity controller every tick. "
+        "A whole number of ticks",
+    )
     setpoint_delay_ticks: int = Field(
         0,
         ge=0,

@@ -19,9 +19,12 @@ from catabot.traffic_plan import Boat
 Array = NDArray[np.float64]
 CIRCLE, WAYPOINTS, HOLD = 0, 1, 2
 KINDS = {"circle": CIRCLE, "waypoints": WAYPOINTS, "hold": HOLD}
-YAW_GAIN = 1.0  # 1/s: yaw rate per radian of course error
+YAW_GAIN = 1.0  # 1/s: yaw rate per radian of course error (pursuit, hold)
 MAX_YAW_RATE = 0.35  # rad/s: what a 5 m/s traffic boat can turn (about 20 deg/s)
 CIRCLE_LOOKAHEAD_M = 8.0  # radial error at which the correction reaches 45 degrees
+# 1/s: the circle's course loop. Half of YAW_GAIN because the vector field's own turn rate is
+# fed forward: 1.0 left a limit cycle with set-points held 0.1 s (a 10 Hz guidance rate).
+CIRCLE_GAIN = 0.5
 HOLD_RADIUS_M = 3.0  # closer than this, hold the heading instead of turning to the point
 
 
@@ -37,14 +40,27 @@ def course(yaw: Array, velocity_b: Array) -> Array:
 
 
 def circle_law(
-    pos: Array, chi: Array, centre: Array, radius: Array, direction: Array, speed: Array
+    pos: Array,
+    chi: Array,
+    sog: Array,
+    centre: Array,
+    radius: Array,
+    direction: Array,
+    speed: Array,
 ) -> tuple[Array, Array]:
-    """Feed-forward yaw rate U/R plus a turn towards the circle proportional to radial error."""
+    """A vector field round the circle (course tangent on it, turning in with the radial
+    error, as in Nelson et al. 2007), the field's own turn rate along the boat's motion fed
+    forward, plus CIRCLE_GAIN times the course error. Feeding forward only U/R, as before,
+    left a boat that started 15 m inside its circle oscillating a minute later."""
     rel = pos - centre
     theta = np.arctan2(rel[:, 1], rel[:, 0])
-    error = np.hypot(rel[:, 0], rel[:, 1]) - radius
-    desired = theta + direction * (np.pi / 2 + np.arctan(error / CIRCLE_LOOKAHEAD_M))
-    rate = direction * speed / radius + YAW_GAIN * wrap(desired - chi)
+    dist = np.maximum(np.hypot(rel[:, 0], rel[:, 1]), 1.0)
+    error = (dist - radius) / CIRCLE_LOOKAHEAD_M
+    desired = theta + direction * (np.pi / 2 + np.arctan(error))
+    # d(desired)/dt: the bearing turns at U sin(chi - theta) / d, the correction with U cos(...)
+    bearing_rate = sog * np.sin(chi - theta) / dist
+    approach_rate = sog * np.cos(chi - theta) / CIRCLE_LOOKAHEAD_M / (1 + error**2)
+    rate = bearing_rate + direction * approach_rate + CIRCLE_GAIN * wrap(desired - chi)
     return speed.copy(), np.clip(rate, -MAX_YAW_RATE, MAX_YAW_RATE)
 
 
@@ -108,28 +124,28 @@ class Behaviours:
     def command(self, pos: Array, yaw: Array, velocity_b: Array) -> tuple[Array, Array]:
         """Set-points for every boat: pos (N, 2) m, yaw (N,), body velocity (N, >=2)."""
         chi = course(yaw, velocity_b)
+        sog = np.hypot(velocity_b[:, 0], velocity_b[:, 1])
         surge, rate = np.zeros(len(yaw)), np.zeros(len(yaw))
         for kind, law in ((CIRCLE, self._circle), (WAYPOINTS, self._path), (HOLD, self._hold)):
             rows = np.flatnonzero(self.kind == kind)
             if rows.size:
-                surge[rows], rate[rows] = law(rows, pos[rows], yaw[rows], chi[rows])
+                surge[rows], rate[rows] = law(rows, pos[rows], yaw[rows], chi[rows], sog[rows])
         return surge, rate
 
     def _circle(
-        self, rows: NDArray[np.intp], pos: Array, _: Array, chi: Array
+        self, rows: NDArray[np.intp], pos: Array, _: Array, chi: Array, sog: Array
     ) -> tuple[Array, Array]:
-        return circle_law(
-            pos, chi, self.centre[rows], self.radius[rows], self.direction[rows], self.speed[rows]
-        )
+        centre, radius, direction = self.centre[rows], self.radius[rows], self.direction[rows]
+        return circle_law(pos, chi, sog, centre, radius, direction, self.speed[rows])
 
     def _hold(
-        self, rows: NDArray[np.intp], pos: Array, yaw: Array, _: Array
+        self, rows: NDArray[np.intp], pos: Array, yaw: Array, *_: Array
     ) -> tuple[Array, Array]:
         target = self.centre[rows]
         return hold_law(pos, yaw, target, self.hold_yaw[rows], self.hold_gain, self.speed[rows])
 
     def _path(
-        self, rows: NDArray[np.intp], pos: Array, _: Array, chi: Array
+        self, rows: NDArray[np.intp], pos: Array, _: Array, chi: Array, __: Array
     ) -> tuple[Array, Array]:
         target = np.array([self.paths[i][self.index[i]] for i in rows]).reshape(-1, 2)
         reached = np.hypot(*(target - pos).T) < self.tol[rows]

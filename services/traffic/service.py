@@ -1,9 +1,11 @@
-"""The traffic service: every tick, each boat's behaviour turns its state into a twist set-point.
+"""The traffic service: each boat's behaviour turns its state into a twist set-point.
 
-At tick k it reads the boats' rows of the `BodyStates` tagged k-1 (at t_k; the plan's
-start poses at rest at tick 0), runs the guidance laws for all boats at once and publishes
-every boat's set-point in one `TwistBatch` on `world/cmd/twist` tagged k, which physics
-applies from tick k+1 (the one-tick delay of DESIGN.md §4). External control never fights these
+At every guidance tick k (a multiple of the period of `traffic.guidance_hz`) it reads the
+boats' rows of the `BodyStates` tagged k-1 (at t_k; the plan's start poses at rest at
+tick 0), runs the guidance laws for all boats at once and publishes every boat's set-point
+in one `TwistBatch` on `world/cmd/twist` tagged k, which physics applies from tick k+1 (the
+one-tick delay of DESIGN.md §4) and holds until the next one, as an autopilot's inner loop
+holds its outer loop's last order. External control never fights these
 set-points: physics lets an external twist or thrust (tick -1) outrank them until a
 `WaypointsCmd` hands the boat back; a `WaypointsCmd` with a path makes this service steer
 that path instead, and `mode="release"` restores the scenario behaviour.
@@ -20,6 +22,7 @@ from catabot import codec
 from catabot.inbox import Inputs
 from catabot.messages import BodyStates, Message, Tick, TwistBatch, WaypointsCmd
 from catabot.participant import Participant
+from catabot.scenario import guidance_period_ticks
 from catabot.service import Built, ServiceContext, run_service
 from catabot.streams import BodyRows, body_ids, states_stream, waypoint_streams
 from catabot.traffic_plan import plan_traffic
@@ -49,6 +52,7 @@ class TrafficService:
             if ctx.keys.vessel_of(s.key) in self.row
         ]
         self.twists_key = ctx.keys.world_twists()
+        self.period = guidance_period_ticks(ctx.scenario)
         self.participant = Participant(
             ctx.session,
             ctx.keys,
@@ -58,14 +62,20 @@ class TrafficService:
         )
 
     def step(self, tick: Tick, inputs: Inputs) -> None:
+        guide = tick.tick % self.period == 0
         for key, msgs in inputs.items():
             if key == self.states_key:
-                self._take_states(msgs[-1])
+                if guide:  # the states of the ticks between are not needed
+                    self._take_states(msgs[-1])
                 continue
             i = self.row[self.keys.vessel_of(key)]
             for msg in msgs:
                 if isinstance(msg, WaypointsCmd):
                     self._take_waypoints(i, key, msg)
+        if guide:
+            self._guide(tick)
+
+    def _guide(self, tick: Tick) -> None:
         surge, rate = self.behaviours.command(self.pos, self.yaw, self.vel)
         batch = TwistBatch(tick.tick, tick.stamp_ns, self.ids, surge, rate)
         self.participant.publish(self.twists_key, batch)

@@ -14,6 +14,7 @@ from catabot.scenario import (
     BUNDLED,
     Scenario,
     ScenarioError,
+    guidance_period_ticks,
     json_schema,
     load_scenario,
     parse_scenario,
@@ -335,3 +336,22 @@ def test_a_setpoint_delay_that_is_not_a_whole_number_of_ticks(delay: object) -> 
     data = _base()
     data["traffic"] = {"count": 2, "setpoint_delay_ticks": delay}
     assert "traffic.setpoint_delay_ticks:" in _error(data)
+
+
+@pytest.mark.parametrize(
+    ("rate", "says"),
+    [(30.0, "not a whole number of ticks"), (0.0, "greater than 0"), ("fast", "valid number")],
+)
+def test_a_guidance_rate_that_is_not_a_whole_number_of_ticks(rate: object, says: str) -> None:
+    data = _base()
+    data["traffic"] = {"count": 2, "guidance_hz": rate}
+    error = _error(data)
+    assert "traffic.guidance_hz" in error and says in error, error
+
+
+def test_the_guidance_rate_sets_the_period_of_the_set_points() -> None:
+    data = _base()
+    data["traffic"] = {"count": 2, "guidance_hz": 25.0}
+    assert guidance_period_ticks(parse_scenario(data)) == 4
+    data["traffic"] = {"count": 0, "guidance_hz": 30.0}  # no boats: nothing to refuse
+    assert parse_scenario(data).traffic.guidance_hz == 30.0

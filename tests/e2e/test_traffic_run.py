@@ -125,3 +125,18 @@ def test_a_setpoint_reaches_its_boat_after_the_configured_delay(tmp_path: Path) 
         states = _states(only_run_dir(out), "boat_000")
         moving = np.flatnonzero(states[:, 9] > 1e-4)  # linear_velocity_x
         assert moving[0] == 1 + delay and (states[moving[0] :, 9] > 1e-4).all(), moving[:3]
+
+
+def test_set_points_come_at_the_guidance_rate_and_are_held_between(tmp_path: Path) -> None:
+    """`traffic.guidance_hz` 20 at 100 Hz physics: one set-point every 5 ticks, recorded as
+    such, and the boat keeps accelerating on the ticks between (physics holds the last)."""
+    data = _traffic("guidance", 1, duration_s=0.3, recording={"mcap": False})
+    data["traffic"] |= {"behaviour_mix": {"circle": 1.0}, "guidance_hz": 20.0}
+    result = catabot("run", str(scenario_file(tmp_path, data)), "--out", str(tmp_path / "o"),
+                     "--quiet")  # fmt: skip
+    assert result.returncode == 0, result.stderr
+    run = only_run_dir(tmp_path / "o")
+    twists = np.loadtxt(run / "vessel.boat_000.cmd.twist.csv", delimiter=",", skiprows=1)
+    assert twists[:, 1].tolist() == list(range(0, 30, 5))  # the tick column
+    speed = _states(run, "boat_000")[:, 9]  # linear_velocity_x
+    assert (np.diff(speed[1:]) > 0).all(), speed
