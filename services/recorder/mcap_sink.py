@@ -31,6 +31,7 @@ from mcap.stream_reader import MAGIC_SIZE, StreamReader
 from mcap.well_known import MessageEncoding, SchemaEncoding
 from mcap.writer import LIBRARY_IDENTIFIER
 from mcap_ros2.decoder import DecoderFactory
+from numpy.typing import NDArray
 
 from catabot.messages import CameraFrame, LidarScan, Message, VesselState
 from services.recorder import cdr, images, json_schemas, pointcloud, ros2_msgdefs
@@ -80,12 +81,12 @@ class _TickBuffer(io.BufferedIOBase):
 
 @dataclass
 class _Channel:
-    """A registered channel and how its messages become bytes."""
+    """A registered channel and how its messages become bytes (its sequence numbers live in
+    `McapSink._sequence`, one array for all, so a tick's block takes them in one index)."""
 
     id: int
     cls: type[Message]
     encode: typing.Callable[[Message, int], bytes]
-    sequence: int = 0
 
 
 class McapSink:
@@ -100,7 +101,8 @@ class McapSink:
         self._out.flush()
         self._schemas: dict[type[Message] | str, int] = {}  # by message class or ROS 2 type
         self._channels: dict[str, _Channel] = {}
-        self._groups: dict[tuple[tuple[str, ...], type[Message]], tuple[list[_Channel], Any]] = {}
+        self._groups: dict[tuple[tuple[str, ...], type[Message]], NDArray[np.uint16]] = {}
+        self._sequence = np.zeros(1, np.uint32)  # the next sequence number by channel id
         self._closed = False
 
     def write(self, stream: str, msg: Message, *, stamp_ns: int) -> None:
@@ -110,8 +112,7 @@ class McapSink:
             data = chan.encode(msg, stamp_ns)
         except (ValueError, TypeError, IndexError, struct.error) as exc:
             raise RecorderError(f"{stream}: cannot encode {type(msg).__name__}: {exc}") from exc
-        self._writer.add_messages([chan.id], [chan.sequence], stamp_ns, [data])
-        chan.sequence += 1
+        self._add([chan.id], stamp_ns, [data])
 
     def write_block(
         self,
@@ -123,12 +124,11 @@ class McapSink:
     ) -> None:
         """`payloads[i]`, already encoded as the channel of `cls` expects, on `streams[i]`:
         the batch path (`services/recorder/batches.py`), one write for a whole tick."""
-        chans = [self._channel(stream, cls) for stream in streams]
-        self._writer.add_messages(
-            [c.id for c in chans], [c.sequence for c in chans], stamp_ns, payloads
-        )
-        for chan in chans:
-            chan.sequence += 1
+        if not streams:
+            return
+        ids = self._group(streams, cls)
+        sequences = self._next_sequences(ids).tolist()
+        self._writer.add_messages(ids.tolist(), sequences, stamp_ns, payloads)
 
     def write_matrix(
         self, streams: Sequence[str], cls: type[Message], payloads: Any, *, stamp_ns: int
@@ -137,17 +137,32 @@ class McapSink:
         of bodies with equally long ids) go into the file as one block."""
         if not streams:
             return
+        ids = self._group(streams, cls)
+        self._writer.add_block(ids, self._next_sequences(ids), stamp_ns, payloads)
+
+    def _group(self, streams: Sequence[str], cls: type[Message]) -> NDArray[np.uint16]:
+        """The channel ids of `streams`, looked up once: a batch names the same streams every
+        tick (per-stream work in every tick was a loop over 100 boats)."""
         if self._closed:
             raise RecorderError(f"{streams[0]}: the MCAP sink is closed")
         group = (tuple(streams), cls)
-        if group not in self._groups:  # the same streams every tick: look them up once
-            chans = [self._channel(stream, cls) for stream in streams]
-            self._groups[group] = (chans, np.array([c.id for c in chans], np.uint16))
-        chans, ids = self._groups[group]
-        seqs = np.fromiter((c.sequence for c in chans), np.uint32, len(chans))
-        self._writer.add_block(ids, seqs, stamp_ns, payloads)
-        for chan in chans:
-            chan.sequence += 1
+        ids = self._groups.get(group)
+        if ids is None:
+            if len(set(streams)) != len(streams):
+                raise RecorderError(f"a stream appears twice in one block: {list(streams)}")
+            ids = np.array([self._channel(stream, cls).id for stream in streams], np.uint16)
+            self._groups[group] = ids
+        return ids
+
+    def _next_sequences(self, ids: NDArray[np.uint16]) -> NDArray[np.uint32]:
+        """Each channel's next sequence number, counted on (ids are distinct)."""
+        sequences = self._sequence[ids]
+        self._sequence[ids] += 1
+        return sequences
+
+    def _add(self, ids: list[int], stamp_ns: int, payloads: list[bytes]) -> None:
+        sequences = self._next_sequences(np.array(ids, np.uint16))
+        self._writer.add_messages(ids, sequences.tolist(), stamp_ns, payloads)
 
     def write_ros2(
         self, stream: str, type_name: str, msgdef: str, data: bytes, *, stamp_ns: int
@@ -165,10 +180,10 @@ class McapSink:
                 topic, MessageEncoding.CDR, self._schemas[type_name]
             )
             chan = self._channels[stream] = _Channel(cid, _Encoded, _already_encoded)
+            self._sequence = np.append(self._sequence, np.uint32(0))
         elif chan.cls is not _Encoded:
             raise RecorderError(f"{stream}: a {type_name} on a channel of {chan.cls.__name__}")
-        self._writer.add_messages([chan.id], [chan.sequence], stamp_ns, [data])
-        chan.sequence += 1
+        self._add([chan.id], stamp_ns, [data])
 
     def _channel(self, stream: str, cls: type[Message]) -> _Channel:
         if self._closed:
@@ -194,6 +209,7 @@ class McapSink:
         channel_id = self._writer.register_channel(topic, encoding, self._schema(cls))
         chan = _Channel(channel_id, cls, encode)
         self._channels[stream] = chan
+        self._sequence = np.append(self._sequence, np.uint32(0))
         return chan
 
     def _schema(self, cls: type[Message]) -> int:
