@@ -85,8 +85,7 @@ class PhysicsService:
             except ValueError as exc:
                 log.error("vessel %s: refused thrust command: %s", self.world.vessel_ids[row], exc)
         if rows.size:
-            s = self.world.state_arrays()
-            measured = np.stack([s.linear_velocity[rows, 0], s.angular_velocity[rows, 2]], axis=1)
+            measured = self.world.surge_and_yaw_rate(rows)
             try:
                 self.world.set_thrusts(rows, self.controllers.command(rows, target, measured))
             except ValueError as exc:

@@ -208,16 +208,25 @@ class PhysicsWorld:
         return self._kinematics(slice(self._n_vessels, None))
 
     def _kinematics(self, rows: slice) -> KinematicsArrays:
-        rot_t = self._rot[rows].transpose(0, 2, 1)
-        to_body = lambda v: np.einsum("nij,nj->ni", rot_t, v[rows])  # noqa: E731
+        # The four world-frame vectors of each body as rows: v_b^T = v_w^T R, one matmul.
+        world = np.concatenate((self._vel_w[rows], self._acc_w[rows]), axis=1).reshape(-1, 4, 3)
+        body = np.matmul(world, self._rot[rows])  # (N, 4, 3): w, v, dw/dt, dv/dt
         return KinematicsArrays(
             position=self._pos[rows].copy(),
             orientation=self._quat[rows].copy(),
-            linear_velocity=to_body(self._vel_w[:, 3:]),
-            angular_velocity=to_body(self._vel_w[:, :3]),
-            linear_acceleration=to_body(self._acc_w[:, 3:]),
-            angular_acceleration=to_body(self._acc_w[:, :3]),
+            linear_velocity=body[:, 1],
+            angular_velocity=body[:, 0],
+            linear_acceleration=body[:, 3],
+            angular_acceleration=body[:, 2],
         )
+
+    def surge_and_yaw_rate(self, rows: NDArray[np.intp]) -> Array:
+        """(len(rows), 2): body-frame surge speed u and yaw rate r, what the velocity
+        controllers measure (two dot products, not the whole body-frame state)."""
+        rot, vel = self._rot[rows], self._vel_w[rows]
+        u = np.einsum("ni,ni->n", rot[:, :, 0], vel[:, 3:])
+        r = np.einsum("ni,ni->n", rot[:, :, 2], vel[:, :3])
+        return np.stack((u, r), axis=1)
 
     def states(self) -> dict[str, VesselKinematics]:
         """Every vessel's state keyed by vessel id."""
