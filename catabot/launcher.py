@@ -20,6 +20,7 @@ from pathlib import Path
 from catabot.placement import resolve_poses
 from catabot.progress import ProgressBar
 from catabot.scenario import Scenario, ScenarioError, load_scenario
+from catabot.scheduling import SchedulingError, requested_policy
 from catabot.session import free_port
 from catabot.streams import services as needed_services
 from catabot.traffic_plan import plan_traffic
@@ -50,6 +51,7 @@ class RunOptions:
 
 def prepare(opts: RunOptions) -> Scenario:
     """Everything that can be refused is refused here, before any process starts."""
+    requested_policy()  # a bad CATABOT_SCHED would stop every service
     scenario = load_scenario(opts.scenario)
     data = scenario.model_dump()
     if opts.duration_s is not None:
@@ -101,7 +103,7 @@ def _spawn(args: list[str], log_file: Path, *, stdout_pipe: bool = False) -> sub
 def run(opts: RunOptions) -> int:
     try:
         scenario = prepare(opts)
-    except (ScenarioError, VesselModelError, LaunchError) as exc:
+    except (ScenarioError, SchedulingError, VesselModelError, LaunchError) as exc:
         print(f"catabot run: {exc}", file=sys.stderr)
         return 2
     run_dir = make_run_dir(opts.out, scenario)

@@ -28,6 +28,7 @@ from catabot.messages import End
 from catabot.participant import EndFn, Participant, StepFn
 from catabot.placement import resolve_poses
 from catabot.scenario import Scenario, ScenarioError, load_scenario
+from catabot.scheduling import SchedulingError, batch_scheduling
 from catabot.session import SessionError, add_connection_args, connection_from_args, open_session
 from catabot.streams import participants
 from catabot.vessel import VesselModelError
@@ -103,11 +104,12 @@ def run_service(name: str, build: BuildFn, argv: list[str] | None = None) -> int
     single_thread_blas()  # idle BLAS threads spin on the cores other services need
     signal.signal(signal.SIGTERM, lambda *_: sys.exit(143))
     try:
+        batch_scheduling()  # before Zenoh starts its threads, so that they inherit it
         scenario = load_scenario(args.scenario)
         if any(v.pose is None for v in scenario.vessels):
             scenario = resolve_poses(scenario)  # deterministic: every service picks the same
         session = open_session(connection_from_args(args))
-    except (ScenarioError, SessionError, VesselModelError) as exc:
+    except (ScenarioError, SchedulingError, SessionError, VesselModelError) as exc:
         log.error("%s: %s", name, exc)
         return 2
     ctx = ServiceContext(

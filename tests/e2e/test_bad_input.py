@@ -4,6 +4,7 @@ from __future__ import annotations
 
 from pathlib import Path
 
+import pytest
 from conftest import basic_scenario, catabot, scenario_file
 
 
@@ -39,3 +40,14 @@ def test_schema_command_writes_a_json_schema(tmp_path: Path) -> None:
     result = catabot("scenario", "schema", "-o", str(tmp_path / "s.json"))
     assert result.returncode == 0
     assert '"title": "CataBot scenario"' in (tmp_path / "s.json").read_text()
+
+
+def test_an_unknown_scheduling_policy_is_refused_before_start(
+    tmp_path: Path, out: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    monkeypatch.setenv("CATABOT_SCHED", "fifo")
+    result = catabot("run", str(scenario_file(tmp_path, basic_scenario())), "--out", str(out))
+    assert result.returncode == 2, result.stderr
+    assert "CATABOT_SCHED='fifo'" in result.stderr and "batch, normal" in result.stderr
+    assert "Traceback" not in result.stderr
+    assert list(out.iterdir()) == [], "nothing may start"

@@ -2,10 +2,23 @@
 
 from __future__ import annotations
 
+import contextlib
 import json
+import os
+import time
 from pathlib import Path
 
-from conftest import catabot, csv_rows, only_run_dir
+import pytest
+from conftest import (
+    basic_scenario,
+    catabot,
+    csv_rows,
+    only_run_dir,
+    scenario_file,
+    service_pid,
+    start,
+    wait_for_line,
+)
 
 from catabot.vessel import load_vessel_model
 from services.recorder.mcap_sink import read_mcap_messages
@@ -52,3 +65,23 @@ def column(
 ) -> list[float]:
     i = header.index(name)
     return [float(r[i]) for r in data if t_from <= int(r[0]) / 1e9 <= t_to]
+
+
+@pytest.mark.skipif(not hasattr(os, "SCHED_BATCH"), reason="SCHED_BATCH is Linux-only")
+def test_services_step_under_batch_scheduling(tmp_path: Path, out: Path) -> None:
+    """catabot/scheduling.py: every stepping service, and its Zenoh threads, is batch work."""
+    data = basic_scenario(duration_s=3.0, clock={"realtime_factor": 1.0})
+    proc = start("run", str(scenario_file(tmp_path, data)), "--out", str(out), "--quiet")
+    wait_for_line(proc, "zenoh:")
+    threads: list[int] = []
+    for _ in range(100):  # until its Zenoh session has started its threads
+        with contextlib.suppress(LookupError, FileNotFoundError):
+            pid = service_pid(proc.pid, "services.physics")
+            threads = [int(t) for t in os.listdir(f"/proc/{pid}/task")]
+        if len(threads) >= 4:
+            break
+        time.sleep(0.05)
+    policies = {os.sched_getscheduler(t) for t in threads}
+    _, err = proc.communicate(timeout=60)
+    assert proc.returncode == 0, err
+    assert policies == {os.SCHED_BATCH}, policies
