@@ -81,8 +81,8 @@ class _TickBuffer(io.BufferedIOBase):
 
 @dataclass
 class _Channel:
-    """A registered channel and how its messages become bytes (its sequence numbers live in
-    `McapSink._sequence`, one array for all, so a tick's block takes them in one index)."""
+    """A registered channel and how its messages become bytes (its sequence numbers are the
+    writer's message counts: `McapWriter.written`)."""
 
     id: int
     cls: type[Message]
@@ -102,7 +102,6 @@ class McapSink:
         self._schemas: dict[type[Message] | str, int] = {}  # by message class or ROS 2 type
         self._channels: dict[str, _Channel] = {}
         self._groups: dict[tuple[tuple[str, ...], type[Message]], NDArray[np.uint16]] = {}
-        self._sequence = np.zeros(1, np.uint32)  # the next sequence number by channel id
         self._closed = False
 
     def write(self, stream: str, msg: Message, *, stamp_ns: int) -> None:
@@ -154,11 +153,9 @@ class McapSink:
             self._groups[group] = ids
         return ids
 
-    def _next_sequences(self, ids: NDArray[np.uint16]) -> NDArray[np.uint32]:
-        """Each channel's next sequence number, counted on (ids are distinct)."""
-        sequences = self._sequence[ids]
-        self._sequence[ids] += 1
-        return sequences
+    def _next_sequences(self, ids: NDArray[np.uint16]) -> NDArray[np.int64]:
+        """Each channel's next sequence number (ids are distinct): its messages so far."""
+        return self._writer.written(ids)
 
     def _add(self, ids: list[int], stamp_ns: int, payloads: list[bytes]) -> None:
         sequences = self._next_sequences(np.array(ids, np.uint16))
@@ -180,7 +177,6 @@ class McapSink:
                 topic, MessageEncoding.CDR, self._schemas[type_name]
             )
             chan = self._channels[stream] = _Channel(cid, _Encoded, _already_encoded)
-            self._sequence = np.append(self._sequence, np.uint32(0))
         elif chan.cls is not _Encoded:
             raise RecorderError(f"{stream}: a {type_name} on a channel of {chan.cls.__name__}")
         self._add([chan.id], stamp_ns, [data])
@@ -209,7 +205,6 @@ class McapSink:
         channel_id = self._writer.register_channel(topic, encoding, self._schema(cls))
         chan = _Channel(channel_id, cls, encode)
         self._channels[stream] = chan
-        self._sequence = np.append(self._sequence, np.uint32(0))
         return chan
 
     def _schema(self, cls: type[Message]) -> int:

@@ -89,6 +89,11 @@ class McapWriter:
         self._note_times(log_time, len(payloads))
         self._write(b"".join(parts))
 
+    def written(self, channels: NDArray[np.integer]) -> NDArray[np.int64]:
+        """Messages written so far on each of `channels`: the sequence numbers their next
+        messages take when, as in `McapSink`, every channel counts from 0 in steps of 1."""
+        return self._counts[channels]
+
     def _count(self, channels: NDArray[np.integer]) -> None:
         """One more message on each of `channels` (ids may repeat); unknown ids refused
         before anything is counted or written."""
