@@ -12,6 +12,7 @@ import functools
 import itertools
 import math
 import zlib
+from collections.abc import Sequence
 from dataclasses import dataclass
 
 import numpy as np
@@ -103,17 +104,24 @@ class Planner:
         for v in scenario.vessels:
             assert v.pose is not None
             self.placed.append((v.pose.x_m, v.pose.y_m, footprint_m(load_vessel_model(v.model))))
+        self.buoy_r = footprint_m(load_vessel_model("buoy"))
+        # Buoys are moored: a boat must not start on one, nor circle through one every lap.
+        self.marks: Placed = [(b.x_m, b.y_m, self.buoy_r) for b in scenario.buoys]
+        self.rings: list[tuple[float, float, float, float]] = []  # circles: x, y, R, hull r
+        self.footprints: dict[str, float] = {}  # by model, as drawn
         self.overrides = {b.index: b for b in self.cfg.boats}
 
     def plan(self) -> TrafficPlan:
         boats = tuple(self._boat(i) for i in range(self.cfg.count))
-        buoys = tuple(
-            BuoyConfig(id=f"{b.id}_wp{k}", x_m=x, y_m=y)
-            for b in boats
-            if b.behaviour == "waypoints" and self.cfg.waypoints.buoys
-            for k, (x, y) in enumerate(b.path)
-        )
-        return TrafficPlan(boats, buoys)
+        buoys: list[BuoyConfig] = []
+        for b in boats:
+            if b.behaviour == "waypoints" and self.cfg.waypoints.buoys:
+                buoys += [
+                    BuoyConfig(id=f"{b.id}_wp{k}", x_m=x, y_m=y)
+                    for k, (x, y) in enumerate(b.path)
+                    if not any(_touch(x, y, self.buoy_r, q.x_m, q.y_m, self.buoy_r) for q in buoys)
+                ]  # a point several paths share (given points) gets one buoy, not a pile
+        return TrafficPlan(boats, tuple(buoys))
 
     def _boat(self, index: int) -> Boat:
         over = self.overrides.get(index, BoatOverride(index=index))
@@ -122,6 +130,7 @@ class Planner:
         behaviour = over.behaviour or self._pick(list(mix), list(mix.values()))
         hull = load_vessel_model(model)
         radius, draft = footprint_m(hull), keel_depth_m(hull)
+        self.footprints[model] = radius
         for _ in range(TRIES):
             x, y = self._point(self.cfg.region)
             x, y = over.x_m if over.x_m is not None else x, over.y_m if over.y_m is not None else y
@@ -159,9 +168,8 @@ class Planner:
         return 0.0, 0.0
 
     def _free(self, x: float, y: float, radius: float, draft: float) -> bool:
-        """Clear of every vessel placed so far, and in water deep enough for the hull."""
-        gap = CLEARANCE_M
-        if any(math.hypot(x - px, y - py) <= radius + pr + gap for px, py, pr in self.placed):
+        """Clear of every vessel and buoy placed so far, and in water deep enough for the hull."""
+        if any(_touch(x, y, radius, *other) for other in (*self.placed, *self.marks)):
             return False
         if self.terrain is None:
             return True
@@ -180,6 +188,20 @@ class Planner:
         w, h = self.terrain.size_m
         inside = bool(((xs >= 0) & (xs <= w) & (ys >= 0) & (ys <= h)).all())
         return inside and bool((self.terrain.depth(xs, ys) > 2.0).all())
+
+    def _buoys_clear(self, path: Sequence[Point], boat: Boat) -> bool:
+        """Random waypoints (each to get a buoy) clear of every start, the boat's own
+        included, of every buoy and of every circling boat's track."""
+        if not self.cfg.waypoints.buoys:
+            return True
+        r = self.buoy_r
+        own = (boat.pose.x_m, boat.pose.y_m, self.footprints[boat.model])
+        starts = (*self.placed, *self.marks, own)
+        return not any(
+            any(_touch(x, y, r, *o) for o in starts)
+            or any(_on_ring(x, y, r, *c) for c in self.rings)
+            for x, y in path
+        )
 
     def _behave(
         self, index: int, model: str, pose: Pose, behaviour: str, over: BoatOverride
@@ -203,6 +225,10 @@ class Planner:
         a = np.linspace(0, 2 * math.pi, 48, endpoint=False)
         if not self._wet(cx + (radius + 3) * np.cos(a), cy + (radius + 3) * np.sin(a)):
             return None
+        ring = (cx, cy, radius, self.footprints[base.model])
+        if any(_on_ring(*mark, *ring) for mark in self.marks):
+            return None
+        self.rings.append(ring)
         return Boat(base.id, base.model, p, "circle", c.speed_mps, (cx, cy), radius, direction)
 
     def _waypoints(self, base: Boat, points: list[Point] | None) -> Boat | None:
@@ -210,18 +236,34 @@ class Planner:
         given = points or w.points
         for _ in range(1 if given else 50):
             path = (
-                [tuple(q) for q in given]
+                [(float(q[0]), float(q[1])) for q in given]
                 if given
                 else [self._point(w.region) for _ in range(w.count)]
             )
             track = np.array([(base.pose.x_m, base.pose.y_m), *path])
+            if not given and not self._buoys_clear(path, base):
+                continue
             if self._wet(*_densify(track, loop=w.mode == "loop")):
+                if w.buoys:
+                    self.marks += [(x, y, self.buoy_r) for x, y in path]
                 return Boat(
                     base.id, base.model, base.pose, "waypoints", w.speed_mps,
                     path=tuple((float(x), float(y)) for x, y in path),
                     loop=w.mode == "loop", tolerance_m=w.tolerance_m,
                 )  # fmt: skip
         return None
+
+
+def _touch(x: float, y: float, r: float, ox: float, oy: float, o_r: float) -> bool:
+    """Two footprints closer than the placement clearance."""
+    return math.hypot(x - ox, y - oy) <= r + o_r + CLEARANCE_M
+
+
+def _on_ring(
+    x: float, y: float, r: float, cx: float, cy: float, radius: float, hull: float
+) -> bool:
+    """A footprint that a boat of footprint `hull` circling (cx, cy) at `radius` sweeps."""
+    return abs(math.hypot(x - cx, y - cy) - radius) <= r + hull + CLEARANCE_M
 
 
 def _densify(

@@ -98,7 +98,8 @@ class Behaviours:
         self.radius = np.array([max(b.radius_m, 1.0) for b in boats], dtype=np.float64)
         self.direction = np.array([b.direction for b in boats], dtype=np.float64)
         self.hold_yaw = np.array([b.pose.yaw_rad for b in boats], dtype=np.float64)
-        self.paths: list[Array] = [np.zeros((0, 2))] * n
+        self.paths = np.zeros((n, 1, 2))  # (N, longest path, 2), padded
+        self.length = np.ones(n, dtype=np.int64)  # points in each boat's path
         self.index = np.zeros(n, dtype=np.int64)
         self.step = np.ones(n, dtype=np.int64)
         self.loop = np.zeros(n, dtype=bool)
@@ -110,7 +111,16 @@ class Behaviours:
     def set_path(self, i: int, points: Array, speed: float, *, loop: bool, tol: float) -> None:
         """Boat i follows `points` (K, 2) from the first one on."""
         self.kind[i], self.speed[i], self.loop[i], self.tol[i] = WAYPOINTS, speed, loop, tol
-        self.paths[i] = np.asarray(points, dtype=np.float64).reshape(-1, 2)
+        self._store_path(i, np.asarray(points, dtype=np.float64).reshape(-1, 2))
+
+    def _store_path(self, i: int, points: Array) -> None:
+        """Boat i's path into the padded array (widened when a longer path arrives)."""
+        if len(points) > self.paths.shape[1]:
+            wider = np.zeros((len(self.paths), len(points), 2))
+            wider[:, : self.paths.shape[1]] = self.paths
+            self.paths = wider
+        self.paths[i, : len(points)] = points
+        self.length[i] = max(len(points), 1)
         self.index[i], self.step[i] = 0, 1
 
     def release(self, i: int) -> None:
@@ -118,8 +128,7 @@ class Behaviours:
         b = self.boats[i]
         self.kind[i], self.speed[i] = KINDS[b.behaviour], b.speed_mps
         self.tol[i], self.loop[i] = b.tolerance_m, b.loop
-        self.paths[i] = np.array(b.path, dtype=np.float64).reshape(-1, 2)
-        self.index[i], self.step[i] = 0, 1
+        self._store_path(i, np.array(b.path, dtype=np.float64).reshape(-1, 2))
 
     def command(self, pos: Array, yaw: Array, velocity_b: Array) -> tuple[Array, Array]:
         """Set-points for every boat: pos (N, 2) m, yaw (N,), body velocity (N, >=2)."""
@@ -147,20 +156,17 @@ class Behaviours:
     def _path(
         self, rows: NDArray[np.intp], pos: Array, _: Array, chi: Array, __: Array
     ) -> tuple[Array, Array]:
-        target = np.array([self.paths[i][self.index[i]] for i in rows]).reshape(-1, 2)
-        reached = np.hypot(*(target - pos).T) < self.tol[rows]
-        for i in rows[reached]:
-            self._advance(int(i))
-        target = np.array([self.paths[i][self.index[i]] for i in rows]).reshape(-1, 2)
+        target = self.paths[rows, self.index[rows]]
+        reached = rows[np.hypot(*(target - pos).T) < self.tol[rows]]
+        if reached.size:
+            self._advance(reached)
+            target = self.paths[rows, self.index[rows]]
         return pursuit_law(pos, chi, target, self.speed[rows])
 
-    def _advance(self, i: int) -> None:
+    def _advance(self, rows: NDArray[np.intp]) -> None:
         """Next point: wrap round when looping, turn back at either end otherwise."""
-        k, n = self.index[i] + self.step[i], len(self.paths[i])
-        if self.loop[i]:
-            self.index[i] = k % n
-            return
-        if not 0 <= k < n:
-            self.step[i] = -self.step[i]
-            k = self.index[i] + self.step[i]
-        self.index[i] = k
+        k, n = self.index[rows] + self.step[rows], self.length[rows]
+        back = ~self.loop[rows] & ((k < 0) | (k >= n))
+        self.step[rows[back]] *= -1
+        k[back] = self.index[rows[back]] + self.step[rows[back]]
+        self.index[rows] = np.where(self.loop[rows], k % n, np.clip(k, 0, n - 1))  # 1 point

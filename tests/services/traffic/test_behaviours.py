@@ -156,3 +156,23 @@ def test_a_bad_mix_is_refused_naming_the_field() -> None:
 
     with pytest.raises(ScenarioError, match=r"traffic\.behaviour_mix"):
         parse_scenario(_scenario(3) | {"traffic": {"count": 3, "behaviour_mix": {"zigzag": 1}}})
+
+
+def test_path_points_advance_for_many_boats_at_once() -> None:
+    """Looping, back and forth, a one-point path, and a longer path adopted at run time."""
+    boats = [Boat(f"b{i}", "monohull", Pose(), "waypoints", 5.0, path=((0.0, 0.0), (50.0, 0.0),
+             (50.0, 50.0)), loop=i == 0, tolerance_m=5.0) for i in range(2)]  # fmt: skip
+    boats.append(Boat("b2", "monohull", Pose(), "waypoints", 5.0, path=((9.0, 9.0),)))
+    behaviours = Behaviours(boats)
+    seen = []
+    for _ in range(5):  # every boat sits on its current point: each call advances it
+        pos = behaviours.paths[np.arange(3), behaviours.index]
+        behaviours.command(pos, np.zeros(3), np.zeros((3, 2)))
+        seen.append(behaviours.index.tolist())
+    assert [s[0] for s in seen] == [1, 2, 0, 1, 2]  # loop
+    assert [s[1] for s in seen] == [1, 2, 1, 0, 1]  # back and forth
+    assert [s[2] for s in seen] == [0] * 5  # a single point stays the target
+    behaviours.set_path(2, np.array([(0.0, 0.0), (1.0, 1.0), (2.0, 2.0), (3.0, 3.0)]), 2.0,
+                        loop=False, tol=1.0)  # fmt: skip
+    assert behaviours.paths.shape[1] == 4 and behaviours.length.tolist() == [3, 3, 4]
+    assert behaviours.paths[0, :3].tolist() == [[0, 0], [50, 0], [50, 50]]

@@ -1,0 +1,48 @@
+"""The traffic plan keeps moored buoys clear: of every start and of every circling track."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from catabot.placement import footprint_m
+from catabot.scenario import parse_scenario
+from catabot.traffic_plan import TrafficPlan, plan_traffic
+from catabot.vessel import load_vessel_model
+
+HULL = footprint_m(load_vessel_model("monohull"))
+BUOY = footprint_m(load_vessel_model("buoy"))
+
+
+def _plan(count: int, **traffic: object) -> TrafficPlan:
+    data = {
+        "seed": 3,
+        "vessels": [{"id": "ego", "pose": {"x_m": 0.0, "y_m": 0.0}}],
+        "buoys": [{"id": "mark", "x_m": 40.0, "y_m": 0.0}],
+        "traffic": {
+            "count": count,
+            "behaviour_mix": {"circle": 0.5, "waypoints": 0.5},
+            "region": {"size_m": [400.0, 400.0]},
+            "waypoints": {"region": {"size_m": [400.0, 400.0]}},
+            **traffic,
+        },
+    }
+    return plan_traffic(parse_scenario(data))
+
+
+def test_no_boat_starts_on_a_buoy_and_no_circle_runs_through_one() -> None:
+    plan = _plan(120)
+    buoys = np.array([(40.0, 0.0)] + [(b.x_m, b.y_m) for b in plan.buoys])
+    assert len(buoys) > 150  # the region is crowded enough for the check to bite
+    starts = np.array([(0.0, 0.0)] + [(b.pose.x_m, b.pose.y_m) for b in plan.boats])
+    gap = np.hypot(*(starts[:, None] - buoys[None]).transpose(2, 0, 1))
+    assert gap.min() > HULL + BUOY
+    for boat in (b for b in plan.boats if b.behaviour == "circle"):
+        off_ring = np.abs(np.hypot(*(buoys - boat.center).T) - boat.radius_m)
+        assert off_ring.min() > HULL + BUOY, boat.id
+
+
+def test_buoys_never_overlap_even_where_every_path_shares_its_points() -> None:
+    points = [[60.0, 60.0], [-60.0, 60.0], [-60.0, -60.0]]
+    plan = _plan(6, behaviour_mix={"waypoints": 1.0}, waypoints={"points": points})
+    assert [(b.x_m, b.y_m) for b in plan.buoys] == [tuple(p) for p in points]
+    assert all(b.path == tuple(map(tuple, points)) for b in plan.boats)
