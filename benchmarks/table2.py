@@ -5,10 +5,10 @@ Each cell is one `catabot run --quiet` (real processes, the recorder on): physic
 GPS, plus N traffic boats; then with a segmentation camera, then with all four camera
 outputs. The boats circle, the original's default (`boatControlType` "Circles"); a last
 row runs 100 boats half of them on waypoint paths, with a floating buoy at each of their
-255 waypoints. It prints the real-time factor and LiDAR scans per wall-clock second (from
-each run's log/run.json) beside the paper's frames per second. The paper's FPS is the Unity
-frame rate; our nearest figure is the LiDAR scan rate, and the real-time factor says
-whether the run kept up with the clock at all. Sensor types not registered in
+waypoints (275 with seed 1). It prints the real-time factor and LiDAR scans per wall-clock
+second (from each run's log/run.json) beside the paper's frames per second. The paper's
+FPS is the Unity frame rate; our nearest figure is the LiDAR scan rate, and the real-time
+factor says whether the run kept up with the clock at all. Sensor types not registered in
 catabot/sensor_types.py are left out, and the table says which.
 
 Usage: python -m benchmarks.table2 [seconds]  (simulated seconds per run, default 5), or
@@ -24,7 +24,9 @@ import tempfile
 from pathlib import Path
 from typing import Any
 
+from catabot.scenario import parse_scenario
 from catabot.sensor_types import SENSOR_TYPES
+from catabot.traffic_plan import plan_traffic
 
 BOATS = (0, 5, 10, 20, 50, 100)
 LIDAR_HZ = 10.0
@@ -65,6 +67,11 @@ def scenario(
         "vessels": [{"id": "ego", "pose": {"x_m": 0.0, "y_m": 0.0}, "sensors": sensors(column)}],
         "traffic": {"count": boats, "behaviour_mix": mix},
     }
+
+
+def buoys(seconds: float) -> int:
+    """The waypoint buoys of the last row, as the traffic plan places them."""
+    return len(plan_traffic(parse_scenario(scenario(100, 0, seconds, MIX))).buoys)
 
 
 def run_once(data: dict[str, Any], folder: Path) -> dict[str, Any]:
@@ -115,7 +122,9 @@ def main(argv: list[str] | None = None) -> None:
     rtf: dict[int, float] = {}
     with tempfile.TemporaryDirectory(prefix="table2-") as tmp:
         for boats, mix in [(b, CIRCLES) for b in BOATS] + [(100, MIX)]:
-            label = f"{boats:4d} boats" + (" (half on waypoints, 255 buoys)" if mix is MIX else "")
+            label = f"{boats:4d} boats" + (
+                f" (half on waypoints, {buoys(seconds)} buoys)" if mix is MIX else ""
+            )
             row = [label]
             for column in columns:
                 result = run_once(scenario(boats, column, seconds, mix), Path(tmp))
