@@ -24,7 +24,6 @@ from catabot.traffic_config import BEHAVIOURS, BoatOverride, Point, Region, Traf
 from catabot.vessel import load_vessel_model
 
 TRIES = 2000
-Placed = list[tuple[float, float, float]]  # x, y, footprint radius
 
 
 @dataclass(frozen=True)
@@ -100,27 +99,30 @@ class Planner:
         self.terrain = terrain
         seed = scenario.seed if self.cfg.seed is None else self.cfg.seed
         self.rng = np.random.default_rng([seed & 0xFFFFFFFF, zlib.crc32(b"traffic")])
-        self.placed: Placed = []
+        self.placed = _Rows(3)  # vessels' starts: x, y, footprint radius
         for v in scenario.vessels:
             assert v.pose is not None
-            self.placed.append((v.pose.x_m, v.pose.y_m, footprint_m(load_vessel_model(v.model))))
+            self.placed.add(v.pose.x_m, v.pose.y_m, footprint_m(load_vessel_model(v.model)))
         self.buoy_r = footprint_m(load_vessel_model("buoy"))
         # Buoys are moored: a boat must not start on one, nor circle through one every lap.
-        self.marks: Placed = [(b.x_m, b.y_m, self.buoy_r) for b in scenario.buoys]
-        self.rings: list[tuple[float, float, float, float]] = []  # circles: x, y, R, hull r
+        self.marks = _Rows(3)  # buoys: x, y, footprint radius
+        for b in scenario.buoys:
+            self.marks.add(b.x_m, b.y_m, self.buoy_r)
+        self.rings = _Rows(4)  # circling boats: centre x, y, radius, hull footprint
         self.footprints: dict[str, float] = {}  # by model, as drawn
         self.overrides = {b.index: b for b in self.cfg.boats}
 
     def plan(self) -> TrafficPlan:
         boats = tuple(self._boat(i) for i in range(self.cfg.count))
         buoys: list[BuoyConfig] = []
+        laid = _Rows(3)
         for b in boats:
-            if b.behaviour == "waypoints" and self.cfg.waypoints.buoys:
-                buoys += [
-                    BuoyConfig(id=f"{b.id}_wp{k}", x_m=x, y_m=y)
-                    for k, (x, y) in enumerate(b.path)
-                    if not any(_touch(x, y, self.buoy_r, q.x_m, q.y_m, self.buoy_r) for q in buoys)
-                ]  # a point several paths share (given points) gets one buoy, not a pile
+            if b.behaviour != "waypoints" or not self.cfg.waypoints.buoys:
+                continue
+            for k, (x, y) in enumerate(b.path):  # a point several paths share (given
+                if _clear(np.array([(x, y)]), self.buoy_r, laid.array):  # points): one buoy
+                    buoys.append(BuoyConfig(id=f"{b.id}_wp{k}", x_m=x, y_m=y))
+                    laid.add(x, y, self.buoy_r)
         return TrafficPlan(boats, tuple(buoys))
 
     def _boat(self, index: int) -> Boat:
@@ -141,7 +143,7 @@ class Planner:
                 continue
             boat = self._behave(index, model, Pose(x_m=x, y_m=y, yaw_rad=yaw), behaviour, over)
             if boat is not None:
-                self.placed.append((x, y, radius))
+                self.placed.add(x, y, radius)
                 return boat
         raise ScenarioError(f"traffic: no free open water for boat {index} in {TRIES} draws")
 
@@ -169,7 +171,8 @@ class Planner:
 
     def _free(self, x: float, y: float, radius: float, draft: float) -> bool:
         """Clear of every vessel and buoy placed so far, and in water deep enough for the hull."""
-        if any(_touch(x, y, radius, *other) for other in (*self.placed, *self.marks)):
+        here = np.array([(x, y)])
+        if not (_clear(here, radius, self.placed.array) and _clear(here, radius, self.marks.array)):
             return False
         if self.terrain is None:
             return True
@@ -194,13 +197,13 @@ class Planner:
         included, of every buoy and of every circling boat's track."""
         if not self.cfg.waypoints.buoys:
             return True
-        r = self.buoy_r
-        own = (boat.pose.x_m, boat.pose.y_m, self.footprints[boat.model])
-        starts = (*self.placed, *self.marks, own)
-        return not any(
-            any(_touch(x, y, r, *o) for o in starts)
-            or any(_on_ring(x, y, r, *c) for c in self.rings)
-            for x, y in path
+        points, r = np.array(path, dtype=np.float64).reshape(-1, 2), self.buoy_r
+        own = np.array([(boat.pose.x_m, boat.pose.y_m, self.footprints[boat.model])])
+        return (
+            _clear(points, r, self.placed.array)
+            and _clear(points, r, self.marks.array)
+            and _clear(points, r, own)
+            and _off_rings(points, r, self.rings.array)
         )
 
     def _behave(
@@ -226,9 +229,10 @@ class Planner:
         if not self._wet(cx + (radius + 3) * np.cos(a), cy + (radius + 3) * np.sin(a)):
             return None
         ring = (cx, cy, radius, self.footprints[base.model])
-        if any(_on_ring(*mark, *ring) for mark in self.marks):
+        marks = self.marks.array
+        if not _off_rings(marks[:, :2], marks[:, 2], np.array([ring])):
             return None
-        self.rings.append(ring)
+        self.rings.add(*ring)
         return Boat(base.id, base.model, p, "circle", c.speed_mps, (cx, cy), radius, direction)
 
     def _waypoints(self, base: Boat, points: list[Point] | None) -> Boat | None:
@@ -245,7 +249,8 @@ class Planner:
                 continue
             if self._wet(*_densify(track, loop=w.mode == "loop")):
                 if w.buoys:
-                    self.marks += [(x, y, self.buoy_r) for x, y in path]
+                    for x, y in path:
+                        self.marks.add(x, y, self.buoy_r)
                 return Boat(
                     base.id, base.model, base.pose, "waypoints", w.speed_mps,
                     path=tuple((float(x), float(y)) for x, y in path),
@@ -254,16 +259,37 @@ class Planner:
         return None
 
 
-def _touch(x: float, y: float, r: float, ox: float, oy: float, o_r: float) -> bool:
-    """Two footprints closer than the placement clearance."""
-    return math.hypot(x - ox, y - oy) <= r + o_r + CLEARANCE_M
+class _Rows:
+    """Rows added one at a time, read as one array: the planner tests every draw against
+    all of them (1300 buoys with 500 boats). Storage doubles when full, so an add is O(1)."""
+
+    def __init__(self, width: int) -> None:
+        self._data = np.zeros((16, width))
+        self._count = 0
+
+    def add(self, *row: float) -> None:
+        if self._count == len(self._data):
+            self._data = np.concatenate((self._data, np.zeros_like(self._data)))
+        self._data[self._count] = row
+        self._count += 1
+
+    @property
+    def array(self) -> np.ndarray:
+        return self._data[: self._count]
 
 
-def _on_ring(
-    x: float, y: float, r: float, cx: float, cy: float, radius: float, hull: float
-) -> bool:
-    """A footprint that a boat of footprint `hull` circling (cx, cy) at `radius` sweeps."""
-    return abs(math.hypot(x - cx, y - cy) - radius) <= r + hull + CLEARANCE_M
+def _clear(points: np.ndarray, r: float | np.ndarray, discs: np.ndarray) -> bool:
+    """Footprints of radius r at points (K, 2) clear of discs (M, 3: x, y, radius)."""
+    gap = np.hypot(points[:, None, 0] - discs[:, 0], points[:, None, 1] - discs[:, 1])
+    return not bool((gap <= np.reshape(r, (-1, 1)) + discs[:, 2] + CLEARANCE_M).any())
+
+
+def _off_rings(points: np.ndarray, r: float | np.ndarray, rings: np.ndarray) -> bool:
+    """Footprints at points (K, 2) clear of what boats circling rings (M, 4: centre x, y,
+    radius, hull footprint) sweep."""
+    d = np.hypot(points[:, None, 0] - rings[:, 0], points[:, None, 1] - rings[:, 1])
+    reach = np.reshape(r, (-1, 1)) + rings[:, 3] + CLEARANCE_M
+    return not bool((np.abs(d - rings[:, 2]) <= reach).any())
 
 
 def _densify(
