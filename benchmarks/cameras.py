@@ -22,11 +22,12 @@ from collections.abc import Callable
 import numpy as np
 
 from benchmarks.sensors import TERRAIN
-from catabot.blas import single_thread_blas
-from catabot.messages import VesselState
-from catabot.sensor_types import CameraParams, RadarParams
-from catabot.terrain import load_terrain
-from catabot.waves import WaveConfig, WaveField
+from catabot.bus.blas import single_thread_blas
+from catabot.bus.messages import VesselState
+from catabot.config.sensors import CameraParams, RadarParams
+from catabot.config.waves import WaveConfig
+from catabot.world.terrain import load_terrain
+from catabot.world.waves import WaveField
 from services.sensors.camera import CameraModel
 from services.sensors.camera_boxes import candidate_rays
 from services.sensors.radar import RadarModel

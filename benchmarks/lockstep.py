@@ -16,10 +16,10 @@ import time
 
 import zenoh
 
-from catabot.conductor import ClockSpec, Conductor
-from catabot.keys import Keys
-from catabot.scenario import ClockConfig
-from catabot.session import Connection, free_port, open_session
+from catabot.bus.conductor import ClockSpec, Conductor
+from catabot.bus.keys import Keys
+from catabot.bus.session import Connection, free_port, open_session
+from catabot.config.scenario import ClockConfig
 
 TICKS = 3000
 PEERS = (1, 2, 4, 8)

@@ -6,10 +6,10 @@ import argparse
 
 import zenoh
 
-from catabot.keys import Keys
-from catabot.messages import Tick
-from catabot.participant import Participant
-from catabot.session import Connection, open_session
+from catabot.bus.keys import Keys
+from catabot.bus.messages import Tick
+from catabot.bus.participant import Participant
+from catabot.bus.session import Connection, open_session
 
 
 def catabot_peer(session: zenoh.Session, world: str, name: str, peers: list[str]) -> None:

@@ -12,9 +12,11 @@ import time
 
 import numpy as np
 
-from catabot.environment import CurrentField, WindConfig, WindField, WindZone
-from catabot.vessel import load_vessel_model
-from catabot.waves import WaveConfig, WaveField
+from catabot.config.environment import WindConfig, WindZone
+from catabot.config.vessel import load_vessel_model
+from catabot.config.waves import WaveConfig
+from catabot.world.environment import CurrentField, WindField
+from catabot.world.waves import WaveField
 from services.physics.world import PhysicsWorld
 
 COUNTS = (1, 10, 50, 100, 101, 200)

@@ -20,11 +20,13 @@ from pathlib import Path
 
 import numpy as np
 
-from catabot.blas import single_thread_blas
-from catabot.messages import VesselState
-from catabot.sensor_types import LidarParams
-from catabot.terrain import TerrainConfig, load_terrain
-from catabot.waves import WaveConfig, WaveField
+from catabot.bus.blas import single_thread_blas
+from catabot.bus.messages import VesselState
+from catabot.config.sensors import LidarParams
+from catabot.config.terrain import TerrainConfig
+from catabot.config.waves import WaveConfig
+from catabot.world.terrain import load_terrain
+from catabot.world.waves import WaveField
 from services.sensors.lidar import LidarModel
 from services.sensors.rain import RainParams, apply_rain
 from services.sensors.scene import CLASS_BUOY, CLASS_VESSEL, Body, Scene

@@ -24,9 +24,9 @@ import tempfile
 from pathlib import Path
 from typing import Any
 
-from catabot.scenario import parse_scenario
-from catabot.sensor_types import SENSOR_TYPES
-from catabot.traffic_plan import plan_traffic
+from catabot.config.scenario import parse_scenario
+from catabot.config.sensors import SENSOR_TYPES
+from catabot.world.traffic_plan import plan_traffic
 
 BOATS = (0, 5, 10, 20, 50, 100)
 LIDAR_HZ = 10.0
@@ -80,7 +80,7 @@ def run_once(data: dict[str, Any], folder: Path) -> dict[str, Any]:
     path.write_text(json.dumps(data))
     out = folder / data["name"]
     proc = subprocess.run(
-        [sys.executable, "-m", "catabot.cli", "run", str(path), "--quiet", "--out", str(out)],
+        [sys.executable, "-m", "catabot", "run", str(path), "--quiet", "--out", str(out)],
         capture_output=True,
         text=True,
     )

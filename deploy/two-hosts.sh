@@ -21,13 +21,13 @@ for ns in "$A" "$B"; do ip -n "$ns" link set lo up; done
 ip -n "$A" link set "$VA" up; ip -n "$B" link set "$VB" up
 router=tcp/10.203.0.1:7447
 flags=(--scenario "$scenario" --connect "$router" --mode client)
-ip netns exec "$A" "$py" -m catabot.cli router --listen "$router" >"$out/router.log" 2>&1 &
+ip netns exec "$A" "$py" -m catabot router --listen "$router" >"$out/router.log" 2>&1 &
 sleep 1
 for svc in physics sensors recorder; do
-  ip netns exec "$B" "$py" -m catabot.cli service "$svc" "${flags[@]}" --run-dir "$out" \
+  ip netns exec "$B" "$py" -m catabot service "$svc" "${flags[@]}" --run-dir "$out" \
     >"$out/$svc.log" 2>&1 &
 done
-ip netns exec "$A" "$py" -m catabot.cli service conductor "${flags[@]}" >"$out/conductor.out" \
+ip netns exec "$A" "$py" -m catabot service conductor "${flags[@]}" >"$out/conductor.out" \
   2>"$out/conductor.log"
 status=$?
 sleep 2

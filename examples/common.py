@@ -6,7 +6,7 @@ import argparse
 
 import zenoh
 
-from catabot.session import add_connection_args, connection_from_args, open_session
+from catabot.bus.session import add_connection_args, connection_from_args, open_session
 
 
 def parser(description: str) -> argparse.ArgumentParser:

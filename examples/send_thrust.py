@@ -8,9 +8,9 @@ import time
 
 from common import parser, session
 
-from catabot import codec
-from catabot.keys import Keys
-from catabot.messages import ThrustCmd
+from catabot.bus import codec
+from catabot.bus.keys import Keys
+from catabot.bus.messages import ThrustCmd
 
 p = parser(__doc__)
 p.add_argument("--thrust", type=float, nargs="+", required=True)

@@ -7,9 +7,9 @@ import time
 
 from common import parser, session
 
-from catabot import codec
-from catabot.keys import Keys
-from catabot.messages import VesselState
+from catabot.bus import codec
+from catabot.bus.keys import Keys
+from catabot.bus.messages import VesselState
 
 args = parser(__doc__).parse_args()
 

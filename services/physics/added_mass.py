@@ -40,7 +40,7 @@ from collections.abc import Sequence
 
 import numpy as np
 
-from catabot.vessel import VesselModel
+from catabot.config.vessel import VesselModel
 from services.physics.hydro import Array
 
 

@@ -20,10 +20,10 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
-from catabot import codec
-from catabot.clock import NS_PER_S
-from catabot.messages import Message, ThrustCmd, TwistBatch, TwistCmd, WaypointsCmd
-from catabot.scenario import ScriptStep, VesselConfig
+from catabot.bus import codec
+from catabot.bus.clock import NS_PER_S
+from catabot.bus.messages import Message, ThrustCmd, TwistBatch, TwistCmd, WaypointsCmd
+from catabot.config.scenario import ScriptStep, VesselConfig
 
 Array = NDArray[np.float64]
 

@@ -19,7 +19,7 @@ from __future__ import annotations
 import numpy as np
 from numpy.typing import NDArray
 
-from catabot.vessel import VesselModel
+from catabot.config.vessel import VesselModel
 
 Array = NDArray[np.float64]
 

@@ -25,7 +25,7 @@ from collections.abc import Sequence
 import dartpy as dart
 import numpy as np
 
-from catabot.vessel import VesselModel, load_vessel_model
+from catabot.config.vessel import VesselModel, load_vessel_model
 from services.physics.hydro import Array
 
 StartPose = tuple[float, float, float, float]  # x, y, z (m, map ENU), yaw (rad)

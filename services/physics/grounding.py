@@ -42,8 +42,8 @@ import dartpy as dart
 import numpy as np
 from numpy.typing import NDArray
 
-from catabot.terrain import Terrain
-from catabot.vessel import Hull, VesselModel
+from catabot.config.vessel import Hull, VesselModel
+from catabot.world.terrain import Terrain
 from services.physics.hydro import Array
 
 Index = NDArray[np.intp]

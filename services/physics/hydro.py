@@ -13,7 +13,7 @@ from collections.abc import Callable, Sequence
 import numpy as np
 from numpy.typing import NDArray
 
-from catabot.vessel import Hull, Thruster, VesselModel
+from catabot.config.vessel import Hull, Thruster, VesselModel
 
 Array = NDArray[np.float64]
 WaterHeight = Callable[[Array, Array, float], Array]

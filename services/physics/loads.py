@@ -17,8 +17,8 @@ from collections.abc import Sequence
 
 import numpy as np
 
-from catabot.environment import CurrentField, WindField
-from catabot.vessel import VesselModel
+from catabot.config.vessel import VesselModel
+from catabot.world.environment import CurrentField, WindField
 from services.physics.added_mass import AddedMass
 from services.physics.hydro import Array
 from services.physics.wind import wind_gains, wind_wrench

@@ -12,17 +12,17 @@ import sys
 
 import numpy as np
 
-from catabot.inbox import Inputs
-from catabot.messages import BodyStates, Message, Tick, TwistBatch, VesselState
-from catabot.participant import Participant
-from catabot.service import Built, ServiceContext, run_service
-from catabot.streams import (
+from catabot.bus.inbox import Inputs
+from catabot.bus.messages import BodyStates, Message, Tick, TwistBatch, VesselState
+from catabot.bus.participant import Participant
+from catabot.run.service import Built, ServiceContext, run_service
+from catabot.world.streams import (
     command_streams,
     traffic_boat_ids,
     twist_batch_streams,
     waypoint_streams,
 )
-from catabot.traffic_plan import all_vessels
+from catabot.world.traffic_plan import all_vessels
 from services.physics.commands import CommandBook
 from services.physics.control import TwistControllerBank
 from services.physics.setup import build_world

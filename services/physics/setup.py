@@ -2,13 +2,13 @@
 
 from __future__ import annotations
 
-from catabot.environment.current import CurrentField
-from catabot.environment.wind import WindField
-from catabot.scenario import Scenario
-from catabot.terrain import load_terrain
-from catabot.traffic_plan import all_buoys, all_vessels
-from catabot.vessel import VesselModel, load_vessel_model
-from catabot.waves import WaveField
+from catabot.config.scenario import Scenario
+from catabot.config.vessel import VesselModel, load_vessel_model
+from catabot.world.environment.current import CurrentField
+from catabot.world.environment.wind import WindField
+from catabot.world.terrain import load_terrain
+from catabot.world.traffic_plan import all_buoys, all_vessels
+from catabot.world.waves import WaveField
 from services.physics.world import PhysicsWorld
 
 

@@ -1,4 +1,4 @@
-"""Wind loads on every vessel at once, from each model's windage (catabot.vessel.WindArea).
+"""Wind loads on every vessel at once, from each model's windage (catabot.config.vessel.WindArea).
 
 With the apparent wind (u_a, v_a) = wind velocity in the body frame minus the vessel's own
 body-frame velocity (horizontal components only), per vessel:
@@ -15,7 +15,7 @@ from collections.abc import Sequence
 
 import numpy as np
 
-from catabot.vessel import VesselModel
+from catabot.config.vessel import VesselModel
 from services.physics.hydro import Array
 
 

@@ -24,10 +24,10 @@ import dartpy as dart
 import numpy as np
 from numpy.typing import NDArray
 
-from catabot.environment import CurrentField, WindField
-from catabot.terrain import Terrain
-from catabot.vessel import VesselModel
-from catabot.waves import WaveField
+from catabot.config.vessel import VesselModel
+from catabot.world.environment import CurrentField, WindField
+from catabot.world.terrain import Terrain
+from catabot.world.waves import WaveField
 from services.physics.fleet import Fleet, buoy_bodies
 from services.physics.grounding import Grounding
 from services.physics.hydro import (

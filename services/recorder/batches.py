@@ -15,8 +15,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from catabot import tabular
-from catabot.messages import (
+from catabot.bus.messages import (
     BodyStates,
     Message,
     TwistBatch,
@@ -24,7 +23,7 @@ from catabot.messages import (
     VesselState,
     check_ids,
 )
-from services.recorder import cdr, ros2_msgdefs
+from services.recorder import cdr, ros2_msgdefs, tabular
 
 # json_schemas.encode of a TwistCmd, field by field: {"surge":..,"yaw_rate":..,"tick":..,..}
 # (JSON keeps repr: it is two floats a boat, and JSON readers expect round-trip values)

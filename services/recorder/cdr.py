@@ -21,7 +21,7 @@ from collections.abc import Iterable, Mapping
 
 import numpy as np
 
-from catabot.messages import VesselState
+from catabot.bus.messages import VesselState
 
 ENCAPSULATION = b"\x00\x01\x00\x00"  # CDR_LE, options 0
 _NS_PER_S = 1_000_000_000

@@ -16,8 +16,8 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import TextIO
 
-from catabot import tabular
-from catabot.messages import Message
+from catabot.bus.messages import Message
+from services.recorder import tabular
 
 
 class RecorderError(ValueError):

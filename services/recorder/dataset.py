@@ -19,10 +19,10 @@ from typing import Any
 import numpy as np
 from PIL import Image
 
-from catabot.messages import CameraFrame, Message, RadarSweep
-from catabot.scenario import Scenario
-from catabot.sensor_types import RadarParams
-from services.sensors.ppi import Ppi
+from catabot.bus.messages import CameraFrame, Message, RadarSweep
+from catabot.config.scenario import Scenario
+from catabot.config.sensors import RadarParams
+from services.recorder.ppi import Ppi
 
 CLASS_NAMES = ("none", "water", "terrain", "vessel", "buoy")
 PNG_LEVEL = 3  # zlib level: fast; fixed, so the same pixels give the same bytes

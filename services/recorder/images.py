@@ -12,7 +12,7 @@ import typing
 import numpy as np
 from mcap_ros2._dynamic import serialize_dynamic
 
-from catabot.messages import CameraFrame, Message
+from catabot.bus.messages import CameraFrame, Message
 from services.recorder.ros2_msgdefs import HEADER_DEPENDENCIES, concatenated, stamp
 
 IMAGE = "sensor_msgs/msg/Image"

@@ -17,7 +17,7 @@ from typing import Any
 
 import numpy as np
 
-from catabot.messages import Message
+from catabot.bus.messages import Message
 
 
 def schema_name(cls: type[Message]) -> str:

@@ -33,7 +33,7 @@ from mcap.writer import LIBRARY_IDENTIFIER
 from mcap_ros2.decoder import DecoderFactory
 from numpy.typing import NDArray
 
-from catabot.messages import CameraFrame, LidarScan, Message, VesselState
+from catabot.bus.messages import CameraFrame, LidarScan, Message, VesselState
 from services.recorder import cdr, images, json_schemas, pointcloud, ros2_msgdefs
 from services.recorder.csv_sink import RecorderError
 from services.recorder.mcap_writer import McapWriter

@@ -14,7 +14,7 @@ from pathlib import Path
 
 import numpy as np
 
-from catabot.messages import BodyStates
+from catabot.bus.messages import BodyStates
 
 
 class Metrics:

@@ -16,7 +16,7 @@ import typing
 
 import numpy as np
 
-from catabot.messages import LidarScan, Message
+from catabot.bus.messages import LidarScan, Message
 from services.recorder.cdr import pointcloud2_encoder
 from services.recorder.ros2_msgdefs import HEADER_DEPENDENCIES, concatenated
 

@@ -10,7 +10,7 @@ from __future__ import annotations
 
 from typing import Any
 
-from catabot.messages import VesselState
+from catabot.bus.messages import VesselState
 
 ODOMETRY = "nav_msgs/msg/Odometry"
 WORLD_FRAME = "map"

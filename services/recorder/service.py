@@ -15,12 +15,12 @@ import time
 from collections.abc import Callable
 from typing import Any
 
-from catabot.inbox import Inputs
-from catabot.messages import BodyStates, CameraFrame, End, Message, Tick, TwistBatch
-from catabot.participant import Participant
-from catabot.service import Built, ServiceContext, run_service
-from catabot.streams import body_ids, command_streams, traffic_boat_ids, world_streams
-from catabot.traffic_plan import all_vessels
+from catabot.bus.inbox import Inputs
+from catabot.bus.messages import BodyStates, CameraFrame, End, Message, Tick, TwistBatch
+from catabot.bus.participant import Participant
+from catabot.run.service import Built, ServiceContext, run_service
+from catabot.world.streams import body_ids, command_streams, traffic_boat_ids, world_streams
+from catabot.world.traffic_plan import all_vessels
 from services.recorder import images
 from services.recorder.batches import BatchFormatter, Block
 from services.recorder.csv_sink import CsvSink, RecorderError

@@ -22,11 +22,12 @@ from typing import ClassVar, Protocol
 import numpy as np
 from numpy.typing import NDArray
 
-from catabot.messages import CameraFrame, Message, VesselState
-from catabot.sensor_types import CameraParams
+from catabot.bus.messages import CameraFrame, Message, VesselState
+from catabot.config.sensors import CameraParams
+from catabot.world import seeding
 from services.sensors import camera_boxes as cb
 from services.sensors.camera_shading import rain_streaks, rain_veil, shade
-from services.sensors.common import SensorError, rotation_from_quaternion, sensor_rng
+from services.sensors.common import SensorError, rotation_from_quaternion
 from services.sensors.scene import Body, Hits
 
 F64 = NDArray[np.float64]
@@ -99,7 +100,7 @@ class CameraModel:
         self.rays = pixel_rays(self.cam)
         self.mount_rot = rpy_matrix(params.mount_rpy_deg) @ OPTICAL_TO_BODY
         self.mount_pos = np.asarray(params.mount_xyz, dtype=np.float64)
-        self._rng = sensor_rng(seed, name)
+        self._rng = seeding.rng(seed, name)
 
     def pose(self, state: VesselState) -> tuple[F64, F64]:
         """Optical frame in `map`: origin (3,) and rotation (v_map = R @ v_optical)."""

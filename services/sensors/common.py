@@ -1,15 +1,13 @@
-"""What every sensor model shares: its error class, its seeded noise stream, frame helpers.
+"""What every sensor model shares: its error class and checks of its inputs.
 
-A sensor's noise comes from its own generator, seeded from the scenario seed and the
-sensor's name (`<vessel>/<sensor>`) through a stable hash (CRC-32, not Python's salted
-`hash`), so a run's samples do not depend on which process hosts the sensor, on how many
-other sensors exist, or on the order they were built in (DESIGN.md §2).
+A sensor's noise comes from its own generator, `catabot.world.seeding.rng(seed,
+"<vessel>/<sensor>")`, so a run's samples do not depend on which process hosts the sensor,
+on how many other sensors exist, or on the order they were built in (DESIGN.md §2).
 """
 
 from __future__ import annotations
 
 import math
-import zlib
 from collections.abc import Sequence
 
 import numpy as np
@@ -20,22 +18,6 @@ Array = NDArray[np.float64]
 
 class SensorError(ValueError):
     """A sensor configuration or input that cannot give a meaningful sample."""
-
-
-def stable_hash(name: str) -> int:
-    """A 32-bit hash of `name` that is the same in every process and Python version."""
-    return zlib.crc32(name.encode("utf-8"))
-
-
-def sensor_rng(seed: int, name: str) -> np.random.Generator:
-    """The noise generator of the source `name` in a scenario with `seed`.
-
-    Negative seeds are folded into 64 bits because NumPy's SeedSequence takes only
-    non-negative entropy.
-    """
-    if not name:
-        raise SensorError("a random source needs a non-empty name")
-    return np.random.default_rng([int(seed) % 2**64, stable_hash(name)])
 
 
 def finite_vector(values: Sequence[float], what: str, length: int = 3) -> Array:

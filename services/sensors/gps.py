@@ -1,10 +1,10 @@
 """GPS model: the antenna's `map` (ENU) position, plus noise, as a WGS84 fix.
 
-`method="wgs84"` (default) converts exactly (catabot.geo.EnuFrame, < 1 mm); a fix taken
+`method="wgs84"` (default) converts exactly (catabot.world.geo.EnuFrame, < 1 mm); a fix taken
 far from the origin then shows the Earth's curvature, e.g. +31 m of altitude at 20 km,
 because `map` is the tangent plane at the origin. `method="paper_table"` reproduces the
 original simulator's eq. (8)-(9) tables, which ignore curvature (errors in the docstring
-of catabot.geo.paper_table_enu_to_geodetic).
+of catabot.world.geo.paper_table_enu_to_geodetic).
 
 Noise is white Gaussian, drawn in metres before the conversion: `horizontal_sigma` on each
 of east and north, `vertical_sigma` on up. Defaults 0.5 m and 1.0 m: a good single-band
@@ -21,14 +21,14 @@ from typing import ClassVar, Literal
 
 import numpy as np
 
-from catabot.geo import EnuFrame, GeoError, paper_table_enu_to_geodetic
-from catabot.messages import GpsFix, Message, VesselState
+from catabot.bus.messages import GpsFix, Message, VesselState
+from catabot.world import seeding
+from catabot.world.geo import EnuFrame, GeoError, paper_table_enu_to_geodetic
 from services.sensors.common import (
     SensorError,
     finite_vector,
     non_negative,
     rotation_from_quaternion,
-    sensor_rng,
 )
 
 Method = Literal["wgs84", "paper_table"]
@@ -65,7 +65,7 @@ class GpsModel:
         self.vertical_sigma = non_negative(vertical_sigma, "vertical_sigma (m)")
         self.antenna_offset = finite_vector(antenna_offset, "antenna_offset (m, body FLU)")
         self.noise, self.name = bool(noise), name
-        self._rng = sensor_rng(seed, name)
+        self._rng = seeding.rng(seed, name)
 
     @property
     def sigmas(self) -> tuple[float, float]:

@@ -25,7 +25,8 @@ from typing import ClassVar
 
 import numpy as np
 
-from catabot.messages import ImuSample, Message, VesselState
+from catabot.bus.messages import ImuSample, Message, VesselState
+from catabot.world import seeding
 from services.sensors.common import (
     Array,
     SensorError,
@@ -33,7 +34,6 @@ from services.sensors.common import (
     finite_vector,
     non_negative,
     rotation_from_quaternion,
-    sensor_rng,
 )
 
 GRAVITY = 9.81  # m/s^2, the physics service's default (services/physics/world.py)
@@ -85,7 +85,7 @@ class ImuModel:
         self.lever_arm = finite_vector(lever_arm, "lever_arm (m, body FLU)")
         self.gravity = non_negative(gravity, "gravity (m/s^2)")
         self.noise, self.name = bool(noise), name
-        self._rng = sensor_rng(seed, name)
+        self._rng = seeding.rng(seed, name)
         # rows: gyro, accel; Gauss-Markov part drawn from its stationary law, walk from 0
         self._markov = self.bias_sigma[:, None] * self._rng.standard_normal((2, 3))
         self._walked = np.zeros((2, 3))

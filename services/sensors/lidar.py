@@ -8,7 +8,7 @@ shared Scene (terrain, bodies, waves), adds Gaussian range noise to real returns
 every beam through services/sensors/rain.py. The whole scan is taken at one instant (no
 motion skew within the turn). The scan is published in the sensor frame with labels.
 
-Randomness: one generator per sensor (common.sensor_rng, `<vessel>/<sensor>`); each scan draws
+Randomness: one generator per sensor (`seeding.rng(seed, "<vessel>/<sensor>")`); each scan draws
 a fixed number of values (noise, Poisson, uniform per beam) whatever it sees, so a sensor's
 draws never depend on other sensors or on the scene.
 """
@@ -20,9 +20,10 @@ import math
 import numpy as np
 from numpy.typing import NDArray
 
-from catabot.messages import LidarScan, VesselState
-from catabot.sensor_types import LidarParams
-from services.sensors.common import SensorError, rotation_from_quaternion, sensor_rng
+from catabot.bus.messages import LidarScan, VesselState
+from catabot.config.sensors import LidarParams
+from catabot.world import seeding
+from services.sensors.common import SensorError, rotation_from_quaternion
 from services.sensors.cull import grid_pairs
 from services.sensors.rain import RainParams, apply_rain
 from services.sensors.scene import CLASS_NONE, Scene
@@ -87,7 +88,7 @@ class LidarModel:
         self.mount_rot = mount_rotation(params.mount_yaw_deg, params.mount_pitch_deg)
         self.mount_xyz = np.asarray(params.mount_xyz, dtype=np.float64)
         self.ring = np.repeat(np.arange(params.channels, dtype=np.uint16), params.columns)
-        self.rng = sensor_rng(seed, name)
+        self.rng = seeding.rng(seed, name)
 
     def sample(self, state: VesselState, *, tick: int, stamp_ns: int) -> LidarScan:
         """One scan at the vessel's pose in `state`, stamped `stamp_ns`."""

@@ -25,10 +25,11 @@ from typing import ClassVar
 import numpy as np
 from numpy.typing import NDArray
 
-from catabot.messages import Message, RadarSweep, VesselState
-from catabot.sensor_types import RadarParams
+from catabot.bus.messages import Message, RadarSweep, VesselState
+from catabot.config.sensors import RadarParams
+from catabot.world import seeding
 from services.sensors.camera import CastScene
-from services.sensors.common import SensorError, rotation_from_quaternion, sensor_rng
+from services.sensors.common import SensorError, rotation_from_quaternion
 from services.sensors.scene import CLASS_NONE, CLASS_WATER
 
 F64 = NDArray[np.float64]
@@ -80,7 +81,7 @@ class RadarModel:
         self.elevations = np.concatenate([fan(params), np.radians(params.elevations_deg)])
         if self.elevations.size == 0:
             raise SensorError(f"radar {name!r} has no rays: give elevations_deg or a fan")
-        self._rng = sensor_rng(seed, name)
+        self._rng = seeding.rng(seed, name)
 
     def beam_indices(self, stamp_ns: int) -> NDArray[np.int64]:
         """Beams emitted in [stamp - period, stamp): j with j T / n in that interval."""

@@ -14,8 +14,8 @@ from collections.abc import Callable
 from dataclasses import dataclass
 from typing import Any, Protocol
 
-from catabot.messages import Message, VesselState
-from catabot.scenario import Origin, SensorConfig
+from catabot.bus.messages import Message, VesselState
+from catabot.config.scenario import Origin, SensorConfig
 from services.sensors.camera import CameraModel
 from services.sensors.common import SensorError
 from services.sensors.gps import GpsModel

@@ -30,8 +30,8 @@ from typing import TYPE_CHECKING
 import numpy as np
 from numpy.typing import NDArray
 
-from catabot.terrain import Terrain
-from catabot.waves import WaveField
+from catabot.world.terrain import Terrain
+from catabot.world.waves import WaveField
 from services.sensors.common import (
     SensorError,
     rotation_from_quaternion,
@@ -43,7 +43,7 @@ from services.sensors.terrain_cast import TerrainCaster
 from services.sensors.water import calm_hits, wave_hits
 
 if TYPE_CHECKING:
-    from catabot.scenario import Scenario
+    from catabot.config.scenario import Scenario
 
 CLASS_NONE, CLASS_WATER, CLASS_TERRAIN, CLASS_VESSEL, CLASS_BUOY = 0, 1, 2, 3, 4
 F32 = NDArray[np.float32]
@@ -364,8 +364,8 @@ def _slab(ob: F64, db: F64, lo: F64, hi: F64) -> tuple[F64, F64]:
 def bodies_for(scenario: Scenario) -> list[Body]:
     """Every vessel, traffic boats included (instance 1 + its index), then every buoy
     (instances after the vessels), as a box: the union of its model's hull bounds."""
-    from catabot.traffic_plan import all_buoys, all_vessels
-    from catabot.vessel import load_vessel_model
+    from catabot.config.vessel import load_vessel_model
+    from catabot.world.traffic_plan import all_buoys, all_vessels
 
     vessels, buoys = all_vessels(scenario), all_buoys(scenario)
     bounds = {m: _hull_bounds(load_vessel_model(m)) for m in {v.model for v in vessels}}
@@ -378,7 +378,7 @@ def bodies_for(scenario: Scenario) -> list[Body]:
 
 
 def _hull_bounds(model: object) -> tuple[Vec3, Vec3]:
-    from catabot.vessel import VesselModel
+    from catabot.config.vessel import VesselModel
 
     assert isinstance(model, VesselModel)
     centre = np.array([h.center_m for h in model.hulls])

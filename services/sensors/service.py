@@ -14,15 +14,15 @@ import math
 import sys
 from dataclasses import dataclass
 
-from catabot.inbox import Inputs
-from catabot.messages import BodyStates, Message, Tick, VesselState
-from catabot.participant import Participant
-from catabot.scenario import Pose, Scenario, VesselConfig
-from catabot.service import Built, ServiceContext, run_service
-from catabot.streams import BodyRows, body_ids, states_stream
-from catabot.terrain import load_terrain
-from catabot.traffic_plan import all_buoys, all_vessels
-from catabot.waves import WaveField
+from catabot.bus.inbox import Inputs
+from catabot.bus.messages import BodyStates, Message, Tick, VesselState
+from catabot.bus.participant import Participant
+from catabot.config.scenario import Pose, Scenario, VesselConfig
+from catabot.run.service import Built, ServiceContext, run_service
+from catabot.world.streams import BodyRows, body_ids, states_stream
+from catabot.world.terrain import load_terrain
+from catabot.world.traffic_plan import all_buoys, all_vessels
+from catabot.world.waves import WaveField
 from services.sensors.registry import Sensor, build_sensor
 from services.sensors.scene import Scene, bodies_for
 

@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 from numpy.typing import NDArray
 
-from catabot.terrain import Terrain
+from catabot.world.terrain import Terrain
 
 F64 = NDArray[np.float64]
 F32 = NDArray[np.float32]

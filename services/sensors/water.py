@@ -25,7 +25,7 @@ from __future__ import annotations
 import numpy as np
 from numpy.typing import NDArray
 
-from catabot.waves import WaveField
+from catabot.world.waves import WaveField
 from services.sensors.common import rows_of
 
 F64 = NDArray[np.float64]

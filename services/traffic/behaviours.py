@@ -14,7 +14,7 @@ from collections.abc import Sequence
 import numpy as np
 from numpy.typing import NDArray
 
-from catabot.traffic_plan import Boat
+from catabot.world.traffic_plan import Boat
 
 Array = NDArray[np.float64]
 CIRCLE, WAYPOINTS, HOLD = 0, 1, 2

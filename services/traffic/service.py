@@ -18,14 +18,14 @@ import sys
 
 import numpy as np
 
-from catabot import codec
-from catabot.inbox import Inputs
-from catabot.messages import BodyStates, Message, Tick, TwistBatch, WaypointsCmd
-from catabot.participant import Participant
-from catabot.scenario import guidance_period_ticks
-from catabot.service import Built, ServiceContext, run_service
-from catabot.streams import BodyRows, body_ids, states_stream, waypoint_streams
-from catabot.traffic_plan import plan_traffic
+from catabot.bus import codec
+from catabot.bus.inbox import Inputs
+from catabot.bus.messages import BodyStates, Message, Tick, TwistBatch, WaypointsCmd
+from catabot.bus.participant import Participant
+from catabot.config.scenario import guidance_period_ticks
+from catabot.run.service import Built, ServiceContext, run_service
+from catabot.world.streams import BodyRows, body_ids, states_stream, waypoint_streams
+from catabot.world.traffic_plan import plan_traffic
 from services.traffic.behaviours import Behaviours
 
 log = logging.getLogger("traffic")

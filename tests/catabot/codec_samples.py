@@ -7,8 +7,8 @@ import dataclasses
 import msgpack
 import numpy as np
 
-from catabot import codec
-from catabot.messages import (
+from catabot.bus import codec
+from catabot.bus.messages import (
     Ack,
     BodyStates,
     CameraFrame,

@@ -16,14 +16,14 @@ from typing import Any
 
 import zenoh
 
-from catabot import codec
-from catabot.clock import Stream
-from catabot.conductor import ClockSpec, Conductor, RunResult
-from catabot.inbox import Inputs
-from catabot.keys import Keys
-from catabot.messages import End, GpsFix, Tick, VesselState
-from catabot.participant import Participant
-from catabot.session import Connection, free_port, open_session
+from catabot.bus import codec
+from catabot.bus.clock import Stream
+from catabot.bus.conductor import ClockSpec, Conductor, RunResult
+from catabot.bus.inbox import Inputs
+from catabot.bus.keys import Keys
+from catabot.bus.messages import End, GpsFix, Tick, VesselState
+from catabot.bus.participant import Participant
+from catabot.bus.session import Connection, free_port, open_session
 
 DT_NS = 10_000_000
 JOIN_S = 10.0  # generous bound on thread joins; a healthy test takes far less

@@ -7,7 +7,7 @@ import sys
 import numpy as np
 import pytest
 
-from catabot.blas import single_thread_blas
+from catabot.bus.blas import single_thread_blas
 
 
 @pytest.mark.skipif(not sys.platform.startswith("linux"), reason="reads /proc/self/maps")

@@ -5,14 +5,14 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from catabot import codec
-from catabot.clock import ClockError, Policy, Stream, period_in_ticks, ticks_for
-from catabot.codec import CodecError
-from catabot.inbox import Inbox
-from catabot.keys import Keys
-from catabot.messages import BodyStates, GpsFix, ImuSample, ThrustCmd, VesselState
-from catabot.scenario import parse_scenario
-from catabot.streams import BodyRows, body_ids, participants, state_streams, world_streams
+from catabot.bus import codec
+from catabot.bus.clock import ClockError, Policy, Stream, period_in_ticks, ticks_for
+from catabot.bus.codec import CodecError
+from catabot.bus.inbox import Inbox
+from catabot.bus.keys import Keys
+from catabot.bus.messages import BodyStates, GpsFix, ImuSample, ThrustCmd, VesselState
+from catabot.config.scenario import parse_scenario
+from catabot.world.streams import BodyRows, body_ids, participants, state_streams, world_streams
 
 KEYS = Keys("w")
 STATE = KEYS.vessel_state("ego")

@@ -7,9 +7,9 @@ import math
 import msgpack
 import pytest
 
-from catabot import codec
-from catabot.codec import ARRAY_EXT, CodecError
-from catabot.messages import (
+from catabot.bus import codec
+from catabot.bus.codec import ARRAY_EXT, CodecError
+from catabot.bus.messages import (
     MESSAGE_TYPES,
     SCHEMA_VERSION,
     Ack,

@@ -11,16 +11,15 @@ import pytest
 from PIL import Image
 from pydantic import ValidationError
 
-from catabot.environment import (
+from catabot.config.environment import (
     CurrentConfig,
-    CurrentField,
     CurrentMapConfig,
     CurrentMapError,
     WindConfig,
-    WindField,
     WindZone,
 )
-from catabot.environment.geometry import Polygon
+from catabot.config.geometry import Polygon
+from catabot.world.environment import CurrentField, WindField
 
 L_SHAPE = [(0.0, 0.0), (10.0, 0.0), (10.0, 4.0), (4.0, 4.0), (4.0, 10.0), (0.0, 10.0)]
 

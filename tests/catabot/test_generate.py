@@ -6,9 +6,9 @@ from pathlib import Path
 
 import pytest
 
-from catabot.cli import main
-from catabot.scenario import load_scenario
-from catabot.traffic_plan import plan_traffic
+from catabot.config.scenario import load_scenario
+from catabot.run.cli import main
+from catabot.world.traffic_plan import plan_traffic
 
 
 def test_generated_scenario_is_valid_and_has_the_traffic(tmp_path: Path) -> None:

@@ -13,7 +13,7 @@ import numpy as np
 import pyproj
 import pytest
 
-from catabot import geo
+from catabot.world import geo
 
 ORIGINS = [
     (0.0, 0.0, 0.0),  # equator, prime meridian

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import pytest
 
-from catabot.keys import KeyError_, Keys, check_name
+from catabot.bus.keys import KeyError_, Keys, check_name
 
 BAD_NAMES = ["a/b", "*", "a*", "**", "$x", "a$", "a b", " ", "", "a?b", "a#b"]
 

@@ -14,11 +14,11 @@ from collections.abc import Callable
 
 import pytest
 
-from catabot import codec
-from catabot.clock import Stream
-from catabot.inbox import Inputs
-from catabot.messages import Ack, GpsFix, Tick
-from catabot.participant import Participant
+from catabot.bus import codec
+from catabot.bus.clock import Stream
+from catabot.bus.inbox import Inputs
+from catabot.bus.messages import Ack, GpsFix, Tick
+from catabot.bus.participant import Participant
 from tests.catabot.lockstep_world import DT_NS, Member, Step, World, _fix
 
 # -- (a) the happy path -------------------------------------------------------------------

@@ -8,11 +8,11 @@ import time
 
 import pytest
 
-from catabot import codec
-from catabot.clock import Policy, Stream
-from catabot.inbox import Inputs
-from catabot.messages import Tick, VesselState
-from catabot.participant import Participant
+from catabot.bus import codec
+from catabot.bus.clock import Policy, Stream
+from catabot.bus.inbox import Inputs
+from catabot.bus.messages import Tick, VesselState
+from catabot.bus.participant import Participant
 from tests.catabot.lockstep_world import Step, World, _fix, _state
 
 # -- (c) deadline -------------------------------------------------------------------------
@@ -175,7 +175,7 @@ def test_malformed_input_is_logged_and_the_participant_goes_on(
 
     holder["p"] = world.member("inj", inject, peers=names).participant
     cons = world.member("cons", inputs=[Stream(key, VesselState, "inj", 1)], peers=names)
-    with caplog.at_level(logging.WARNING, logger="catabot.participant"):
+    with caplog.at_level(logging.WARNING, logger="catabot.bus.participant"):
         result = world.run(names, 20, deadline_s=2.0, start_timeout_s=5.0)
         for m in world.members.values():
             m.join()
@@ -184,7 +184,7 @@ def test_malformed_input_is_logged_and_the_participant_goes_on(
     assert cons.ticks == list(range(20))
     for k in range(1, 20):
         assert [m.tick for m in cons.released[k][key]] == [k - 1]
-    warnings = [r.getMessage() for r in caplog.records if r.name == "catabot.participant"]
+    warnings = [r.getMessage() for r in caplog.records if r.name == "catabot.bus.participant"]
     malformed = [w for w in warnings if "malformed" in w]
     assert len(malformed) == 2, warnings
     assert all(key in w and w.startswith("cons:") for w in malformed)

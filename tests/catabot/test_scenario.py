@@ -10,7 +10,7 @@ from typing import Any
 import jsonschema
 import pytest
 
-from catabot.scenario import (
+from catabot.config.scenario import (
     BUNDLED,
     Scenario,
     ScenarioError,

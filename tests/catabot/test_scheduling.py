@@ -8,14 +8,14 @@ import sys
 
 import pytest
 
-from catabot.scheduling import SchedulingError, requested_policy
+from catabot.bus.scheduling import SchedulingError, requested_policy
 
 LINUX = pytest.mark.skipif(not hasattr(os, "SCHED_BATCH"), reason="SCHED_BATCH is Linux-only")
 PROBE = """
 import os, threading, time
 early = threading.Thread(target=time.sleep, args=(2,), daemon=True)  # before the call
 early.start()
-from catabot.scheduling import batch_scheduling
+from catabot.bus.scheduling import batch_scheduling
 print(batch_scheduling(), os.sched_getscheduler(early.native_id) == os.SCHED_BATCH, end=" ")
 seen = []
 thread = threading.Thread(target=lambda: seen.append(os.sched_getscheduler(0) == os.SCHED_BATCH))

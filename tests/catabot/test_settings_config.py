@@ -9,8 +9,8 @@ from typing import Any
 
 import pytest
 
-from catabot.scenario import ScenarioError, load_scenario, parse_scenario
-from catabot.settings_config import is_settings_config
+from catabot.config.scenario import ScenarioError, load_scenario, parse_scenario
+from catabot.config.settings_config import is_settings_config
 
 # The original CataBotSim defaults (reference/anchors.md).
 ORIGINAL_DEFAULTS: dict[str, Any] = {
@@ -35,7 +35,7 @@ ORIGINAL_DEFAULTS: dict[str, Any] = {
     "terrainPixelScale": 5.0,
     "terrainPathToElevationFile": "New York River Elevation.png",
 }
-LOGGER = "catabot.settings_config"
+LOGGER = "catabot.config.settings_config"
 
 
 def _settings(**changes: Any) -> dict[str, Any]:

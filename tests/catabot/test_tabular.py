@@ -5,8 +5,8 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from catabot import tabular
-from catabot.messages import Ack, ThrustCmd, TwistCmd, VesselState
+from catabot.bus.messages import Ack, ThrustCmd, TwistCmd, VesselState
+from services.recorder import tabular
 
 
 def _state() -> VesselState:

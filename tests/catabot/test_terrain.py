@@ -11,7 +11,8 @@ import tifffile
 from PIL import Image
 from pydantic import ValidationError
 
-from catabot.terrain import MAX_MESH_TRIANGLES, Terrain, TerrainConfig, TerrainError, load_terrain
+from catabot.config.terrain import TerrainConfig, TerrainError
+from catabot.world.terrain import MAX_MESH_TRIANGLES, Terrain, load_terrain
 
 REAL_IMAGE = Path("/work/shared/data/elevation/new-york-river.png")
 LO, HI, MPP = -35.0, 60.0, 5.0

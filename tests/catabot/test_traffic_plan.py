@@ -4,10 +4,10 @@ from __future__ import annotations
 
 import numpy as np
 
-from catabot.placement import footprint_m
-from catabot.scenario import parse_scenario
-from catabot.traffic_plan import TrafficPlan, plan_traffic
-from catabot.vessel import load_vessel_model
+from catabot.config.scenario import parse_scenario
+from catabot.config.vessel import load_vessel_model
+from catabot.world.placement import footprint_m
+from catabot.world.traffic_plan import TrafficPlan, plan_traffic
 
 HULL = footprint_m(load_vessel_model("monohull"))
 BUOY = footprint_m(load_vessel_model("buoy"))

@@ -10,20 +10,14 @@ import sys
 import numpy as np
 import pytest
 
-from catabot.waves import (
-    BAND,
-    PRESETS,
-    WaveConfig,
-    WaveError,
-    WaveField,
-    parse_wave_config,
-    spectral_density,
-)
+from catabot.config.waves import PRESETS, WaveConfig, WaveError, parse_wave_config
+from catabot.world.waves import BAND, WaveField, spectral_density
 
 _PRINT_HEIGHTS = """
 import sys
 import numpy as np
-from catabot.waves import WaveConfig, WaveField
+from catabot.config.waves import WaveConfig
+from catabot.world.waves import WaveField
 field = WaveField(WaveConfig(preset="heavy"), seed=int(sys.argv[1]))
 x = np.array([0.0, 12.5, -300.0, 1234.5])
 y = np.array([0.0, -7.25, 80.0, 999.0])
@@ -210,9 +204,9 @@ def test_explicit_fields_override_the_preset() -> None:
 @pytest.mark.parametrize(
     ("data", "message"),
     [
-        ({"significant_height_m": -1.0}, r"waves\.significant_height_m: must be >= 0.0 \(got -1"),
-        ({"peak_period_s": 0.0}, r"waves\.peak_period_s: must be > 0.0 \(got 0.0\)"),
-        ({"peak_period_s": -3}, r"waves\.peak_period_s: must be > 0.0 \(got -3\)"),
+        ({"significant_height_m": -1.0}, r"waves\.significant_height_m: must be >= 0 \(got -1"),
+        ({"peak_period_s": 0.0}, r"waves\.peak_period_s: must be > 0 \(got 0.0\)"),
+        ({"peak_period_s": -3}, r"waves\.peak_period_s: must be > 0 \(got -3\)"),
         ({"preset": "stormy"}, r"waves\.preset: must be one of 'calm', 'medium' or 'heavy'"),
         ({"height": 1.0}, r"waves\.height: unknown field \(allowed: preset, spectrum, "),
         ({"direction_rad": math.inf}, r"waves\.direction_rad: "),
@@ -233,6 +227,8 @@ def test_bad_field_arguments() -> None:
         WaveField({"preset": "heavy"}, seed=1)  # type: ignore[arg-type]
     with pytest.raises(WaveError, match="seed must be an integer"):
         WaveField(WaveConfig(), seed=1.5)  # type: ignore[arg-type]
-    field = WaveField(WaveConfig(preset="medium"), seed=-3)  # folded into 64 bits, as sensors
+    with pytest.raises(WaveError, match=r"seed must be in \[0, 2\*\*63\) \(got -3\)"):
+        WaveField(WaveConfig(), seed=-3)  # one seeding rule: no folding of negative seeds
+    field = WaveField(WaveConfig(preset="medium"), seed=3)
     with pytest.raises(WaveError, match="non-finite position or time"):
         field.height(np.nan, 0.0, 0.0)

@@ -20,7 +20,7 @@ def catabot(
     *args: str, timeout: float = 180, cwd: Path | None = None
 ) -> subprocess.CompletedProcess[str]:
     return subprocess.run(
-        [sys.executable, "-m", "catabot.cli", *args],
+        [sys.executable, "-m", "catabot", *args],
         capture_output=True,
         text=True,
         timeout=timeout,
@@ -30,7 +30,7 @@ def catabot(
 
 def start(*args: str) -> subprocess.Popen[str]:
     return subprocess.Popen(
-        [sys.executable, "-m", "catabot.cli", *args],
+        [sys.executable, "-m", "catabot", *args],
         stdout=subprocess.PIPE,
         stderr=subprocess.PIPE,
         text=True,

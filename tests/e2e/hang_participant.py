@@ -8,9 +8,9 @@ import signal
 import sys
 import time
 
-from catabot.keys import Keys
-from catabot.participant import Participant
-from catabot.session import Connection, open_session
+from catabot.bus.keys import Keys
+from catabot.bus.participant import Participant
+from catabot.bus.session import Connection, open_session
 
 endpoint, world, name, at, how = sys.argv[1:6]
 session = open_session(Connection(connect=(endpoint,)))

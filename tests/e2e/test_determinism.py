@@ -7,7 +7,7 @@ from pathlib import Path
 
 from conftest import basic_scenario, catabot, files_of, only_run_dir, scenario_file, start
 
-from catabot.session import free_port
+from catabot.bus.session import free_port
 
 
 def _record(tmp: Path, scenario: Path, tag: str, *extra: str) -> dict[str, bytes]:

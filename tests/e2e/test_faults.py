@@ -24,11 +24,11 @@ from conftest import (
     wait_for_line,
 )
 
-from catabot import codec
-from catabot.keys import Keys
-from catabot.messages import ThrustCmd
-from catabot.scenario import ClockConfig
-from catabot.session import Connection, free_port, open_session
+from catabot.bus import codec
+from catabot.bus.keys import Keys
+from catabot.bus.messages import ThrustCmd
+from catabot.bus.session import Connection, free_port, open_session
+from catabot.config.scenario import ClockConfig
 from services.recorder.mcap_sink import read_mcap_messages
 
 HERE = Path(__file__).parent

@@ -20,7 +20,7 @@ from conftest import (
     wait_for_line,
 )
 
-from catabot.vessel import load_vessel_model
+from catabot.config.vessel import load_vessel_model
 from services.recorder.mcap_sink import read_mcap_messages
 
 

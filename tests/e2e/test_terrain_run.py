@@ -8,7 +8,8 @@ from pathlib import Path
 import pytest
 from conftest import basic_scenario, catabot, csv_rows, only_run_dir, scenario_file
 
-from catabot.terrain import TerrainConfig, load_terrain
+from catabot.config.terrain import TerrainConfig
+from catabot.world.terrain import load_terrain
 
 SHARED = Path(__file__).resolve().parents[3] / "shared" / "data" / "elevation"
 RIVER = SHARED / "new-york-river.png"

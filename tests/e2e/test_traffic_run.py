@@ -10,13 +10,13 @@ from typing import Any
 import numpy as np
 from conftest import catabot, files_of, only_run_dir, scenario_file, start, wait_for_line
 
-from catabot import codec
-from catabot.keys import Keys
-from catabot.messages import TwistCmd, WaypointsCmd
-from catabot.scenario import ClockConfig, load_scenario
-from catabot.session import Connection, free_port, open_session
-from catabot.terrain import load_terrain
-from catabot.traffic_plan import plan_traffic
+from catabot.bus import codec
+from catabot.bus.keys import Keys
+from catabot.bus.messages import TwistCmd, WaypointsCmd
+from catabot.bus.session import Connection, free_port, open_session
+from catabot.config.scenario import ClockConfig, load_scenario
+from catabot.world.terrain import load_terrain
+from catabot.world.traffic_plan import plan_traffic
 
 BAY = Path(__file__).resolve().parents[2] / "catabot" / "data" / "terrain" / "bay.png"
 CIRCLE_RATE = math.radians(15.0)  # 5 m/s on the default 19.1 m circle

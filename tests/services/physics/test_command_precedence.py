@@ -2,8 +2,8 @@
 
 from __future__ import annotations
 
-from catabot.messages import ThrustCmd, TwistCmd, WaypointsCmd
-from catabot.scenario import VesselConfig
+from catabot.bus.messages import ThrustCmd, TwistCmd, WaypointsCmd
+from catabot.config.scenario import VesselConfig
 from services.physics.commands import CommandBook, Order
 
 KEY = "catabot/w/vessel/boat_000/cmd/twist"

@@ -5,9 +5,9 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from catabot.messages import ThrustCmd, TwistBatch, TwistCmd
-from catabot.scenario import VesselConfig
-from catabot.vessel import load_vessel_model
+from catabot.bus.messages import ThrustCmd, TwistBatch, TwistCmd
+from catabot.config.scenario import VesselConfig
+from catabot.config.vessel import load_vessel_model
 from services.physics.commands import CommandBook, Order
 from services.physics.world import PhysicsWorld
 

@@ -10,7 +10,7 @@ import dartpy as dart
 import numpy as np
 import pytest
 
-from catabot.vessel import VesselModel, VesselModelError, load_vessel_model
+from catabot.config.vessel import VesselModel, VesselModelError, load_vessel_model
 from services.physics.hydro import (
     Columns,
     buoyancy_wrench,

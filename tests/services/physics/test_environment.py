@@ -9,8 +9,9 @@ import dartpy as dart
 import numpy as np
 import pytest
 
-from catabot.environment import CurrentField, WindConfig, WindField, WindZone
-from catabot.vessel import VesselModel, load_vessel_model
+from catabot.config.environment import WindConfig, WindZone
+from catabot.config.vessel import VesselModel, load_vessel_model
+from catabot.world.environment import CurrentField, WindField
 from services.physics.added_mass import rigid_body_matrix
 from services.physics.control import TwistController
 from services.physics.fleet import GROUP

@@ -9,8 +9,8 @@ from collections.abc import Callable
 import numpy as np
 import pytest
 
-from catabot.terrain import Terrain
-from catabot.vessel import VesselModel, load_vessel_model
+from catabot.config.vessel import VesselModel, load_vessel_model
+from catabot.world.terrain import Terrain
 from services.physics.world import PhysicsWorld
 
 DT = 0.01

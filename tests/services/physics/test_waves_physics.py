@@ -14,8 +14,9 @@ from dataclasses import dataclass
 import numpy as np
 import pytest
 
-from catabot.vessel import Damping, VesselModel, load_vessel_model
-from catabot.waves import WaveConfig, WaveField
+from catabot.config.vessel import Damping, VesselModel, load_vessel_model
+from catabot.config.waves import WaveConfig
+from catabot.world.waves import WaveField
 from services.physics.world import PhysicsWorld
 
 DT = 0.01

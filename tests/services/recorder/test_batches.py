@@ -7,7 +7,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from catabot.messages import BodyStates, TwistBatch, TwistCmd, VesselState
+from catabot.bus.messages import BodyStates, TwistBatch, TwistCmd, VesselState
 from services.recorder import cdr, json_schemas, ros2_msgdefs
 from services.recorder.batches import BatchFormatter, Block
 from services.recorder.csv_sink import CsvSink, RecorderError

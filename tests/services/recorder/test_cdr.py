@@ -11,7 +11,7 @@ from mcap.reader import make_reader
 from mcap_ros2._dynamic import serialize_dynamic
 from mcap_ros2.decoder import DecoderFactory
 
-from catabot.messages import LidarScan, VesselState
+from catabot.bus.messages import LidarScan, VesselState
 from services.recorder import cdr, pointcloud, ros2_msgdefs
 from services.recorder.mcap_sink import McapSink
 

@@ -7,7 +7,7 @@ from pathlib import Path
 
 import numpy as np
 
-from catabot.messages import BodyStates
+from catabot.bus.messages import BodyStates
 from services.recorder.metrics import Metrics
 
 

@@ -10,7 +10,7 @@ import pytest
 from mcap.reader import make_reader
 from mcap_ros2.decoder import DecoderFactory
 
-from catabot.messages import Message, ThrustCmd, TwistCmd, VesselState
+from catabot.bus.messages import Message, ThrustCmd, TwistCmd, VesselState
 from services.recorder.csv_sink import CsvSink, RecorderError
 from services.recorder.mcap_sink import McapSink, read_mcap_messages
 

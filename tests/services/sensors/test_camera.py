@@ -9,9 +9,10 @@ import math
 import numpy as np
 import pytest
 
-from catabot.messages import CameraFrame, VesselState
-from catabot.sensor_types import CameraParams
-from catabot.waves import WaveConfig, WaveField
+from catabot.bus.messages import CameraFrame, VesselState
+from catabot.config.sensors import CameraParams
+from catabot.config.waves import WaveConfig
+from catabot.world.waves import WaveField
 from services.sensors.camera import CameraModel
 from services.sensors.camera_shading import VEIL
 from services.sensors.scene import CLASS_NONE, CLASS_VESSEL, CLASS_WATER, Body, Scene

@@ -9,9 +9,9 @@ import numpy as np
 import pyproj
 import pytest
 
-from catabot.geo import enu_to_geodetic
-from catabot.messages import GpsFix, ImuSample, VesselState
-from catabot.scenario import Origin, SensorConfig
+from catabot.bus.messages import GpsFix, ImuSample, VesselState
+from catabot.config.scenario import Origin, SensorConfig
+from catabot.world.geo import enu_to_geodetic
 from services.sensors.common import SensorError
 from services.sensors.gps import GpsModel
 from services.sensors.imu import GRAVITY, ImuModel
@@ -206,7 +206,7 @@ def test_gps_paper_table_method_and_errors() -> None:
 
 
 def test_registry_builds_seeded_sensors() -> None:
-    from catabot.sensor_types import SENSOR_TYPES as SCENARIO_TYPES
+    from catabot.config.sensors import SENSOR_TYPES as SCENARIO_TYPES
 
     assert set(SENSOR_TYPES) == set(SCENARIO_TYPES)  # every scenario type has a model
     origin = Origin(latitude_deg=ORIGIN[0], longitude_deg=ORIGIN[1], altitude_m=ORIGIN[2])

@@ -8,10 +8,11 @@ import numpy as np
 import pytest
 from pydantic import ValidationError
 
-from catabot.messages import RadarSweep, VesselState
-from catabot.sensor_types import RadarParams
-from catabot.waves import WaveConfig, WaveField
-from services.sensors.ppi import Ppi
+from catabot.bus.messages import RadarSweep, VesselState
+from catabot.config.sensors import RadarParams
+from catabot.config.waves import WaveConfig
+from catabot.world.waves import WaveField
+from services.recorder.ppi import Ppi
 from services.sensors.radar import RadarModel
 from services.sensors.scene import CLASS_VESSEL, Body, Scene
 

@@ -7,10 +7,11 @@ import math
 import numpy as np
 import pytest
 
-from catabot.messages import LidarScan, VesselState
-from catabot.sensor_types import LidarParams
-from catabot.terrain import Terrain
-from catabot.waves import WaveConfig, WaveField
+from catabot.bus.messages import LidarScan, VesselState
+from catabot.config.sensors import LidarParams
+from catabot.config.waves import WaveConfig
+from catabot.world.terrain import Terrain
+from catabot.world.waves import WaveField
 from services.sensors.lidar import LidarModel, beam_directions
 from services.sensors.scene import (
     CLASS_BUOY,

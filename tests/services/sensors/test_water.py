@@ -5,7 +5,8 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from catabot.waves import WaveConfig, WaveField
+from catabot.config.waves import WaveConfig
+from catabot.world.waves import WaveField
 from services.sensors.water import BLOCK, RaySurface, wave_hits
 
 SEA = WaveField(WaveConfig(significant_height_m=0.3, peak_period_s=4.0, direction_rad=1.2), 1)

@@ -7,12 +7,12 @@ import math
 import numpy as np
 import pytest
 
-from catabot.placement import footprint_m
-from catabot.scenario import Pose, parse_scenario
-from catabot.terrain import Terrain
-from catabot.traffic_config import TrafficConfig
-from catabot.traffic_plan import Boat, Planner, plan_traffic
-from catabot.vessel import load_vessel_model
+from catabot.config.scenario import Pose, parse_scenario
+from catabot.config.traffic import TrafficConfig
+from catabot.config.vessel import load_vessel_model
+from catabot.world.placement import footprint_m
+from catabot.world.terrain import Terrain
+from catabot.world.traffic_plan import Boat, Planner, plan_traffic
 from services.physics.control import TwistControllerBank
 from services.physics.world import PhysicsWorld
 from services.traffic.behaviours import Behaviours
@@ -152,7 +152,7 @@ def test_no_boat_starts_or_steers_on_land() -> None:
 
 
 def test_a_bad_mix_is_refused_naming_the_field() -> None:
-    from catabot.scenario import ScenarioError
+    from catabot.config.scenario import ScenarioError
 
     with pytest.raises(ScenarioError, match=r"traffic\.behaviour_mix"):
         parse_scenario(_scenario(3) | {"traffic": {"count": 3, "behaviour_mix": {"zigzag": 1}}})

@@ -1,0 +1,84 @@
+"""The lockstep protocol's shared rules (DESIGN.md §4), free of any I/O.
+
+Jacobi stepping: at tick k every participant advances from t_k to t_(k+1) using only
+samples produced in ticks < k, publishes what it produced (tagged k), then acks k.
+A stream has a period in ticks and is produced at ticks k with k % period == 0; a
+consumer steps tick k only once the last due sample of each stream it reads has
+arrived. That rule, not message ordering, makes runs deterministic across routes.
+A consumer may read a stream with a lag of L ticks (a sample tagged j reaches step k
+only when j < k - L): a fixed transport delay, the same on every run, that lets the
+consumer step up to L ticks ahead of the producer instead of waiting for it every tick.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from enum import StrEnum
+
+from catabot.bus.messages import Message
+
+NS_PER_S = 1_000_000_000
+
+
+class ClockError(RuntimeError):
+    """The run cannot go on: a participant vanished, missed the deadline or never came."""
+
+
+class Policy(StrEnum):
+    """What the conductor does with a faulty participant."""
+
+    ABORT = "abort"
+    DROP = "drop"
+
+
+@dataclass(frozen=True)
+class Stream:
+    """A key with one producer and a period in ticks; `period=None` is free-running.
+    `lag`: this consumer's fixed delay in ticks on top of the one tick (clocked only)."""
+
+    key: str
+    message: type[Message]
+    producer: str
+    period: int | None = 1
+    lag: int = 0
+
+    def __post_init__(self) -> None:
+        if self.lag < 0 or (self.lag and self.period is None):
+            raise ValueError(
+                f"{self.key}: a lag must be >= 0, on a clocked stream (got {self.lag})"
+            )
+
+    def due_before(self, tick: int) -> int:
+        """The last tick < `tick` - lag at which a sample is due; -1 if none is due yet."""
+        tick -= self.lag
+        if self.period is None or tick <= 0:
+            return -1
+        return ((tick - 1) // self.period) * self.period
+
+    def released_before(self, tick: int) -> int:
+        """Samples tagged below this tick are handed to the step of `tick`."""
+        return tick - self.lag
+
+    def due_through(self, tick: int) -> int:
+        """The last tick <= `tick` at which a sample is due (used at run end)."""
+        return self.due_before(tick + 1)
+
+
+def ticks_for(duration_ns: int, dt_ns: int) -> int:
+    """Number of ticks covering a duration; a duration shorter than one tick is an error."""
+    if dt_ns <= 0:
+        raise ClockError(f"dt must be a positive number of nanoseconds (got {dt_ns})")
+    if duration_ns < dt_ns:
+        raise ClockError(f"duration {duration_ns} ns is shorter than one tick ({dt_ns} ns)")
+    return duration_ns // dt_ns
+
+
+def period_in_ticks(period_ns: int, dt_ns: int, *, what: str) -> int:
+    """A rate expressed in ticks; refuses periods that are not a whole number of ticks."""
+    if period_ns <= 0 or period_ns % dt_ns:
+        raise ClockError(
+            f"{what}: period {period_ns} ns is not a whole number of ticks of {dt_ns} ns "
+            f"(allowed: multiples of {dt_ns} ns, i.e. rates {NS_PER_S / dt_ns:g} Hz divided "
+            "by a whole number)"
+        )
+    return period_ns // dt_ns

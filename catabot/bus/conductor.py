@@ -1,0 +1,288 @@
+"""The conductor: owns the clock, publishes ticks, collects acks, ends the run.
+
+Zenoh callbacks only put events on a queue (they must never block); the conductor's
+own thread takes them off with a timeout, which is how the per-tick deadline and
+liveliness faults are noticed without polling.
+"""
+
+from __future__ import annotations
+
+import logging
+import queue
+import threading
+import time
+import uuid
+from collections.abc import Callable
+from dataclasses import dataclass, field
+
+import zenoh
+
+from catabot.bus import codec
+from catabot.bus.clock import ClockError, Policy
+from catabot.bus.keys import Keys
+from catabot.bus.messages import Ack, End, Tick
+
+log = logging.getLogger("catabot.bus.conductor")
+CONDUCTOR = "conductor"
+BLOCK = zenoh.CongestionControl.BLOCK
+
+
+@dataclass(frozen=True)
+class ClockSpec:
+    dt_ns: int
+    ticks: int
+    participants: tuple[str, ...]
+    deadline_s: float = 10.0
+    start_timeout_s: float = 60.0
+    policy: Policy = Policy.ABORT
+    realtime_factor: float | None = None
+    window_ticks: int = 1
+
+    @property
+    def ack_every(self) -> int:
+        """Participants ack every this many ticks (and at the end of a grant): half the
+        window, so the slowest one's ack extends the grant before the fastest runs dry."""
+        return max(1, self.window_ticks // 2)
+
+
+@dataclass
+class Progress:
+    tick: int
+    stamp_ns: int
+    ticks_per_s: float
+    realtime_factor: float
+
+
+@dataclass
+class RunResult:
+    ticks_done: int
+    wall_s: float
+    error: str = ""
+    dropped: list[str] = field(default_factory=list)
+    reason: str = "completed"
+    join_s: float = 0.0
+
+
+class Conductor:
+    def __init__(self, session: zenoh.Session, keys: Keys, spec: ClockSpec) -> None:
+        self.session, self.keys, self.spec = session, keys, spec
+        self.run_id = uuid.uuid4().hex[:12]
+        self._created = time.monotonic()
+        self.events: queue.SimpleQueue[tuple[str, str, bytes]] = queue.SimpleQueue()
+        self.members: set[str] = set()
+        self.dropped: list[str] = []
+        self._stop_reason = ""
+        self._done = 0  # ticks every active participant has acked
+        self._granted = -1  # the last tick granted
+        self._acked = {name: -1 for name in spec.participants}
+        self._t0 = self._created
+        self._tick_pub = session.declare_publisher(keys.tick(), congestion_control=BLOCK)
+        self._end_pub = session.declare_publisher(keys.end(), congestion_control=BLOCK)
+        self._token = session.liveliness().declare_token(keys.live(CONDUCTOR))
+        # Acks arrive on a FIFO channel (no Python callback per ack: the hot path); rare
+        # events (a participant leaving, a deadline passing, a stop) go to `events`, and the
+        # watchdog thread wakes the tick loop by publishing a poke on the conductor's own ack key.
+        self._acks = session.declare_subscriber(keys.acks(), zenoh.handlers.FifoChannel(4096))
+        self._poke_key = keys.ack(CONDUCTOR)
+        self._poke_pub = session.declare_publisher(self._poke_key)
+        self._live = session.liveliness().declare_subscriber(
+            keys.lives(), self._on_live, history=True
+        )
+        self._deadline: float | None = None
+        self._closed = threading.Event()
+        self._watchdog = threading.Thread(
+            target=self._watch, name="conductor-watchdog", daemon=True
+        )
+        self._watchdog.start()
+
+    def _on_live(self, sample: zenoh.Sample) -> None:
+        kind = "join" if sample.kind == zenoh.SampleKind.PUT else "leave"
+        self.events.put((kind, str(sample.key_expr), b""))
+
+    def stop(self, reason: str) -> None:
+        """Ask the run to end at the next tick boundary (Ctrl-C, a signal)."""
+        self._stop_reason = reason
+        self.events.put(("stop", "", b""))
+
+    def _watch(self) -> None:
+        """Poke the tick loop when an event is pending or the tick's deadline has passed."""
+        poked_for: float | None = None
+        while not self._closed.wait(0.02):
+            deadline = self._deadline
+            late = deadline is not None and time.monotonic() > deadline and poked_for != deadline
+            if late or (deadline is not None and not self.events.empty()):
+                poked_for = deadline if late else poked_for
+                self._poke_pub.put(b"")
+
+    # -- run ---------------------------------------------------------------------------
+
+    def run(self, on_progress: Callable[[Progress], None] | None = None) -> RunResult:
+        """Wait for every participant, tick to the end; wall time counts from tick 0."""
+        joined = start = time.monotonic()
+        try:
+            self._await_members()
+            joined = start = time.monotonic()
+            self._tick_loop(on_progress, start)
+            error = ""
+        except ClockError as exc:
+            error = str(exc)
+        done = self._done  # complete ticks, also when a fault or a stop cut the run short
+        reason = self._stop_reason or ("completed" if not error else "fault")
+        self._end_pub.put(codec.encode(End(self.run_id, done - 1, reason, error)))
+        wall = time.monotonic() - start
+        return RunResult(done, wall, error, list(self.dropped), reason, joined - self._created)
+
+    def _await_members(self) -> None:
+        expected = set(self.spec.participants)
+        limit = time.monotonic() + self.spec.start_timeout_s
+        while not expected <= self.members:
+            if self._stop_reason:
+                return
+            if self._next_event(limit)[0] == "late":
+                raise ClockError(self._start_timeout(expected))
+
+    def _start_timeout(self, expected: set[str]) -> str:
+        missing = ", ".join(sorted(expected - self.members))
+        return f"participant(s) never joined within {self.spec.start_timeout_s:g} s: {missing}"
+
+    def _tick_loop(self, on_progress: Callable[[Progress], None] | None, start: float) -> None:
+        """Grant ticks while the window and the pace allow, take acks, report progress.
+
+        After a stop no more ticks are granted, but every granted tick completes, so every
+        participant ends on the same last tick.
+        """
+        last_report = self._t0 = start
+        self._deadline = None
+        while self._done < self.spec.ticks and not self._stop_reason:
+            self._grant(self._horizon())
+            self._await_progress()
+            now = time.monotonic()
+            if on_progress and now - last_report >= 0.25:
+                on_progress(self._progress(self._done - 1, now - start))
+                last_report = now
+        while self._done <= self._granted:
+            self._await_progress()
+        if on_progress:
+            on_progress(self._progress(self._done - 1, time.monotonic() - start))
+
+    def _progress(self, k: int, wall: float) -> Progress:
+        sim_s = (k + 1) * self.spec.dt_ns / 1e9
+        return Progress(k, (k + 1) * self.spec.dt_ns, (k + 1) / max(wall, 1e-9), sim_s / wall)
+
+    def _horizon(self) -> int:
+        """The last tick that may be stepped now: the window past the slowest participant,
+        the run's end, and (paced runs) the ticks whose wall-clock time has come."""
+        last = self._window_end()
+        factor = self.spec.realtime_factor
+        if factor:
+            due = (time.monotonic() - self._t0) * factor * 1e9 / self.spec.dt_ns
+            last = min(last, int(due))
+        return last
+
+    def _window_end(self) -> int:
+        """The last tick the window and the run's length allow, whatever the pace."""
+        return min(self._done - 1 + self.spec.window_ticks, self.spec.ticks - 1)
+
+    def _pace_wait(self) -> float | None:
+        """Seconds until the next tick is due when only the pace holds it back, else None."""
+        factor = self.spec.realtime_factor
+        nxt = self._granted + 1
+        if not factor or nxt > self._window_end():
+            return None
+        return max(self._t0 + nxt * self.spec.dt_ns / 1e9 / factor - time.monotonic(), 0.0)
+
+    def _grant(self, last: int, *, again: bool = False) -> None:
+        """Publish a Tick granting every tick up to `last` (again: repeat it with a new
+        dropped list)."""
+        if last <= self._granted and not again:
+            return
+        was_idle = self._done > self._granted
+        self._granted = max(last, self._granted)
+        if was_idle:  # work is outstanding from now on
+            self._restart_deadline()
+        k, dt = self._granted, self.spec.dt_ns
+        tick = Tick(self.run_id, k, k * dt, dt, tuple(self.dropped), self.spec.ack_every)
+        self._tick_pub.put(codec.encode(tick))
+
+    def _await_progress(self) -> None:
+        """Wait for an ack or an event, or (paced runs) until the next tick is due, then take
+        every ack queued; apply membership and the deadline."""
+        wait = self._pace_wait()
+        if wait is None:
+            self._take(self._acks.recv())  # some tick is outstanding: an ack or a poke comes
+        elif wait > 0:
+            time.sleep(wait)
+        while (sample := self._acks.try_recv()) is not None:
+            self._take(sample)
+        self._check_events()
+
+    def _take(self, sample: zenoh.Sample) -> None:
+        key = str(sample.key_expr)
+        if key == self._poke_key:
+            return
+        try:
+            ack = codec.decode(sample.payload.to_bytes(), Ack)
+        except codec.CodecError as exc:
+            log.warning("malformed ack on %s: %s", key, exc)
+            return
+        name = self.keys.participant_of(key)
+        if ack.run == self.run_id and name in self._acked:
+            self._acked[name] = max(self._acked[name], min(ack.tick, self._granted))
+            self._advance()
+
+    def _advance(self) -> None:
+        """Every active participant has acked up to `_done - 1`; restart the deadline on
+        progress."""
+        done = min((self._acked[n] for n in self._active()), default=self._granted) + 1
+        if done > self._done:
+            self._done = done
+            self._restart_deadline()
+
+    def _restart_deadline(self) -> None:
+        """`deadline_s` from now while a granted tick is outstanding; none otherwise."""
+        outstanding = self._done <= self._granted
+        self._deadline = time.monotonic() + self.spec.deadline_s if outstanding else None
+
+    def _active(self) -> list[str]:
+        return [n for n in sorted(self._acked) if n not in self.dropped]
+
+    def _check_events(self) -> None:
+        """Apply pending membership events (a stop is noted in `_stop_reason`) and the deadline."""
+        while not self.events.empty():
+            self._next_event(0.0)
+        active = self._active()
+        for name in [n for n in active if n not in self.members]:
+            self._fault(name, f"left the run at tick {self._acked[name] + 1}")
+        k = self._done
+        if self._deadline is not None and time.monotonic() > self._deadline:
+            for name in [n for n in active if self._acked[n] < k <= self._granted]:
+                self._fault(name, f"missed the {self.spec.deadline_s:g} s deadline of tick {k}")
+
+    def _fault(self, name: str, what: str) -> None:
+        message = f"participant {name!r} {what}"
+        if self.spec.policy is Policy.ABORT:
+            raise ClockError(message)
+        log.error("%s; dropping it and going on (policy drop)", message)
+        self.dropped.append(name)
+        self._advance()
+        self._grant(self._horizon(), again=True)  # tell the others to stop waiting for it
+
+    def _next_event(self, deadline: float) -> tuple[str, str, bytes]:
+        """Wait for one event ("late" when the deadline passes); membership is tracked here."""
+        try:
+            event = self.events.get(timeout=max(deadline - time.monotonic(), 0.0))
+        except queue.Empty:
+            return ("late", "", b"")
+        kind, key, _ = event
+        if kind == "join":
+            self.members.add(self.keys.participant_of(key))
+        elif kind == "leave":
+            self.members.discard(self.keys.participant_of(key))
+        return event
+
+    def close(self) -> None:
+        self._closed.set()
+        self._watchdog.join()
+        self._acks.undeclare()
+        self._live.undeclare()
+        self._token.undeclare()

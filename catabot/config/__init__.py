@@ -1,0 +1,2 @@
+"""Configuration: every pydantic model of a scenario and its parts, vessel model files, the
+original simulator's SettingsConfig mapping. Validated before anything starts."""

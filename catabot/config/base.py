@@ -1,0 +1,97 @@
+"""What every configuration model shares: strictness, and one way to explain what is wrong.
+
+Every scenario section and file format (vessel models, waves, terrain, sensors, traffic)
+derives from `Strict`: unknown keys are errors (a misspelt key must not be silently
+ignored), values are frozen, and NaN or infinity is refused. `explain` turns pydantic's
+errors into one line per problem naming the dotted field, the rule and the value.
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+from pydantic import BaseModel, ConfigDict, ValidationError
+
+from catabot.errors import CataBotError
+
+
+class ConfigError(CataBotError, ValueError):
+    """A configuration (scenario, model file, section) that cannot be used; names the field."""
+
+
+class Strict(BaseModel):
+    model_config = ConfigDict(extra="forbid", frozen=True, allow_inf_nan=False)
+
+
+class FieldProblem(ValueError):
+    """Raised by a cross-field validator so the message can name the offending field."""
+
+    def __init__(self, field: str, message: str) -> None:
+        super().__init__(message)
+        self.field = field
+
+
+_BOUNDS = {
+    "greater_than": ">",
+    "greater_than_equal": ">=",
+    "less_than": "<",
+    "less_than_equal": "<=",
+}
+
+
+def explain(exc: ValidationError, *, model: type[BaseModel], where: str = "") -> str:
+    """One line per problem, joined by '; ': `path.to.field: rule (got value)`."""
+    return "; ".join(describe(err, model=model, where=where) for err in exc.errors())
+
+
+def describe(err: Any, *, model: type[BaseModel], where: str = "") -> str:
+    loc = [str(p) for p in err["loc"]]
+    ctx, kind, got = err.get("ctx") or {}, err["type"], err.get("input")
+    problem = ctx.get("error")
+    if isinstance(problem, FieldProblem):
+        return ".".join([*filter(None, [where]), *loc, problem.field]) + f": {problem}"
+    path = ".".join([*filter(None, [where]), *loc]) or "(top level)"
+    shown = "" if isinstance(got, dict | list) else f" (got {_short(got)})"
+    if kind == "missing":
+        return f"{path}: required field missing"
+    if kind == "extra_forbidden":
+        allowed = ", ".join(_allowed_fields(model, err["loc"][:-1]))
+        return f"{path}: unknown field (allowed: {allowed})"
+    if kind == "literal_error":
+        return f"{path}: must be one of {ctx.get('expected')}{shown}"
+    if kind in _BOUNDS:
+        bound = next(v for k, v in ctx.items() if k in ("gt", "ge", "lt", "le"))
+        return f"{path}: must be {_BOUNDS[kind]} {bound:g}{shown}"
+    if kind == "finite_number":
+        return f"{path}: must be a finite number{shown}"
+    return f"{path}: {str(err['msg']).removeprefix('Value error, ')}{shown}"
+
+
+def _short(value: Any) -> str:
+    """A value as shown in a message: its repr, cut short (a 10,000-character name)."""
+    text = repr(value)
+    return text if len(text) <= 80 else text[:77] + "..."
+
+
+def _allowed_fields(model: type[BaseModel], loc: tuple[Any, ...]) -> list[str]:
+    """Field names of the model found by walking `loc` from `model` (for unknown keys)."""
+    for part in loc:
+        if isinstance(part, int):
+            continue
+        info = model.model_fields.get(str(part))
+        nested = _model_in(info.annotation) if info is not None else None
+        if nested is None:
+            break
+        model = nested
+    return list(model.model_fields)
+
+
+def _model_in(annotation: Any) -> type[BaseModel] | None:
+    """The BaseModel class inside an annotation such as `list[Hull]`, if any."""
+    if isinstance(annotation, type) and issubclass(annotation, BaseModel):
+        return annotation
+    for arg in getattr(annotation, "__args__", ()) or ():
+        found = _model_in(arg)
+        if found is not None:
+            return found
+    return None

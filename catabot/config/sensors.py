@@ -1,0 +1,128 @@
+"""Every sensor type the scenario accepts: its parameters (validated before anything
+starts) and the message it publishes. The sensor's model lives in `services/sensors/`
+and is registered there under the same name; this table is the library's half, so the
+scenario, the stream table and the recorder know a type without importing a service.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Literal
+
+from pydantic import BaseModel, ConfigDict, Field
+
+from catabot.bus.messages import CameraFrame, GpsFix, ImuSample, LidarScan, Message, RadarSweep
+
+Vec3 = tuple[float, float, float]
+
+
+class SensorParams(BaseModel):
+    """Base of a sensor's parameters: strict, frozen, finite."""
+
+    model_config = ConfigDict(extra="forbid", frozen=True, allow_inf_nan=False)
+
+
+class ImuParams(SensorParams):
+    gyro_sigma: float = Field(0.009, ge=0, description="rad/s, white noise per sample")
+    accel_sigma: float = Field(0.021, ge=0, description="m/s^2, white noise per sample")
+    gyro_bias_instability: float = Field(0.0008, ge=0, description="rad/s, Gauss-Markov bias")
+    accel_bias_instability: float = Field(0.004, ge=0, description="m/s^2, Gauss-Markov bias")
+    bias_tau_s: float = Field(300.0, gt=0)
+    gyro_random_walk: float = Field(0.0, ge=0, description="rad/s/sqrt(s)")
+    accel_random_walk: float = Field(0.0, ge=0, description="m/s^2/sqrt(s)")
+    lever_arm: Vec3 = (0.0, 0.0, 0.0)
+
+
+class GpsParams(SensorParams):
+    horizontal_sigma: float = Field(0.5, ge=0, description="m, per axis")
+    vertical_sigma: float = Field(1.0, ge=0, description="m")
+    antenna_offset: Vec3 = (0.0, 0.0, 0.0)
+    method: Literal["wgs84", "paper_table"] = "wgs84"
+
+
+class RadarParams(SensorParams):
+    """Marine radar (paper III-B.2.b: 250 m, one turn in 2 s, range noise sigma 0.2 m)."""
+
+    range_m: float = Field(250.0, gt=0)
+    rotation_period_s: float = Field(2.0, gt=0, description="one antenna turn, clockwise")
+    range_bins: int = Field(512, ge=1, le=4096)
+    beam_width_deg: float = Field(1.5, gt=0, le=20, description="horizontal; beams at half")
+    sub_rays: int = Field(3, ge=1, le=16, description="rays across one beam's width")
+    elevations_deg: tuple[float, ...] = Field(
+        (0.0, 1.0, 3.0), description="rays at or above the horizon (shores, tall ships)"
+    )
+    fan_target_height_m: float = Field(
+        0.3, ge=0, description="down-looking fan sees targets this tall at any range; 0: no fan"
+    )
+    fan_min_range_m: float = Field(10.0, gt=0, description="nearest sea range of the fan")
+    range_noise_sigma_m: float = Field(0.2, ge=0)
+    antenna_height_m: float = Field(3.0, description="above the body origin")
+    sea_clutter: bool = Field(False, description="keep returns from the water surface")
+    ppi_size_px: int = Field(256, ge=16, le=2048)
+    fade_s: float = Field(1.0, gt=0, description="PPI returns fade to nothing in this time")
+
+
+class CameraOutputs(SensorParams):
+    color: bool = True
+    depth: bool = True
+    normals: bool = True
+    segmentation: bool = True
+
+
+class CameraParams(SensorParams):
+    """Pinhole camera (services/sensors/camera.py); the mount is in the body frame (FLU), its
+    rpy turn the camera's forward-looking axes (x forward, z up; positive pitch looks down)
+    before the optical frame (z forward, x right, y down). Rain is the scenario's
+    `rain.rate_mm_h`; it veils and streaks the colour image only."""
+
+    width: int = Field(640, ge=2, le=4096)
+    height: int = Field(480, ge=2, le=4096)
+    hfov_deg: float = Field(80.0, gt=1, lt=170)
+    mount_xyz: Vec3 = Field(
+        (0.5, 0.0, 1.5),
+        description="m, body FLU; above the hull: rays from inside its box stop at 0",
+    )
+    mount_rpy_deg: Vec3 = (0.0, 0.0, 0.0)
+    outputs: CameraOutputs = CameraOutputs()
+    max_range_m: float = Field(1000.0, gt=0)
+    occluded_fraction: float = Field(
+        0.3, ge=0, le=1, description="occluded when visible px < fraction x projected box"
+    )
+
+
+class LidarParams(SensorParams):
+    """A spinning LiDAR (paper III-B.2.a: OS1-like, 32 x 512, 45 deg vertical, 360 deg, 100 m)
+    and the constants of its rain model (services/sensors/rain.py; paper defaults, Q at 905 nm).
+    The rain rate itself is the scenario's `rain.rate_mm_h`. `preset: "os1"` is those figures.
+    The carrier's own hull box is in the scene: mount the sensor where it sees over it."""
+
+    preset: Literal["os1"] | None = "os1"
+    channels: int = Field(32, ge=1, le=256)
+    columns: int = Field(512, ge=1, le=8192)
+    vertical_fov_deg: float = Field(45.0, gt=0, le=180, description="symmetric about level")
+    max_range_m: float = Field(100.0, gt=0)
+    range_noise_sigma_m: float = Field(0.01, ge=0)
+    mount_xyz: Vec3 = (0.0, 0.0, 1.0)
+    mount_yaw_deg: float = 0.0
+    mount_pitch_deg: float = 0.0
+    drop_diameter_mm: float = Field(3.25, gt=0, le=10)
+    beam_radius_m: float = Field(0.02, gt=0)
+    detection_threshold: float = Field(5e-6, gt=0)
+    reflectivity: float = Field(0.9, gt=0, le=1, description="s in rho = s / pi")
+    q_ext: float = Field(2.0, ge=0)
+    q_back: float = Field(2.0, ge=0)
+
+
+@dataclass(frozen=True)
+class SensorType:
+    params: type[SensorParams]
+    message: type[Message]
+
+
+SENSOR_TYPES: dict[str, SensorType] = {
+    "imu": SensorType(ImuParams, ImuSample),
+    "gps": SensorType(GpsParams, GpsFix),
+    "radar": SensorType(RadarParams, RadarSweep),
+    "camera": SensorType(CameraParams, CameraFrame),
+    "lidar": SensorType(LidarParams, LidarScan),
+}

@@ -1,0 +1,294 @@
+"""Vessel model files: hull geometry, mass properties, damping and thruster layout.
+
+A vessel model is its own JSON file (DESIGN.md §6), referenced from a scenario by a bundled
+name (`"catabot"`, `"wamv"`) or by a path. The schema is strict (`extra="forbid"`) so that a
+misspelt key is an error, not a silently ignored setting; new optional fields (added mass,
+wind area, ...) extend it without breaking existing files.
+
+Frames and units (DESIGN.md §2): body frame FLU (x forward, y left, z up) with its origin at
+the waterline-level reference point on the centreline; SI units, named in the field names.
+"""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+from typing import Annotated, Any, Literal
+
+from pydantic import (
+    BaseModel,
+    BeforeValidator,
+    ConfigDict,
+    Field,
+    ValidationError,
+    model_validator,
+)
+from pydantic.types import FiniteFloat
+
+BUNDLED_DIR = Path(__file__).parents[1] / "data" / "vessels"
+
+
+def _length(n: int, what: str = "") -> BeforeValidator:
+    """Reject a list of the wrong length with one message for the field, not one per item."""
+
+    def check(value: Any) -> Any:
+        if not isinstance(value, list | tuple) or len(value) != n:
+            raise ValueError(f"must be a list of {n} numbers{what}")
+        return value
+
+    return BeforeValidator(check)
+
+
+PositiveFloat = Annotated[FiniteFloat, Field(gt=0)]
+NonNegativeFloat = Annotated[FiniteFloat, Field(ge=0)]
+Vec3 = Annotated[tuple[FiniteFloat, FiniteFloat, FiniteFloat], _length(3, " [x, y, z]")]
+Inertia3 = Annotated[
+    tuple[PositiveFloat, PositiveFloat, PositiveFloat], _length(3, " [Ixx, Iyy, Izz]")
+]
+_Six = tuple[
+    NonNegativeFloat,
+    NonNegativeFloat,
+    NonNegativeFloat,
+    NonNegativeFloat,
+    NonNegativeFloat,
+    NonNegativeFloat,
+]
+Dof6 = Annotated[_Six, _length(6, " [X_u, Y_v, Z_w, K_p, M_q, N_r]")]
+AddedMass6 = Annotated[_Six, _length(6, " [X_udot, Y_vdot, Z_wdot, K_pdot, M_qdot, N_rdot]")]
+WindCoefficients3 = Annotated[
+    tuple[NonNegativeFloat, NonNegativeFloat, FiniteFloat], _length(3, " [C_x, C_y, C_n]")
+]
+
+
+class VesselModelError(ValueError):
+    """A vessel model file is missing, unreadable or invalid; the message names file and field."""
+
+
+class FieldProblem(ValueError):
+    """Raised by cross-field validators so the error path can name the offending field."""
+
+    def __init__(self, field: str, message: str) -> None:
+        super().__init__(message)
+        self.field = field
+
+
+class _Strict(BaseModel):
+    model_config = ConfigDict(extra="forbid", frozen=True)
+
+
+class Hull(_Strict):
+    """A parametric hull, discretised into vertical columns for buoyancy.
+
+    `beam_m` is a box's width or a cylinder's diameter; a cylinder lies along body x.
+    `columns_along` / `columns_across` set the buoyancy discretisation (None: a default per
+    shape, more across for cylinders because their cross-section is curved).
+    """
+
+    shape: Literal["box", "cylinder"]
+    center_m: Vec3
+    length_m: PositiveFloat
+    beam_m: PositiveFloat
+    height_m: PositiveFloat | None = None
+    columns_along: Annotated[int, Field(ge=1, le=256)] = 16
+    columns_across: Annotated[int, Field(ge=1, le=64)] | None = None
+
+    @model_validator(mode="after")
+    def _shape_fields(self) -> Hull:
+        if self.shape == "box" and self.height_m is None:
+            raise FieldProblem("height_m", "required when shape is 'box'")
+        if self.shape == "cylinder" and self.height_m is not None:
+            raise FieldProblem(
+                "height_m", "only for shape 'box' (a cylinder's height is its beam_m)"
+            )
+        return self
+
+    @property
+    def vertical_extent_m(self) -> float:
+        """Full height of the hull along body z."""
+        return self.height_m if self.height_m is not None else self.beam_m
+
+    @property
+    def across(self) -> int:
+        if self.columns_across is not None:
+            return self.columns_across
+        return 2 if self.shape == "box" else 10
+
+
+class Damping(_Strict):
+    """Fossen damping per DOF [X_u, Y_v, Z_w, K_p, M_q, N_r]: tau = -(linear + quadratic*|v|)*v.
+
+    Units: linear N·s/m (surge, sway, heave) and N·m·s/rad (roll, pitch, yaw);
+    quadratic N·s²/m² and N·m·s²/rad².
+    """
+
+    linear: Dof6
+    quadratic: Dof6
+
+
+class Thruster(_Strict):
+    """A fixed thruster; `yaw_rad` turns its thrust direction in the body xy plane (0: forward).
+
+    A command c in [-1, 1] asks for c*max_forward_n (c >= 0) or c*max_reverse_n (c < 0);
+    the delivered force follows with a first-order lag of `time_constant_s` (0: none).
+    """
+
+    position_m: Vec3
+    yaw_rad: FiniteFloat = 0.0
+    max_forward_n: NonNegativeFloat
+    max_reverse_n: NonNegativeFloat
+    time_constant_s: NonNegativeFloat = 0.0
+
+
+class WindArea(_Strict):
+    """Above-water windage: areas and drag coefficients (Fossen 2011 §10.1, simplified).
+
+    With (u_a, v_a) the apparent wind (air velocity relative to the vessel, body frame),
+    rho_a the air density, V_a^2 = u_a^2 + v_a^2 and gamma = atan2(v_a, u_a):
+        X = 1/2 rho_a A_F C_x u_a |u_a|
+        Y = 1/2 rho_a A_L C_y v_a |v_a|
+        N = -1/2 rho_a A_L L C_n V_a^2 sin(2 gamma)   ( = -rho_a A_L L C_n u_a v_a )
+    i.e. VRX's wind law with its lumped coefficients split into 1/2 rho_a A C. C_n > 0 turns
+    the bow away from the wind (bow falls off downwind), as for a slender hull (Munk moment).
+    Applied at the body origin: no heeling moment.
+    """
+
+    frontal_area_m2: NonNegativeFloat
+    lateral_area_m2: NonNegativeFloat
+    coefficients: WindCoefficients3
+    length_m: PositiveFloat
+
+
+class VesselModel(_Strict):
+    """One vessel model file. Inertia is about the centre of gravity, in body axes."""
+
+    name: Annotated[str, Field(min_length=1)]
+    description: str = ""
+    mass_kg: PositiveFloat
+    inertia_kgm2: Inertia3
+    cog_m: Vec3
+    hulls: Annotated[list[Hull], Field(min_length=1)]
+    damping: Damping
+    thrusters: list[Thruster] = Field(default_factory=list)
+    # Added mass magnitudes (>= 0, i.e. -X_udot ...), diagonal, about the body origin (kg, kg m^2).
+    added_mass: AddedMass6 = (0.0, 0.0, 0.0, 0.0, 0.0, 0.0)
+    wind: WindArea | None = None  # None: the wind exerts no force on this vessel
+
+    @model_validator(mode="after")
+    def _physical_inertia(self) -> VesselModel:
+        ixx, iyy, izz = self.inertia_kgm2
+        if ixx + iyy < izz or iyy + izz < ixx or izz + ixx < iyy:
+            raise FieldProblem(
+                "inertia_kgm2",
+                "principal moments must satisfy the triangle inequality "
+                f"(Ixx + Iyy >= Izz and cyclic), got {list(self.inertia_kgm2)}",
+            )
+        return self
+
+
+def bundled_vessel_names() -> list[str]:
+    """Names of the vessel models shipped with catabot."""
+    return sorted(p.stem for p in BUNDLED_DIR.glob("*.json"))
+
+
+def load_vessel_model(ref: str, *, base_dir: Path | None = None) -> VesselModel:
+    """Load a vessel model by bundled name or JSON path (relative to `base_dir` if given)."""
+    path = _resolve(ref, base_dir)
+    try:
+        text = path.read_text(encoding="utf-8")
+    except OSError as exc:
+        raise VesselModelError(
+            f"vessel model '{ref}': cannot read {path}: {exc.strerror}"
+        ) from None
+    try:
+        data = json.loads(text)
+    except json.JSONDecodeError as exc:
+        raise VesselModelError(
+            f"vessel model '{ref}': invalid JSON at line {exc.lineno} column {exc.colno}: {exc.msg}"
+        ) from None
+    return parse_vessel_model(data, source=ref)
+
+
+def parse_vessel_model(data: Any, *, source: str = "<data>") -> VesselModel:
+    """Validate already-decoded JSON data; errors name `source`, the field path and the rule."""
+    if not isinstance(data, dict):
+        raise VesselModelError(
+            f"vessel model '{source}': must be a JSON object (got {type(data).__name__})"
+        )
+    try:
+        return VesselModel.model_validate(data)
+    except ValidationError as exc:
+        lines = [_describe(err) for err in exc.errors()]
+        raise VesselModelError(f"vessel model '{source}': " + "; ".join(lines)) from None
+
+
+def _resolve(ref: str, base_dir: Path | None) -> Path:
+    """A bare name (no separator, no .json suffix) is bundled; anything else is a path."""
+    is_path = ref.endswith(".json") or "/" in ref or "\\" in ref
+    if not is_path:
+        path = BUNDLED_DIR / f"{ref}.json"
+        if not path.is_file():
+            names = ", ".join(bundled_vessel_names())
+            raise VesselModelError(
+                f"vessel model '{ref}': unknown bundled name (bundled: {names}); "
+                "give a path ending in .json to load a file"
+            )
+        return path
+    path = Path(ref)
+    if not path.is_absolute() and base_dir is not None:
+        path = Path(base_dir) / path
+    return path
+
+
+def _describe(err: Any) -> str:
+    """One readable line per pydantic error: `field.path: rule (got value)`."""
+    loc = [str(p) for p in err["loc"]]
+    ctx = err.get("ctx") or {}
+    kind = err["type"]
+    problem = ctx.get("error")
+    if isinstance(problem, FieldProblem):
+        return ".".join([*loc, problem.field]) + f": {problem}"
+    where = ".".join(loc) or "(top level)"
+    got = err.get("input")
+    if kind == "missing":
+        return f"{where}: required field missing"
+    if kind == "extra_forbidden":
+        allowed = ", ".join(_allowed_fields(err["loc"][:-1]))
+        return f"{where}: unknown field (allowed: {allowed})"
+    if kind == "literal_error":
+        return f"{where}: must be one of {ctx.get('expected')} (got {got!r})"
+    limits = {"greater_than": ">", "greater_than_equal": ">=", "less_than": "<"}
+    limits["less_than_equal"] = "<="
+    if kind in limits:
+        bound = next(v for k, v in ctx.items() if k in ("gt", "ge", "lt", "le"))
+        return f"{where}: must be {limits[kind]} {bound:g} (got {got!r})"
+    if kind == "finite_number":
+        return f"{where}: must be a finite number (got {got!r})"
+    message = str(err["msg"]).removeprefix("Value error, ")
+    return f"{where}: {message} (got {got!r})"
+
+
+def _allowed_fields(loc: tuple[Any, ...]) -> list[str]:
+    """Field names of the model found by walking `loc` from VesselModel (for unknown keys)."""
+    model: type[BaseModel] = VesselModel
+    for part in loc:
+        if isinstance(part, int):
+            continue
+        info = model.model_fields.get(str(part))
+        if info is None:
+            break
+        nested = _model_in(info.annotation)
+        if nested is None:
+            break
+        model = nested
+    return list(model.model_fields)
+
+
+def _model_in(annotation: Any) -> type[BaseModel] | None:
+    """The BaseModel class inside an annotation such as `list[Hull]`, if any."""
+    if isinstance(annotation, type) and issubclass(annotation, BaseModel):
+        return annotation
+    for arg in getattr(annotation, "__args__", ()) or ():
+        found = _model_in(arg)
+        if found is not None:
+            return found
+    return None

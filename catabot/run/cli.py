@@ -1,0 +1,129 @@
+"""The `catabot` command: run, service, conductor, router, scenario."""
+
+from __future__ import annotations
+
+import argparse
+import importlib
+import json
+import sys
+import time
+from pathlib import Path
+
+from catabot.bus.session import Connection, SessionError, add_connection_args, open_session
+from catabot.config.scenario import ScenarioError, json_schema, load_scenario
+from catabot.run import launcher
+from catabot.run.generate import add_arguments as add_generate_arguments
+
+
+def _run(args: argparse.Namespace) -> int:
+    opts = launcher.RunOptions(
+        scenario=args.scenario,
+        duration_s=args.duration,
+        realtime=args.realtime,
+        out=Path(args.out),
+        connect=tuple(args.connect),
+        listen=args.listen,
+        quiet=args.quiet,
+    )
+    return launcher.run(opts)
+
+
+def _service(args: argparse.Namespace, rest: list[str]) -> int:
+    if args.name == "conductor":
+        from catabot.run import conduct
+
+        return conduct.main(rest)
+    module = launcher.SERVICE_MODULES.get(args.name)
+    if module is None:
+        names = ", ".join(["conductor", *launcher.SERVICE_MODULES])
+        print(f"catabot service: unknown service {args.name!r} (known: {names})", file=sys.stderr)
+        return 2
+    main = importlib.import_module(f"{module}.service").main
+    return int(main(rest))
+
+
+def _router(args: argparse.Namespace) -> int:
+    listen = tuple(args.listen) or ("tcp/0.0.0.0:7447",)
+    try:
+        session = open_session(
+            Connection(connect=tuple(args.connect), listen=listen, mode="router")
+        )
+    except SessionError as exc:
+        print(f"catabot router: {exc}", file=sys.stderr)
+        return 2
+    print(f"zenoh router listening on {', '.join(listen)} (Ctrl-C to stop)", flush=True)
+    try:
+        while True:
+            time.sleep(3600)
+    except KeyboardInterrupt:
+        session.close()
+    return 0
+
+
+def _scenario(args: argparse.Namespace) -> int:
+    if args.action == "schema":
+        text = json.dumps(json_schema(), indent=2) + "\n"
+        if args.output:
+            Path(args.output).write_text(text)
+        else:
+            sys.stdout.write(text)
+        return 0
+    if args.action == "generate":
+        from catabot.run.generate import generate
+
+        return generate(args)
+    try:
+        scenario = load_scenario(args.file)
+    except ScenarioError as exc:
+        print(f"catabot scenario validate: {exc}", file=sys.stderr)
+        return 2
+    counts = f"{len(scenario.vessels)} vessel(s), {scenario.ticks} ticks"
+    print(f"{args.file or 'default'}: valid ({counts})")
+    return 0
+
+
+def parser() -> argparse.ArgumentParser:
+    p = argparse.ArgumentParser(prog="catabot", description=__doc__)
+    sub = p.add_subparsers(dest="command", required=True)
+    run = sub.add_parser("run", help="run a scenario: conductor and services as processes")
+    run.add_argument("scenario", nargs="?", help="scenario file or bundled name (default: default)")
+    run.add_argument("--duration", type=float, help="simulated seconds (overrides the scenario)")
+    run.add_argument("--realtime", type=float, metavar="FACTOR", help="pace: 1.0 = wall clock")
+    run.add_argument("--out", default="runs", help="folder for run folders (default: runs)")
+    run.add_argument(
+        "--connect",
+        action="append",
+        default=[],
+        metavar="ENDPOINT",
+        help="use a zenoh router instead of the embedded peer mesh",
+    )
+    run.add_argument(
+        "--listen",
+        metavar="ENDPOINT",
+        help="embedded mesh endpoint (default tcp/127.0.0.1:<free port>)",
+    )
+    run.add_argument("--quiet", action="store_true", help="no progress bar")
+    svc = sub.add_parser("service", help="run one service (conductor, physics, ...) alone")
+    svc.add_argument("name")
+    rtr = sub.add_parser("router", help="run a zenoh router for distributed runs")
+    add_connection_args(rtr)
+    scen = sub.add_parser("scenario", help="scenario tools")
+    scen.add_argument("action", choices=["schema", "validate", "generate"])
+    scen.add_argument("file", nargs="?", help="scenario to validate")
+    scen.add_argument("--output", "-o", help="write the schema (or generated scenario) here")
+    add_generate_arguments(scen)
+    return p
+
+
+def main(argv: list[str] | None = None) -> int:
+    args, rest = parser().parse_known_args(argv)
+    if args.command == "service":
+        return _service(args, rest)
+    if rest:
+        parser().error(f"unrecognized arguments: {' '.join(rest)}")
+    handlers = {"run": _run, "router": _router, "scenario": _scenario}
+    return handlers[args.command](args)
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,90 @@
+"""`catabot conductor`: the conductor as a program; progress as JSON lines on stdout.
+
+The launcher reads those lines to draw its progress bar; on another machine the same
+program runs alone against a router.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import logging
+import signal
+import sys
+from dataclasses import asdict
+
+from catabot.bus.blas import single_thread_blas
+from catabot.bus.clock import Policy
+from catabot.bus.conductor import ClockSpec, Conductor, Progress
+from catabot.bus.keys import Keys
+from catabot.bus.session import (
+    SessionError,
+    add_connection_args,
+    connection_from_args,
+    open_session,
+)
+from catabot.config.scenario import Scenario, ScenarioError, load_scenario
+from catabot.run.service import quiet_gc
+from catabot.world.streams import participants
+
+log = logging.getLogger("catabot.bus.conductor")
+
+
+def clock_spec(scenario: Scenario) -> ClockSpec:
+    c = scenario.clock
+    return ClockSpec(
+        dt_ns=scenario.dt_ns,
+        ticks=scenario.ticks,
+        participants=tuple(participants(scenario)),
+        deadline_s=c.deadline_s,
+        start_timeout_s=c.start_timeout_s,
+        policy=Policy(c.policy),
+        realtime_factor=c.realtime_factor,
+        window_ticks=c.window_ticks,
+    )
+
+
+def emit(kind: str, **fields: object) -> bool:
+    """One JSON line on stdout; False once nobody reads it (the launcher is gone)."""
+    try:
+        print(json.dumps({"kind": kind, **fields}), flush=True)
+    except (BrokenPipeError, ValueError):  # ValueError: stdout already closed
+        return False
+    return True
+
+
+def main(argv: list[str] | None = None) -> int:
+    parser = argparse.ArgumentParser(prog="catabot conductor")
+    parser.add_argument("--scenario", help="scenario file (default: the bundled default)")
+    add_connection_args(parser)
+    args = parser.parse_args(argv)
+    single_thread_blas()
+    logging.basicConfig(level=logging.INFO, format="%(asctime)s %(name)s %(levelname)s %(message)s")
+    try:
+        scenario = load_scenario(args.scenario)
+        session = open_session(connection_from_args(args))
+    except (ScenarioError, SessionError) as exc:
+        emit("result", ticks=0, wall_s=0.0, error=str(exc), dropped=[])
+        return 2
+    conductor = Conductor(session, Keys(scenario.name), clock_spec(scenario))
+    quiet_gc()
+    for sig in (signal.SIGINT, signal.SIGTERM):
+        signal.signal(sig, lambda *_: conductor.stop("interrupted"))
+
+    def progress(p: Progress) -> None:
+        # Without its launcher the run has no one to report to: end it cleanly (services
+        # flush and exit) rather than tick on as orphans.
+        if not emit("progress", **asdict(p)):
+            conductor.stop("interrupted")
+
+    result = conductor.run(progress)
+    emit("result", **asdict(result))
+    if result.error:
+        log.error("run ended by a fault: %s", result.error)
+    conductor.close()
+    session.close()
+    return 1 if result.error else (130 if result.reason == "interrupted" else 0)
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,213 @@
+"""`catabot run`: the conductor and every service as separate OS processes.
+
+The launcher owns no simulation state: it checks the scenario, makes the run folder,
+starts the processes with their logs in `log/`, draws progress from the conductor's
+JSON lines, and turns the end of the run into a summary and an exit code.
+"""
+
+from __future__ import annotations
+
+import json
+import signal
+import subprocess
+import sys
+import threading
+import time
+from dataclasses import dataclass
+from datetime import datetime
+from pathlib import Path
+
+from catabot.bus.scheduling import SchedulingError, requested_policy
+from catabot.bus.session import free_port
+from catabot.config.scenario import Scenario, ScenarioError, load_scenario
+from catabot.config.vessel import VesselModelError
+from catabot.run.progress import ProgressBar
+from catabot.world.placement import resolve_poses
+from catabot.world.streams import services as needed_services
+from catabot.world.traffic_plan import plan_traffic
+
+SERVICE_MODULES = {
+    "physics": "services.physics",
+    "sensors": "services.sensors",
+    "traffic": "services.traffic",
+    "recorder": "services.recorder",
+}
+
+
+class LaunchError(RuntimeError):
+    """The run could not start (bad scenario, missing model, unknown service)."""
+
+
+@dataclass(frozen=True)
+class RunOptions:
+    scenario: str | None = None
+    duration_s: float | None = None
+    realtime: float | None = None
+    out: Path = Path("runs")
+    connect: tuple[str, ...] = ()
+    listen: str | None = None
+    quiet: bool = False
+
+
+def prepare(opts: RunOptions) -> Scenario:
+    """Everything that can be refused is refused here, before any process starts."""
+    requested_policy()  # a bad CATABOT_SCHED would stop every service
+    scenario = load_scenario(opts.scenario)
+    data = scenario.model_dump()
+    if opts.duration_s is not None:
+        data["duration_s"] = opts.duration_s
+    if opts.realtime is not None:
+        data["clock"]["realtime_factor"] = opts.realtime
+    from catabot.config.scenario import parse_scenario
+
+    scenario = resolve_poses(parse_scenario(data, source="command line"))
+    plan_traffic(scenario)  # boats that find no open water are refused here, not in a service
+    for name in needed_services(scenario):
+        if name not in SERVICE_MODULES:
+            raise LaunchError(f"scenario needs service {name!r}, which this version does not have")
+    return scenario
+
+
+def make_run_dir(out: Path, scenario: Scenario) -> Path:
+    stamp = datetime.now().strftime("%Y%m%d-%H%M%S")
+    base = out / f"{scenario.name}-{stamp}"
+    run_dir, n = base, 1
+    while run_dir.exists():
+        n += 1
+        run_dir = Path(f"{base}-{n}")
+    (run_dir / "log").mkdir(parents=True)
+    (run_dir / "scenario.json").write_text(scenario.model_dump_json(indent=2) + "\n")
+    return run_dir
+
+
+def _endpoints(opts: RunOptions) -> tuple[list[str], list[str]]:
+    """Flags for the conductor and for the services: embedded peer mesh, or a router."""
+    if opts.connect:
+        flags = [f for ep in opts.connect for f in ("--connect", ep)] + ["--mode", "client"]
+        return flags, flags
+    listen = opts.listen or f"tcp/127.0.0.1:{free_port()}"
+    return ["--listen", listen], ["--connect", listen]
+
+
+def _spawn(args: list[str], log_file: Path, *, stdout_pipe: bool = False) -> subprocess.Popen[str]:
+    log = log_file.open("w")
+    return subprocess.Popen(
+        [sys.executable, "-m", *args],
+        stdout=subprocess.PIPE if stdout_pipe else log,
+        stderr=log,
+        text=True,
+        start_new_session=True,  # Ctrl-C reaches the launcher only; it ends the run cleanly
+    )
+
+
+def run(opts: RunOptions) -> int:
+    try:
+        scenario = prepare(opts)
+    except (ScenarioError, SchedulingError, VesselModelError, LaunchError) as exc:
+        print(f"catabot run: {exc}", file=sys.stderr)
+        return 2
+    run_dir = make_run_dir(opts.out, scenario)
+    cond_flags, svc_flags = _endpoints(opts)
+    print(
+        f"run folder: {run_dir}\nzenoh: clients connect to {svc_flags[1]} (world "
+        f"{scenario.name!r}, keys catabot/{scenario.name}/...)",
+        flush=True,
+    )
+    scen = str(run_dir / "scenario.json")
+    conductor = _spawn(
+        ["catabot.run.conduct", "--scenario", scen, *cond_flags],
+        run_dir / "log" / "conductor.log",
+        stdout_pipe=True,
+    )
+    services = {
+        name: _spawn(
+            [SERVICE_MODULES[name], "--scenario", scen, "--run-dir", str(run_dir), *svc_flags],
+            run_dir / "log" / f"{name}.log",
+        )
+        for name in needed_services(scenario)
+    }
+    return Supervisor(scenario, run_dir, conductor, services, quiet=opts.quiet).wait()
+
+
+class Supervisor:
+    """Watches the processes of one run until all have ended."""
+
+    def __init__(
+        self,
+        scenario: Scenario,
+        run_dir: Path,
+        conductor: subprocess.Popen[str],
+        services: dict[str, subprocess.Popen[str]],
+        *,
+        quiet: bool,
+    ) -> None:
+        self.scenario, self.run_dir = scenario, run_dir
+        self.conductor, self.services = conductor, services
+        self.bar = ProgressBar(scenario.duration_ns, enabled=not quiet)
+        self.result: dict[str, object] = {}
+
+    def wait(self) -> int:
+        """Ctrl-C, SIGTERM and SIGHUP all end the run cleanly through the conductor: a
+        launcher killed by its shell or a process manager must not leave orphans ticking."""
+        stops = (signal.SIGINT, signal.SIGTERM, signal.SIGHUP)
+        previous = {
+            sig: signal.signal(sig, lambda *_: self.conductor.send_signal(signal.SIGINT))
+            for sig in stops
+        }
+        try:
+            self._read_conductor()
+            self._reap_services(timeout_s=15.0)
+        finally:
+            for sig, handler in previous.items():
+                signal.signal(sig, handler)
+        return self._summary()
+
+    def _read_conductor(self) -> None:
+        """Follow the conductor's lines; stop it if a service dies before it notices."""
+        reader = threading.Thread(target=self._follow, daemon=True)
+        reader.start()
+        stopped = False
+        while reader.is_alive():
+            reader.join(timeout=0.1)
+            died = [n for n, p in self.services.items() if p.poll() not in (None, 0)]
+            if died and not stopped and self.conductor.poll() is None:
+                self.conductor.send_signal(signal.SIGTERM)
+                stopped = True
+        self.conductor.wait()
+        self.bar.close()
+
+    def _follow(self) -> None:
+        assert self.conductor.stdout is not None
+        for line in self.conductor.stdout:
+            try:
+                event = json.loads(line)
+            except json.JSONDecodeError:
+                continue
+            if event.get("kind") == "progress":
+                self.bar.update(event)
+            elif event.get("kind") == "result":
+                self.result = event
+
+    def _reap_services(self, *, timeout_s: float) -> None:
+        limit = time.monotonic() + timeout_s
+        for proc in self.services.values():
+            try:
+                proc.wait(timeout=max(limit - time.monotonic(), 0.1))
+            except subprocess.TimeoutExpired:
+                proc.terminate()
+                try:
+                    proc.wait(timeout=3)
+                except subprocess.TimeoutExpired:
+                    proc.kill()
+                    proc.wait()
+
+    def _summary(self) -> int:
+        from catabot.run.summary import summarise
+
+        return summarise(
+            self.scenario,
+            self.run_dir,
+            self.result,
+            self.conductor.returncode,
+            {n: p.returncode for n, p in self.services.items()},
+        )

@@ -1,0 +1,82 @@
+"""The end of `catabot run`: a summary, `log/run.json`, and the exit code.
+
+Exit codes: 0 completed, 1 a fault (the failing participant is named), 130 interrupted.
+Wall-clock figures go to `log/` only: the rest of the run folder must not depend on
+wall-clock time (DESIGN.md §7).
+"""
+
+from __future__ import annotations
+
+import contextlib
+import json
+import signal
+import sys
+from collections.abc import Mapping
+from pathlib import Path
+
+from catabot.config.scenario import Scenario
+
+
+def describe_exit(code: int | None) -> str:
+    if code is None:
+        return "still running"
+    if code < 0:
+        return f"killed by {signal.Signals(-code).name}"
+    return f"exit code {code}"
+
+
+def _usage(run_dir: Path, services: Mapping[str, object]) -> dict[str, float]:
+    """Each service's CPU seconds in its stepping loop (start-up excluded), where reported."""
+    out: dict[str, float] = {}
+    for name in services:
+        path = run_dir / "log" / f"{name}.usage.json"
+        with contextlib.suppress(OSError, ValueError, KeyError):
+            out[name] = float(json.loads(path.read_text())["cpu_s"])
+    return out
+
+
+def summarise(
+    scenario: Scenario,
+    run_dir: Path,
+    result: Mapping[str, object],
+    conductor_code: int | None,
+    service_codes: Mapping[str, int | None],
+) -> int:
+    ticks = int(result.get("ticks_done", 0))  # type: ignore[call-overload]
+    wall = float(result.get("wall_s", 0.0))  # type: ignore[arg-type]
+    sim_s = ticks * scenario.dt_ns / 1e9
+    error = str(result.get("error", "") or "")
+    failed = {n: c for n, c in service_codes.items() if c not in (0, None)}
+    if not result:
+        error = error or f"the conductor ended without a result ({describe_exit(conductor_code)})"
+    elif not error and failed:
+        error = "service(s) failed: " + ", ".join(failed)
+    record = {
+        "ticks": ticks,
+        "sim_s": sim_s,
+        "wall_s": wall,
+        "error": error,
+        "reason": result.get("reason", ""),
+        "services": dict(service_codes),
+        "cpu_s": _usage(run_dir, service_codes),
+    }
+    (run_dir / "log" / "run.json").write_text(json.dumps(record, indent=2) + "\n")
+    rtf = sim_s / wall if wall > 0 else 0.0
+    print(
+        f"{ticks} ticks, {sim_s:.2f} s simulated in {wall:.2f} s "
+        f"({ticks / max(wall, 1e-9):.0f} ticks/s, real-time factor {rtf:.1f})"
+    )
+    for name, code in service_codes.items():
+        if code not in (0, None):
+            print(
+                f"  {name}: {describe_exit(code)} (see {run_dir / 'log' / (name + '.log')})",
+                file=sys.stderr,
+            )
+    print(f"run folder: {run_dir}")
+    if error:
+        print(f"run failed: {error}", file=sys.stderr)
+        return 1
+    if result.get("reason") == "interrupted" or conductor_code == 130:
+        print("run interrupted; files are complete up to the last tick", file=sys.stderr)
+        return 130
+    return 0

@@ -1,0 +1,92 @@
+"""Where vessels start: given poses are checked against the terrain, missing ones chosen.
+
+Runs in the launcher before anything starts (a pose on land is refused there, naming the
+vessel), and the chosen poses are written into the resolved scenario that every service
+reads, so all processes agree on them. Placement is a pure function of the scenario.
+"""
+
+from __future__ import annotations
+
+import math
+
+from catabot.config.scenario import Pose, Scenario, ScenarioError
+from catabot.config.terrain import TerrainError
+from catabot.config.vessel import VesselModel, load_vessel_model
+from catabot.world.terrain import Terrain, load_terrain
+
+CLEARANCE_M = 0.5
+
+
+def keel_depth_m(model: VesselModel) -> float:
+    """How far the hull reaches below the body origin (an upper bound of the draft)."""
+    return max(max(0.0, -(h.center_m[2] - h.vertical_extent_m / 2)) for h in model.hulls)
+
+
+def footprint_m(model: VesselModel) -> float:
+    """Radius of the circle around the body origin that covers every hull."""
+    return max(
+        math.hypot(abs(h.center_m[0]) + h.length_m / 2, abs(h.center_m[1]) + h.beam_m / 2)
+        for h in model.hulls
+    )
+
+
+def resolve_poses(scenario: Scenario, terrain: Terrain | None = None) -> Scenario:
+    """Every vessel with a pose: given ones checked, missing ones placed in open water."""
+    if scenario.terrain is not None and terrain is None:
+        try:
+            terrain = load_terrain(scenario.terrain)
+        except TerrainError as exc:
+            raise ScenarioError(str(exc)) from None
+    placed: list[tuple[float, float, float]] = []
+    vessels = []
+    for index, vessel in enumerate(scenario.vessels):
+        model = load_vessel_model(vessel.model)
+        pose = vessel.pose or _choose(index, model, terrain, placed)
+        if terrain is not None:
+            _check(index, vessel.id, pose, model, terrain)
+        placed.append((pose.x_m, pose.y_m, footprint_m(model)))
+        vessels.append(vessel.model_copy(update={"pose": pose}))
+    return scenario.model_copy(update={"vessels": vessels})
+
+
+def _check(index: int, vid: str, pose: Pose, model: VesselModel, terrain: Terrain) -> None:
+    try:
+        terrain.check_start(
+            pose.x_m,
+            pose.y_m,
+            draft_m=keel_depth_m(model),
+            footprint_m=footprint_m(model),
+            clearance_m=CLEARANCE_M,
+        )
+    except TerrainError as exc:
+        raise ScenarioError(f"vessels.{index}.pose ({vid}): {exc}") from None
+
+
+def _choose(
+    index: int,
+    model: VesselModel,
+    terrain: Terrain | None,
+    placed: list[tuple[float, float, float]],
+) -> Pose:
+    """Open water near the terrain centre (or the origin), clear of vessels already placed."""
+    radius = footprint_m(model)
+    for ring in range(200):
+        x, y = _candidate(ring, terrain)
+        if terrain is not None:
+            try:
+                x, y = terrain.find_open_water(
+                    keel_depth_m(model), near=(x, y), clearance_m=CLEARANCE_M, footprint_m=radius
+                )
+            except TerrainError as exc:
+                raise ScenarioError(f"vessels.{index}.pose: {exc}") from None
+        if all(math.hypot(x - px, y - py) > 2 * (radius + pr) for px, py, pr in placed):
+            return Pose(x_m=x, y_m=y, yaw_rad=0.0)
+    raise ScenarioError(f"vessels.{index}.pose: no free open water found; give a pose")
+
+
+def _candidate(ring: int, terrain: Terrain | None) -> tuple[float, float]:
+    """A spiral of search points around the centre, 8 m apart."""
+    cx, cy = (terrain.size_m[0] / 2, terrain.size_m[1] / 2) if terrain is not None else (0.0, 0.0)
+    angle = ring * 2.39996  # golden angle: an even spread without a grid
+    r = 8.0 * math.sqrt(ring)
+    return cx + r * math.cos(angle), cy + r * math.sin(angle)
