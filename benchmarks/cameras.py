@@ -23,15 +23,16 @@ import numpy as np
 
 from benchmarks.sensors import TERRAIN
 from catabot.bus.blas import single_thread_blas
-from catabot.bus.messages import VesselState
+from catabot.bus.messages import CLASS_VESSEL, VesselState
 from catabot.config.sensors import CameraParams, RadarParams
 from catabot.config.waves import WaveConfig
 from catabot.world.terrain import load_terrain
 from catabot.world.waves import WaveField
 from services.sensors.camera import CameraModel
 from services.sensors.camera_boxes import candidate_rays
+from services.sensors.mount import Mount
 from services.sensors.radar import RadarModel
-from services.sensors.scene import CLASS_VESSEL, Body, Scene
+from services.sensors.scene import Body, Scene
 
 BOATS = 20
 REPEATS = 15
@@ -85,14 +86,14 @@ def median_ms(fn: Callable[[], object], repeats: int = REPEATS) -> tuple[float, 
 
 def camera_rows(world: Scene, sea: str) -> list[tuple[str, tuple[float, float, float]]]:
     state = ego_state()
-    full = CameraModel(CameraParams(), scene=world, seed=1, name="ego/cam")
+    full = CameraModel(CameraParams(), Mount(scene=world, seed=1, name="ego/cam"))
     seg = CameraModel(
         CameraParams(outputs={"color": False, "depth": False, "normals": False}),
-        scene=world,
-        seed=1,
-        name="ego/seg",
+        Mount(scene=world, seed=1, name="ego/seg"),
     )
-    small = CameraModel(CameraParams(width=320, height=240), scene=world, seed=1, name="ego/s")
+    small = CameraModel(
+        CameraParams(width=320, height=240), Mount(scene=world, seed=1, name="ego/s")
+    )
     origin, rot = full.pose(state)
     dirs = np.dot(full.rays, rot.T.astype(np.float32))
     pairs = candidate_rays((world.corners() - origin) @ rot, full.cam)
@@ -118,7 +119,9 @@ def camera_rows(world: Scene, sea: str) -> list[tuple[str, tuple[float, float, f
 
 def radar_row(world: Scene, sea: str) -> tuple[str, tuple[float, float, float]]:
     state = ego_state()
-    radar = RadarModel(RadarParams(), scene=world, period_ns=10_000_000, seed=1, name="ego/radar")
+    radar = RadarModel(
+        RadarParams(), Mount(scene=world, period_ns=10_000_000, seed=1, name="ego/radar")
+    )
     ticks = iter(range(10**9))
 
     def one() -> None:

@@ -21,15 +21,16 @@ from pathlib import Path
 import numpy as np
 
 from catabot.bus.blas import single_thread_blas
-from catabot.bus.messages import VesselState
+from catabot.bus.messages import CLASS_BUOY, CLASS_VESSEL, VesselState
 from catabot.config.sensors import LidarParams
 from catabot.config.terrain import TerrainConfig
 from catabot.config.waves import WaveConfig
 from catabot.world.terrain import load_terrain
 from catabot.world.waves import WaveField
 from services.sensors.lidar import LidarModel
+from services.sensors.mount import Mount
 from services.sensors.rain import RainParams, apply_rain
-from services.sensors.scene import CLASS_BUOY, CLASS_VESSEL, Body, Scene
+from services.sensors.scene import Body, Scene
 
 BAY = Path(__file__).resolve().parents[1] / "catabot" / "data" / "terrain" / "bay.png"
 TERRAIN = TerrainConfig(
@@ -85,7 +86,7 @@ def times_ms(fn: Callable[[], object]) -> list[float]:
 
 def row(sea: str, rain: float) -> tuple[str, float, float, float, float, float, float, int]:
     scene, build_s = scene_of(SEAS[sea], rain)
-    lidar = LidarModel(LidarParams(), scene=scene, seed=1, name="ego/lidar")
+    lidar = LidarModel(LidarParams(), Mount(scene=scene, seed=1, name="ego/lidar"))
     zero = (0.0, 0.0, 0.0)
     state = VesselState(0, 0, (*EGO, 0.0), _yaw(1.57), zero, zero, zero, zero)
     scans = times_ms(lambda: lidar.sample(state, tick=0, stamp_ns=0))

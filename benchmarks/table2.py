@@ -26,7 +26,7 @@ from typing import Any
 
 from catabot.config.scenario import parse_scenario
 from catabot.config.sensors import SENSOR_TYPES
-from catabot.world.traffic_plan import plan_traffic
+from catabot.world.world import World
 
 BOATS = (0, 5, 10, 20, 50, 100)
 LIDAR_HZ = 10.0
@@ -71,7 +71,7 @@ def scenario(
 
 def buoys(seconds: float) -> int:
     """The waypoint buoys of the last row, as the traffic plan places them."""
-    return len(plan_traffic(parse_scenario(scenario(100, 0, seconds, MIX))).buoys)
+    return len(World.resolve(parse_scenario(scenario(100, 0, seconds, MIX))).traffic.buoys)
 
 
 def run_once(data: dict[str, Any], folder: Path) -> dict[str, Any]:

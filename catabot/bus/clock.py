@@ -16,11 +16,12 @@ from dataclasses import dataclass
 from enum import StrEnum
 
 from catabot.bus.messages import Message
+from catabot.errors import CataBotError
 
 NS_PER_S = 1_000_000_000
 
 
-class ClockError(RuntimeError):
+class ClockError(CataBotError, RuntimeError):
     """The run cannot go on: a participant vanished, missed the deadline or never came."""
 
 

@@ -18,6 +18,7 @@ import msgpack
 import numpy as np
 
 from catabot.bus.messages import MESSAGE_TYPES, SCHEMA_VERSION, Message
+from catabot.errors import CataBotError
 
 ARRAY_EXT = 1
 ALLOWED_DTYPES = frozenset(
@@ -27,7 +28,7 @@ ALLOWED_DTYPES = frozenset(
 M = TypeVar("M", bound=Message)
 
 
-class CodecError(ValueError):
+class CodecError(CataBotError, ValueError):
     """A payload that is not a valid message of a known type and schema version."""
 
 

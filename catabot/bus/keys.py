@@ -9,18 +9,20 @@ from __future__ import annotations
 import re
 from dataclasses import dataclass
 
+from catabot.errors import CataBotError
+
 ROOT = "catabot"
 _NAME = re.compile(r"^[A-Za-z0-9_.\-]+$")
 
 
-class KeyError_(ValueError):
+class KeyNameError(CataBotError, ValueError):
     """A name that cannot be one chunk of a Zenoh key expression."""
 
 
 def check_name(kind: str, name: str) -> str:
     """Refuse names that would change a key's meaning ('/', wildcards, '$', spaces)."""
     if not isinstance(name, str) or not _NAME.match(name):
-        raise KeyError_(
+        raise KeyNameError(
             f"{kind} name {name!r} is not allowed in a key: use letters, digits, '_', '-' or '.'"
         )
     return name
@@ -99,14 +101,14 @@ class Keys:
         """The part of a key after `catabot/<world>/`, used to name files and topics."""
         head = self.prefix + "/"
         if not key.startswith(head):
-            raise KeyError_(f"key {key!r} is not in world {self.world!r}")
+            raise KeyNameError(f"key {key!r} is not in world {self.world!r}")
         return key[len(head) :]
 
     def vessel_of(self, key: str) -> str:
         """The vessel id of a `vessel/<id>/...` or `sensor/<id>/...` key of this world."""
         parts = self.relative(key).split("/")
         if len(parts) < 3 or parts[0] not in ("vessel", "sensor"):
-            raise KeyError_(f"key {key!r} names no vessel")
+            raise KeyNameError(f"key {key!r} names no vessel")
         return parts[1]
 
     def participant_of(self, key: str) -> str:

@@ -16,6 +16,11 @@ import numpy as np
 
 SCHEMA_VERSION = 1
 
+LABEL_CLASSES = ("none", "water", "terrain", "vessel", "buoy")
+"""Semantic classes of LiDAR points, camera pixels and boxes: the id is the index. "none"
+is no surface (the sky, a raindrop, beyond range). One table for every producer and reader."""
+CLASS_NONE, CLASS_WATER, CLASS_TERRAIN, CLASS_VESSEL, CLASS_BUOY = range(len(LABEL_CLASSES))
+
 XYZ = ("x", "y", "z")
 QUAT = ("x", "y", "z", "w")
 
@@ -265,10 +270,10 @@ class CameraFrame(Message):
 
     Optical frame (ROS): z forward, x right, y down. `depth` (H, W) float32 is the distance
     along z (inf: no hit); `normals` (H, W, 3) int8 are unit normals in the optical frame
-    times 127; `segmentation` (H, W) uint8 is the class (0 sky, 1 water, 2 terrain, 3 vessel,
-    4 buoy) and `instance` (H, W) uint16 the instance (0: none). `boxes` (K, 6) float32 rows
-    are [instance, class, x0, y0, x1, y1] in pixels (x1, y1 exclusive) and `box_flags` (K, 2)
-    uint8 [truncated, occluded].
+    times 127; `segmentation` (H, W) uint8 is the class (`LABEL_CLASSES`: 0 none, 1 water,
+    2 terrain, 3 vessel, 4 buoy) and `instance` (H, W) uint16 the instance (0: none).
+    `boxes` (K, 6) float32 rows are [instance, class, x0, y0, x1, y1] in pixels (x1, y1
+    exclusive) and `box_flags` (K, 2) uint8 [truncated, occluded].
     """
 
     TYPE: ClassVar[str] = "camera_frame"
@@ -293,7 +298,7 @@ class LidarScan(Message):
 
     Bulk fields are arrays, one entry per return: `points` (N, 3) float32 m, `intensity`
     float32 (relative power, paper eq. 4), `ring` uint16 (channel, 0 = lowest beam), `cls` uint8
-    (services/sensors/scene.py CLASS_*; 0 for raindrops), `instance` int32, `is_rain` bool.
+    (`LABEL_CLASSES`; 0 for raindrops), `instance` int32, `is_rain` bool.
     `range_image` (channels, columns) float32 m holds every beam, inf where nothing returned.
     Its CSV row is a summary: the number of returns and of rain returns (catabot/tabular.py).
     """

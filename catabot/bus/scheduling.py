@@ -15,11 +15,13 @@ from __future__ import annotations
 import logging
 import os
 
+from catabot.errors import CataBotError
+
 log = logging.getLogger("catabot.bus.scheduling")
 POLICIES = ("batch", "normal")
 
 
-class SchedulingError(ValueError):
+class SchedulingError(CataBotError, ValueError):
     """`CATABOT_SCHED` names no policy CataBot knows."""
 
 

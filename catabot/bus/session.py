@@ -16,10 +16,12 @@ from dataclasses import dataclass, field
 
 import zenoh
 
+from catabot.errors import CataBotError
+
 MODES = ("peer", "client", "router")
 
 
-class SessionError(RuntimeError):
+class SessionError(CataBotError, RuntimeError):
     """Zenoh could not be opened with the given endpoints."""
 
 

@@ -14,8 +14,9 @@ from __future__ import annotations
 import math
 from typing import Annotated, Literal
 
-from pydantic import BaseModel, ConfigDict, Field, model_validator
+from pydantic import Field, model_validator
 
+from catabot.config.base import ConfigError, Strict
 from catabot.config.geometry import polygon_area, polygon_self_intersects
 
 Vec2 = tuple[float, float]
@@ -23,7 +24,7 @@ NonNegative = Annotated[float, Field(ge=0)]
 Positive = Annotated[float, Field(gt=0)]
 
 
-class EnvironmentConfigError(ValueError):
+class EnvironmentConfigError(ConfigError):
     """An environment setting (wind zone, current map) is invalid; the message names it."""
 
 
@@ -31,11 +32,7 @@ class CurrentMapError(EnvironmentConfigError):
     """A current map file is missing, unreadable or has the wrong shape or values."""
 
 
-class _Model(BaseModel):
-    model_config = ConfigDict(extra="forbid", frozen=True, allow_inf_nan=False)
-
-
-class CurrentMapConfig(_Model):
+class CurrentMapConfig(Strict):
     """A gridded current map: (u, v) water velocity at the nodes of a regular grid.
 
     `path` is a `.npy` file holding a float array of shape (rows, cols, 2) in m/s, where
@@ -54,14 +51,14 @@ class CurrentMapConfig(_Model):
     outside: Literal["edge", "zero"] = "edge"
 
 
-class CurrentConfig(_Model):
+class CurrentConfig(Strict):
     """Water current: a uniform world-frame vector (m/s, the way the water flows) plus a map."""
 
     velocity_mps: Vec2 = (0.0, 0.0)
     map: CurrentMapConfig | None = None
 
 
-class WindZone(_Model):
+class WindZone(Strict):
     """A region where the wind differs: a circle or a polygon, with its own speed and direction.
 
     Inside the zone its wind replaces the global wind; where zones overlap, the zone listed
@@ -105,7 +102,7 @@ def _check_polygon(vertices: list[Vec2] | None) -> None:
         raise ValueError(f"polygon vertices_m: edges {crossing[0]} and {crossing[1]} cross")
 
 
-class WindConfig(_Model):
+class WindConfig(Strict):
     """Global wind plus zones; gusts are a first-order Gauss-Markov process per wind source.
 
     speed_mps / toward_rad: the mean global wind (see the module docstring for the direction
@@ -131,7 +128,7 @@ class WindConfig(_Model):
         )
 
 
-class RainConfig(_Model):
+class RainConfig(Strict):
     """Rain in force over the whole world: the rate the LiDAR rain model (paper eq. 1) takes,
     within the 0-50 mm/h the original simulator offered."""
 

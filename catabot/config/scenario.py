@@ -14,8 +14,6 @@ from pathlib import Path
 from typing import Any, Literal
 
 from pydantic import (
-    BaseModel,
-    ConfigDict,
     Field,
     ValidationError,
     ValidationInfo,
@@ -25,6 +23,7 @@ from pydantic import (
 
 from catabot.bus.clock import NS_PER_S, ClockError, period_in_ticks, ticks_for
 from catabot.bus.keys import check_name
+from catabot.config.base import ConfigError, Strict, explain
 from catabot.config.environment import CurrentConfig, RainConfig, WindConfig
 from catabot.config.sensors import SENSOR_TYPES
 from catabot.config.terrain import TerrainConfig
@@ -34,15 +33,11 @@ from catabot.config.waves import WaveConfig
 BUNDLED = Path(__file__).parents[1] / "data" / "scenarios"
 
 
-class ScenarioError(ValueError):
+class ScenarioError(ConfigError):
     """A scenario that cannot run; the message names the file, field and allowed values."""
 
 
-class _Model(BaseModel):
-    model_config = ConfigDict(extra="forbid", frozen=True, allow_inf_nan=False)
-
-
-class ClockConfig(_Model):
+class ClockConfig(Strict):
     deadline_s: float = Field(10.0, gt=0, description="per-tick deadline for every participant")
     start_timeout_s: float = Field(60.0, gt=0, description="time allowed for services to join")
     policy: Literal["abort", "drop"] = "abort"
@@ -60,7 +55,7 @@ class ClockConfig(_Model):
         return [check_name("participant", n) for n in names]
 
 
-class Pose(_Model):
+class Pose(Strict):
     """Start pose in `map` (ENU); z is ignored for floating vessels (they settle)."""
 
     x_m: float = 0.0
@@ -68,12 +63,12 @@ class Pose(_Model):
     yaw_rad: float = 0.0
 
 
-class TwistStep(_Model):
+class TwistStep(Strict):
     surge_mps: float
     yaw_rate_radps: float
 
 
-class ScriptStep(_Model):
+class ScriptStep(Strict):
     """From `t_s` on, the vessel gets this command (until the next step)."""
 
     t_s: float = Field(ge=0)
@@ -89,7 +84,7 @@ class ScriptStep(_Model):
         return self
 
 
-class SensorConfig(_Model):
+class SensorConfig(Strict):
     name: str
     type: str = Field(
         description="a sensor type: see catabot/sensor_types.py",
@@ -127,7 +122,7 @@ class SensorConfig(_Model):
         return round(NS_PER_S / self.rate_hz)
 
 
-class VesselConfig(_Model):
+class VesselConfig(Strict):
     id: str
     model: str = "catabot"
     pose: Pose | None = Field(None, description="null: open water near the terrain centre")
@@ -148,13 +143,13 @@ class VesselConfig(_Model):
         return sensors
 
 
-class WaterConfig(_Model):
+class WaterConfig(Strict):
     density_kg_m3: float = Field(1025.0, gt=900, lt=1100)
     waves: WaveConfig = WaveConfig()
     current: CurrentConfig = CurrentConfig()
 
 
-class BuoyConfig(_Model):
+class BuoyConfig(Strict):
     """A floating buoy body (the bundled `buoy` model), moored at (x_m, y_m) by a soft
     horizontal spring (services/physics/loads.py): it bobs, heels, yields when hit, returns."""
 
@@ -168,7 +163,7 @@ class BuoyConfig(_Model):
         return check_name("buoy", v)
 
 
-class Origin(_Model):
+class Origin(Strict):
     """WGS84 position of the world origin (the terrain image's bottom-left corner)."""
 
     latitude_deg: float = Field(0.0, ge=-90, le=90)
@@ -176,12 +171,12 @@ class Origin(_Model):
     altitude_m: float = 0.0
 
 
-class RecordingConfig(_Model):
+class RecordingConfig(Strict):
     csv: bool = True
     mcap: bool = True
 
 
-class Scenario(_Model):
+class Scenario(Strict):
     name: str = "default"
     seed: int = 0
     duration_s: float = Field(60.0, gt=0)
@@ -250,6 +245,23 @@ def guidance_period_ticks(scenario: Scenario) -> int:
     return rate_in_ticks(scenario.traffic.guidance_hz, scenario.dt_ns, where="traffic.guidance_hz")
 
 
+def services(scenario: Scenario) -> list[str]:
+    """The CataBot services a scenario needs, in start order."""
+    names = ["physics"]
+    if any(v.sensors for v in scenario.vessels):
+        names.append("sensors")
+    if scenario.traffic.count > 0:
+        names.append("traffic")
+    if scenario.recording.csv or scenario.recording.mcap:
+        names.append("recorder")
+    return names
+
+
+def participants(scenario: Scenario) -> list[str]:
+    """Every stepping participant of the run: services, then external ones."""
+    return services(scenario) + list(scenario.clock.external_participants)
+
+
 def parse_scenario(data: Any, *, source: str = "<data>") -> Scenario:
     from catabot.config.settings_config import is_settings_config, map_settings_config
 
@@ -258,7 +270,7 @@ def parse_scenario(data: Any, *, source: str = "<data>") -> Scenario:
     try:
         scenario = Scenario.model_validate(data)
     except ValidationError as exc:
-        raise ScenarioError(f"scenario {source}: {explain(exc)}") from None
+        raise ScenarioError(f"scenario {source}: {explain(exc, model=Scenario)}") from None
     check_rates(scenario)
     return scenario
 
@@ -306,20 +318,6 @@ def _node(data: dict[str, Any], *path: str) -> dict[str, Any]:
 def _absolute(node: dict[str, Any], key: str, base: Path) -> None:
     if isinstance(node.get(key), str):
         node[key] = str(base / Path(node[key]).expanduser())
-
-
-def explain(exc: ValidationError) -> str:
-    """One line per problem: the dotted field path, what is wrong and what is allowed."""
-    lines = []
-    for err in exc.errors():
-        where = ".".join(str(p) for p in err["loc"]) or "(top level)"
-        msg = err["msg"].removeprefix("Value error, ")
-        if err["type"] == "extra_forbidden":
-            msg = "unknown field"
-        got = err.get("input")
-        shown = f" (got {got!r})" if not isinstance(got, dict | list) else ""
-        lines.append(f"{where}: {msg}{shown}")
-    return "; ".join(lines)
 
 
 def json_schema() -> dict[str, Any]:

@@ -1,7 +1,6 @@
-"""Every sensor type the scenario accepts: its parameters (validated before anything
-starts) and the message it publishes. The sensor's model lives in `services/sensors/`
-and is registered there under the same name; this table is the library's half, so the
-scenario, the stream table and the recorder know a type without importing a service.
+"""Every sensor type the scenario accepts, in one registry: its parameters (validated before
+anything starts), the message it publishes and the entry point of its model. A new sensor
+type is one params model here, one line in SENSOR_TYPES and its model in services/sensors/.
 """
 
 from __future__ import annotations
@@ -9,17 +8,16 @@ from __future__ import annotations
 from dataclasses import dataclass
 from typing import Literal
 
-from pydantic import BaseModel, ConfigDict, Field
+from pydantic import Field
 
 from catabot.bus.messages import CameraFrame, GpsFix, ImuSample, LidarScan, Message, RadarSweep
+from catabot.config.base import Strict
 
 Vec3 = tuple[float, float, float]
 
 
-class SensorParams(BaseModel):
+class SensorParams(Strict):
     """Base of a sensor's parameters: strict, frozen, finite."""
-
-    model_config = ConfigDict(extra="forbid", frozen=True, allow_inf_nan=False)
 
 
 class ImuParams(SensorParams):
@@ -114,15 +112,21 @@ class LidarParams(SensorParams):
 
 
 @dataclass(frozen=True)
-class SensorType:
+class SensorSpec:
+    """One sensor type (Gymnasium's `EnvSpec` shape): its parameters, validated before anything
+    starts; the message it publishes; and its model, `"module:Class"`, which the sensors
+    service imports and builds as `Class(params, mount)` (the library never imports it)."""
+
     params: type[SensorParams]
     message: type[Message]
+    entry_point: str
+    casts: bool = False  # casts rays into the shared scene (terrain, bodies, water)
 
 
-SENSOR_TYPES: dict[str, SensorType] = {
-    "imu": SensorType(ImuParams, ImuSample),
-    "gps": SensorType(GpsParams, GpsFix),
-    "radar": SensorType(RadarParams, RadarSweep),
-    "camera": SensorType(CameraParams, CameraFrame),
-    "lidar": SensorType(LidarParams, LidarScan),
+SENSOR_TYPES: dict[str, SensorSpec] = {
+    "imu": SensorSpec(ImuParams, ImuSample, "services.sensors.imu:ImuModel"),
+    "gps": SensorSpec(GpsParams, GpsFix, "services.sensors.gps:GpsModel"),
+    "radar": SensorSpec(RadarParams, RadarSweep, "services.sensors.radar:RadarModel", casts=True),
+    "camera": SensorSpec(CameraParams, CameraFrame, "services.sensors.camera:CameraModel", True),
+    "lidar": SensorSpec(LidarParams, LidarScan, "services.sensors.lidar:LidarModel", casts=True),
 }

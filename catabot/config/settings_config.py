@@ -10,6 +10,8 @@ from __future__ import annotations
 import logging
 from typing import Any
 
+from catabot.config.base import ConfigError
+
 log = logging.getLogger("catabot.config.settings_config")
 
 BOOL_KEYS = (
@@ -47,7 +49,7 @@ NOT_YET = {
 }
 
 
-class SettingsConfigError(ValueError):
+class SettingsConfigError(ConfigError):
     pass
 
 

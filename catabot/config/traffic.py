@@ -9,18 +9,16 @@ from __future__ import annotations
 
 from typing import Literal
 
-from pydantic import BaseModel, ConfigDict, Field, field_validator, model_validator
+from pydantic import Field, field_validator, model_validator
+
+from catabot.config.base import Strict
 
 BEHAVIOURS = ("circle", "waypoints", "hold")
 Behaviour = Literal["circle", "waypoints", "hold"]
 Point = tuple[float, float]
 
 
-class _Model(BaseModel):
-    model_config = ConfigDict(extra="forbid", frozen=True, allow_inf_nan=False)
-
-
-class Region(_Model):
+class Region(Strict):
     """A square (or rectangle) in `map`: centre and size; null centre = terrain centre or origin."""
 
     center_m: Point | None = None
@@ -34,12 +32,12 @@ class Region(_Model):
         return v
 
 
-class ModelWeight(_Model):
+class ModelWeight(Strict):
     model: str = "monohull"
     weight: float = Field(1.0, gt=0)
 
 
-class CircleParams(_Model):
+class CircleParams(Strict):
     """The original's Circles: 5 m/s at 15 deg/s, i.e. a radius of about 19 m."""
 
     radius_m: Point = Field((19.1, 19.1), description="[min, max] radius drawn per boat")
@@ -54,7 +52,7 @@ class CircleParams(_Model):
         return v
 
 
-class WaypointParams(_Model):
+class WaypointParams(Strict):
     """The original's Waypoints: 5 random points in a 1000 m square, 5 m/s, back and forth."""
 
     points: list[Point] | None = Field(None, description="explicit path; null: random per boat")
@@ -73,12 +71,12 @@ class WaypointParams(_Model):
         return v
 
 
-class HoldParams(_Model):
+class HoldParams(Strict):
     gain: float = Field(0.5, gt=0, description="surge set-point per metre of error, 1/s")
     max_speed_mps: float = Field(2.0, gt=0)
 
 
-class BoatOverride(_Model):
+class BoatOverride(Strict):
     """Per-boat settings that replace the drawn ones (index = the boat's number)."""
 
     index: int = Field(ge=0)
@@ -90,7 +88,7 @@ class BoatOverride(_Model):
     points: list[Point] | None = None
 
 
-class TrafficConfig(_Model):
+class TrafficConfig(Strict):
     count: int = Field(0, ge=0, le=500)
     models: list[ModelWeight] = [ModelWeight()]
     region: Region = Region()

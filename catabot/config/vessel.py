@@ -15,15 +15,17 @@ import json
 from pathlib import Path
 from typing import Annotated, Any, Literal
 
+import numpy as np
+from numpy.typing import NDArray
 from pydantic import (
-    BaseModel,
     BeforeValidator,
-    ConfigDict,
     Field,
     ValidationError,
     model_validator,
 )
 from pydantic.types import FiniteFloat
+
+from catabot.config.base import ConfigError, FieldProblem, Strict, explain
 
 BUNDLED_DIR = Path(__file__).parents[1] / "data" / "vessels"
 
@@ -60,23 +62,11 @@ WindCoefficients3 = Annotated[
 ]
 
 
-class VesselModelError(ValueError):
+class VesselModelError(ConfigError):
     """A vessel model file is missing, unreadable or invalid; the message names file and field."""
 
 
-class FieldProblem(ValueError):
-    """Raised by cross-field validators so the error path can name the offending field."""
-
-    def __init__(self, field: str, message: str) -> None:
-        super().__init__(message)
-        self.field = field
-
-
-class _Strict(BaseModel):
-    model_config = ConfigDict(extra="forbid", frozen=True)
-
-
-class Hull(_Strict):
+class Hull(Strict):
     """A parametric hull, discretised into vertical columns for buoyancy.
 
     `beam_m` is a box's width or a cylinder's diameter; a cylinder lies along body x.
@@ -114,7 +104,7 @@ class Hull(_Strict):
         return 2 if self.shape == "box" else 10
 
 
-class Damping(_Strict):
+class Damping(Strict):
     """Fossen damping per DOF [X_u, Y_v, Z_w, K_p, M_q, N_r]: tau = -(linear + quadratic*|v|)*v.
 
     Units: linear N·s/m (surge, sway, heave) and N·m·s/rad (roll, pitch, yaw);
@@ -125,7 +115,7 @@ class Damping(_Strict):
     quadratic: Dof6
 
 
-class Thruster(_Strict):
+class Thruster(Strict):
     """A fixed thruster; `yaw_rad` turns its thrust direction in the body xy plane (0: forward).
 
     A command c in [-1, 1] asks for c*max_forward_n (c >= 0) or c*max_reverse_n (c < 0);
@@ -139,7 +129,7 @@ class Thruster(_Strict):
     time_constant_s: NonNegativeFloat = 0.0
 
 
-class WindArea(_Strict):
+class WindArea(Strict):
     """Above-water windage: areas and drag coefficients (Fossen 2011 §10.1, simplified).
 
     With (u_a, v_a) the apparent wind (air velocity relative to the vessel, body frame),
@@ -158,7 +148,7 @@ class WindArea(_Strict):
     length_m: PositiveFloat
 
 
-class VesselModel(_Strict):
+class VesselModel(Strict):
     """One vessel model file. Inertia is about the centre of gravity, in body axes."""
 
     name: Annotated[str, Field(min_length=1)]
@@ -183,6 +173,13 @@ class VesselModel(_Strict):
                 f"(Ixx + Iyy >= Izz and cyclic), got {list(self.inertia_kgm2)}",
             )
         return self
+
+    def hull_box(self) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+        """The axis-aligned body-frame box (lo, hi corners, m) around every hull: the body's
+        collision shape in physics and its shape in the sensors' ray casts."""
+        centre = np.array([h.center_m for h in self.hulls], dtype=np.float64)
+        half = np.array([(h.length_m, h.beam_m, h.vertical_extent_m) for h in self.hulls]) / 2
+        return (centre - half).min(axis=0), (centre + half).max(axis=0)
 
 
 def bundled_vessel_names() -> list[str]:
@@ -217,8 +214,8 @@ def parse_vessel_model(data: Any, *, source: str = "<data>") -> VesselModel:
     try:
         return VesselModel.model_validate(data)
     except ValidationError as exc:
-        lines = [_describe(err) for err in exc.errors()]
-        raise VesselModelError(f"vessel model '{source}': " + "; ".join(lines)) from None
+        message = explain(exc, model=VesselModel)
+        raise VesselModelError(f"vessel model '{source}': {message}") from None
 
 
 def _resolve(ref: str, base_dir: Path | None) -> Path:
@@ -237,58 +234,3 @@ def _resolve(ref: str, base_dir: Path | None) -> Path:
     if not path.is_absolute() and base_dir is not None:
         path = Path(base_dir) / path
     return path
-
-
-def _describe(err: Any) -> str:
-    """One readable line per pydantic error: `field.path: rule (got value)`."""
-    loc = [str(p) for p in err["loc"]]
-    ctx = err.get("ctx") or {}
-    kind = err["type"]
-    problem = ctx.get("error")
-    if isinstance(problem, FieldProblem):
-        return ".".join([*loc, problem.field]) + f": {problem}"
-    where = ".".join(loc) or "(top level)"
-    got = err.get("input")
-    if kind == "missing":
-        return f"{where}: required field missing"
-    if kind == "extra_forbidden":
-        allowed = ", ".join(_allowed_fields(err["loc"][:-1]))
-        return f"{where}: unknown field (allowed: {allowed})"
-    if kind == "literal_error":
-        return f"{where}: must be one of {ctx.get('expected')} (got {got!r})"
-    limits = {"greater_than": ">", "greater_than_equal": ">=", "less_than": "<"}
-    limits["less_than_equal"] = "<="
-    if kind in limits:
-        bound = next(v for k, v in ctx.items() if k in ("gt", "ge", "lt", "le"))
-        return f"{where}: must be {limits[kind]} {bound:g} (got {got!r})"
-    if kind == "finite_number":
-        return f"{where}: must be a finite number (got {got!r})"
-    message = str(err["msg"]).removeprefix("Value error, ")
-    return f"{where}: {message} (got {got!r})"
-
-
-def _allowed_fields(loc: tuple[Any, ...]) -> list[str]:
-    """Field names of the model found by walking `loc` from VesselModel (for unknown keys)."""
-    model: type[BaseModel] = VesselModel
-    for part in loc:
-        if isinstance(part, int):
-            continue
-        info = model.model_fields.get(str(part))
-        if info is None:
-            break
-        nested = _model_in(info.annotation)
-        if nested is None:
-            break
-        model = nested
-    return list(model.model_fields)
-
-
-def _model_in(annotation: Any) -> type[BaseModel] | None:
-    """The BaseModel class inside an annotation such as `list[Hull]`, if any."""
-    if isinstance(annotation, type) and issubclass(annotation, BaseModel):
-        return annotation
-    for arg in getattr(annotation, "__args__", ()) or ():
-        found = _model_in(arg)
-        if found is not None:
-            return found
-    return None

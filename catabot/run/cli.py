@@ -10,9 +10,11 @@ import time
 from pathlib import Path
 
 from catabot.bus.session import Connection, SessionError, add_connection_args, open_session
-from catabot.config.scenario import ScenarioError, json_schema, load_scenario
+from catabot.config.scenario import json_schema, load_scenario
+from catabot.errors import CataBotError
 from catabot.run import launcher
 from catabot.run.generate import add_arguments as add_generate_arguments
+from catabot.world.world import World
 
 
 def _run(args: argparse.Namespace) -> int:
@@ -72,12 +74,16 @@ def _scenario(args: argparse.Namespace) -> int:
         from catabot.run.generate import generate
 
         return generate(args)
-    try:
-        scenario = load_scenario(args.file)
-    except ScenarioError as exc:
+    try:  # what `catabot run` checks before it starts anything, no less
+        world = World.resolve(load_scenario(args.file))
+    except CataBotError as exc:
         print(f"catabot scenario validate: {exc}", file=sys.stderr)
         return 2
-    counts = f"{len(scenario.vessels)} vessel(s), {scenario.ticks} ticks"
+    s = world.scenario
+    counts = (
+        f"{len(s.vessels)} vessel(s), {len(world.boat_ids)} traffic boat(s), "
+        f"{len(world.buoys)} buoy(s), {len(world.sensors)} sensor(s), {s.ticks} ticks"
+    )
     print(f"{args.file or 'default'}: valid ({counts})")
     return 0
 

@@ -18,14 +18,13 @@ from catabot.bus.clock import Policy
 from catabot.bus.conductor import ClockSpec, Conductor, Progress
 from catabot.bus.keys import Keys
 from catabot.bus.session import (
-    SessionError,
     add_connection_args,
     connection_from_args,
     open_session,
 )
-from catabot.config.scenario import Scenario, ScenarioError, load_scenario
+from catabot.config.scenario import Scenario, load_scenario, participants
+from catabot.errors import CataBotError
 from catabot.run.service import quiet_gc
-from catabot.world.streams import participants
 
 log = logging.getLogger("catabot.bus.conductor")
 
@@ -63,7 +62,7 @@ def main(argv: list[str] | None = None) -> int:
     try:
         scenario = load_scenario(args.scenario)
         session = open_session(connection_from_args(args))
-    except (ScenarioError, SessionError) as exc:
+    except CataBotError as exc:
         emit("result", ticks=0, wall_s=0.0, error=str(exc), dropped=[])
         return 2
     conductor = Conductor(session, Keys(scenario.name), clock_spec(scenario))

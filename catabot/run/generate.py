@@ -12,13 +12,13 @@ import sys
 from pathlib import Path
 from typing import Any
 
-from catabot.config.scenario import ScenarioError, parse_scenario
+from catabot.config.scenario import parse_scenario
 from catabot.config.traffic import BEHAVIOURS
-from catabot.world.placement import resolve_poses
-from catabot.world.traffic_plan import plan_traffic
+from catabot.errors import CataBotError
+from catabot.world.world import World
 
 
-class GenerateError(ValueError):
+class GenerateError(CataBotError, ValueError):
     """Flags that cannot make a scenario; the message names the flag."""
 
 
@@ -68,9 +68,8 @@ def generate(args: argparse.Namespace) -> int:
     """Write the scenario to args.output (stdout when none); 2 on a bad flag or scenario."""
     try:
         data = scenario_data(args)
-        scenario = resolve_poses(parse_scenario(data, source="generate"))
-        plan_traffic(scenario)  # refuse now a traffic that finds no water, not at run time
-    except (GenerateError, ScenarioError) as exc:
+        World.resolve(parse_scenario(data, source="generate"))  # refuse now what cannot run
+    except CataBotError as exc:
         print(f"catabot scenario generate: {exc}", file=sys.stderr)
         return 2
     text = json.dumps(data, indent=2) + "\n"

@@ -17,14 +17,12 @@ from dataclasses import dataclass
 from datetime import datetime
 from pathlib import Path
 
-from catabot.bus.scheduling import SchedulingError, requested_policy
+from catabot.bus.scheduling import requested_policy
 from catabot.bus.session import free_port
-from catabot.config.scenario import Scenario, ScenarioError, load_scenario
-from catabot.config.vessel import VesselModelError
+from catabot.config.scenario import Scenario, load_scenario, parse_scenario
+from catabot.errors import CataBotError
 from catabot.run.progress import ProgressBar
-from catabot.world.placement import resolve_poses
-from catabot.world.streams import services as needed_services
-from catabot.world.traffic_plan import plan_traffic
+from catabot.world.world import World
 
 SERVICE_MODULES = {
     "physics": "services.physics",
@@ -34,7 +32,7 @@ SERVICE_MODULES = {
 }
 
 
-class LaunchError(RuntimeError):
+class LaunchError(CataBotError, RuntimeError):
     """The run could not start (bad scenario, missing model, unknown service)."""
 
 
@@ -49,8 +47,9 @@ class RunOptions:
     quiet: bool = False
 
 
-def prepare(opts: RunOptions) -> Scenario:
-    """Everything that can be refused is refused here, before any process starts."""
+def prepare(opts: RunOptions) -> World:
+    """Everything that can be refused is refused here, before any process starts: the world
+    is resolved once (poses, traffic, models, terrain), as every service will resolve it."""
     requested_policy()  # a bad CATABOT_SCHED would stop every service
     scenario = load_scenario(opts.scenario)
     data = scenario.model_dump()
@@ -58,14 +57,11 @@ def prepare(opts: RunOptions) -> Scenario:
         data["duration_s"] = opts.duration_s
     if opts.realtime is not None:
         data["clock"]["realtime_factor"] = opts.realtime
-    from catabot.config.scenario import parse_scenario
-
-    scenario = resolve_poses(parse_scenario(data, source="command line"))
-    plan_traffic(scenario)  # boats that find no open water are refused here, not in a service
-    for name in needed_services(scenario):
+    world = World.resolve(parse_scenario(data, source="command line"))
+    for name in world.services:
         if name not in SERVICE_MODULES:
             raise LaunchError(f"scenario needs service {name!r}, which this version does not have")
-    return scenario
+    return world
 
 
 def make_run_dir(out: Path, scenario: Scenario) -> Path:
@@ -102,10 +98,11 @@ def _spawn(args: list[str], log_file: Path, *, stdout_pipe: bool = False) -> sub
 
 def run(opts: RunOptions) -> int:
     try:
-        scenario = prepare(opts)
-    except (ScenarioError, SchedulingError, VesselModelError, LaunchError) as exc:
+        world = prepare(opts)
+    except CataBotError as exc:
         print(f"catabot run: {exc}", file=sys.stderr)
         return 2
+    scenario = world.scenario
     run_dir = make_run_dir(opts.out, scenario)
     cond_flags, svc_flags = _endpoints(opts)
     print(
@@ -124,7 +121,7 @@ def run(opts: RunOptions) -> int:
             [SERVICE_MODULES[name], "--scenario", scen, "--run-dir", str(run_dir), *svc_flags],
             run_dir / "log" / f"{name}.log",
         )
-        for name in needed_services(scenario)
+        for name in world.services
     }
     return Supervisor(scenario, run_dir, conductor, services, quiet=opts.quiet).wait()
 

@@ -26,29 +26,39 @@ from catabot.bus.clock import ClockError
 from catabot.bus.keys import Keys
 from catabot.bus.messages import End
 from catabot.bus.participant import EndFn, Participant, StepFn
-from catabot.bus.scheduling import SchedulingError, batch_scheduling
+from catabot.bus.scheduling import batch_scheduling
 from catabot.bus.session import (
-    SessionError,
     add_connection_args,
     connection_from_args,
     open_session,
 )
-from catabot.config.scenario import Scenario, ScenarioError, load_scenario
-from catabot.config.vessel import VesselModelError
-from catabot.world.placement import resolve_poses
-from catabot.world.streams import participants
+from catabot.config.scenario import Scenario, load_scenario
+from catabot.errors import CataBotError
+from catabot.world.world import World
 
 log = logging.getLogger("catabot.run.service")
 
 
 @dataclass
 class ServiceContext:
+    """What a service is built from: the resolved world, its session and run folder."""
+
     name: str
-    scenario: Scenario
-    keys: Keys
+    world: World
     session: zenoh.Session
     run_dir: Path
-    peers: list[str]
+
+    @property
+    def scenario(self) -> Scenario:
+        return self.world.scenario
+
+    @property
+    def keys(self) -> Keys:
+        return self.world.keys
+
+    @property
+    def peers(self) -> list[str]:
+        return self.world.participants
 
 
 Built = tuple[Participant, StepFn, EndFn | None]
@@ -110,16 +120,12 @@ def run_service(name: str, build: BuildFn, argv: list[str] | None = None) -> int
     signal.signal(signal.SIGTERM, lambda *_: sys.exit(143))
     try:
         batch_scheduling()  # before Zenoh starts its threads, so that they inherit it
-        scenario = load_scenario(args.scenario)
-        if any(v.pose is None for v in scenario.vessels):
-            scenario = resolve_poses(scenario)  # deterministic: every service picks the same
+        world = World.resolve(load_scenario(args.scenario))  # the same in every process
         session = open_session(connection_from_args(args))
-    except (ScenarioError, SchedulingError, SessionError, VesselModelError) as exc:
+    except CataBotError as exc:
         log.error("%s: %s", name, exc)
         return 2
-    ctx = ServiceContext(
-        name, scenario, Keys(scenario.name), session, Path(args.run_dir), participants(scenario)
-    )
+    ctx = ServiceContext(name, world, session, Path(args.run_dir))
     try:
         participant, step, on_end = build(ctx)
         quiet_gc()
@@ -129,6 +135,9 @@ def run_service(name: str, build: BuildFn, argv: list[str] | None = None) -> int
     except ClockError as exc:
         log.error("%s", exc)
         return 3
+    except CataBotError as exc:
+        log.error("%s: %s", name, exc)
+        return 2
     finally:
         session.close()
     log.info("%s: run ended at tick %d (%s) %s", name, end.tick, end.reason, end.error)

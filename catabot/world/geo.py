@@ -15,6 +15,8 @@ from functools import lru_cache
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from catabot.errors import CataBotError
+
 Array = NDArray[np.float64]
 Triple = tuple[Array, Array, Array]
 LatLonAlt = tuple[float, float, float]  # an origin: latitude (deg), longitude (deg), altitude (m)
@@ -26,7 +28,7 @@ WGS84_E2 = WGS84_F * (2.0 - WGS84_F)  # first eccentricity squared
 WGS84_EP2 = WGS84_E2 / (1.0 - WGS84_E2)  # second eccentricity squared
 
 
-class GeoError(ValueError):
+class GeoError(CataBotError, ValueError):
     """A coordinate outside its domain (latitude beyond +-90 degrees, non-finite values...)."""
 
 

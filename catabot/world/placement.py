@@ -12,7 +12,7 @@ import math
 from catabot.config.scenario import Pose, Scenario, ScenarioError
 from catabot.config.terrain import TerrainError
 from catabot.config.vessel import VesselModel, load_vessel_model
-from catabot.world.terrain import Terrain, load_terrain
+from catabot.world.terrain import Terrain
 
 CLEARANCE_M = 0.5
 
@@ -30,13 +30,8 @@ def footprint_m(model: VesselModel) -> float:
     )
 
 
-def resolve_poses(scenario: Scenario, terrain: Terrain | None = None) -> Scenario:
+def resolve_poses(scenario: Scenario, terrain: Terrain | None) -> Scenario:
     """Every vessel with a pose: given ones checked, missing ones placed in open water."""
-    if scenario.terrain is not None and terrain is None:
-        try:
-            terrain = load_terrain(scenario.terrain)
-        except TerrainError as exc:
-            raise ScenarioError(str(exc)) from None
     placed: list[tuple[float, float, float]] = []
     vessels = []
     for index, vessel in enumerate(scenario.vessels):

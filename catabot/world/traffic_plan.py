@@ -1,14 +1,12 @@
 """The traffic plan: where each boat starts and what it does, a pure function of the scenario.
 
-Every process (physics, traffic, sensors, recorder) derives the same plan from the same
-scenario, so the boats need no announcement on the bus: `all_vessels(scenario)` is the
-vessel list everyone uses. Randomness comes from the traffic seed and the name "traffic"
-only (DESIGN.md §2), so adding a sensor does not move a boat.
+Every process derives the same plan from the same scenario (once, in `World.resolve`), so
+the boats need no announcement on the bus. Randomness comes from the traffic seed and the
+name "traffic" only (DESIGN.md §2), so adding a sensor does not move a boat.
 """
 
 from __future__ import annotations
 
-import functools
 import itertools
 import math
 from collections.abc import Sequence
@@ -16,13 +14,13 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from catabot.config.scenario import BuoyConfig, Pose, Scenario, ScenarioError, VesselConfig
+from catabot.config.scenario import BuoyConfig, Pose, Scenario, ScenarioError
 from catabot.config.terrain import TerrainError
 from catabot.config.traffic import BEHAVIOURS, BoatOverride, Point, Region, TrafficConfig
-from catabot.config.vessel import load_vessel_model
+from catabot.config.vessel import VesselModel, load_vessel_model
 from catabot.world import seeding
-from catabot.world.placement import CLEARANCE_M, footprint_m, keel_depth_m, resolve_poses
-from catabot.world.terrain import Terrain, load_terrain
+from catabot.world.placement import CLEARANCE_M, footprint_m, keel_depth_m
+from catabot.world.terrain import Terrain
 
 TRIES = 2000
 
@@ -54,42 +52,11 @@ def boat_id(index: int) -> str:
     return f"boat_{index:03d}"
 
 
-def plan_traffic(scenario: Scenario) -> TrafficPlan:
-    """The plan of a scenario (cached: every stream table asks for it)."""
-    return _plan_cached(scenario.model_dump_json())
-
-
-def all_vessels(scenario: Scenario) -> list[VesselConfig]:
-    """The scenario's own vessels, then every traffic boat, as vessel configs with poses."""
-    boats = [
-        VesselConfig(id=b.id, model=b.model, pose=b.pose) for b in plan_traffic(scenario).boats
-    ]
-    return [*scenario.vessels, *boats]
-
-
-def all_buoys(scenario: Scenario) -> list[BuoyConfig]:
-    """The scenario's buoys, then a buoy at every traffic waypoint that asks for one."""
-    return [*scenario.buoys, *plan_traffic(scenario).buoys]
-
-
-@functools.lru_cache(maxsize=8)
-def _plan_cached(text: str) -> TrafficPlan:
-    scenario = Scenario.model_validate_json(text)
+def plan_traffic(scenario: Scenario, terrain: Terrain | None) -> TrafficPlan:
+    """The plan of a scenario whose vessels all have poses (World.resolve calls it once)."""
     if scenario.traffic.count == 0:
         return TrafficPlan((), ())
-    if any(v.pose is None for v in scenario.vessels):
-        scenario = resolve_poses(scenario)
-    terrain = _terrain(scenario)
     return Planner(scenario, terrain).plan()
-
-
-def _terrain(scenario: Scenario) -> Terrain | None:
-    if scenario.terrain is None:
-        return None
-    try:
-        return load_terrain(scenario.terrain)
-    except TerrainError as exc:
-        raise ScenarioError(str(exc)) from None
 
 
 class Planner:
@@ -100,11 +67,12 @@ class Planner:
         self.terrain = terrain
         seed = scenario.seed if self.cfg.seed is None else self.cfg.seed
         self.rng = seeding.rng(seed, "traffic")
+        self._models: dict[str, VesselModel] = {}
         self.placed = _Rows(3)  # vessels' starts: x, y, footprint radius
         for v in scenario.vessels:
             assert v.pose is not None
-            self.placed.add(v.pose.x_m, v.pose.y_m, footprint_m(load_vessel_model(v.model)))
-        self.buoy_r = footprint_m(load_vessel_model("buoy"))
+            self.placed.add(v.pose.x_m, v.pose.y_m, footprint_m(self._model(v.model)))
+        self.buoy_r = footprint_m(self._model("buoy"))
         # Buoys are moored: a boat must not start on one, nor circle through one every lap.
         self.marks = _Rows(3)  # buoys: x, y, footprint radius
         for b in scenario.buoys:
@@ -131,7 +99,7 @@ class Planner:
         model = over.model or self._pick([m.model for m in self.cfg.models], self._model_w())
         mix = self.cfg.behaviour_mix
         behaviour = over.behaviour or self._pick(list(mix), list(mix.values()))
-        hull = load_vessel_model(model)
+        hull = self._model(model)
         radius, draft = footprint_m(hull), keel_depth_m(hull)
         self.footprints[model] = radius
         for _ in range(TRIES):
@@ -147,6 +115,12 @@ class Planner:
                 self.placed.add(x, y, radius)
                 return boat
         raise ScenarioError(f"traffic: no free open water for boat {index} in {TRIES} draws")
+
+    def _model(self, ref: str) -> VesselModel:
+        """Each model file read once per plan (500 boats share a handful of models)."""
+        if ref not in self._models:
+            self._models[ref] = load_vessel_model(ref)
+        return self._models[ref]
 
     def _model_w(self) -> list[float]:
         return [m.weight for m in self.cfg.models]

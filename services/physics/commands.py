@@ -14,6 +14,7 @@ from __future__ import annotations
 
 import bisect
 import logging
+from collections.abc import Sequence
 from dataclasses import dataclass
 from typing import Any
 
@@ -23,7 +24,8 @@ from numpy.typing import NDArray
 from catabot.bus import codec
 from catabot.bus.clock import NS_PER_S
 from catabot.bus.messages import Message, ThrustCmd, TwistBatch, TwistCmd, WaypointsCmd
-from catabot.config.scenario import ScriptStep, VesselConfig
+from catabot.config.scenario import ScriptStep
+from catabot.world.world import Body
 
 Array = NDArray[np.float64]
 
@@ -43,10 +45,10 @@ class CommandBook:
     participant's twist) live in arrays, so `orders` costs a few array operations a tick
     whatever the number of boats; external overrides and scripts, few, stay per vessel."""
 
-    def __init__(self, vessels: list[VesselConfig], thrusters: dict[str, int]) -> None:
+    def __init__(self, vessels: Sequence[Body]) -> None:
         self.ids = tuple(v.id for v in vessels)
         self.row = {vid: i for i, vid in enumerate(self.ids)}
-        self.thrusters = thrusters
+        self.thrusters = {v.id: len(v.model.thrusters) for v in vessels}
         self.scripts = {v.id: sorted(v.script, key=lambda s: s.t_s) for v in vessels}
         self.times = {
             vid: [round(s.t_s * NS_PER_S) for s in steps] for vid, steps in self.scripts.items()

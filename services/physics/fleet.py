@@ -91,22 +91,11 @@ def _add_body(fleet: dart.dynamics.Skeleton, vessel_id: str, model: VesselModel)
     ixx, iyy, izz = model.inertia_kgm2
     body.setMomentOfInertia(ixx, iyy, izz, 0.0, 0.0, 0.0)
     body.setLocalCOM(np.asarray(model.cog_m, dtype=np.float64))
-    lo, hi = hull_bounds(model)
+    lo, hi = model.hull_box()
     node = body.createShapeNode(dart.dynamics.BoxShape(hi - lo))
     node.setRelativeTranslation((lo + hi) / 2)
     node.createCollisionAspect()
     node.createDynamicsAspect()
-
-
-def hull_bounds(model: VesselModel) -> tuple[Array, Array]:
-    """Axis-aligned body-frame box around all hulls."""
-    lows, highs = [], []
-    for hull in model.hulls:
-        half = np.array([hull.length_m, hull.beam_m, hull.vertical_extent_m]) / 2
-        centre = np.asarray(hull.center_m, dtype=np.float64)
-        lows.append(centre - half)
-        highs.append(centre + half)
-    return np.min(lows, axis=0), np.max(highs, axis=0)
 
 
 class TreeView:

@@ -205,28 +205,3 @@ class ThrusterBank:
     def wrench(self) -> Array:
         """Body-frame wrench (N, 6) of the delivered thruster forces about the body origin."""
         return np.einsum("nt,ntk->nk", self.force_n, self.unit_wrench)
-
-
-# --- rotations --------------------------------------------------------------------------
-
-
-def quat_from_rotvec(rv: Array) -> Array:
-    """Unit quaternions (x, y, z, w) from rotation vectors (N, 3), stable near zero angle."""
-    theta = np.linalg.norm(rv, axis=1)
-    small = theta < 1e-6
-    safe = np.where(small, 1.0, theta)
-    scale = np.where(small, 0.5 - theta * theta / 48.0, np.sin(0.5 * safe) / safe)
-    return np.concatenate([rv * scale[:, None], np.cos(0.5 * theta)[:, None]], axis=1)
-
-
-def rot_from_quat(q: Array) -> Array:
-    """Rotation matrices (N, 3, 3), body to world, from unit quaternions (x, y, z, w)."""
-    x, y, z, w = q[:, 0], q[:, 1], q[:, 2], q[:, 3]
-    return np.stack(
-        [
-            np.stack([1 - 2 * (y * y + z * z), 2 * (x * y - z * w), 2 * (x * z + y * w)], -1),
-            np.stack([2 * (x * y + z * w), 1 - 2 * (x * x + z * z), 2 * (y * z - x * w)], -1),
-            np.stack([2 * (x * z - y * w), 2 * (y * z + x * w), 1 - 2 * (x * x + y * y)], -1),
-        ],
-        axis=1,
-    )

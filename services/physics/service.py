@@ -16,13 +16,6 @@ from catabot.bus.inbox import Inputs
 from catabot.bus.messages import BodyStates, Message, Tick, TwistBatch, VesselState
 from catabot.bus.participant import Participant
 from catabot.run.service import Built, ServiceContext, run_service
-from catabot.world.streams import (
-    command_streams,
-    traffic_boat_ids,
-    twist_batch_streams,
-    waypoint_streams,
-)
-from catabot.world.traffic_plan import all_vessels
 from services.physics.commands import CommandBook
 from services.physics.control import TwistControllerBank
 from services.physics.setup import build_world
@@ -40,24 +33,23 @@ FIELDS = (  # the KinematicsArrays fields, in BodyStates / VesselState order
 
 class PhysicsService:
     def __init__(self, ctx: ServiceContext) -> None:
-        scenario = ctx.scenario
-        self.world, models = build_world(scenario)
+        world = ctx.world
+        self.world = build_world(world)
         self.keys = ctx.keys
-        self.dt_ns = scenario.dt_ns
-        ids = self.world.vessel_ids
-        self.controllers = TwistControllerBank([models[v] for v in ids], dt_s=self.dt_ns / 1e9)
-        self.book = CommandBook(
-            all_vessels(scenario), {vid: len(m.thrusters) for vid, m in models.items()}
+        self.dt_ns = world.scenario.dt_ns
+        self.controllers = TwistControllerBank(
+            [v.model for v in world.vessels], dt_s=self.dt_ns / 1e9
         )
-        assert self.book.ids == tuple(ids), "the command book's rows are the world's rows"
-        self.streams = command_streams(scenario, ctx.keys) + waypoint_streams(scenario, ctx.keys)
+        self.book = CommandBook(world.vessels)
+        streams = world.streams
+        self.streams = [*streams.commands, *streams.waypoints]
         self.vessel_of = {s.key: ctx.keys.vessel_of(s.key) for s in self.streams}
         self.twists_key = ctx.keys.world_twists()
-        self.boats = traffic_boat_ids(scenario)
-        delay = scenario.traffic.setpoint_delay_ticks  # lets physics step ahead of traffic
-        self.streams += twist_batch_streams(scenario, ctx.keys, lag=delay)
-        self.body_ids = (*ids, *self.world.buoy_ids)
-        self.state_keys = [ctx.keys.vessel_state(vid) for vid in ids]
+        self.boats = world.boat_ids
+        delay = world.scenario.traffic.setpoint_delay_ticks  # physics steps ahead of traffic
+        self.streams += streams.twist_batches(lag=delay)
+        self.body_ids = world.body_ids
+        self.state_keys = [s.key for s in streams.vessel_states]
         self.participant = Participant(
             ctx.session, ctx.keys, ctx.name, inputs=self.streams, peers=ctx.peers
         )

@@ -1,34 +1,27 @@
-"""A PhysicsWorld from a scenario: vessels at their resolved poses, and the environment."""
+"""A PhysicsWorld from the resolved world: every body at its start pose, and the environment."""
 
 from __future__ import annotations
 
-from catabot.config.scenario import Scenario
-from catabot.config.vessel import VesselModel, load_vessel_model
 from catabot.world.environment.current import CurrentField
 from catabot.world.environment.wind import WindField
-from catabot.world.terrain import load_terrain
-from catabot.world.traffic_plan import all_buoys, all_vessels
 from catabot.world.waves import WaveField
+from catabot.world.world import World
 from services.physics.world import PhysicsWorld
 
 
-def build_world(scenario: Scenario) -> tuple[PhysicsWorld, dict[str, VesselModel]]:
-    vessels = all_vessels(scenario)  # the scenario's own, then the traffic boats
-    models = {v.id: load_vessel_model(v.model) for v in vessels}
-    starts = []
-    for v in vessels:
-        assert v.pose is not None, "poses are resolved before physics starts"
-        starts.append((v.id, models[v.id], (v.pose.x_m, v.pose.y_m, 0.0, v.pose.yaw_rad)))
-    buoys = all_buoys(scenario)
-    world = PhysicsWorld(
+def build_world(world: World) -> PhysicsWorld:
+    """Vessels (the scenario's, then traffic boats) and buoys in the world's row order."""
+    scenario = world.scenario
+    starts = [(v.id, v.model, (v.pose.x_m, v.pose.y_m, 0.0, v.pose.yaw_rad)) for v in world.vessels]
+    buoys = world.buoys
+    return PhysicsWorld(
         starts,
         dt_s=scenario.dt_ns / 1e9,
         water_density=scenario.water.density_kg_m3,
         waves=WaveField(scenario.water.waves, scenario.seed),
-        terrain=load_terrain(scenario.terrain) if scenario.terrain is not None else None,
+        terrain=world.terrain,
         current=CurrentField.from_config(scenario.water.current),
         wind=WindField(scenario.wind, seed=scenario.seed),
-        buoys=[(b.id, (b.x_m, b.y_m)) for b in buoys],
-        buoy_model=load_vessel_model("buoy") if buoys else None,
+        buoys=[(b.id, (b.pose.x_m, b.pose.y_m)) for b in buoys],
+        buoy_model=buoys[0].model if buoys else None,
     )
-    return world, models

@@ -25,6 +25,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from catabot.config.vessel import VesselModel
+from catabot.world import rotations
 from catabot.world.environment import CurrentField, WindField
 from catabot.world.terrain import Terrain
 from catabot.world.waves import WaveField
@@ -36,8 +37,6 @@ from services.physics.hydro import (
     build_columns,
     buoyancy_wrench,
     damping_wrench,
-    quat_from_rotvec,
-    rot_from_quat,
     water_height,
 )
 from services.physics.loads import EnvironmentLoads
@@ -260,8 +259,8 @@ class PhysicsWorld:
         q = self._fleet.positions()
         self._vel_w = self._fleet.velocities()
         self._pos = q[:, 3:]
-        self._quat = quat_from_rotvec(q[:, :3])
-        self._rot = rot_from_quat(self._quat)
+        self._quat = rotations.from_rotvec(q[:, :3])
+        self._rot = rotations.matrices(self._quat)
 
     def _body_wrench(self) -> Array:
         """Sum of buoyancy, damping and thrust, body frame, Fossen order, about the origin."""

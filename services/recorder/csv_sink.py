@@ -17,10 +17,11 @@ from pathlib import Path
 from typing import TextIO
 
 from catabot.bus.messages import Message
+from catabot.errors import CataBotError
 from services.recorder import tabular
 
 
-class RecorderError(ValueError):
+class RecorderError(CataBotError, ValueError):
     """A sample the recorder cannot write without corrupting a file; the service logs it."""
 
 

@@ -3,10 +3,10 @@
 Layout (one folder per sensor, `<vessel>.<sensor>`):
 - cameras: `<tick>_color.png` (RGB), `<tick>_depth.png` (16-bit grey, millimetres along the
   optical axis; 0 = no return or beyond 65.535 m), `<tick>_normals.png` (RGB = (n + 1) / 2 in
-  the optical frame z forward, x right, y down), `<tick>_class.png` (8-bit class ids, 0 sky,
-  1 water, 2 terrain, 3 vessel, 4 buoy) and `<tick>_instance.png` (16-bit), for the outputs
-  that are on, plus one `labels.jsonl` line per frame with its boxes;
-- radars: `ppi_<tick>.png`, the north-up PPI (services/sensors/ppi.py) once per antenna turn.
+  the optical frame z forward, x right, y down), `<tick>_class.png` (8-bit class ids of
+  `LABEL_CLASSES`: 0 none, 1 water, 2 terrain, 3 vessel, 4 buoy) and `<tick>_instance.png`
+  (16-bit), for the outputs that are on, plus one `labels.jsonl` line per frame with its boxes;
+- radars: `ppi_<tick>.png`, the north-up PPI (services/recorder/ppi.py) once per antenna turn.
 PNGs are written with fixed settings and no time chunk, so the same run gives the same bytes.
 """
 
@@ -19,12 +19,11 @@ from typing import Any
 import numpy as np
 from PIL import Image
 
-from catabot.bus.messages import CameraFrame, Message, RadarSweep
-from catabot.config.scenario import Scenario
+from catabot.bus.messages import LABEL_CLASSES, CameraFrame, Message, RadarSweep
 from catabot.config.sensors import RadarParams
+from catabot.world.world import World
 from services.recorder.ppi import Ppi
 
-CLASS_NAMES = ("none", "water", "terrain", "vessel", "buoy")
 PNG_LEVEL = 3  # zlib level: fast; fixed, so the same pixels give the same bytes
 
 
@@ -44,8 +43,8 @@ def labels(frame: CameraFrame, files: dict[str, str]) -> dict[str, Any]:
     objects = [
         {
             "instance": int(row[0]),
-            "class": CLASS_NAMES[int(row[1])]
-            if int(row[1]) < len(CLASS_NAMES)
+            "class": LABEL_CLASSES[int(row[1])]
+            if int(row[1]) < len(LABEL_CLASSES)
             else str(int(row[1])),
             "box": [int(v) for v in row[2:6]],
             "truncated": bool(flag[0]),
@@ -66,13 +65,12 @@ def labels(frame: CameraFrame, files: dict[str, str]) -> dict[str, Any]:
 class Dataset:
     """Writes the dataset of every camera and radar of a scenario under `root`."""
 
-    def __init__(self, root: Path, scenario: Scenario) -> None:
+    def __init__(self, root: Path, world: World) -> None:
         self.root = root
         self.radar: dict[str, tuple[RadarParams, int]] = {
-            f"sensor/{v.id}/{s.name}": (s.typed_params(), s.period_ns)
-            for v in scenario.vessels
-            for s in v.sensors
-            if s.type == "radar"
+            world.keys.relative(s.key): (s.params, s.config.period_ns)
+            for s in world.sensors
+            if s.config.type == "radar"
         }
         self._ppi: dict[str, Ppi] = {}
 

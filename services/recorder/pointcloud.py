@@ -17,6 +17,7 @@ import typing
 import numpy as np
 
 from catabot.bus.messages import LidarScan, Message
+from catabot.errors import CataBotError
 from services.recorder.cdr import pointcloud2_encoder
 from services.recorder.ros2_msgdefs import HEADER_DEPENDENCIES, concatenated
 
@@ -67,7 +68,7 @@ FIELDS = [
 ]
 
 
-class PointCloudError(ValueError):
+class PointCloudError(CataBotError, ValueError):
     """A stream that cannot carry a point cloud (not named sensor/<vessel>/<sensor>)."""
 
 

@@ -19,8 +19,6 @@ from catabot.bus.inbox import Inputs
 from catabot.bus.messages import BodyStates, CameraFrame, End, Message, Tick, TwistBatch
 from catabot.bus.participant import Participant
 from catabot.run.service import Built, ServiceContext, run_service
-from catabot.world.streams import body_ids, command_streams, traffic_boat_ids, world_streams
-from catabot.world.traffic_plan import all_vessels
 from services.recorder import images
 from services.recorder.batches import BatchFormatter, Block
 from services.recorder.csv_sink import CsvSink, RecorderError
@@ -40,14 +38,11 @@ class Recorder:
         self.keys = ctx.keys
         self.csv = CsvSink(ctx.run_dir) if rec.csv else None
         self.mcap = McapSink(ctx.run_dir / "run.mcap") if rec.mcap else None
-        self.dataset = Dataset(ctx.run_dir / "dataset", ctx.scenario)
-        streams = world_streams(ctx.scenario, ctx.keys) + command_streams(ctx.scenario, ctx.keys)
-        self.batches = BatchFormatter(
-            body_ids(ctx.scenario),
-            traffic_boat_ids(ctx.scenario),
-            vessels=len(all_vessels(ctx.scenario)),
-        )
-        self.metrics = Metrics([v.id for v in all_vessels(ctx.scenario)])
+        world = ctx.world
+        self.dataset = Dataset(ctx.run_dir / "dataset", world)
+        streams = [*world.streams.lockstep(), *world.streams.commands]
+        self.batches = BatchFormatter(world.body_ids, world.boat_ids, vessels=len(world.vessels))
+        self.metrics = Metrics([v.id for v in world.vessels])
         self.run_dir = ctx.run_dir
         self._flushed_at = 0.0
         self.participant = Participant(

@@ -24,10 +24,11 @@ from numpy.typing import NDArray
 
 from catabot.bus.messages import CameraFrame, Message, VesselState
 from catabot.config.sensors import CameraParams
-from catabot.world import seeding
+from catabot.world import rotations, seeding
 from services.sensors import camera_boxes as cb
 from services.sensors.camera_shading import rain_streaks, rain_veil, shade
 from services.sensors.common import SensorError, rotation_from_quaternion
+from services.sensors.mount import Mount
 from services.sensors.scene import Body, Hits
 
 F64 = NDArray[np.float64]
@@ -55,20 +56,9 @@ class CastScene(Protocol):
 
 
 def rpy_matrix(rpy_deg: Sequence[float]) -> F64:
-    """Rz(yaw) @ Ry(pitch) @ Rx(roll) of angles in degrees."""
-    r, p, y = (math.radians(a) for a in rpy_deg)
-    cr, sr, cp, sp, cy, sy = (
-        math.cos(r),
-        math.sin(r),
-        math.cos(p),
-        math.sin(p),
-        math.cos(y),
-        math.sin(y),
-    )
-    rz = np.array([[cy, -sy, 0.0], [sy, cy, 0.0], [0.0, 0.0, 1.0]])
-    ry = np.array([[cp, 0.0, sp], [0.0, 1.0, 0.0], [-sp, 0.0, cp]])
-    rx = np.array([[1.0, 0.0, 0.0], [0.0, cr, -sr], [0.0, sr, cr]])
-    return rz @ ry @ rx
+    """Rz(yaw) @ Ry(pitch) @ Rx(roll) of (roll, pitch, yaw) in degrees."""
+    roll, pitch, yaw = rpy_deg
+    return rotations.rpy(roll, pitch, yaw)
 
 
 def pinhole(width: int, height: int, hfov_deg: float) -> cb.Pinhole:
@@ -90,9 +80,9 @@ class CameraModel:
 
     message: ClassVar[type[Message]] = CameraFrame
 
-    def __init__(
-        self, params: CameraParams, *, scene: CastScene | None, seed: int = 0, name: str = "camera"
-    ) -> None:
+    def __init__(self, params: CameraParams, mount: Mount) -> None:
+        scene: CastScene | None = mount.scene
+        seed, name = mount.seed, mount.name
         if scene is None:
             raise SensorError(f"camera {name!r} needs the ray-casting scene")
         self.params, self.scene, self.name = params, scene, name

@@ -18,7 +18,7 @@ from __future__ import annotations
 import numpy as np
 from numpy.typing import NDArray
 
-from services.sensors.scene import CLASS_BUOY, CLASS_TERRAIN, CLASS_VESSEL, CLASS_WATER
+from catabot.bus.messages import CLASS_BUOY, CLASS_TERRAIN, CLASS_VESSEL, CLASS_WATER
 
 F32 = NDArray[np.float32]
 

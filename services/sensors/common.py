@@ -13,10 +13,13 @@ from collections.abc import Sequence
 import numpy as np
 from numpy.typing import NDArray
 
+from catabot.errors import CataBotError
+from catabot.world import rotations
+
 Array = NDArray[np.float64]
 
 
-class SensorError(ValueError):
+class SensorError(CataBotError, ValueError):
     """A sensor configuration or input that cannot give a meaningful sample."""
 
 
@@ -44,40 +47,18 @@ def cross3(a: Array, b: Array) -> Array:
 
 
 def rotation_from_quaternion(q: Sequence[float]) -> Array:
-    """Body-to-map rotation matrix of a unit quaternion (x, y, z, w); v_map = R @ v_body.
-
-    The quaternion is normalised first so that a state rounded in transit (float32,
-    text) still gives a proper rotation; a zero or non-finite one is refused.
-    """
-    x, y, z, w = finite_vector(q, "orientation quaternion (x, y, z, w)", 4)
-    norm = math.sqrt(x * x + y * y + z * z + w * w)
-    if norm < 1e-9:
+    """Body-to-map rotation of a unit quaternion (x, y, z, w), normalised first (a state rounded
+    in transit still gives a proper rotation); a zero or non-finite one is refused."""
+    rot = rotations.matrix(finite_vector(q, "orientation quaternion (x, y, z, w)", 4))
+    if rot is None:
         raise SensorError(f"orientation quaternion has zero length (got {tuple(q)!r})")
-    x, y, z, w = x / norm, y / norm, z / norm, w / norm
-    return np.array(
-        [
-            [1 - 2 * (y * y + z * z), 2 * (x * y - z * w), 2 * (x * z + y * w)],
-            [2 * (x * y + z * w), 1 - 2 * (x * x + z * z), 2 * (y * z - x * w)],
-            [2 * (x * z - y * w), 2 * (y * z + x * w), 1 - 2 * (x * x + y * y)],
-        ]
-    )
+    return rot
 
 
 def rotations_from_quaternions(q: Array) -> Array | None:
-    """(n, 3, 3) rotations of n quaternions (x, y, z, w), the same bits as
-    `rotation_from_quaternion` one by one (same operations in the same order), or None if
-    any is non-finite or of zero length (the caller then names it one by one)."""
-    x, y, z, w = np.asarray(q, dtype=np.float64).T
-    norm = np.sqrt(x * x + y * y + z * z + w * w)
-    if not (np.isfinite(norm).all() and (norm >= 1e-9).all()):
-        return None
-    x, y, z, w = x / norm, y / norm, z / norm, w / norm
-    rows = [
-        [1 - 2 * (y * y + z * z), 2 * (x * y - z * w), 2 * (x * z + y * w)],
-        [2 * (x * y + z * w), 1 - 2 * (x * x + z * z), 2 * (y * z - x * w)],
-        [2 * (x * z - y * w), 2 * (y * z + x * w), 1 - 2 * (x * x + y * y)],
-    ]
-    return np.stack([np.stack(r, axis=-1) for r in rows], axis=-2)
+    """(n, 3, 3) rotations of n quaternions, the same bits as `rotation_from_quaternion` one
+    by one, or None if any is non-finite or of zero length (the caller then names it)."""
+    return rotations.normalised_matrices(q)
 
 
 def rows_of(a: Array, rows: NDArray[np.intp]) -> Array:

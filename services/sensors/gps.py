@@ -16,20 +16,20 @@ term belongs here when a consumer needs it. The fix reports the sigmas it was dr
 
 from __future__ import annotations
 
-from collections.abc import Sequence
 from typing import ClassVar, Literal
 
 import numpy as np
 
 from catabot.bus.messages import GpsFix, Message, VesselState
+from catabot.config.sensors import GpsParams
 from catabot.world import seeding
 from catabot.world.geo import EnuFrame, GeoError, paper_table_enu_to_geodetic
 from services.sensors.common import (
     SensorError,
     finite_vector,
-    non_negative,
     rotation_from_quaternion,
 )
+from services.sensors.mount import Mount
 
 Method = Literal["wgs84", "paper_table"]
 METHODS: tuple[Method, ...] = ("wgs84", "paper_table")
@@ -40,32 +40,17 @@ class GpsModel:
 
     message: ClassVar[type[Message]] = GpsFix
 
-    def __init__(
-        self,
-        *,
-        origin_lat_deg: float = 0.0,
-        origin_lon_deg: float = 0.0,
-        origin_alt_m: float = 0.0,
-        horizontal_sigma: float = 0.5,
-        vertical_sigma: float = 1.0,
-        antenna_offset: Sequence[float] = (0.0, 0.0, 0.0),
-        method: Method = "wgs84",
-        noise: bool = True,
-        seed: int = 0,
-        name: str = "gps",
-    ) -> None:
-        if method not in METHODS:
-            raise SensorError(f"GPS method must be one of {METHODS} (got {method!r})")
+    def __init__(self, params: GpsParams, mount: Mount) -> None:
+        origin = mount.origin
         try:
-            self.frame = EnuFrame(origin_lat_deg, origin_lon_deg, origin_alt_m)
+            self.frame = EnuFrame(origin.latitude_deg, origin.longitude_deg, origin.altitude_m)
         except GeoError as exc:
-            raise SensorError(f"GPS {name!r} origin: {exc}") from None
-        self.method: Method = method
-        self.horizontal_sigma = non_negative(horizontal_sigma, "horizontal_sigma (m)")
-        self.vertical_sigma = non_negative(vertical_sigma, "vertical_sigma (m)")
-        self.antenna_offset = finite_vector(antenna_offset, "antenna_offset (m, body FLU)")
-        self.noise, self.name = bool(noise), name
-        self._rng = seeding.rng(seed, name)
+            raise SensorError(f"GPS {mount.name!r} origin: {exc}") from None
+        self.method: Method = params.method
+        self.horizontal_sigma, self.vertical_sigma = params.horizontal_sigma, params.vertical_sigma
+        self.antenna_offset = np.array(params.antenna_offset, dtype=np.float64)
+        self.noise, self.name = mount.noise, mount.name
+        self._rng = seeding.rng(mount.seed, mount.name)
 
     @property
     def sigmas(self) -> tuple[float, float]:

@@ -20,12 +20,13 @@ With `noise=False` the IMU is ideal. Orientation is passed through from the stat
 from __future__ import annotations
 
 import math
-from collections.abc import Sequence
 from typing import ClassVar
 
 import numpy as np
 
 from catabot.bus.messages import ImuSample, Message, VesselState
+from catabot.config.sensors import ImuParams
+from catabot.config.waves import GRAVITY
 from catabot.world import seeding
 from services.sensors.common import (
     Array,
@@ -35,8 +36,8 @@ from services.sensors.common import (
     non_negative,
     rotation_from_quaternion,
 )
+from services.sensors.mount import Mount
 
-GRAVITY = 9.81  # m/s^2, the physics service's default (services/physics/world.py)
 UP = np.array([0.0, 0.0, 1.0])
 
 
@@ -45,47 +46,16 @@ class ImuModel:
 
     message: ClassVar[type[Message]] = ImuSample
 
-    def __init__(
-        self,
-        *,
-        gyro_sigma: float = 0.009,
-        accel_sigma: float = 0.021,
-        gyro_bias_instability: float = 0.0008,
-        accel_bias_instability: float = 0.004,
-        bias_tau_s: float = 300.0,
-        gyro_random_walk: float = 0.0,
-        accel_random_walk: float = 0.0,
-        lever_arm: Sequence[float] = (0.0, 0.0, 0.0),
-        gravity: float = GRAVITY,
-        noise: bool = True,
-        seed: int = 0,
-        name: str = "imu",
-    ) -> None:
-        self.sigma = np.array(
-            [
-                non_negative(gyro_sigma, "gyro_sigma (rad/s)"),
-                non_negative(accel_sigma, "accel_sigma (m/s^2)"),
-            ]
-        )
-        self.bias_sigma = np.array(
-            [
-                non_negative(gyro_bias_instability, "gyro_bias_instability (rad/s)"),
-                non_negative(accel_bias_instability, "accel_bias_instability (m/s^2)"),
-            ]
-        )
-        self.walk = np.array(
-            [
-                non_negative(gyro_random_walk, "gyro_random_walk (rad/s/sqrt(s))"),
-                non_negative(accel_random_walk, "accel_random_walk (m/s^2/sqrt(s))"),
-            ]
-        )
-        if not (math.isfinite(bias_tau_s) and bias_tau_s > 0.0):
-            raise SensorError(f"bias_tau_s must be a finite number > 0 (got {bias_tau_s!r})")
-        self.bias_tau_s = float(bias_tau_s)
-        self.lever_arm = finite_vector(lever_arm, "lever_arm (m, body FLU)")
+    def __init__(self, params: ImuParams, mount: Mount, *, gravity: float = GRAVITY) -> None:
+        p = params  # validated: sigmas >= 0, tau > 0, all finite (catabot.config.sensors)
+        self.sigma = np.array([p.gyro_sigma, p.accel_sigma])
+        self.bias_sigma = np.array([p.gyro_bias_instability, p.accel_bias_instability])
+        self.walk = np.array([p.gyro_random_walk, p.accel_random_walk])
+        self.bias_tau_s = float(p.bias_tau_s)
+        self.lever_arm = np.array(p.lever_arm, dtype=np.float64)
         self.gravity = non_negative(gravity, "gravity (m/s^2)")
-        self.noise, self.name = bool(noise), name
-        self._rng = seeding.rng(seed, name)
+        self.noise, self.name = mount.noise, mount.name
+        self._rng = seeding.rng(mount.seed, mount.name)
         # rows: gyro, accel; Gauss-Markov part drawn from its stationary law, walk from 0
         self._markov = self.bias_sigma[:, None] * self._rng.standard_normal((2, 3))
         self._walked = np.zeros((2, 3))

@@ -20,13 +20,13 @@ import math
 import numpy as np
 from numpy.typing import NDArray
 
-from catabot.bus.messages import LidarScan, VesselState
+from catabot.bus.messages import CLASS_NONE, LidarScan, VesselState
 from catabot.config.sensors import LidarParams
-from catabot.world import seeding
+from catabot.world import rotations, seeding
 from services.sensors.common import SensorError, rotation_from_quaternion
 from services.sensors.cull import grid_pairs
+from services.sensors.mount import Mount
 from services.sensors.rain import RainParams, apply_rain
-from services.sensors.scene import CLASS_NONE, Scene
 
 F64 = NDArray[np.float64]
 
@@ -48,12 +48,7 @@ def beam_directions(channels: int, columns: int, vertical_fov_deg: float) -> F64
 
 def mount_rotation(yaw_deg: float, pitch_deg: float) -> F64:
     """Sensor-to-body rotation Rz(yaw) @ Ry(pitch); positive pitch tilts the sensor nose-down."""
-    y, p = math.radians(yaw_deg), math.radians(pitch_deg)
-    rz = np.array([[math.cos(y), -math.sin(y), 0.0], [math.sin(y), math.cos(y), 0.0], [0, 0, 1]])
-    ry = np.array(
-        [[math.cos(p), 0.0, math.sin(p)], [0.0, 1.0, 0.0], [-math.sin(p), 0, math.cos(p)]]
-    )
-    return rz @ ry
+    return rotations.rpy(0.0, pitch_deg, yaw_deg)
 
 
 class LidarModel:
@@ -61,15 +56,8 @@ class LidarModel:
 
     message = LidarScan
 
-    def __init__(
-        self,
-        params: LidarParams,
-        *,
-        scene: Scene | None,
-        noise: bool = True,
-        seed: int = 0,
-        name: str = "lidar",
-    ) -> None:
+    def __init__(self, params: LidarParams, mount: Mount) -> None:
+        scene, noise, seed, name = mount.scene, mount.noise, mount.seed, mount.name
         if scene is None:
             raise SensorError(f"lidar {name!r} needs the ray-casting scene")
         self.params, self.scene, self.noise = params, scene, noise

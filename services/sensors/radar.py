@@ -25,20 +25,15 @@ from typing import ClassVar
 import numpy as np
 from numpy.typing import NDArray
 
-from catabot.bus.messages import Message, RadarSweep, VesselState
+from catabot.bus.messages import CLASS_NONE, CLASS_WATER, Message, RadarSweep, VesselState
 from catabot.config.sensors import RadarParams
-from catabot.world import seeding
+from catabot.world import rotations, seeding
 from services.sensors.camera import CastScene
 from services.sensors.common import SensorError, rotation_from_quaternion
-from services.sensors.scene import CLASS_NONE, CLASS_WATER
+from services.sensors.mount import Mount
 
 F64 = NDArray[np.float64]
 NS_PER_S = 1_000_000_000
-
-
-def yaw_of(rot: F64) -> float:
-    """ENU heading (rad, counter-clockwise from east) of a body-to-map rotation."""
-    return math.atan2(float(rot[1, 0]), float(rot[0, 0]))
 
 
 def fan(p: RadarParams) -> F64:
@@ -59,16 +54,11 @@ class RadarModel:
 
     message: ClassVar[type[Message]] = RadarSweep
 
-    def __init__(
-        self,
-        params: RadarParams,
-        *,
-        scene: CastScene | None,
-        period_ns: int,
-        noise: bool = True,
-        seed: int = 0,
-        name: str = "radar",
-    ) -> None:
+    def __init__(self, params: RadarParams, mount: Mount) -> None:
+        scene: CastScene | None = mount.scene
+        noise, seed, name, period_ns = mount.noise, mount.seed, mount.name, mount.period_ns
+        if period_ns <= 0:
+            raise SensorError(f"radar {name!r} needs its sample period (got {period_ns} ns)")
         if scene is None:
             raise SensorError(f"radar {name!r} needs the ray-casting scene")
         self.params, self.scene, self.noise = params, scene, noise
@@ -92,7 +82,7 @@ class RadarModel:
 
     def sample(self, state: VesselState, *, tick: int, stamp_ns: int) -> RadarSweep:
         rot = rotation_from_quaternion(state.orientation)
-        heading = yaw_of(rot)
+        heading = rotations.yaw_of_matrix(rot)
         origin = np.asarray(state.position, dtype=np.float64) + rot @ (
             0.0,
             0.0,

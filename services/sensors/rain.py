@@ -35,10 +35,12 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import NDArray
 
+from catabot.errors import CataBotError
+
 F64 = NDArray[np.float64]
 
 
-class RainModelError(ValueError):
+class RainModelError(CataBotError, ValueError):
     """Rain-model parameters or inputs outside their meaningful range."""
 
 

@@ -25,11 +25,11 @@ from __future__ import annotations
 
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
-from typing import TYPE_CHECKING
 
 import numpy as np
 from numpy.typing import NDArray
 
+from catabot.bus.messages import CLASS_NONE, CLASS_TERRAIN, CLASS_WATER
 from catabot.world.terrain import Terrain
 from catabot.world.waves import WaveField
 from services.sensors.common import (
@@ -42,10 +42,6 @@ from services.sensors.cull import cone_pairs, sphere_pairs
 from services.sensors.terrain_cast import TerrainCaster
 from services.sensors.water import calm_hits, wave_hits
 
-if TYPE_CHECKING:
-    from catabot.config.scenario import Scenario
-
-CLASS_NONE, CLASS_WATER, CLASS_TERRAIN, CLASS_VESSEL, CLASS_BUOY = 0, 1, 2, 3, 4
 F32 = NDArray[np.float32]
 F64 = NDArray[np.float64]
 Vec3 = tuple[float, float, float]
@@ -359,29 +355,3 @@ def _slab(ob: F64, db: F64, lo: F64, hi: F64) -> tuple[F64, F64]:
     rows = np.arange(ob.shape[0])
     face[rows, axis] = -np.sign(dbt[axis, rows])
     return t, face
-
-
-def bodies_for(scenario: Scenario) -> list[Body]:
-    """Every vessel, traffic boats included (instance 1 + its index), then every buoy
-    (instances after the vessels), as a box: the union of its model's hull bounds."""
-    from catabot.config.vessel import load_vessel_model
-    from catabot.world.traffic_plan import all_buoys, all_vessels
-
-    vessels, buoys = all_vessels(scenario), all_buoys(scenario)
-    bounds = {m: _hull_bounds(load_vessel_model(m)) for m in {v.model for v in vessels}}
-    bodies = [Body(v.id, CLASS_VESSEL, 1 + i, *bounds[v.model]) for i, v in enumerate(vessels)]
-    if buoys:
-        lo, hi = _hull_bounds(load_vessel_model("buoy"))
-        first = 1 + len(vessels)
-        bodies += [Body(b.id, CLASS_BUOY, first + j, lo, hi) for j, b in enumerate(buoys)]
-    return bodies
-
-
-def _hull_bounds(model: object) -> tuple[Vec3, Vec3]:
-    from catabot.config.vessel import VesselModel
-
-    assert isinstance(model, VesselModel)
-    centre = np.array([h.center_m for h in model.hulls])
-    half = np.array([(h.length_m, h.beam_m, h.vertical_extent_m) for h in model.hulls]) / 2
-    lo, hi = (centre - half).min(axis=0), (centre + half).max(axis=0)
-    return (float(lo[0]), float(lo[1]), float(lo[2])), (float(hi[0]), float(hi[1]), float(hi[2]))

@@ -24,8 +24,7 @@ from catabot.bus.messages import BodyStates, Message, Tick, TwistBatch, Waypoint
 from catabot.bus.participant import Participant
 from catabot.config.scenario import guidance_period_ticks
 from catabot.run.service import Built, ServiceContext, run_service
-from catabot.world.streams import BodyRows, body_ids, states_stream, waypoint_streams
-from catabot.world.traffic_plan import plan_traffic
+from catabot.world import rotations
 from services.traffic.behaviours import Behaviours
 
 log = logging.getLogger("traffic")
@@ -34,8 +33,9 @@ MODES = ("loop", "back_and_forth", "release")
 
 class TrafficService:
     def __init__(self, ctx: ServiceContext) -> None:
-        boats = plan_traffic(ctx.scenario).boats
-        self.ids = tuple(b.id for b in boats)
+        world = ctx.world
+        boats = world.traffic.boats
+        self.ids = world.boat_ids
         self.row = {vid: i for i, vid in enumerate(self.ids)}
         self.keys = ctx.keys
         self.behaviours = Behaviours(boats, hold_gain=ctx.scenario.traffic.hold.gain)
@@ -43,21 +43,17 @@ class TrafficService:
         self.pos = np.array([(b.pose.x_m, b.pose.y_m) for b in boats], dtype=np.float64)
         self.yaw = np.array([b.pose.yaw_rad for b in boats], dtype=np.float64)
         self.vel = np.zeros((n, 2))
+        self.world = world
         self.states_key = ctx.keys.world_states()
-        self.body_rows = BodyRows(body_ids(ctx.scenario))
-        self.boat_rows: np.ndarray | None = None
-        waypoints = [
-            s
-            for s in waypoint_streams(ctx.scenario, ctx.keys)
-            if ctx.keys.vessel_of(s.key) in self.row
-        ]
+        self.boat_rows = np.array([world.body(vid).row for vid in self.ids], dtype=np.intp)
+        waypoints = [s for s in world.streams.waypoints if ctx.keys.vessel_of(s.key) in self.row]
         self.twists_key = ctx.keys.world_twists()
         self.period = guidance_period_ticks(ctx.scenario)
         self.participant = Participant(
             ctx.session,
             ctx.keys,
             ctx.name,
-            inputs=[states_stream(ctx.keys), *waypoints],
+            inputs=[world.streams.states, *waypoints],
             peers=ctx.peers,
         )
 
@@ -81,15 +77,12 @@ class TrafficService:
         self.participant.publish(self.twists_key, batch)
 
     def _take_states(self, batch: Message) -> None:
-        """The boats' rows of the batch, all at once (rows mapped at the first batch)."""
+        """The boats' rows of the batch, all at once."""
         assert isinstance(batch, BodyStates)
-        row = self.body_rows.check(batch)
-        if self.boat_rows is None:
-            self.boat_rows = np.array([row[vid] for vid in self.ids], dtype=np.intp)
+        self.world.check_rows(batch)
         rows = self.boat_rows
-        x, y, z, w = batch.orientation[rows].T
         self.pos = batch.position[rows, :2].copy()
-        self.yaw = np.arctan2(2 * (w * z + x * y), 1 - 2 * (y * y + z * z))
+        self.yaw = rotations.yaw_of_quaternions(batch.orientation[rows])
         self.vel = batch.linear_velocity[rows, :2].copy()
 
     def _take_waypoints(self, i: int, key: str, msg: WaypointsCmd) -> None:

@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import numpy as np
 import pytest
 
 from catabot.bus import codec
@@ -10,9 +9,7 @@ from catabot.bus.clock import ClockError, Policy, Stream, period_in_ticks, ticks
 from catabot.bus.codec import CodecError
 from catabot.bus.inbox import Inbox
 from catabot.bus.keys import Keys
-from catabot.bus.messages import BodyStates, GpsFix, ImuSample, ThrustCmd, VesselState
-from catabot.config.scenario import parse_scenario
-from catabot.world.streams import BodyRows, body_ids, participants, state_streams, world_streams
+from catabot.bus.messages import GpsFix, ImuSample, ThrustCmd, VesselState
 
 KEYS = Keys("w")
 STATE = KEYS.vessel_state("ego")
@@ -234,63 +231,3 @@ def test_inbox_keys() -> None:
 
 
 # -- streams of a scenario ----------------------------------------------------------------
-
-
-def _scenario(**changes: object):
-    data = {
-        "name": "w",
-        "vessels": [
-            {
-                "id": "ego",
-                "sensors": [
-                    {"name": "imu", "type": "imu", "rate_hz": 100.0},
-                    {"name": "gps", "type": "gps", "rate_hz": 10.0},
-                ],
-            },
-            {"id": "buoy"},
-        ],
-    }
-    data.update(changes)
-    return parse_scenario(data)
-
-
-def test_participants() -> None:
-    assert participants(_scenario())[:3] == ["physics", "sensors", "recorder"]
-    no_sensors = _scenario(vessels=[{"id": "a"}])
-    assert "sensors" not in participants(no_sensors)
-    no_recording = _scenario(recording={"csv": False, "mcap": False})
-    assert "recorder" not in participants(no_recording)
-    assert participants(no_recording)[:2] == ["physics", "sensors"]
-
-
-def test_world_streams() -> None:
-    streams = world_streams(_scenario(), KEYS)
-    table = {s.key: (s.message, s.producer, s.period) for s in streams}
-    assert table == {
-        KEYS.world_states(): (BodyStates, "physics", 1),
-        KEYS.sensor("ego", "imu"): (ImuSample, "sensors", 1),
-        KEYS.sensor("ego", "gps"): (GpsFix, "sensors", 10),
-    }
-    assert len(streams) == len(table)
-
-
-def test_per_vessel_states_are_for_observers_only() -> None:
-    """Lockstep consumers wait for the one batch; per-vessel states stay off the table."""
-    scenario = _scenario()  # two vessels ("buoy" is a vessel's id here), no moored buoys
-    assert KEYS.world_states() == "catabot/w/world/states"
-    states = [s.key for s in state_streams(scenario, KEYS)]
-    assert states == [KEYS.vessel_state("ego"), KEYS.vessel_state("buoy")]
-    assert body_ids(scenario) == ("ego", "buoy")
-    lockstep = {s.key for s in world_streams(scenario, KEYS)}
-    assert not lockstep & {KEYS.vessel_state("ego"), KEYS.vessel_state("buoy")}
-
-
-def test_body_rows_refuse_a_changed_row_order() -> None:
-    def batch(ids: tuple[str, ...]) -> BodyStates:
-        z3, z4 = np.zeros((len(ids), 3)), np.zeros((len(ids), 4))
-        return BodyStates(0, 0, ids, z3, z4, z3, z3, z3, z3)
-
-    rows = BodyRows(("ego", "buoy"))
-    assert rows.check(batch(("ego", "buoy"))) == {"ego": 0, "buoy": 1}
-    with pytest.raises(ValueError, match="expected"):
-        rows.check(batch(("buoy", "ego")))

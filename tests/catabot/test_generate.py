@@ -8,7 +8,7 @@ import pytest
 
 from catabot.config.scenario import load_scenario
 from catabot.run.cli import main
-from catabot.world.traffic_plan import plan_traffic
+from catabot.world.world import World
 
 
 def test_generated_scenario_is_valid_and_has_the_traffic(tmp_path: Path) -> None:
@@ -17,7 +17,7 @@ def test_generated_scenario_is_valid_and_has_the_traffic(tmp_path: Path) -> None
     assert main([*argv, "--seed", "9", "-o", str(out)]) == 0
     scenario = load_scenario(out)
     assert scenario.seed == 9 and scenario.traffic.count == 30
-    kinds = {b.behaviour for b in plan_traffic(scenario).boats}
+    kinds = {b.behaviour for b in World.resolve(scenario).traffic.boats}
     assert kinds == {"circle", "waypoints"}
 
 

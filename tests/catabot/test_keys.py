@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import pytest
 
-from catabot.bus.keys import KeyError_, Keys, check_name
+from catabot.bus.keys import KeyNameError, Keys, check_name
 
 BAD_NAMES = ["a/b", "*", "a*", "**", "$x", "a$", "a b", " ", "", "a?b", "a#b"]
 
@@ -38,7 +38,7 @@ def test_allowed_name_characters() -> None:
 
 @pytest.mark.parametrize("name", BAD_NAMES)
 def test_world_name_refused(name: str) -> None:
-    with pytest.raises(KeyError_, match=r"^world name .* is not allowed in a key"):
+    with pytest.raises(KeyNameError, match=r"^world name .* is not allowed in a key"):
         Keys(name)
 
 
@@ -58,7 +58,7 @@ def test_world_name_refused(name: str) -> None:
     ],
 )
 def test_chunk_names_refused_naming_the_kind(name: str, kind: str, build) -> None:
-    with pytest.raises(KeyError_) as info:
+    with pytest.raises(KeyNameError) as info:
         build(Keys("w"), name)
     msg = str(info.value)
     assert msg.startswith(f"{kind} name {name!r}")
@@ -66,23 +66,23 @@ def test_chunk_names_refused_naming_the_kind(name: str, kind: str, build) -> Non
 
 
 def test_non_string_name_refused() -> None:
-    with pytest.raises(KeyError_, match="vessel name 3"):
+    with pytest.raises(KeyNameError, match="vessel name 3"):
         check_name("vessel", 3)  # type: ignore[arg-type]
 
 
 def test_key_error_is_a_value_error() -> None:
-    assert issubclass(KeyError_, ValueError)
+    assert issubclass(KeyNameError, ValueError)
 
 
 def test_relative() -> None:
     k = Keys("w")
     assert k.relative(k.sensor("ego", "gps")) == "sensor/ego/gps"
     assert k.relative(k.tick()) == "clock/tick"
-    with pytest.raises(KeyError_, match=r"not in world 'w'"):
+    with pytest.raises(KeyNameError, match=r"not in world 'w'"):
         k.relative("catabot/other/clock/tick")
-    with pytest.raises(KeyError_, match="not in world"):
+    with pytest.raises(KeyNameError, match="not in world"):
         k.relative("catabot/w")  # the prefix alone is not a key of the world
-    with pytest.raises(KeyError_, match="not in world"):
+    with pytest.raises(KeyNameError, match="not in world"):
         k.relative("catabot/ww/clock/tick")  # a world whose name merely starts the same
 
 
@@ -97,5 +97,5 @@ def test_vessel_of_reads_the_vessel_id_back_from_a_key() -> None:
     keys = Keys("w")
     assert keys.vessel_of(keys.cmd_twist("boat_007")) == "boat_007"
     assert keys.vessel_of(keys.sensor("ego", "lidar")) == "ego"
-    with pytest.raises(KeyError_, match="names no vessel"):
+    with pytest.raises(KeyNameError, match="names no vessel"):
         keys.vessel_of(keys.tick())

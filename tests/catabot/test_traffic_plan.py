@@ -7,7 +7,8 @@ import numpy as np
 from catabot.config.scenario import parse_scenario
 from catabot.config.vessel import load_vessel_model
 from catabot.world.placement import footprint_m
-from catabot.world.traffic_plan import TrafficPlan, plan_traffic
+from catabot.world.traffic_plan import TrafficPlan
+from catabot.world.world import World
 
 HULL = footprint_m(load_vessel_model("monohull"))
 BUOY = footprint_m(load_vessel_model("buoy"))
@@ -26,7 +27,7 @@ def _plan(count: int, **traffic: object) -> TrafficPlan:
             **traffic,
         },
     }
-    return plan_traffic(parse_scenario(data))
+    return World.resolve(parse_scenario(data)).traffic
 
 
 def test_no_boat_starts_on_a_buoy_and_no_circle_runs_through_one() -> None:

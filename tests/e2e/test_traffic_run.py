@@ -16,7 +16,7 @@ from catabot.bus.messages import TwistCmd, WaypointsCmd
 from catabot.bus.session import Connection, free_port, open_session
 from catabot.config.scenario import ClockConfig, load_scenario
 from catabot.world.terrain import load_terrain
-from catabot.world.traffic_plan import plan_traffic
+from catabot.world.world import World
 
 BAY = Path(__file__).resolve().parents[2] / "catabot" / "data" / "terrain" / "bay.png"
 CIRCLE_RATE = math.radians(15.0)  # 5 m/s on the default 19.1 m circle
@@ -75,7 +75,7 @@ def test_external_twist_takes_over_a_boat_and_release_restores_it(
     straight = _window(rate, max(first, 0), np.abs(rate) < 0.02, 300)
     again = _window(rate, max(straight, 0), np.abs(rate) > 0.1, 300)  # steering again
     assert first >= 0 and straight > first and again > straight, (first, straight, again)
-    boat = plan_traffic(load_scenario(run / "scenario.json")).boats[0]
+    boat = World.resolve(load_scenario(run / "scenario.json")).traffic.boats[0]
     radius = np.hypot(*(states[-500:, 2:4] - boat.center).T)  # back on its circle
     assert np.abs(radius / boat.radius_m - 1).max() < 0.1, (radius.min(), radius.max())
 

@@ -3,14 +3,14 @@
 from __future__ import annotations
 
 from catabot.bus.messages import ThrustCmd, TwistCmd, WaypointsCmd
-from catabot.config.scenario import VesselConfig
 from services.physics.commands import CommandBook, Order
+from tests.services.physics.helpers import vessels
 
 KEY = "catabot/w/vessel/boat_000/cmd/twist"
 
 
 def _book() -> CommandBook:
-    return CommandBook([VesselConfig(id="boat_000")], {"boat_000": 2})
+    return CommandBook(vessels({"id": "boat_000"}))
 
 
 def test_traffic_set_points_drive_a_boat_until_an_external_command_takes_it() -> None:

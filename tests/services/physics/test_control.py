@@ -6,10 +6,10 @@ import numpy as np
 import pytest
 
 from catabot.bus.messages import ThrustCmd, TwistBatch, TwistCmd
-from catabot.config.scenario import VesselConfig
 from catabot.config.vessel import load_vessel_model
 from services.physics.commands import CommandBook, Order
 from services.physics.world import PhysicsWorld
+from tests.services.physics.helpers import vessels
 
 
 def _world() -> PhysicsWorld:
@@ -41,7 +41,7 @@ def test_twist_batch_sets_each_boats_order_and_skips_bad_entries(
     caplog: pytest.LogCaptureFixture,
 ) -> None:
     boats = ("boat_000", "boat_001")
-    book = CommandBook([VesselConfig(id=b) for b in boats], {b: 2 for b in boats})
+    book = CommandBook(vessels(*({"id": b} for b in boats)))
     batch = TwistBatch(3, 30, boats, np.array([1.0, np.nan]), np.array([0.1, 0.2]))
     book.take_batch(batch, boats)
     assert book.order("boat_000", 40) == Order(twist=(1.0, 0.1))
@@ -55,17 +55,15 @@ def test_twist_batch_sets_each_boats_order_and_skips_bad_entries(
 def test_orders_gathers_every_vessel_in_world_rows() -> None:
     """Script, lockstep set-point, external override: `orders` agrees with `order` vessel by
     vessel and hands the velocity-controlled rows over as arrays."""
-    ego = VesselConfig.model_validate(
-        {
-            "id": "ego",
-            "script": [
-                {"t_s": 0.0, "thrust": [0.5, 0.5]},
-                {"t_s": 1.0, "twist": {"surge_mps": 2.0, "yaw_rate_radps": 0.0}},
-            ],
-        }
-    )
+    ego = {
+        "id": "ego",
+        "script": [
+            {"t_s": 0.0, "thrust": [0.5, 0.5]},
+            {"t_s": 1.0, "twist": {"surge_mps": 2.0, "yaw_rate_radps": 0.0}},
+        ],
+    }
     boats = ("boat_000", "boat_001", "boat_002")
-    book = CommandBook([ego, *(VesselConfig(id=b) for b in boats)], {v: 2 for v in ("ego", *boats)})
+    book = CommandBook(vessels(ego, *({"id": b} for b in boats)))
     book.take_batch(TwistBatch(0, 10, boats, np.array([1.0, 2.0, 3.0]), np.zeros(3)), boats)
     book.take("boat_001", "k", [TwistCmd(0.5, 0.1, tick=-1)])
     book.take("boat_002", "k", [ThrustCmd((0.1, -0.1))])

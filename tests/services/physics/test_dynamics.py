@@ -11,12 +11,11 @@ import numpy as np
 import pytest
 
 from catabot.config.vessel import VesselModel, VesselModelError, load_vessel_model
+from catabot.world import rotations
 from services.physics.hydro import (
     Columns,
     buoyancy_wrench,
     hull_columns,
-    quat_from_rotvec,
-    rot_from_quat,
 )
 from services.physics.world import PhysicsWorld
 
@@ -56,7 +55,7 @@ def test_reported_state_matches_dart_body(catabot: VesselModel) -> None:
     state = world.states()["cb"]
     body = world._skeletons[0].getBodyNode(0)
     transform = body.getWorldTransform()
-    rot = rot_from_quat(state.orientation[None])[0]
+    rot = rotations.matrices(state.orientation[None])[0]
     assert np.allclose(rot, transform.rotation(), atol=1e-12)
     assert np.allclose(state.position, transform.translation(), atol=1e-12)
     spatial = body.getSpatialVelocity()  # body frame [angular, linear]
@@ -231,8 +230,8 @@ def test_submerged_box_buoyancy_is_archimedes_at_any_attitude(catabot: VesselMod
     volume = sum(h.length_m * h.beam_m * h.vertical_extent_m for h in catabot.hulls)
     centre = np.mean([h.center_m for h in catabot.hulls], axis=0)
     for rv in ([0.0, 0.0, 0.0], [0.4, -0.3, 1.0], [math.pi * 0.9, 0.2, 0.0]):
-        quat = quat_from_rotvec(np.array([rv]))
-        rot = rot_from_quat(quat)
+        quat = rotations.from_rotvec(np.array([rv]))
+        rot = rotations.matrices(quat)
         wrench = buoyancy_wrench(cols, rot, np.array([[0.0, 0.0, -5.0]]), density=RHO, gravity=9.81)
         up = rot[0, 2, :]
         assert np.allclose(wrench[0, :3], RHO * 9.81 * volume * up, rtol=1e-12)
@@ -241,7 +240,7 @@ def test_submerged_box_buoyancy_is_archimedes_at_any_attitude(catabot: VesselMod
 
 def test_roll_gives_restoring_moment(catabot: VesselModel) -> None:
     cols = _columns_of(catabot)
-    rot = rot_from_quat(quat_from_rotvec(np.array([[0.1, 0.0, 0.0]])))  # port side up
+    rot = rotations.matrices(rotations.from_rotvec(np.array([[0.1, 0.0, 0.0]])))  # port side up
     wrench = buoyancy_wrench(cols, rot, np.zeros((1, 3)), density=RHO, gravity=9.81)
     assert wrench[0, 3] < -100.0  # pushes the roll back towards level
 

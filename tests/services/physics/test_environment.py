@@ -11,11 +11,11 @@ import pytest
 
 from catabot.config.environment import WindConfig, WindZone
 from catabot.config.vessel import VesselModel, load_vessel_model
+from catabot.world import rotations
 from catabot.world.environment import CurrentField, WindField
 from services.physics.added_mass import rigid_body_matrix
 from services.physics.control import TwistController
 from services.physics.fleet import GROUP
-from services.physics.hydro import rot_from_quat
 from services.physics.wind import wind_gains, wind_wrench
 from services.physics.world import PhysicsWorld
 
@@ -38,7 +38,7 @@ def damping_root(linear: float, quadratic: float, force: float) -> float:
 
 def world_velocity(world: PhysicsWorld) -> np.ndarray:
     s = world.state_arrays()
-    return np.einsum("nij,nj->ni", rot_from_quat(s.orientation), s.linear_velocity)
+    return np.einsum("nij,nj->ni", rotations.matrices(s.orientation), s.linear_velocity)
 
 
 @pytest.fixture(scope="module")
@@ -68,7 +68,7 @@ def test_first_step_acceleration_is_that_of_rigid_plus_added_mass(catabot: Vesse
         tau[3:] += np.cross(t.position_m, (force, 0.0, 0.0))
     expected = np.linalg.solve(rigid_body_matrix(model) + np.diag(model.added_mass), tau)
     s = world.state_arrays()  # reported in the end-of-step frame; the start frame is identity
-    rot = rot_from_quat(s.orientation)[0]
+    rot = rotations.matrices(s.orientation)[0]
     got = np.concatenate([rot @ s.linear_acceleration[0], rot @ s.angular_acceleration[0]])
     assert np.allclose(got, expected, rtol=1e-9, atol=1e-12)
 
@@ -142,7 +142,7 @@ def test_terminal_drift_under_steady_wind_head_and_beam(catabot: VesselModel) ->
 def test_wind_law_is_vrx_for_the_wamv() -> None:
     """X = 0.5 u|u|, Y = 0.5 v|v|, N = -2 * 0.33 u v on the apparent wind (VRX's plugin)."""
     gains = wind_gains([load_vessel_model("wamv")], 1.225)
-    rot = rot_from_quat(np.array([[0.0, 0.0, math.sin(0.3), math.cos(0.3)]]))  # yaw 0.6 rad
+    rot = rotations.matrices(np.array([[0.0, 0.0, math.sin(0.3), math.cos(0.3)]]))  # yaw 0.6 rad
     wind = np.array([[4.0, -3.0]])
     nu = np.array([[1.0, 0.5, 0.0, 0.0, 0.0, 0.2]])
     u, v = rot[0, :2, :2].T @ wind[0] - nu[0, :2]

@@ -9,13 +9,14 @@ import math
 import numpy as np
 import pytest
 
-from catabot.bus.messages import CameraFrame, VesselState
+from catabot.bus.messages import CLASS_NONE, CLASS_VESSEL, CLASS_WATER, CameraFrame, VesselState
 from catabot.config.sensors import CameraParams
 from catabot.config.waves import WaveConfig
 from catabot.world.waves import WaveField
 from services.sensors.camera import CameraModel
 from services.sensors.camera_shading import VEIL
-from services.sensors.scene import CLASS_NONE, CLASS_VESSEL, CLASS_WATER, Body, Scene
+from services.sensors.mount import Mount
+from services.sensors.scene import Body, Scene
 
 BOAT = ((-2.0, -1.0, -0.2), (2.0, 1.0, 1.0))
 TALL = ((-2.0, -1.0, -0.2), (2.0, 1.0, 3.0))
@@ -40,7 +41,7 @@ def scene_with(boats: dict[str, tuple[float, float, tuple[tuple[float, ...], ...
 
 
 def shoot(scene: Scene, **params: object) -> tuple[CameraModel, CameraFrame]:
-    cam = CameraModel(CameraParams.model_validate(params), scene=scene, seed=3, name="v/cam")
+    cam = CameraModel(CameraParams.model_validate(params), Mount(scene=scene, seed=3, name="v/cam"))
     return cam, cam.sample(own_state(), tick=0, stamp_ns=0)
 
 
@@ -136,7 +137,7 @@ def test_frames_are_deterministic_and_outputs_can_be_switched_off() -> None:
 
 def test_a_camera_needs_the_scene() -> None:
     with pytest.raises(ValueError, match="scene"):
-        CameraModel(CameraParams(), scene=None)
+        CameraModel(CameraParams(), Mount(scene=None))
 
 
 def test_projected_pixel_cull_gives_the_same_hits_as_the_full_test() -> None:

@@ -8,14 +8,19 @@ from typing import Any
 import numpy as np
 import pyproj
 import pytest
+from pydantic import ValidationError
 
 from catabot.bus.messages import GpsFix, ImuSample, VesselState
-from catabot.config.scenario import Origin, SensorConfig
+from catabot.config.scenario import Origin, parse_scenario
+from catabot.config.sensors import SENSOR_TYPES, GpsParams, ImuParams
+from catabot.config.waves import GRAVITY
 from catabot.world.geo import enu_to_geodetic
+from catabot.world.world import World
 from services.sensors.common import SensorError
 from services.sensors.gps import GpsModel
-from services.sensors.imu import GRAVITY, ImuModel
-from services.sensors.registry import SENSOR_TYPES, build_sensor
+from services.sensors.imu import ImuModel
+from services.sensors.mount import Mount
+from services.sensors.registry import build_sensor, model_class
 
 LEVEL = (0.0, 0.0, 0.0, 1.0)
 DT_NS = 10_000_000
@@ -47,6 +52,15 @@ def about(axis: str, angle_rad: float) -> tuple[float, float, float, float]:
     return {"x": (s, 0.0, 0.0, c), "y": (0.0, s, 0.0, c), "z": (0.0, 0.0, s, c)}[axis]
 
 
+MOUNT_FIELDS = ("noise", "seed", "name")
+
+
+def make_imu(**kwargs: Any) -> ImuModel:
+    """An IMU with these parameters and mount settings (seed, name, noise)."""
+    mount = {k: kwargs.pop(k) for k in MOUNT_FIELDS if k in kwargs}
+    return ImuModel(ImuParams(**kwargs), Mount(**{"name": "imu", **mount}))
+
+
 def run_imu(model: ImuModel, n: int, st: VesselState | None = None) -> np.ndarray:
     """n samples as rows (gyro xyz, accel xyz), one tick apart."""
     st = st or state()
@@ -67,30 +81,30 @@ def run_imu(model: ImuModel, n: int, st: VesselState | None = None) -> np.ndarra
     ],
 )
 def test_imu_reads_gravity_as_specific_force(orientation, expected) -> None:
-    ideal = ImuModel(noise=False).sample(state(orientation=orientation), tick=0, stamp_ns=0)
+    ideal = make_imu(noise=False).sample(state(orientation=orientation), tick=0, stamp_ns=0)
     assert isinstance(ideal, ImuSample)
     np.testing.assert_allclose(ideal.linear_acceleration, expected, atol=1e-12)
     assert ideal.orientation == orientation
-    noisy = run_imu(ImuModel(seed=3), 2000, state(orientation=orientation))
+    noisy = run_imu(make_imu(seed=3), 2000, state(orientation=orientation))
     np.testing.assert_allclose(noisy[:, 3:].mean(axis=0), expected, atol=0.02)  # bias + noise
     assert np.abs(noisy[:, 3:] - expected).max() < 5 * 0.021 + 0.02
 
 
 def test_imu_lever_arm_and_motion() -> None:
-    imu = ImuModel(noise=False, lever_arm=(1.0, 0.0, 0.0))
+    imu = make_imu(noise=False, lever_arm=(1.0, 0.0, 0.0))
     spinning = state(angular_velocity=(0.0, 0.0, 2.0), angular_acceleration=(0.0, 0.0, 0.5))
     s = imu.sample(spinning, tick=0, stamp_ns=0)
     # centripetal -w^2 r on x, tangential alpha x r on y, gravity on z
     np.testing.assert_allclose(s.linear_acceleration, (-4.0, 0.5, GRAVITY), atol=1e-12)
     np.testing.assert_allclose(s.angular_velocity, (0.0, 0.0, 2.0))
-    surging = ImuModel(noise=False).sample(
+    surging = make_imu(noise=False).sample(
         state(linear_acceleration=(1.5, 0, 0)), tick=0, stamp_ns=0
     )
     np.testing.assert_allclose(surging.linear_acceleration, (1.5, 0.0, GRAVITY), atol=1e-12)
 
 
 def test_imu_white_noise_matches_configured_sigma() -> None:
-    imu = ImuModel(gyro_bias_instability=0.0, accel_bias_instability=0.0, seed=11, name="v/imu")
+    imu = make_imu(gyro_bias_instability=0.0, accel_bias_instability=0.0, seed=11, name="v/imu")
     rows = run_imu(imu, 20000, state(angular_velocity=(0.1, -0.2, 0.3)))
     assert rows[:, :3].std(axis=0) == pytest.approx([0.009] * 3, rel=0.05)
     assert rows[:, 3:].std(axis=0) == pytest.approx([0.021] * 3, rel=0.05)
@@ -99,7 +113,7 @@ def test_imu_white_noise_matches_configured_sigma() -> None:
 
 def test_imu_gauss_markov_bias_has_its_sigma_and_correlation_time() -> None:
     tau, dt = 0.05, DT_NS * 1e-9
-    imu = ImuModel(gyro_sigma=0.0, accel_sigma=0.0, bias_tau_s=tau, seed=5)
+    imu = make_imu(gyro_sigma=0.0, accel_sigma=0.0, bias_tau_s=tau, seed=5)
     rows = run_imu(imu, 20000)
     bias = rows[:, :3]  # the gyro reads its bias only
     assert bias.std(axis=0) == pytest.approx([0.0008] * 3, rel=0.1)
@@ -110,7 +124,7 @@ def test_imu_gauss_markov_bias_has_its_sigma_and_correlation_time() -> None:
 def test_imu_bias_random_walk_grows_as_sqrt_time() -> None:
     finals = []
     for k in range(300):
-        imu = ImuModel(
+        imu = make_imu(
             gyro_sigma=0.0,
             accel_sigma=0.0,
             gyro_bias_instability=0.0,
@@ -125,28 +139,30 @@ def test_imu_bias_random_walk_grows_as_sqrt_time() -> None:
 
 
 def test_imu_is_deterministic_per_seed_and_name() -> None:
-    a = run_imu(ImuModel(seed=1, name="boat/imu"), 50)
-    assert np.array_equal(a, run_imu(ImuModel(seed=1, name="boat/imu"), 50))
-    assert not np.allclose(a, run_imu(ImuModel(seed=1, name="boat/imu2"), 50))
-    assert not np.allclose(a, run_imu(ImuModel(seed=2, name="boat/imu"), 50))
+    a = run_imu(make_imu(seed=1, name="boat/imu"), 50)
+    assert np.array_equal(a, run_imu(make_imu(seed=1, name="boat/imu"), 50))
+    assert not np.allclose(a, run_imu(make_imu(seed=1, name="boat/imu2"), 50))
+    assert not np.allclose(a, run_imu(make_imu(seed=2, name="boat/imu"), 50))
 
 
 def test_imu_refuses_bad_input() -> None:
-    with pytest.raises(SensorError, match=r"gyro_sigma \(rad/s\) must be a finite number >= 0"):
-        ImuModel(gyro_sigma=-1.0)
-    with pytest.raises(SensorError, match="bias_tau_s must be a finite number > 0"):
-        ImuModel(bias_tau_s=0.0)
-    imu = ImuModel()
+    with pytest.raises(ValidationError, match="gyro_sigma"):  # refused with the scenario
+        make_imu(gyro_sigma=-1.0)
+    with pytest.raises(ValidationError, match="bias_tau_s"):
+        make_imu(bias_tau_s=0.0)
+    imu = make_imu()
     imu.sample(state(), tick=1, stamp_ns=20)
     with pytest.raises(SensorError, match="stamp_ns went back from 20 to 10"):
         imu.sample(state(), tick=0, stamp_ns=10)
     with pytest.raises(SensorError, match="zero length"):
-        ImuModel().sample(state(orientation=(0, 0, 0, 0)), tick=0, stamp_ns=0)
+        make_imu().sample(state(orientation=(0, 0, 0, 0)), tick=0, stamp_ns=0)
 
 
 def gps_at(origin=ORIGIN, **kwargs: Any) -> GpsModel:
     lat, lon, alt = origin
-    return GpsModel(origin_lat_deg=lat, origin_lon_deg=lon, origin_alt_m=alt, **kwargs)
+    mount = {k: kwargs.pop(k) for k in MOUNT_FIELDS if k in kwargs}
+    place = Origin.model_construct(latitude_deg=lat, longitude_deg=lon, altitude_m=alt)
+    return GpsModel(GpsParams(**kwargs), Mount(**{"name": "gps", **mount}, origin=place))
 
 
 def fix_position(fix: GpsFix) -> tuple[float, float, float]:
@@ -199,29 +215,34 @@ def test_gps_paper_table_method_and_errors() -> None:
     assert paper.latitude == pytest.approx(exact.latitude, abs=0.2 / 111_000)
     assert paper.longitude == pytest.approx(exact.longitude, abs=0.2 / 80_000)
     assert paper.altitude == pytest.approx(exact.altitude, abs=0.1)
-    with pytest.raises(SensorError, match=r"GPS method must be one of \('wgs84', 'paper_table'\)"):
-        GpsModel(method="utm")  # type: ignore[arg-type]
+    with pytest.raises(ValidationError, match="method"):  # refused with the scenario
+        gps_at(method="utm")
     with pytest.raises(SensorError, match=r"origin: latitude \(deg\) must be within \[-90, 90\]"):
-        GpsModel(origin_lat_deg=95.0)
+        gps_at((95.0, 0.0, 0.0))
 
 
 def test_registry_builds_seeded_sensors() -> None:
-    from catabot.config.sensors import SENSOR_TYPES as SCENARIO_TYPES
-
-    assert set(SENSOR_TYPES) == set(SCENARIO_TYPES)  # every scenario type has a model
-    origin = Origin(latitude_deg=ORIGIN[0], longitude_deg=ORIGIN[1], altitude_m=ORIGIN[2])
-    imu_cfg = SensorConfig(name="imu", type="imu", rate_hz=100.0)
-    build = lambda cfg, vid: build_sensor(cfg, vessel_id=vid, seed=9, origin=origin, dt_ns=DT_NS)  # noqa: E731
-    a, b, c = build(imu_cfg, "boat1"), build(imu_cfg, "boat1"), build(imu_cfg, "boat2")
+    for name, spec in SENSOR_TYPES.items():  # every registered type has its model
+        assert model_class(name).message is spec.message
+    imu_cfg = {"name": "imu", "type": "imu", "rate_hz": 100.0}
+    gps_cfg = {"name": "gps", "type": "gps", "rate_hz": 10.0, "noise": False}
+    origin = dict(zip(("latitude_deg", "longitude_deg", "altitude_m"), ORIGIN, strict=True))
+    vessels = [
+        {"id": "boat1", "sensors": [imu_cfg, gps_cfg]},
+        {"id": "boat2", "sensors": [imu_cfg]},
+    ]
+    scenario = {"seed": 9, "origin": origin, "vessels": vessels}
+    world = World.resolve(parse_scenario(scenario))
+    a, gps, c = (build_sensor(s, world) for s in world.sensors)
+    b = build_sensor(world.sensors[0], world)
     assert a.message is ImuSample
     sa, sb, sc = (s.sample(state(), tick=0, stamp_ns=0) for s in (a, b, c))
-    assert sa == sb and sa != sc
-    gps = build(SensorConfig(name="gps", type="gps", rate_hz=10.0, noise=False), "boat1")
+    assert sa == sb and sa != sc  # seeded by the scenario seed and "<vessel>/<sensor>"
     fix = gps.sample(state(), tick=0, stamp_ns=0)
     assert gps.message is GpsFix and isinstance(fix, GpsFix)
     assert fix_position(fix) == pytest.approx(ORIGIN, abs=1e-9)
-    with pytest.raises(SensorError, match="is not a whole number of 10000000 ns ticks"):
-        build(SensorConfig(name="imu", type="imu", rate_hz=30.0), "boat1")
+    with pytest.raises(SensorError, match="unknown sensor type 'sonar'"):
+        model_class("sonar")
 
 
 def test_cross3_gives_the_bits_of_np_cross() -> None:

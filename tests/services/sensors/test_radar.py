@@ -8,13 +8,14 @@ import numpy as np
 import pytest
 from pydantic import ValidationError
 
-from catabot.bus.messages import RadarSweep, VesselState
+from catabot.bus.messages import CLASS_VESSEL, RadarSweep, VesselState
 from catabot.config.sensors import RadarParams
 from catabot.config.waves import WaveConfig
 from catabot.world.waves import WaveField
 from services.recorder.ppi import Ppi
+from services.sensors.mount import Mount
 from services.sensors.radar import RadarModel
-from services.sensors.scene import CLASS_VESSEL, Body, Scene
+from services.sensors.scene import Body, Scene
 
 BOAT = ((-2.0, -1.0, -0.2), (2.0, 1.0, 1.0))
 WALL = ((-2.0, -60.0, -1.0), (2.0, 60.0, 5.0))
@@ -63,7 +64,7 @@ def test_sees_a_boat_at_200_m_at_its_bearing_and_range(
 ) -> None:
     b = math.radians(bearing_deg)
     scene = scene_with(200 * math.cos(b), 200 * math.sin(b), b)  # bow toward us: face at 198 m
-    radar = RadarModel(RadarParams(), scene=scene, period_ns=5 * DT, seed=1, name="v/radar")
+    radar = RadarModel(RadarParams(), Mount(scene=scene, period_ns=5 * DT, seed=1, name="v/radar"))
     bearing, rng = returns(turn(radar, own(math.radians(heading_deg))), radar.step_rad)
     assert bearing.size > 0
     width = math.radians(RadarParams().beam_width_deg)
@@ -78,11 +79,13 @@ def test_range_noise_sigma() -> None:
     for noise in (True, False):
         radar = RadarModel(
             params,
-            scene=scene_with(100.0, 0.0, 0.0, WALL),
-            period_ns=10 * DT,
-            noise=noise,
-            seed=2,
-            name="v/r",
+            Mount(
+                scene=scene_with(100.0, 0.0, 0.0, WALL),
+                period_ns=10 * DT,
+                noise=noise,
+                seed=2,
+                name="v/r",
+            ),
         )
         errors.append(returns(turn(radar, own(), turns=6), radar.step_rad)[1])
     diff = errors[0].astype(np.float64) - errors[1]
@@ -95,10 +98,9 @@ def test_rain_does_not_change_the_returns() -> None:
     for rain in (0.0, 50.0):
         radar = RadarModel(
             RadarParams(),
-            scene=scene_with(150.0, 20.0, 0.3, rain=rain),
-            period_ns=5 * DT,
-            seed=4,
-            name="v/r",
+            Mount(
+                scene=scene_with(150.0, 20.0, 0.3, rain=rain), period_ns=5 * DT, seed=4, name="v/r"
+            ),
         )
         sweeps.append(turn(radar, own(), 0.5))
     for a, b in zip(*sweeps, strict=True):
@@ -112,7 +114,7 @@ def test_rain_does_not_change_the_returns() -> None:
 
 def test_water_is_not_a_return_and_sweeps_tile_the_turn() -> None:
     radar = RadarModel(
-        RadarParams(), scene=scene_with(5000.0, 0.0, 0.0), period_ns=DT, seed=1, name="v/r"
+        RadarParams(), Mount(scene=scene_with(5000.0, 0.0, 0.0), period_ns=DT, seed=1, name="v/r")
     )
     sweeps = turn(radar, own())
     assert sum(s.beams for s in sweeps) == radar.beams_per_turn
@@ -121,7 +123,7 @@ def test_water_is_not_a_return_and_sweeps_tile_the_turn() -> None:
 
 def test_ppi_paints_north_up_and_fades() -> None:
     scene = scene_with(0.0, 150.0, math.pi / 2)  # due north
-    radar = RadarModel(RadarParams(), scene=scene, period_ns=5 * DT, seed=1, name="v/r")
+    radar = RadarModel(RadarParams(), Mount(scene=scene, period_ns=5 * DT, seed=1, name="v/r"))
     p = RadarParams()
     ppi = Ppi(
         size_px=p.ppi_size_px, range_m=p.range_m, fade_s=p.fade_s, beam_step_rad=radar.step_rad

@@ -7,22 +7,22 @@ import math
 import numpy as np
 import pytest
 
-from catabot.bus.messages import LidarScan, VesselState
-from catabot.config.sensors import LidarParams
-from catabot.config.waves import WaveConfig
-from catabot.world.terrain import Terrain
-from catabot.world.waves import WaveField
-from services.sensors.lidar import LidarModel, beam_directions
-from services.sensors.scene import (
+from catabot.bus.messages import (
     CLASS_BUOY,
     CLASS_NONE,
     CLASS_TERRAIN,
     CLASS_VESSEL,
     CLASS_WATER,
-    Body,
-    Scene,
-    SceneError,
+    LidarScan,
+    VesselState,
 )
+from catabot.config.sensors import LidarParams
+from catabot.config.waves import WaveConfig
+from catabot.world.terrain import Terrain
+from catabot.world.waves import WaveField
+from services.sensors.lidar import LidarModel, beam_directions
+from services.sensors.mount import Mount
+from services.sensors.scene import Body, Scene, SceneError
 
 CALM = WaveField(WaveConfig(), 0)
 EGO = Body("ego", CLASS_VESSEL, 1, (-1.0, -0.5, -0.1), (1.0, 0.5, 0.2))
@@ -48,7 +48,7 @@ def _scene(waves: WaveField = CALM, rain: float = 0.0, **poses: tuple[float, ...
 
 def test_lidar_hits_a_posed_box_at_the_known_range() -> None:
     scene = _scene(ego=(0, 0, 0), boat=(20.0, 0.0, 0.0), buoy=(0.0, -10.0, 0.0))
-    scan = LidarModel(LEVEL, scene=scene, noise=False).sample(_state(), tick=3, stamp_ns=7)
+    scan = LidarModel(LEVEL, Mount(scene=scene, noise=False)).sample(_state(), tick=3, stamp_ns=7)
     assert isinstance(scan, LidarScan) and (scan.tick, scan.stamp_ns) == (3, 7)
     level = scan.range_image[1]  # channel 1 is level; column j looks at j degrees
     assert level[0] == pytest.approx(18.0, abs=0.01)  # the boat's stern face at x = 18
@@ -66,9 +66,11 @@ def test_lidar_hits_a_posed_box_at_the_known_range() -> None:
 
 def test_a_turned_box_and_a_moving_sensor() -> None:
     scene = _scene(ego=(5, 5, 0), boat=(25.0, 5.0, math.pi / 2))  # beam-on: 1 m half-width
-    scan = LidarModel(LEVEL, scene=scene, noise=False).sample(_state(5, 5), tick=0, stamp_ns=0)
+    scan = LidarModel(LEVEL, Mount(scene=scene, noise=False)).sample(
+        _state(5, 5), tick=0, stamp_ns=0
+    )
     assert scan.range_image[1, 0] == pytest.approx(19.0, abs=0.01)
-    turned = LidarModel(LEVEL, scene=scene, noise=False).sample(
+    turned = LidarModel(LEVEL, Mount(scene=scene, noise=False)).sample(
         _state(5, 5, math.pi / 2), tick=0, stamp_ns=0
     )
     assert turned.range_image[1, 270] == pytest.approx(19.0, abs=0.01)  # boat now to the right
@@ -117,7 +119,7 @@ def test_nothing_in_range_is_none_and_culling_keeps_far_bodies_out() -> None:
 def test_scans_are_deterministic_and_rain_is_labelled() -> None:
     scene = _scene(rain=50.0, ego=(0, 0, 0), boat=(30.0, 0.0, 0.0))
     params = LidarParams(mount_xyz=(0.0, 0.0, 1.0))
-    a, b, c = (LidarModel(params, scene=scene, seed=s, name="ego/lidar") for s in (1, 1, 2))
+    a, b, c = (LidarModel(params, Mount(scene=scene, seed=s, name="ego/lidar")) for s in (1, 1, 2))
     sa, sb, sc = (m.sample(_state(), tick=0, stamp_ns=0) for m in (a, b, c))
     for name in ("points", "intensity", "ring", "cls", "instance", "is_rain", "range_image"):
         assert np.array_equal(getattr(sa, name), getattr(sb, name))
@@ -137,7 +139,7 @@ def test_pose_arrays_from_a_batch_equal_the_named_poses() -> None:
     named.update({b: (pos[i], quat[i]) for i, b in enumerate(ids)}, 2.0)
     arrays.update_arrays(ids, pos, quat, 2.0)
     scans = [
-        LidarModel(LEVEL, scene=s, noise=False).sample(_state(), tick=0, stamp_ns=0)
+        LidarModel(LEVEL, Mount(scene=s, noise=False)).sample(_state(), tick=0, stamp_ns=0)
         for s in (named, arrays)
     ]
     assert np.array_equal(scans[0].range_image, scans[1].range_image)

@@ -12,7 +12,8 @@ from catabot.config.traffic import TrafficConfig
 from catabot.config.vessel import load_vessel_model
 from catabot.world.placement import footprint_m
 from catabot.world.terrain import Terrain
-from catabot.world.traffic_plan import Boat, Planner, plan_traffic
+from catabot.world.traffic_plan import Boat, Planner
+from catabot.world.world import World
 from services.physics.control import TwistControllerBank
 from services.physics.world import PhysicsWorld
 from services.traffic.behaviours import Behaviours
@@ -119,16 +120,16 @@ def _scenario(count: int, **traffic: object) -> dict[str, object]:
 
 
 def test_same_seed_same_plan_and_another_seed_another() -> None:
-    a = plan_traffic(parse_scenario(_scenario(60)))
-    b = plan_traffic(parse_scenario(_scenario(60)))
-    c = plan_traffic(parse_scenario(_scenario(60, seed=8)))
+    a = World.resolve(parse_scenario(_scenario(60))).traffic
+    b = World.resolve(parse_scenario(_scenario(60))).traffic
+    c = World.resolve(parse_scenario(_scenario(60, seed=8))).traffic
     assert a == b and a != c
     assert [x.id for x in a.boats[:3]] == ["boat_000", "boat_001", "boat_002"]
     assert len(a.buoys) == 5 * sum(x.behaviour == "waypoints" for x in a.boats)
 
 
 def test_no_boat_overlaps_another_or_the_ego() -> None:
-    plan = plan_traffic(parse_scenario(_scenario(200, region={"size_m": [300.0, 300.0]})))
+    plan = World.resolve(parse_scenario(_scenario(200, region={"size_m": [300.0, 300.0]}))).traffic
     xy = np.array([(0.0, 0.0)] + [(b.pose.x_m, b.pose.y_m) for b in plan.boats])
     r = footprint_m(load_vessel_model("monohull"))
     d = np.hypot(*(xy[:, None] - xy[None]).transpose(2, 0, 1)) + np.eye(len(xy)) * 1e9

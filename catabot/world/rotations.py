@@ -1,0 +1,94 @@
+"""Rotations, one module: quaternions (x, y, z, w, DESIGN.md §2), matrices, yaw, rotation
+vectors. Physics, sensors and traffic all turn frames with these, so one convention holds.
+
+Matrices are body-to-map (`v_map = R @ v_body`). The single-quaternion form uses Python
+floats (a few microseconds where NumPy's overhead would be tens); the batch forms are the
+same operations in the same order, so both give the same bits.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Sequence
+
+import numpy as np
+from numpy.typing import NDArray
+
+Array = NDArray[np.float64]
+
+
+def matrices(q: Array) -> Array:
+    """(N, 3, 3) rotations of unit quaternions (N, 4), not normalised again (physics' own)."""
+    x, y, z, w = q[:, 0], q[:, 1], q[:, 2], q[:, 3]
+    return _stack(x, y, z, w)
+
+
+def normalised_matrices(q: Array) -> Array | None:
+    """(N, 3, 3) rotations of quaternions normalised first (states rounded in transit still
+    give proper rotations), or None if any is non-finite or of zero length."""
+    x, y, z, w = np.asarray(q, dtype=np.float64).T
+    norm = np.sqrt(x * x + y * y + z * z + w * w)
+    if not (np.isfinite(norm).all() and (norm >= 1e-9).all()):
+        return None
+    return _stack(x / norm, y / norm, z / norm, w / norm)
+
+
+def _stack(x: Array, y: Array, z: Array, w: Array) -> Array:
+    rows = [
+        [1 - 2 * (y * y + z * z), 2 * (x * y - z * w), 2 * (x * z + y * w)],
+        [2 * (x * y + z * w), 1 - 2 * (x * x + z * z), 2 * (y * z - x * w)],
+        [2 * (x * z - y * w), 2 * (y * z + x * w), 1 - 2 * (x * x + y * y)],
+    ]
+    return np.stack([np.stack(r, axis=-1) for r in rows], axis=-2)
+
+
+def matrix(q: Sequence[float] | Array) -> Array | None:
+    """The rotation of one quaternion, normalised first; None if non-finite or zero."""
+    x, y, z, w = (float(v) for v in q)
+    norm = math.sqrt(x * x + y * y + z * z + w * w)
+    if not (math.isfinite(norm) and norm >= 1e-9):
+        return None
+    x, y, z, w = x / norm, y / norm, z / norm, w / norm
+    return np.array(
+        [
+            [1 - 2 * (y * y + z * z), 2 * (x * y - z * w), 2 * (x * z + y * w)],
+            [2 * (x * y + z * w), 1 - 2 * (x * x + z * z), 2 * (y * z - x * w)],
+            [2 * (x * z - y * w), 2 * (y * z + x * w), 1 - 2 * (x * x + y * y)],
+        ]
+    )
+
+
+def from_rotvec(rv: Array) -> Array:
+    """Unit quaternions (N, 4) of rotation vectors (N, 3), stable near zero angle."""
+    theta = np.linalg.norm(rv, axis=1)
+    small = theta < 1e-6
+    safe = np.where(small, 1.0, theta)
+    scale = np.where(small, 0.5 - theta * theta / 48.0, np.sin(0.5 * safe) / safe)
+    return np.concatenate([rv * scale[:, None], np.cos(0.5 * theta)[:, None]], axis=1)
+
+
+def from_yaw(yaw_rad: float) -> tuple[float, float, float, float]:
+    """The quaternion of a heading (a turn about z)."""
+    half = yaw_rad / 2
+    return (0.0, 0.0, math.sin(half), math.cos(half))
+
+
+def yaw_of_quaternions(q: Array) -> Array:
+    """ENU headings (rad, counter-clockwise from east) of quaternions (N, 4)."""
+    x, y, z, w = q.T
+    return np.arctan2(2 * (w * z + x * y), 1 - 2 * (y * y + z * z))
+
+
+def yaw_of_matrix(rot: Array) -> float:
+    """ENU heading of a body-to-map rotation matrix."""
+    return math.atan2(float(rot[1, 0]), float(rot[0, 0]))
+
+
+def rpy(roll_deg: float, pitch_deg: float, yaw_deg: float) -> Array:
+    """Rz(yaw) @ Ry(pitch) @ Rx(roll) of angles in degrees (a mount's turn in its body)."""
+    r, p, y = (math.radians(a) for a in (roll_deg, pitch_deg, yaw_deg))
+    cr, sr, cp, sp, cy, sy = (f(a) for a in (r, p, y) for f in (math.cos, math.sin))
+    rz = np.array([[cy, -sy, 0.0], [sy, cy, 0.0], [0.0, 0.0, 1.0]])
+    ry = np.array([[cp, 0.0, sp], [0.0, 1.0, 0.0], [-sp, 0.0, cp]])
+    rx = np.array([[1.0, 0.0, 0.0], [0.0, cr, -sr], [0.0, sr, cr]])
+    return rz @ ry @ rx

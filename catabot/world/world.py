@@ -1,0 +1,205 @@
+"""The resolved world of a run: every body, sensor, stream and participant, derived once.
+
+A scenario says what the user asked for; the `World` is what that means, resolved once per
+process (and once in the launcher, which refuses what cannot run before anything starts):
+start poses placed, the terrain loaded, the traffic planned, vessel models loaded, a row of
+`BodyStates` for every body, each sensor's period in ticks, the stream table. Services
+receive it built (dm_control's shape: an environment receives built objects) and never
+re-derive any of it, so a new kind of body is one change here, not one per service.
+
+Rows: every scenario vessel, then every traffic boat, then every buoy (the scenario's, then
+the traffic plan's waypoint buoys). A body's label instance is its row + 1 (0: no body).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from functools import cached_property
+from typing import Any, Literal
+
+import numpy as np
+
+from catabot.bus.clock import period_in_ticks
+from catabot.bus.keys import Keys
+from catabot.bus.messages import CLASS_BUOY, CLASS_VESSEL, BodyStates, check_ids
+from catabot.config.scenario import (
+    Pose,
+    Scenario,
+    ScenarioError,
+    ScriptStep,
+    SensorConfig,
+    participants,
+    services,
+)
+from catabot.config.vessel import VesselModel, load_vessel_model
+from catabot.world.placement import resolve_poses
+from catabot.world.streams import Streams
+from catabot.world.terrain import Terrain, load_terrain
+from catabot.world.traffic_plan import TrafficPlan, plan_traffic
+
+BodyKind = Literal["vessel", "boat", "buoy"]
+BUOY_MODEL = "buoy"
+
+
+@dataclass(frozen=True)
+class Body:
+    """One rigid body of the run: a scenario vessel, a traffic boat or a buoy."""
+
+    id: str
+    kind: BodyKind
+    model_ref: str  # the bundled name or path it was loaded from
+    model: VesselModel
+    pose: Pose  # where it starts, at rest on the calm surface
+    row: int  # its row in every `BodyStates`
+    script: tuple[ScriptStep, ...] = ()
+
+    @property
+    def instance(self) -> int:
+        """Its instance id in LiDAR points, camera masks and boxes."""
+        return self.row + 1
+
+    @property
+    def label_class(self) -> int:
+        return CLASS_BUOY if self.kind == "buoy" else CLASS_VESSEL
+
+
+@dataclass(frozen=True)
+class MountedSensor:
+    """One sensor on one scenario vessel: its configuration, key and period in ticks."""
+
+    vessel: str
+    config: SensorConfig
+    key: str
+    period: int
+
+    @property
+    def seed_name(self) -> str:
+        """The name its randomness is seeded with (catabot.world.seeding)."""
+        return f"{self.vessel}/{self.config.name}"
+
+    @property
+    def params(self) -> Any:
+        """The parameters as the type's own model, every default filled in."""
+        return self.config.typed_params()
+
+
+@dataclass(frozen=True)
+class World:
+    scenario: Scenario  # with every start pose resolved
+    terrain: Terrain | None
+    bodies: tuple[Body, ...]
+    traffic: TrafficPlan
+    sensors: tuple[MountedSensor, ...]
+
+    @classmethod
+    def resolve(cls, scenario: Scenario) -> World:
+        """Everything a run needs from its scenario; ScenarioError names what cannot run."""
+        terrain = _terrain(scenario)
+        scenario = resolve_poses(scenario, terrain)
+        plan = plan_traffic(scenario, terrain)
+        bodies = _bodies(scenario, plan)
+        keys = Keys(scenario.name)
+        sensors = tuple(
+            MountedSensor(v.id, s, keys.sensor(v.id, s.name), _period(scenario, v.id, s))
+            for v in scenario.vessels
+            for s in v.sensors
+        )
+        return cls(scenario, terrain, bodies, plan, sensors)
+
+    @cached_property
+    def keys(self) -> Keys:
+        return Keys(self.scenario.name)
+
+    @cached_property
+    def vessels(self) -> tuple[Body, ...]:
+        """Scenario vessels, then traffic boats: every body that has thrusters and commands."""
+        return tuple(b for b in self.bodies if b.kind != "buoy")
+
+    @cached_property
+    def buoys(self) -> tuple[Body, ...]:
+        return tuple(b for b in self.bodies if b.kind == "buoy")
+
+    @cached_property
+    def body_ids(self) -> tuple[str, ...]:
+        """The rows of every `BodyStates`, in order."""
+        return tuple(b.id for b in self.bodies)
+
+    @cached_property
+    def boat_ids(self) -> tuple[str, ...]:
+        """The traffic boats, in `TwistBatch` order."""
+        return tuple(b.id for b in self.bodies if b.kind == "boat")
+
+    @cached_property
+    def streams(self) -> Streams:
+        return Streams.of(self)
+
+    @property
+    def participants(self) -> list[str]:
+        return participants(self.scenario)
+
+    @property
+    def services(self) -> list[str]:
+        return services(self.scenario)
+
+    def body(self, body_id: str) -> Body:
+        return self._by_id[body_id]
+
+    @cached_property
+    def _by_id(self) -> dict[str, Body]:
+        return {b.id: b for b in self.bodies}
+
+    def check_rows(self, batch: BodyStates) -> None:
+        """Refuse a `BodyStates` whose rows are not this world's bodies, in order."""
+        check_ids("world/states", batch.tick, batch.ids, self.body_ids)
+
+    def start_states(self) -> BodyStates:
+        """Every body at rest at its start pose (tick -1, t = 0): what physics starts from."""
+        n = len(self.bodies)
+        position = np.array([(b.pose.x_m, b.pose.y_m, 0.0) for b in self.bodies]).reshape(n, 3)
+        halves = [b.pose.yaw_rad / 2 for b in self.bodies]
+        quat = np.array([(0.0, 0.0, math.sin(h), math.cos(h)) for h in halves]).reshape(n, 4)
+        zero = np.zeros((n, 3))
+        return BodyStates(-1, 0, self.body_ids, position, quat, zero, zero, zero, zero)
+
+
+def _terrain(scenario: Scenario) -> Terrain | None:
+    return load_terrain(scenario.terrain) if scenario.terrain is not None else None
+
+
+def _bodies(scenario: Scenario, plan: TrafficPlan) -> tuple[Body, ...]:
+    """Every body in row order; two bodies with one id are refused (they share keys)."""
+    models: dict[str, VesselModel] = {}
+
+    def model(ref: str) -> VesselModel:
+        if ref not in models:
+            models[ref] = load_vessel_model(ref)
+        return models[ref]
+
+    rows: list[tuple[str, BodyKind, str, Pose, tuple[ScriptStep, ...]]] = []
+    for v in scenario.vessels:
+        assert v.pose is not None, "resolve_poses placed every vessel"
+        rows.append((v.id, "vessel", v.model, v.pose, tuple(v.script)))
+    rows += [(b.id, "boat", b.model, b.pose, ()) for b in plan.boats]
+    buoys = [*scenario.buoys, *plan.buoys]
+    rows += [(b.id, "buoy", BUOY_MODEL, Pose(x_m=b.x_m, y_m=b.y_m), ()) for b in buoys]
+    _unique([r[0] for r in rows])
+    return tuple(
+        Body(bid, kind, ref, model(ref), pose, row, script)
+        for row, (bid, kind, ref, pose, script) in enumerate(rows)
+    )
+
+
+def _unique(ids: list[str]) -> None:
+    seen: set[str] = set()
+    for bid in ids:
+        if bid in seen:
+            raise ScenarioError(
+                f"body id {bid!r} is used twice (vessels, traffic boats 'boat_NNN' and buoys "
+                "share one namespace: each id names its own keys)"
+            )
+        seen.add(bid)
+
+
+def _period(scenario: Scenario, vessel: str, sensor: SensorConfig) -> int:
+    return period_in_ticks(sensor.period_ns, scenario.dt_ns, what=f"{vessel}/{sensor.name}")

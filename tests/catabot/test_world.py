@@ -1,0 +1,110 @@
+"""The resolved world: bodies and rows, sensors, streams, participants, refusals."""
+
+from __future__ import annotations
+
+from typing import Any
+
+import numpy as np
+import pytest
+
+from catabot.bus.keys import Keys
+from catabot.bus.messages import BodyStates, GpsFix, ImuSample
+from catabot.config.scenario import ScenarioError, parse_scenario
+from catabot.world.world import World
+
+KEYS = Keys("w")
+
+
+def _world(**changes: object) -> World:
+    data = {
+        "name": "w",
+        "vessels": [
+            {
+                "id": "ego",
+                "sensors": [
+                    {"name": "imu", "type": "imu", "rate_hz": 100.0},
+                    {"name": "gps", "type": "gps", "rate_hz": 10.0},
+                ],
+            },
+            {"id": "buoy"},
+        ],
+    }
+    data.update(changes)
+    return World.resolve(parse_scenario(data))
+
+
+def test_participants() -> None:
+    assert _world().participants[:3] == ["physics", "sensors", "recorder"]
+    assert "sensors" not in _world(vessels=[{"id": "a"}]).participants
+    no_recording = _world(recording={"csv": False, "mcap": False})
+    assert "recorder" not in no_recording.participants
+    assert no_recording.participants[:2] == ["physics", "sensors"]
+
+
+def test_lockstep_streams() -> None:
+    streams = _world().streams.lockstep()
+    table = {s.key: (s.message, s.producer, s.period) for s in streams}
+    assert table == {
+        KEYS.world_states(): (BodyStates, "physics", 1),
+        KEYS.sensor("ego", "imu"): (ImuSample, "sensors", 1),
+        KEYS.sensor("ego", "gps"): (GpsFix, "sensors", 10),
+    }
+    assert len(streams) == len(table)
+
+
+def test_per_vessel_states_are_for_observers_only() -> None:
+    """Lockstep consumers wait for the one batch; per-vessel states stay off the table."""
+    world = _world()  # two vessels ("buoy" is a vessel's id here), no moored buoys
+    assert KEYS.world_states() == "catabot/w/world/states"
+    states = [s.key for s in world.streams.vessel_states]
+    assert states == [KEYS.vessel_state("ego"), KEYS.vessel_state("buoy")]
+    assert world.body_ids == ("ego", "buoy")
+    lockstep = {s.key for s in world.streams.lockstep()}
+    assert not lockstep & {KEYS.vessel_state("ego"), KEYS.vessel_state("buoy")}
+
+
+def test_check_rows_refuses_a_changed_row_order() -> None:
+    def batch(ids: tuple[str, ...]) -> BodyStates:
+        z3, z4 = np.zeros((len(ids), 3)), np.zeros((len(ids), 4))
+        return BodyStates(0, 0, ids, z3, z4, z3, z3, z3, z3)
+
+    world = _world()
+    world.check_rows(batch(("ego", "buoy")))
+    with pytest.raises(ValueError, match="expected"):
+        world.check_rows(batch(("buoy", "ego")))
+
+
+def test_rows_are_vessels_then_boats_then_buoys() -> None:
+    world = _world(
+        vessels=[{"id": "ego"}],
+        buoys=[{"id": "mark", "x_m": 40.0, "y_m": 0.0}],
+        traffic={"count": 3, "behaviour_mix": {"waypoints": 1.0}},
+    )
+    kinds = [b.kind for b in world.bodies]
+    assert kinds[:4] == ["vessel", "boat", "boat", "boat"] and set(kinds[4:]) == {"buoy"}
+    assert world.body_ids[4] == "mark"  # the scenario's buoys before the plan's
+    assert [b.row for b in world.bodies] == list(range(len(world.bodies)))
+    assert world.boat_ids == ("boat_000", "boat_001", "boat_002")
+    assert [b.instance for b in world.bodies] == [b.row + 1 for b in world.bodies]
+    assert world.streams.twist_batch is not None
+
+
+def test_start_states_are_the_start_poses_at_rest() -> None:
+    world = _world(vessels=[{"id": "ego", "pose": {"x_m": 3.0, "y_m": -2.0, "yaw_rad": 1.0}}])
+    start = world.start_states()
+    assert start.tick == -1 and start.ids == ("ego",)
+    assert start.position.tolist() == [[3.0, -2.0, 0.0]]
+    assert start.orientation[0, 2:] == pytest.approx([np.sin(0.5), np.cos(0.5)])
+    assert not start.linear_velocity.any()
+
+
+@pytest.mark.parametrize(
+    ("changes", "message"),
+    [
+        ({"buoys": [{"id": "ego", "x_m": 30.0, "y_m": 0.0}]}, "body id 'ego' is used twice"),
+        ({"vessels": [{"id": "boat_000"}], "traffic": {"count": 1}}, "'boat_000' is used twice"),
+    ],
+)
+def test_two_bodies_with_one_id_are_refused(changes: dict[str, Any], message: str) -> None:
+    with pytest.raises(ScenarioError, match=message):
+        _world(**changes)
