@@ -24,7 +24,7 @@ import tempfile
 from pathlib import Path
 from typing import Any
 
-from catabot.config.scenario import parse_scenario
+from catabot.config.load import parse_scenario
 from catabot.config.sensors import SENSOR_TYPES
 from catabot.world.world import World
 

@@ -9,8 +9,10 @@ import zenoh
 from catabot.bus.session import add_connection_args, connection_from_args, open_session
 
 
-def parser(description: str) -> argparse.ArgumentParser:
-    p = argparse.ArgumentParser(description=description)
+def parser(description: str | None) -> argparse.ArgumentParser:
+    p = argparse.ArgumentParser(
+        description=description, formatter_class=argparse.RawDescriptionHelpFormatter
+    )
     add_connection_args(p)
     p.add_argument("--world", default="default", help="scenario name (key prefix catabot/<world>)")
     p.add_argument("--vessel", default="ego", help="vessel id")

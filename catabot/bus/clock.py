@@ -19,6 +19,7 @@ from catabot.bus.messages import Message
 from catabot.errors import CataBotError
 
 NS_PER_S = 1_000_000_000
+CONDUCTOR = "conductor"  # the participant name of the clock's owner
 
 
 class ClockError(CataBotError, RuntimeError):

@@ -11,12 +11,12 @@ from __future__ import annotations
 
 import dataclasses
 import math
-import typing
 from typing import Any, TypeVar
 
 import msgpack
 import numpy as np
 
+from catabot.bus.fields import fields_of
 from catabot.bus.messages import MESSAGE_TYPES, SCHEMA_VERSION, Message
 from catabot.errors import CataBotError
 
@@ -132,21 +132,7 @@ def _field_specs(cls: type[Message]) -> dict[str, tuple[str, int | None, bool]]:
 
 
 def _build_specs(cls: type[Message]) -> dict[str, tuple[str, int | None, bool]]:
-    hints = typing.get_type_hints(cls)
-    specs: dict[str, tuple[str, int | None, bool]] = {}
-    for f in dataclasses.fields(cls):
-        hint = hints[f.name]
-        required = f.default is dataclasses.MISSING and f.default_factory is dataclasses.MISSING
-        axes = f.metadata.get("axes")
-        if hint is np.ndarray:
-            specs[f.name] = ("array", None, required)
-        elif typing.get_origin(hint) is tuple and typing.get_args(hint)[0] is str:
-            specs[f.name] = ("names", None, required)
-        elif typing.get_origin(hint) is tuple:
-            specs[f.name] = ("vector", len(axes) if axes else None, required)
-        else:
-            specs[f.name] = (hint.__name__, None, required)
-    return specs
+    return {f.name: (f.kind, f.length, f.required) for f in fields_of(cls)}
 
 
 def _check(type_name: str, name: str, kind: str, length: int | None, value: Any) -> Any:

@@ -18,13 +18,12 @@ from dataclasses import dataclass, field
 import zenoh
 
 from catabot.bus import codec
-from catabot.bus.clock import ClockError, Policy
+from catabot.bus.clock import CONDUCTOR, ClockError, Policy
 from catabot.bus.keys import Keys
 from catabot.bus.messages import Ack, End, Tick
+from catabot.bus.session import BLOCK
 
 log = logging.getLogger("catabot.bus.conductor")
-CONDUCTOR = "conductor"
-BLOCK = zenoh.CongestionControl.BLOCK
 
 
 @dataclass(frozen=True)

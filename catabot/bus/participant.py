@@ -19,11 +19,11 @@ from typing import Any
 import zenoh
 
 from catabot.bus import codec
-from catabot.bus.clock import ClockError, Stream
-from catabot.bus.conductor import BLOCK, CONDUCTOR
+from catabot.bus.clock import CONDUCTOR, ClockError, Stream
 from catabot.bus.inbox import Inbox, Inputs
 from catabot.bus.keys import Keys
 from catabot.bus.messages import Ack, End, Message, Tick
+from catabot.bus.session import BLOCK
 
 log = logging.getLogger("catabot.bus.participant")
 ORPHAN_GRACE_S = 0.5

@@ -19,6 +19,7 @@ import zenoh
 from catabot.errors import CataBotError
 
 MODES = ("peer", "client", "router")
+BLOCK = zenoh.CongestionControl.BLOCK  # lockstep data and clock messages are never dropped
 
 
 class SessionError(CataBotError, RuntimeError):

@@ -8,15 +8,25 @@ errors into one line per problem naming the dotted field, the rule and the value
 
 from __future__ import annotations
 
-from typing import Any
+from typing import Annotated, Any
 
-from pydantic import BaseModel, ConfigDict, ValidationError
+from pydantic import BaseModel, ConfigDict, Field, StrictInt, ValidationError
 
 from catabot.errors import CataBotError
+
+Seed = Annotated[
+    StrictInt,
+    Field(ge=0, lt=2**63, description="an integer in [0, 2**63): seeds every random source"),
+]
+"""A seed (catabot.world.seeding): JSON integers only (3.0, "3" or true are refused)."""
 
 
 class ConfigError(CataBotError, ValueError):
     """A configuration (scenario, model file, section) that cannot be used; names the field."""
+
+
+class ScenarioError(ConfigError):
+    """A scenario that cannot run; the message names the file, field and allowed values."""
 
 
 class Strict(BaseModel):
@@ -36,6 +46,22 @@ _BOUNDS = {
     "greater_than_equal": ">=",
     "less_than": "<",
     "less_than_equal": "<=",
+}
+
+
+_TYPES = {
+    "int_type": "an integer",
+    "int_parsing": "an integer",
+    "int_from_float": "an integer",
+    "float_type": "a number",
+    "float_parsing": "a number",
+    "bool_type": "true or false",
+    "bool_parsing": "true or false",
+    "string_type": "a string",
+    "list_type": "a list",
+    "dict_type": "an object",
+    "model_type": "an object",
+    "tuple_type": "a list",
 }
 
 
@@ -61,7 +87,10 @@ def describe(err: Any, *, model: type[BaseModel], where: str = "") -> str:
         return f"{path}: must be one of {ctx.get('expected')}{shown}"
     if kind in _BOUNDS:
         bound = next(v for k, v in ctx.items() if k in ("gt", "ge", "lt", "le"))
-        return f"{path}: must be {_BOUNDS[kind]} {bound:g}{shown}"
+        limit = str(bound) if isinstance(bound, int) else f"{bound:g}"
+        return f"{path}: must be {_BOUNDS[kind]} {limit}{shown}"
+    if kind in _TYPES:
+        return f"{path}: must be {_TYPES[kind]}{shown}"
     if kind == "finite_number":
         return f"{path}: must be a finite number{shown}"
     return f"{path}: {str(err['msg']).removeprefix('Value error, ')}{shown}"

@@ -1,21 +1,15 @@
-"""The scenario file (DESIGN.md §6): JSON in, validated models out.
-
-Validation happens before any process starts, and every error names the field and
-what is allowed, because a typo found after a ten-minute run is a lost ten minutes.
-Files in the original simulator's `SettingsConfig.json` format are mapped by
-`catabot.config.settings_config`.
+"""The scenario (DESIGN.md §6): one model per section, and the rules that span sections
+(rates in whole ticks, which services and participants a scenario needs). Reading files
+is `catabot.config.load`; what a scenario means for a run is `catabot.world.World`.
 """
 
 from __future__ import annotations
 
-import json
 import math
-from pathlib import Path
 from typing import Any, Literal
 
 from pydantic import (
     Field,
-    ValidationError,
     ValidationInfo,
     field_validator,
     model_validator,
@@ -23,18 +17,12 @@ from pydantic import (
 
 from catabot.bus.clock import NS_PER_S, ClockError, period_in_ticks, ticks_for
 from catabot.bus.keys import check_name
-from catabot.config.base import ConfigError, Strict, explain
+from catabot.config.base import ScenarioError, Seed, Strict
 from catabot.config.environment import CurrentConfig, RainConfig, WindConfig
 from catabot.config.sensors import SENSOR_TYPES
 from catabot.config.terrain import TerrainConfig
 from catabot.config.traffic import TrafficConfig
 from catabot.config.waves import WaveConfig
-
-BUNDLED = Path(__file__).parents[1] / "data" / "scenarios"
-
-
-class ScenarioError(ConfigError):
-    """A scenario that cannot run; the message names the file, field and allowed values."""
 
 
 class ClockConfig(Strict):
@@ -122,12 +110,30 @@ class SensorConfig(Strict):
         return round(NS_PER_S / self.rate_hz)
 
 
+class ControllerConfig(Strict):
+    """The vessel is driven by a lockstep participant started outside `catabot run` (an
+    autonomy stack): its commands are a clocked stream on `vessel/<id>/cmd/<command>`, so
+    physics waits for each and applies it at the same tick on every run (DESIGN.md §4)."""
+
+    participant: str = Field(description="the stack's participant name")
+    rate_hz: float = Field(10.0, gt=0, description="commands per second, a whole number of ticks")
+    command: Literal["thrust", "twist"] = "thrust"
+
+    @field_validator("participant")
+    @classmethod
+    def _key_safe(cls, v: str) -> str:
+        return check_name("participant", v)
+
+
 class VesselConfig(Strict):
     id: str
     model: str = "catabot"
     pose: Pose | None = Field(None, description="null: open water near the terrain centre")
     script: list[ScriptStep] = []
     sensors: list[SensorConfig] = []
+    controller: ControllerConfig | None = Field(
+        None, description="a lockstep stack outside `catabot run` that commands this vessel"
+    )
 
     @field_validator("id")
     @classmethod
@@ -174,11 +180,13 @@ class Origin(Strict):
 class RecordingConfig(Strict):
     csv: bool = True
     mcap: bool = True
+    dataset: bool = Field(True, description="camera frames as PNGs + labels in dataset/")
+    ppi: bool = Field(True, description="the radar's PPI (the paper's minimap) in dataset/")
 
 
 class Scenario(Strict):
     name: str = "default"
-    seed: int = 0
+    seed: Seed = 0
     duration_s: float = Field(60.0, gt=0)
     dt_ns: int = Field(10_000_000, gt=0, description="physics tick, integer nanoseconds")
     clock: ClockConfig = ClockConfig()
@@ -220,6 +228,9 @@ def check_rates(scenario: Scenario) -> None:
         for s_index, sensor in enumerate(vessel.sensors):
             where = f"vessels.{v_index}.sensors.{s_index}.rate_hz ({vessel.id}/{sensor.name})"
             rate_in_ticks(sensor.rate_hz, scenario.dt_ns, where=where)
+        if vessel.controller is not None:
+            where = f"vessels.{v_index}.controller.rate_hz ({vessel.id})"
+            rate_in_ticks(vessel.controller.rate_hz, scenario.dt_ns, where=where)
     if scenario.traffic.count:
         guidance_period_ticks(scenario)
     try:
@@ -258,71 +269,8 @@ def services(scenario: Scenario) -> list[str]:
 
 
 def participants(scenario: Scenario) -> list[str]:
-    """Every stepping participant of the run: services, then external ones."""
-    return services(scenario) + list(scenario.clock.external_participants)
-
-
-def parse_scenario(data: Any, *, source: str = "<data>") -> Scenario:
-    from catabot.config.settings_config import is_settings_config, map_settings_config
-
-    if isinstance(data, dict) and is_settings_config(data):
-        data = map_settings_config(data, source=source)
-    try:
-        scenario = Scenario.model_validate(data)
-    except ValidationError as exc:
-        raise ScenarioError(f"scenario {source}: {explain(exc, model=Scenario)}") from None
-    check_rates(scenario)
-    return scenario
-
-
-def load_scenario(path: str | Path | None = None) -> Scenario:
-    """Load a scenario file, or the bundled default when `path` is None."""
-    file = BUNDLED / "default.json" if path is None else Path(path)
-    if not file.is_file():
-        bundled = BUNDLED / f"{file.name}.json"
-        if path is not None and "/" not in str(path) and bundled.is_file():
-            file = bundled
-        else:
-            raise ScenarioError(f"scenario file {str(file)!r} does not exist")
-    try:
-        data = json.loads(file.read_text())
-    except json.JSONDecodeError as exc:
-        raise ScenarioError(f"scenario {file}: not valid JSON: {exc}") from None
-    return parse_scenario(absolute_paths(data, file.parent.resolve()), source=str(file))
-
-
-def absolute_paths(data: Any, base: Path) -> Any:
-    """Input files named relative to the scenario become absolute, so the resolved copy in
-    the run folder (and every service reading it) finds the same files."""
-    if not isinstance(data, dict):
-        return data
-    data = json.loads(json.dumps(data))
-    _absolute(_node(data, "terrain"), "elevation_image", base)
-    _absolute(_node(data, "water", "current", "map"), "path", base)
-    vessels = data.get("vessels")
-    for vessel in vessels if isinstance(vessels, list) else []:
-        if isinstance(vessel, dict) and str(vessel.get("model", "")).endswith(".json"):
-            _absolute(vessel, "model", base)
-    return data
-
-
-def _node(data: dict[str, Any], *path: str) -> dict[str, Any]:
-    for key in path:
-        child = data.get(key)
-        if not isinstance(child, dict):
-            return {}
-        data = child
-    return data
-
-
-def _absolute(node: dict[str, Any], key: str, base: Path) -> None:
-    if isinstance(node.get(key), str):
-        node[key] = str(base / Path(node[key]).expanduser())
-
-
-def json_schema() -> dict[str, Any]:
-    """The scenario's JSON Schema, for editors (`catabot scenario schema`)."""
-    schema = Scenario.model_json_schema()
-    schema["$schema"] = "https://json-schema.org/draft/2020-12/schema"
-    schema["title"] = "CataBot scenario"
-    return schema
+    """Every stepping participant of the run: services, then external ones (named in
+    `clock.external_participants` or as a vessel's controller), each once."""
+    controllers = [v.controller.participant for v in scenario.vessels if v.controller]
+    external = dict.fromkeys([*scenario.clock.external_participants, *controllers])
+    return services(scenario) + [n for n in external if n not in services(scenario)]

@@ -11,7 +11,7 @@ from typing import Literal
 
 from pydantic import Field, field_validator, model_validator
 
-from catabot.config.base import Strict
+from catabot.config.base import Seed, Strict
 
 BEHAVIOURS = ("circle", "waypoints", "hold")
 Behaviour = Literal["circle", "waypoints", "hold"]
@@ -92,7 +92,7 @@ class TrafficConfig(Strict):
     count: int = Field(0, ge=0, le=500)
     models: list[ModelWeight] = [ModelWeight()]
     region: Region = Region()
-    seed: int | None = Field(None, description="null: the scenario's seed")
+    seed: Seed | None = Field(None, description="null: the scenario's seed")
     behaviour_mix: dict[Behaviour, float] = {"circle": 1.0}
     circle: CircleParams = CircleParams()
     waypoints: WaypointParams = WaypointParams()

@@ -10,7 +10,7 @@ import time
 from pathlib import Path
 
 from catabot.bus.session import Connection, SessionError, add_connection_args, open_session
-from catabot.config.scenario import json_schema, load_scenario
+from catabot.config.load import json_schema, load_scenario
 from catabot.errors import CataBotError
 from catabot.run import launcher
 from catabot.run.generate import add_arguments as add_generate_arguments

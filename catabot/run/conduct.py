@@ -22,7 +22,8 @@ from catabot.bus.session import (
     connection_from_args,
     open_session,
 )
-from catabot.config.scenario import Scenario, load_scenario, participants
+from catabot.config.load import load_scenario
+from catabot.config.scenario import Scenario, participants
 from catabot.errors import CataBotError
 from catabot.run.service import quiet_gc
 

@@ -12,7 +12,7 @@ import sys
 from pathlib import Path
 from typing import Any
 
-from catabot.config.scenario import parse_scenario
+from catabot.config.load import parse_scenario
 from catabot.config.traffic import BEHAVIOURS
 from catabot.errors import CataBotError
 from catabot.world.world import World

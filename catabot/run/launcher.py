@@ -19,7 +19,8 @@ from pathlib import Path
 
 from catabot.bus.scheduling import requested_policy
 from catabot.bus.session import free_port
-from catabot.config.scenario import Scenario, load_scenario, parse_scenario
+from catabot.config.load import load_scenario, parse_scenario
+from catabot.config.scenario import Scenario
 from catabot.errors import CataBotError
 from catabot.run.progress import ProgressBar
 from catabot.world.world import World

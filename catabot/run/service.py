@@ -32,7 +32,8 @@ from catabot.bus.session import (
     connection_from_args,
     open_session,
 )
-from catabot.config.scenario import Scenario, load_scenario
+from catabot.config.load import load_scenario
+from catabot.config.scenario import Scenario
 from catabot.errors import CataBotError
 from catabot.world.world import World
 

@@ -18,11 +18,11 @@ from catabot.bus.messages import (
     VesselState,
     WaypointsCmd,
 )
-from catabot.config.scenario import guidance_period_ticks
+from catabot.config.scenario import guidance_period_ticks, rate_in_ticks
 from catabot.config.sensors import SENSOR_TYPES
 
 if TYPE_CHECKING:
-    from catabot.world.world import World
+    from catabot.world.world import Body, World
 
 EXTERNAL = "external"  # the producer of commands from outside the lockstep
 
@@ -33,16 +33,14 @@ class Streams:
     vessel_states: tuple[Stream, ...]  # each vessel's own state, for observers only
     sensors: tuple[Stream, ...]
     commands: tuple[Stream, ...]  # thrust and twist of every vessel from outside (tick -1)
+    controls: tuple[Stream, ...]  # the commands of vessels' controllers (lockstep stacks)
     waypoints: tuple[Stream, ...]  # high-level commands from outside
     twist_batch: Stream | None  # the traffic service's set-points (none without traffic)
 
     @classmethod
     def of(cls, world: World) -> Streams:
         keys, vessels = world.keys, world.vessels
-        commands = []
-        for v in vessels:
-            commands.append(Stream(keys.cmd_thrust(v.id), ThrustCmd, EXTERNAL, None))
-            commands.append(Stream(keys.cmd_twist(v.id), TwistCmd, EXTERNAL, None))
+        commands = [s for v in vessels for s in _commands(world, v)]
         batch = None
         if world.boat_ids:
             period = guidance_period_ticks(world.scenario)
@@ -56,7 +54,8 @@ class Streams:
                 Stream(s.key, SENSOR_TYPES[s.config.type].message, "sensors", s.period)
                 for s in world.sensors
             ),
-            commands=tuple(commands),
+            commands=tuple(s for s in commands if s.period is None),
+            controls=tuple(s for s in commands if s.period is not None),
             waypoints=tuple(
                 Stream(keys.cmd_waypoints(v.id), WaypointsCmd, EXTERNAL, None) for v in vessels
             ),
@@ -65,10 +64,27 @@ class Streams:
 
     def lockstep(self) -> list[Stream]:
         """Every clocked stream of the world (what the recorder waits for)."""
-        return [self.states, *self.sensors, *self.twist_batches()]
+        return [self.states, *self.sensors, *self.twist_batches(), *self.controls]
 
     def twist_batches(self, *, lag: int = 0) -> list[Stream]:
         """The traffic set-points as a list (empty without traffic), read `lag` ticks late."""
         if self.twist_batch is None:
             return []
         return [replace(self.twist_batch, lag=lag)]
+
+
+def _commands(world: World, vessel: Body) -> list[Stream]:
+    """A vessel's thrust and twist keys: free-running (tick -1, from anyone), except the one
+    its controller drives, which is clocked (the controller is its producer)."""
+    keys, c = world.keys, vessel.controller
+    out = []
+    for kind, key, message in (
+        ("thrust", keys.cmd_thrust(vessel.id), ThrustCmd),
+        ("twist", keys.cmd_twist(vessel.id), TwistCmd),
+    ):
+        if c is not None and c.command == kind:
+            period = rate_in_ticks(c.rate_hz, world.scenario.dt_ns, where=key)
+            out.append(Stream(key, message, c.participant, period))
+        else:
+            out.append(Stream(key, message, EXTERNAL, None))
+    return out

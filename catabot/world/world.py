@@ -24,11 +24,13 @@ from catabot.bus.clock import period_in_ticks
 from catabot.bus.keys import Keys
 from catabot.bus.messages import CLASS_BUOY, CLASS_VESSEL, BodyStates, check_ids
 from catabot.config.scenario import (
+    ControllerConfig,
     Pose,
     Scenario,
     ScenarioError,
     ScriptStep,
     SensorConfig,
+    VesselConfig,
     participants,
     services,
 )
@@ -53,6 +55,7 @@ class Body:
     pose: Pose  # where it starts, at rest on the calm surface
     row: int  # its row in every `BodyStates`
     script: tuple[ScriptStep, ...] = ()
+    controller: ControllerConfig | None = None
 
     @property
     def instance(self) -> int:
@@ -176,18 +179,25 @@ def _bodies(scenario: Scenario, plan: TrafficPlan) -> tuple[Body, ...]:
             models[ref] = load_vessel_model(ref)
         return models[ref]
 
-    rows: list[tuple[str, BodyKind, str, Pose, tuple[ScriptStep, ...]]] = []
+    rows: list[tuple[str, BodyKind, str, Pose, VesselConfig | None]] = []
     for v in scenario.vessels:
         assert v.pose is not None, "resolve_poses placed every vessel"
-        rows.append((v.id, "vessel", v.model, v.pose, tuple(v.script)))
-    rows += [(b.id, "boat", b.model, b.pose, ()) for b in plan.boats]
+        rows.append((v.id, "vessel", v.model, v.pose, v))
+    rows += [(b.id, "boat", b.model, b.pose, None) for b in plan.boats]
     buoys = [*scenario.buoys, *plan.buoys]
-    rows += [(b.id, "buoy", BUOY_MODEL, Pose(x_m=b.x_m, y_m=b.y_m), ()) for b in buoys]
+    rows += [(b.id, "buoy", BUOY_MODEL, Pose(x_m=b.x_m, y_m=b.y_m), None) for b in buoys]
     _unique([r[0] for r in rows])
     return tuple(
-        Body(bid, kind, ref, model(ref), pose, row, script)
-        for row, (bid, kind, ref, pose, script) in enumerate(rows)
+        Body(bid, kind, ref, model(ref), pose, row, *_scenario_part(config))
+        for row, (bid, kind, ref, pose, config) in enumerate(rows)
     )
+
+
+def _scenario_part(
+    config: VesselConfig | None,
+) -> tuple[tuple[ScriptStep, ...], ControllerConfig | None]:
+    """What only a scenario vessel has: its script and its controller."""
+    return (tuple(config.script), config.controller) if config is not None else ((), None)
 
 
 def _unique(ids: list[str]) -> None:

@@ -42,7 +42,7 @@ class PhysicsService:
         )
         self.book = CommandBook(world.vessels)
         streams = world.streams
-        self.streams = [*streams.commands, *streams.waypoints]
+        self.streams = [*streams.commands, *streams.controls, *streams.waypoints]
         self.vessel_of = {s.key: ctx.keys.vessel_of(s.key) for s in self.streams}
         self.twists_key = ctx.keys.world_twists()
         self.boats = world.boat_ids

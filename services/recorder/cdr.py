@@ -21,10 +21,10 @@ from collections.abc import Iterable, Mapping
 
 import numpy as np
 
+from catabot.bus.clock import NS_PER_S
 from catabot.bus.messages import VesselState
 
 ENCAPSULATION = b"\x00\x01\x00\x00"  # CDR_LE, options 0
-_NS_PER_S = 1_000_000_000
 _COVARIANCE = 36  # float64[36], all zero: the simulator knows the exact state
 _FLOAT64 = 8
 
@@ -78,7 +78,7 @@ class _Layout:
 def _stamp(stamp_ns: int) -> tuple[int, int]:
     """builtin_interfaces/Time (sec, nanosec); floor division keeps nanosec >= 0, as
     `ros2_msgdefs.stamp` does."""
-    return divmod(stamp_ns, _NS_PER_S)
+    return divmod(stamp_ns, NS_PER_S)
 
 
 def _header(layout: _Layout, frame_id: str) -> tuple[int, bytes]:

@@ -67,10 +67,12 @@ class Dataset:
 
     def __init__(self, root: Path, world: World) -> None:
         self.root = root
+        recording = world.scenario.recording
+        self.cameras = recording.dataset
         self.radar: dict[str, tuple[RadarParams, int]] = {
             world.keys.relative(s.key): (s.params, s.config.period_ns)
             for s in world.sensors
-            if s.config.type == "radar"
+            if s.config.type == "radar" and recording.ppi
         }
         self._ppi: dict[str, Ppi] = {}
 
@@ -81,7 +83,7 @@ class Dataset:
         return path
 
     def write(self, stream: str, msg: Message) -> None:
-        if isinstance(msg, CameraFrame):
+        if isinstance(msg, CameraFrame) and self.cameras:
             self._camera(stream, msg)
         elif isinstance(msg, RadarSweep) and stream in self.radar:
             self._radar(stream, msg)

@@ -12,11 +12,11 @@ import base64
 import dataclasses
 import json
 import math
-import typing
 from typing import Any
 
 import numpy as np
 
+from catabot.bus.fields import FieldSpec, fields_of
 from catabot.bus.messages import Message
 
 
@@ -25,27 +25,31 @@ def schema_name(cls: type[Message]) -> str:
     return f"catabot.{cls.__name__}"
 
 
-def _field_schema(hint: Any, meta: typing.Mapping[str, Any]) -> dict[str, Any]:
+ARRAY_SCHEMA = {
+    "type": "object",
+    "properties": {
+        "dtype": {"type": "string"},
+        "shape": {"type": "array", "items": {"type": "integer"}},
+        "data": {"type": "string", "contentEncoding": "base64"},
+    },
+}
+SCALARS = {"int": "integer", "float": "number", "str": "string", "bool": "boolean"}
+
+
+def _field_schema(f: FieldSpec) -> dict[str, Any]:
     """JSON Schema of one field; units and axis names go into its description."""
-    unit, axes = meta.get("unit", ""), meta.get("axes")
-    described: dict[str, Any] = {"description": f"unit: {unit}"} if unit else {}
-    if hint is np.ndarray:
-        return {
-            "type": "object",
-            "properties": {
-                "dtype": {"type": "string"},
-                "shape": {"type": "array", "items": {"type": "integer"}},
-                "data": {"type": "string", "contentEncoding": "base64"},
-            },
-        }
-    if typing.get_origin(hint) is tuple:
-        out = {**described, "type": "array", "items": {"type": "number"}}
-        if axes is not None:
-            out.update(minItems=len(axes), maxItems=len(axes))
-            out["description"] = f"axes: {', '.join(axes)}" + (f"; unit: {unit}" if unit else "")
+    described: dict[str, Any] = {"description": f"unit: {f.unit}"} if f.unit else {}
+    if f.kind == "array":
+        return ARRAY_SCHEMA
+    if f.kind in ("vector", "names"):
+        items = "string" if f.kind == "names" else "number"
+        out = {**described, "type": "array", "items": {"type": items}}
+        if f.axes is not None:
+            out.update(minItems=len(f.axes), maxItems=len(f.axes))
+            unit = f"; unit: {f.unit}" if f.unit else ""
+            out["description"] = f"axes: {', '.join(f.axes)}{unit}"
         return out
-    kinds = {int: "integer", float: "number", str: "string", bool: "boolean"}
-    return {**described, "type": kinds.get(hint, "string")}
+    return {**described, "type": SCALARS.get(f.kind, "string")}
 
 
 def _summary(cls: type[Message]) -> str:
@@ -56,13 +60,12 @@ def _summary(cls: type[Message]) -> str:
 
 def json_schema(cls: type[Message]) -> dict[str, Any]:
     """A JSON Schema of `cls` from its dataclass fields (non-finite floats are written null)."""
-    hints = typing.get_type_hints(cls)
-    fields = dataclasses.fields(cls)
+    fields = fields_of(cls)
     return {
         "title": schema_name(cls),
         "description": _summary(cls),
         "type": "object",
-        "properties": {f.name: _field_schema(hints[f.name], f.metadata) for f in fields},
+        "properties": {f.name: _field_schema(f) for f in fields},
         "required": [f.name for f in fields],
     }
 

@@ -14,9 +14,8 @@ from __future__ import annotations
 import numpy as np
 from numpy.typing import NDArray
 
+from catabot.bus.clock import NS_PER_S
 from catabot.bus.messages import RadarSweep
-
-NS_PER_S = 1_000_000_000
 
 
 class Ppi:

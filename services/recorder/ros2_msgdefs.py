@@ -10,6 +10,7 @@ from __future__ import annotations
 
 from typing import Any
 
+from catabot.bus.clock import NS_PER_S
 from catabot.bus.messages import VesselState
 
 ODOMETRY = "nav_msgs/msg/Odometry"
@@ -116,7 +117,7 @@ def _xyz(v: tuple[float, ...]) -> dict[str, float]:
 
 def stamp(stamp_ns: int) -> dict[str, int]:
     """builtin_interfaces/Time from simulated nanoseconds (floor division keeps nanosec >= 0)."""
-    sec, nanosec = divmod(stamp_ns, 1_000_000_000)
+    sec, nanosec = divmod(stamp_ns, NS_PER_S)
     return {"sec": sec, "nanosec": nanosec}
 
 

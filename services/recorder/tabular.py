@@ -17,11 +17,11 @@ of clouds still says per sample how much was seen.
 from __future__ import annotations
 
 import dataclasses
-import typing
 from typing import Any
 
 import numpy as np
 
+from catabot.bus.fields import fields_of
 from catabot.bus.messages import Message
 
 LEADING = ("stamp_ns", "tick")
@@ -58,22 +58,17 @@ def _layout(cls: type[Message]) -> tuple[_Column, ...]:
 
 
 def _build_layout(cls: type[Message]) -> tuple[_Column, ...]:
-    hints = typing.get_type_hints(cls)
     by_name: dict[str, _Column] = {}
-    for f in dataclasses.fields(cls):
-        hint = hints[f.name]
-        unit = str(f.metadata.get("unit", ""))
-        if hint is np.ndarray:
-            summary = f.metadata.get("summary")
-            if summary is not None:
-                by_name[f.name] = _Column(summary[0], "", (), field=f.name, reduce=summary[1])
+    for f in fields_of(cls):
+        if f.kind == "array":
+            if f.summary is not None:
+                by_name[f.name] = _Column(f.summary[0], "", (), field=f.name, reduce=f.summary[1])
             else:
-                by_name[f.name] = _Column(f.name, unit, (), skip=True)
-        elif typing.get_origin(hint) is tuple:
-            axes = f.metadata.get("axes")
-            by_name[f.name] = _Column(f.name, unit, tuple(axes) if axes is not None else None)
+                by_name[f.name] = _Column(f.name, f.unit, (), skip=True)
+        elif f.kind in ("vector", "names"):
+            by_name[f.name] = _Column(f.name, f.unit, f.axes)
         else:
-            by_name[f.name] = _Column(f.name, unit, ())
+            by_name[f.name] = _Column(f.name, f.unit, ())
     first = [by_name.pop(n) for n in LEADING if n in by_name]
     return tuple(c for c in [*first, *by_name.values()] if not c.skip)
 

@@ -25,6 +25,7 @@ from typing import ClassVar
 import numpy as np
 from numpy.typing import NDArray
 
+from catabot.bus.clock import NS_PER_S
 from catabot.bus.messages import CLASS_NONE, CLASS_WATER, Message, RadarSweep, VesselState
 from catabot.config.sensors import RadarParams
 from catabot.world import rotations, seeding
@@ -33,7 +34,6 @@ from services.sensors.common import SensorError, rotation_from_quaternion
 from services.sensors.mount import Mount
 
 F64 = NDArray[np.float64]
-NS_PER_S = 1_000_000_000
 
 
 def fan(p: RadarParams) -> F64:

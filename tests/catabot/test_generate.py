@@ -6,7 +6,7 @@ from pathlib import Path
 
 import pytest
 
-from catabot.config.scenario import load_scenario
+from catabot.config.load import load_scenario
 from catabot.run.cli import main
 from catabot.world.world import World
 

@@ -10,15 +10,8 @@ from typing import Any
 import jsonschema
 import pytest
 
-from catabot.config.scenario import (
-    BUNDLED,
-    Scenario,
-    ScenarioError,
-    guidance_period_ticks,
-    json_schema,
-    load_scenario,
-    parse_scenario,
-)
+from catabot.config.load import BUNDLED, json_schema, load_scenario, parse_scenario
+from catabot.config.scenario import Scenario, ScenarioError, guidance_period_ticks
 
 
 def _base() -> dict[str, Any]:
@@ -97,7 +90,7 @@ def test_wrong_type_for_duration(value: object) -> None:
     data["duration_s"] = value
     msg = _error(data)
     assert "duration_s:" in msg
-    assert "valid number" in msg
+    assert "must be a number" in msg
 
 
 @pytest.mark.parametrize("value", [-1.0, 0])
@@ -340,7 +333,7 @@ def test_a_setpoint_delay_that_is_not_a_whole_number_of_ticks(delay: object) -> 
 
 @pytest.mark.parametrize(
     ("rate", "says"),
-    [(30.0, "not a whole number of ticks"), (0.0, "must be > 0"), ("fast", "valid number")],
+    [(30.0, "not a whole number of ticks"), (0.0, "must be > 0"), ("fast", "must be a number")],
 )
 def test_a_guidance_rate_that_is_not_a_whole_number_of_ticks(rate: object, says: str) -> None:
     data = _base()

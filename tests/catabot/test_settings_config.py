@@ -9,8 +9,10 @@ from typing import Any
 
 import pytest
 
-from catabot.config.scenario import ScenarioError, load_scenario, parse_scenario
+from catabot.config.load import load_scenario, parse_scenario
+from catabot.config.scenario import ScenarioError
 from catabot.config.settings_config import is_settings_config
+from catabot.world.world import World
 
 # The original CataBotSim defaults (reference/anchors.md).
 ORIGINAL_DEFAULTS: dict[str, Any] = {
@@ -63,8 +65,10 @@ def test_original_defaults_are_accepted_and_mapped() -> None:
     assert scenario.origin.longitude_deg == 0.0
     assert [v.id for v in scenario.vessels] == ["robot_0"]
     assert scenario.vessels[0].model == "catabot"
-    assert _sensor_types(ORIGINAL_DEFAULTS) == ["imu", "gps", "lidar"]
+    assert _sensor_types(ORIGINAL_DEFAULTS) == ["imu", "gps", "lidar", "radar"]
     assert scenario.rain.rate_mm_h == 0.0
+    assert scenario.terrain is None  # terrainFromFile false
+    assert scenario.recording.ppi and not scenario.recording.dataset
 
 
 def test_lidar_and_rain_are_mapped() -> None:
@@ -87,7 +91,7 @@ def test_imu_on_and_off() -> None:
 def test_a_partial_file_takes_the_original_defaults() -> None:
     scenario = parse_scenario({"gpsLatitude": 10.0})
     assert scenario.origin.latitude_deg == 10.0
-    assert _sensor_types({"gpsLatitude": 10.0}) == ["imu", "gps", "lidar"]
+    assert _sensor_types({"gpsLatitude": 10.0}) == ["imu", "gps", "lidar", "radar"]
 
 
 def test_a_native_scenario_is_not_taken_for_a_settings_file() -> None:
@@ -121,7 +125,8 @@ def test_loaded_from_a_file(tmp_path: Path) -> None:
         ("boatControlType", "Zigzag", "['Circles', 'Waypoints', 'pose']"),
         ("imuActive", "true", "true or false"),
         ("radarActive", 1, "true or false"),
-        ("terrainPathToElevationFile", 5, "a string"),
+        ("terrainPathToElevationFile", 5, "a non-empty string"),
+        ("boatsNumberActive", 2.5, "a whole number of boats"),
     ],
 )
 def test_bad_values_name_the_key_and_the_allowed_values(key: str, value: Any, allowed: str) -> None:
@@ -144,40 +149,63 @@ def test_terrain_height_min_must_be_below_max(lo: float, hi: float) -> None:
     assert "must be below" in msg
 
 
-def test_unsupported_features_are_warned_about(caplog: pytest.LogCaptureFixture) -> None:
+def test_every_key_maps_onto_its_feature_with_no_warning(caplog: pytest.LogCaptureFixture) -> None:
     with caplog.at_level(logging.WARNING, logger=LOGGER):
-        parse_scenario(ORIGINAL_DEFAULTS, source="SettingsConfig.json")
-    text = "\n".join(r.getMessage() for r in caplog.records if r.name == LOGGER)
-    assert all(r.levelno == logging.WARNING for r in caplog.records if r.name == LOGGER)
-    for key in ("radarActive", "minimapActive"):
-        assert f"SettingsConfig.json: {key}=true" in text
-    assert "lidarActive" not in text  # LiDAR exists: mapped, not warned about
-    for key in ("screenshotsSaveToFile", "terrainFromFile", "rainIntensity", "boatsNumber"):
-        assert key not in text  # off in the defaults: nothing to warn about
+        scenario = parse_scenario(ORIGINAL_DEFAULTS, source="SettingsConfig.json")
+    assert [r for r in caplog.records if r.name == LOGGER] == []
+    radar = scenario.vessels[0].sensors[-1]
+    assert (radar.type, radar.rate_hz) == ("radar", 10.0)
+    assert not parse_scenario(_settings(minimapActive=False)).recording.ppi
+    assert "radar" not in _sensor_types(_settings(radarActive=False))
 
 
-def test_requested_datasets_rain_and_traffic_are_warned_about(
-    caplog: pytest.LogCaptureFixture,
-) -> None:
+def test_screenshots_become_a_camera_with_those_outputs() -> None:
     data = _settings(
-        radarActive=False,
-        lidarActive=False,
-        minimapActive=False,
-        screenshotsSaveToFile=True,
-        terrainFromFile=True,
-        rainIntensity=12.5,
-        boatsNumberActive=10,
+        screenshotsSaveToFile=True, screenshotsColorActive=True, screenshotsDepthActive=True
     )
+    scenario = parse_scenario(data)
+    camera = scenario.vessels[0].sensors[-1]
+    assert camera.type == "camera" and camera.rate_hz == 5.0
+    outputs = camera.typed_params().outputs
+    assert (outputs.color, outputs.depth, outputs.normals, outputs.segmentation) == (
+        True, True, False, False
+    )  # fmt: skip
+    assert scenario.recording.dataset
+    shown_only = parse_scenario(_settings(screenshotsSegmentationActive=True))
+    assert "camera" in [s.type for s in shown_only.vessels[0].sensors]
+    assert not shown_only.recording.dataset  # on the bus, not written to dataset/
+    assert "camera" not in _sensor_types(_settings(screenshotsSaveToFile=True))
+
+
+def test_terrain_from_file_is_read_relative_to_the_settings_file(tmp_path: Path) -> None:
+    bay = Path(__file__).resolve().parents[2] / "catabot" / "data" / "terrain" / "bay.png"
+    (tmp_path / "maps").mkdir()
+    (tmp_path / "maps" / "river.png").write_bytes(bay.read_bytes())
+    data = _settings(
+        terrainFromFile=True,
+        terrainPathToElevationFile="maps/river.png",
+        terrainHeightMin=-20.0,
+        terrainHeightMax=30.0,
+        terrainPixelScale=4.0,
+    )
+    path = tmp_path / "SettingsConfig.json"
+    path.write_text(json.dumps(data))
+    scenario = load_scenario(path)
+    assert scenario.terrain is not None
+    assert scenario.terrain.elevation_image == str(tmp_path / "maps" / "river.png")
+    assert (scenario.terrain.min_elevation_m, scenario.terrain.max_elevation_m) == (-20.0, 30.0)
+    assert scenario.terrain.metres_per_pixel == 4.0
+    world = World.resolve(scenario)  # robot_0 placed in open water on that terrain
+    assert world.terrain is not None
+    pose = world.body("robot_0").pose
+    assert world.terrain.depth(pose.x_m, pose.y_m) > 0
+
+
+def test_pose_control_of_the_robot_is_reported(caplog: pytest.LogCaptureFixture) -> None:
     with caplog.at_level(logging.WARNING, logger=LOGGER):
-        scenario = parse_scenario(data, source="S.json")
+        parse_scenario(_settings(robotControlType="pose"), source="S.json")
     text = "\n".join(r.getMessage() for r in caplog.records if r.name == LOGGER)
-    for key in ("screenshotsSaveToFile", "terrainFromFile"):
-        assert key in text
-    assert "rainIntensity" not in text  # mapped to the scenario's rain
-    assert "boatsNumberActive" not in text  # mapped to the scenario's traffic
-    assert scenario.traffic.count == 10 and scenario.traffic.behaviour_mix == {"circle": 1.0}
-    for key in ("radarActive", "lidarActive", "minimapActive"):
-        assert key not in text
+    assert "S.json: robotControlType 'pose'" in text and "cmd/twist" in text
 
 
 def test_nothing_requested_nothing_warned(caplog: pytest.LogCaptureFixture) -> None:

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from catabot.config.scenario import parse_scenario
+from catabot.config.load import parse_scenario
 from catabot.config.vessel import load_vessel_model
 from catabot.world.placement import footprint_m
 from catabot.world.traffic_plan import TrafficPlan

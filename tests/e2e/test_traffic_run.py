@@ -14,7 +14,8 @@ from catabot.bus import codec
 from catabot.bus.keys import Keys
 from catabot.bus.messages import TwistCmd, WaypointsCmd
 from catabot.bus.session import Connection, free_port, open_session
-from catabot.config.scenario import ClockConfig, load_scenario
+from catabot.config.load import load_scenario
+from catabot.config.scenario import ClockConfig
 from catabot.world.terrain import load_terrain
 from catabot.world.world import World
 

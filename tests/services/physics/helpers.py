@@ -4,7 +4,7 @@ from __future__ import annotations
 
 from typing import Any
 
-from catabot.config.scenario import parse_scenario
+from catabot.config.load import parse_scenario
 from catabot.world.world import Body, World
 
 

@@ -11,7 +11,8 @@ import pytest
 from pydantic import ValidationError
 
 from catabot.bus.messages import GpsFix, ImuSample, VesselState
-from catabot.config.scenario import Origin, parse_scenario
+from catabot.config.load import parse_scenario
+from catabot.config.scenario import Origin
 from catabot.config.sensors import SENSOR_TYPES, GpsParams, ImuParams
 from catabot.config.waves import GRAVITY
 from catabot.world.geo import enu_to_geodetic

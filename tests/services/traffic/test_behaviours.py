@@ -7,7 +7,8 @@ import math
 import numpy as np
 import pytest
 
-from catabot.config.scenario import Pose, parse_scenario
+from catabot.config.load import parse_scenario
+from catabot.config.scenario import Pose
 from catabot.config.traffic import TrafficConfig
 from catabot.config.vessel import load_vessel_model
 from catabot.world.placement import footprint_m

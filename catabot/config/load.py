@@ -1,0 +1,86 @@
+"""Scenario files (DESIGN.md §6): JSON in, a validated `Scenario` out.
+
+Validation happens before any process starts, and every error names the field and what is
+allowed, because a typo found after a ten-minute run is a lost ten minutes. Files in the
+original simulator's `SettingsConfig.json` format are mapped by `settings_config`.
+"""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+from typing import Any
+
+from pydantic import ValidationError
+
+from catabot.config.base import ScenarioError, explain
+from catabot.config.scenario import Scenario, check_rates
+from catabot.config.settings_config import is_settings_config, map_settings_config
+
+BUNDLED = Path(__file__).parents[1] / "data" / "scenarios"
+
+
+def parse_scenario(data: Any, *, source: str = "<data>") -> Scenario:
+    if isinstance(data, dict) and is_settings_config(data):
+        data = map_settings_config(data, source=source)
+    try:
+        scenario = Scenario.model_validate(data)
+    except ValidationError as exc:
+        raise ScenarioError(f"scenario {source}: {explain(exc, model=Scenario)}") from None
+    check_rates(scenario)
+    return scenario
+
+
+def load_scenario(path: str | Path | None = None) -> Scenario:
+    """Load a scenario file, or the bundled default when `path` is None."""
+    file = BUNDLED / "default.json" if path is None else Path(path)
+    if not file.is_file():
+        bundled = BUNDLED / f"{file.name}.json"
+        if path is not None and "/" not in str(path) and bundled.is_file():
+            file = bundled
+        else:
+            raise ScenarioError(f"scenario file {str(file)!r} does not exist")
+    try:
+        data = json.loads(file.read_text())
+    except json.JSONDecodeError as exc:
+        raise ScenarioError(f"scenario {file}: not valid JSON: {exc}") from None
+    if isinstance(data, dict) and is_settings_config(data):  # first: its paths are relative too
+        data = map_settings_config(data, source=str(file))
+    return parse_scenario(absolute_paths(data, file.parent.resolve()), source=str(file))
+
+
+def absolute_paths(data: Any, base: Path) -> Any:
+    """Input files named relative to the scenario become absolute, so the resolved copy in
+    the run folder (and every service reading it) finds the same files."""
+    if not isinstance(data, dict):
+        return data
+    data = json.loads(json.dumps(data))
+    _absolute(_node(data, "terrain"), "elevation_image", base)
+    _absolute(_node(data, "water", "current", "map"), "path", base)
+    vessels = data.get("vessels")
+    for vessel in vessels if isinstance(vessels, list) else []:
+        if isinstance(vessel, dict) and str(vessel.get("model", "")).endswith(".json"):
+            _absolute(vessel, "model", base)
+    return data
+
+
+def _node(data: dict[str, Any], *path: str) -> dict[str, Any]:
+    for key in path:
+        child = data.get(key)
+        if not isinstance(child, dict):
+            return {}
+        data = child
+    return data
+
+
+def _absolute(node: dict[str, Any], key: str, base: Path) -> None:
+    if isinstance(node.get(key), str):
+        node[key] = str(base / Path(node[key]).expanduser())
+
+
+def json_schema() -> dict[str, Any]:
+    """The scenario's JSON Schema, for editors (`catabot scenario schema`)."""
+    schema = Scenario.model_json_schema()
+    schema["$schema"] = "https://json-schema.org/draft/2020-12/schema"
+    schema["title"] = "CataBot scenario"
+    return schema
