@@ -12,7 +12,7 @@ from dataclasses import dataclass
 from catabot.errors import CataBotError
 
 ROOT = "catabot"
-_NAME = re.compile(r"^[A-Za-z0-9_.\-]+$")
+_NAME = re.compile(r"^[A-Za-z0-9_.\-]{1,64}$")  # one chunk of a key, and part of file names
 
 
 class KeyNameError(CataBotError, ValueError):
@@ -20,10 +20,13 @@ class KeyNameError(CataBotError, ValueError):
 
 
 def check_name(kind: str, name: str) -> str:
-    """Refuse names that would change a key's meaning ('/', wildcards, '$', spaces)."""
+    """Refuse names that would change a key's meaning ('/', wildcards, '$', spaces) or not fit
+    in a file name (the recorder names files after streams)."""
     if not isinstance(name, str) or not _NAME.match(name):
+        shown = repr(name) if len(repr(name)) <= 80 else repr(name)[:77] + "..."
         raise KeyNameError(
-            f"{kind} name {name!r} is not allowed in a key: use letters, digits, '_', '-' or '.'"
+            f"{kind} name {shown} is not allowed in a key: use 1-64 letters, digits, '_', '-' "
+            "or '.'"
         )
     return name
 

@@ -8,10 +8,14 @@ errors into one line per problem naming the dotted field, the rule and the value
 
 from __future__ import annotations
 
+import json
+from functools import partial
+from pathlib import Path
 from typing import Annotated, Any
 
-from pydantic import BaseModel, ConfigDict, Field, StrictInt, ValidationError
+from pydantic import AfterValidator, BaseModel, ConfigDict, Field, StrictInt, ValidationError
 
+from catabot.bus.keys import check_name
 from catabot.errors import CataBotError
 
 Seed = Annotated[
@@ -19,6 +23,22 @@ Seed = Annotated[
     Field(ge=0, lt=2**63, description="an integer in [0, 2**63): seeds every random source"),
 ]
 """A seed (catabot.world.seeding): JSON integers only (3.0, "3" or true are refused)."""
+
+
+WorldName = Annotated[str, AfterValidator(partial(check_name, "world"))]
+VesselId = Annotated[str, AfterValidator(partial(check_name, "vessel"))]
+BuoyId = Annotated[str, AfterValidator(partial(check_name, "buoy"))]
+SensorName = Annotated[str, AfterValidator(partial(check_name, "sensor"))]
+ParticipantName = Annotated[str, AfterValidator(partial(check_name, "participant"))]
+"""Names that become one chunk of a key expression (and part of file names)."""
+
+
+def unique(items: list[Any], *, attr: str, what: str) -> list[Any]:
+    """`items` if no two share `attr` (ids that would share keys and files)."""
+    names = [getattr(item, attr) for item in items]
+    if len(set(names)) != len(names):
+        raise ValueError(f"{what} must be unique (got {names})")
+    return items
 
 
 class ConfigError(CataBotError, ValueError):
@@ -124,3 +144,24 @@ def _model_in(annotation: Any) -> type[BaseModel] | None:
         if found is not None:
             return found
     return None
+
+
+MAX_FILE_BYTES = 64 * 2**20  # a scenario is a page of JSON; a bigger file is a mistake
+
+
+def read_json(file: Path, *, what: str, error: type[ConfigError] = ScenarioError) -> Any:
+    """A JSON file's data; `error` naming the file for anything that is not JSON text
+    (unreadable, not UTF-8, too big, nested deeper than the parser can follow)."""
+    try:
+        if file.stat().st_size > MAX_FILE_BYTES:
+            raise error(f"{what} {file}: over {MAX_FILE_BYTES // 2**20} MiB, not a scenario")
+        text = file.read_bytes().decode("utf-8")
+        return json.loads(text)
+    except OSError as exc:
+        raise error(f"{what} {file}: cannot read: {exc.strerror}") from None
+    except UnicodeDecodeError as exc:
+        raise error(f"{what} {file}: not UTF-8 text (byte {exc.start})") from None
+    except json.JSONDecodeError as exc:
+        raise error(f"{what} {file}: not valid JSON: {exc}") from None
+    except RecursionError:
+        raise error(f"{what} {file}: JSON nested too deeply") from None

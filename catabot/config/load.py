@@ -13,7 +13,7 @@ from typing import Any
 
 from pydantic import ValidationError
 
-from catabot.config.base import ScenarioError, explain
+from catabot.config.base import ScenarioError, explain, read_json
 from catabot.config.scenario import Scenario, check_rates
 from catabot.config.settings_config import is_settings_config, map_settings_config
 
@@ -40,10 +40,7 @@ def load_scenario(path: str | Path | None = None) -> Scenario:
             file = bundled
         else:
             raise ScenarioError(f"scenario file {str(file)!r} does not exist")
-    try:
-        data = json.loads(file.read_text())
-    except json.JSONDecodeError as exc:
-        raise ScenarioError(f"scenario {file}: not valid JSON: {exc}") from None
+    data = read_json(file, what="scenario")
     if isinstance(data, dict) and is_settings_config(data):  # first: its paths are relative too
         data = map_settings_config(data, source=str(file))
     return parse_scenario(absolute_paths(data, file.parent.resolve()), source=str(file))

@@ -10,14 +10,25 @@ from typing import Any, Literal
 
 from pydantic import (
     Field,
+    StrictBool,
+    StrictInt,
     ValidationInfo,
     field_validator,
     model_validator,
 )
 
 from catabot.bus.clock import NS_PER_S, ClockError, period_in_ticks, ticks_for
-from catabot.bus.keys import check_name
-from catabot.config.base import ScenarioError, Seed, Strict
+from catabot.config.base import (
+    BuoyId,
+    ParticipantName,
+    ScenarioError,
+    Seed,
+    SensorName,
+    Strict,
+    VesselId,
+    WorldName,
+    unique,
+)
 from catabot.config.environment import CurrentConfig, RainConfig, WindConfig
 from catabot.config.sensors import SENSOR_TYPES
 from catabot.config.terrain import TerrainConfig
@@ -33,14 +44,9 @@ class ClockConfig(Strict):
     window_ticks: int = Field(
         40, ge=1, le=1000, description="how far a participant may step ahead of the slowest"
     )
-    external_participants: list[str] = Field(
+    external_participants: list[ParticipantName] = Field(
         [], description="names of stepping participants started outside `catabot run`"
     )
-
-    @field_validator("external_participants")
-    @classmethod
-    def _names(cls, names: list[str]) -> list[str]:
-        return [check_name("participant", n) for n in names]
 
 
 class Pose(Strict):
@@ -73,19 +79,14 @@ class ScriptStep(Strict):
 
 
 class SensorConfig(Strict):
-    name: str
+    name: SensorName
     type: str = Field(
         description="a sensor type: see catabot/sensor_types.py",
         json_schema_extra={"enum": list(SENSOR_TYPES)},
     )
     rate_hz: float = Field(gt=0)
-    noise: bool = True
+    noise: StrictBool = True
     params: dict[str, Any] = Field({}, description="the type's parameters (defaults if empty)")
-
-    @field_validator("name")
-    @classmethod
-    def _key_safe(cls, v: str) -> str:
-        return check_name("sensor", v)
 
     @field_validator("type")
     @classmethod
@@ -115,18 +116,13 @@ class ControllerConfig(Strict):
     autonomy stack): its commands are a clocked stream on `vessel/<id>/cmd/<command>`, so
     physics waits for each and applies it at the same tick on every run (DESIGN.md §4)."""
 
-    participant: str = Field(description="the stack's participant name")
+    participant: ParticipantName = Field(description="the stack's participant name")
     rate_hz: float = Field(10.0, gt=0, description="commands per second, a whole number of ticks")
     command: Literal["thrust", "twist"] = "thrust"
 
-    @field_validator("participant")
-    @classmethod
-    def _key_safe(cls, v: str) -> str:
-        return check_name("participant", v)
-
 
 class VesselConfig(Strict):
-    id: str
+    id: VesselId
     model: str = "catabot"
     pose: Pose | None = Field(None, description="null: open water near the terrain centre")
     script: list[ScriptStep] = []
@@ -135,18 +131,10 @@ class VesselConfig(Strict):
         None, description="a lockstep stack outside `catabot run` that commands this vessel"
     )
 
-    @field_validator("id")
-    @classmethod
-    def _key_safe(cls, v: str) -> str:
-        return check_name("vessel", v)
-
     @field_validator("sensors")
     @classmethod
     def _unique_names(cls, sensors: list[SensorConfig]) -> list[SensorConfig]:
-        names = [s.name for s in sensors]
-        if len(set(names)) != len(names):
-            raise ValueError(f"sensor names must be unique (got {names})")
-        return sensors
+        return unique(sensors, attr="name", what="sensor names")
 
 
 class WaterConfig(Strict):
@@ -159,14 +147,9 @@ class BuoyConfig(Strict):
     """A floating buoy body (the bundled `buoy` model), moored at (x_m, y_m) by a soft
     horizontal spring (services/physics/loads.py): it bobs, heels, yields when hit, returns."""
 
-    id: str
+    id: BuoyId
     x_m: float
     y_m: float
-
-    @field_validator("id")
-    @classmethod
-    def _key_safe(cls, v: str) -> str:
-        return check_name("buoy", v)
 
 
 class Origin(Strict):
@@ -178,17 +161,22 @@ class Origin(Strict):
 
 
 class RecordingConfig(Strict):
-    csv: bool = True
-    mcap: bool = True
-    dataset: bool = Field(True, description="camera frames as PNGs + labels in dataset/")
-    ppi: bool = Field(True, description="the radar's PPI (the paper's minimap) in dataset/")
+    csv: StrictBool = True
+    mcap: StrictBool = True
+    dataset: StrictBool = Field(True, description="camera frames as PNGs + labels in dataset/")
+    ppi: StrictBool = Field(True, description="the radar's PPI (the paper's minimap) in dataset/")
 
 
 class Scenario(Strict):
-    name: str = "default"
+    name: WorldName = "default"
     seed: Seed = 0
-    duration_s: float = Field(60.0, gt=0)
-    dt_ns: int = Field(10_000_000, gt=0, description="physics tick, integer nanoseconds")
+    duration_s: float = Field(60.0, gt=0, le=1e7, description="simulated seconds (<= 115 days)")
+    dt_ns: StrictInt = Field(
+        10_000_000,
+        ge=100_000,
+        le=100_000_000,
+        description="physics tick, integer nanoseconds (0.1 ms to 100 ms: stable hydrodynamics)",
+    )
     clock: ClockConfig = ClockConfig()
     origin: Origin = Origin()
     water: WaterConfig = WaterConfig()
@@ -200,18 +188,10 @@ class Scenario(Strict):
     traffic: TrafficConfig = TrafficConfig()
     recording: RecordingConfig = RecordingConfig()
 
-    @field_validator("name")
-    @classmethod
-    def _key_safe(cls, v: str) -> str:
-        return check_name("world", v)
-
     @field_validator("vessels")
     @classmethod
     def _unique_ids(cls, vessels: list[VesselConfig]) -> list[VesselConfig]:
-        ids = [v.id for v in vessels]
-        if len(set(ids)) != len(ids):
-            raise ValueError(f"vessel ids must be unique (got {ids})")
-        return vessels
+        return unique(vessels, attr="id", what="vessel ids")
 
     @property
     def duration_ns(self) -> int:

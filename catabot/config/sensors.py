@@ -8,7 +8,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 from typing import Literal
 
-from pydantic import Field
+from pydantic import Field, StrictBool
 
 from catabot.bus.messages import CameraFrame, GpsFix, ImuSample, LidarScan, Message, RadarSweep
 from catabot.config.base import Strict
@@ -55,16 +55,16 @@ class RadarParams(SensorParams):
     fan_min_range_m: float = Field(10.0, gt=0, description="nearest sea range of the fan")
     range_noise_sigma_m: float = Field(0.2, ge=0)
     antenna_height_m: float = Field(3.0, description="above the body origin")
-    sea_clutter: bool = Field(False, description="keep returns from the water surface")
+    sea_clutter: StrictBool = Field(False, description="keep returns from the water surface")
     ppi_size_px: int = Field(256, ge=16, le=2048)
     fade_s: float = Field(1.0, gt=0, description="PPI returns fade to nothing in this time")
 
 
 class CameraOutputs(SensorParams):
-    color: bool = True
-    depth: bool = True
-    normals: bool = True
-    segmentation: bool = True
+    color: StrictBool = True
+    depth: StrictBool = True
+    normals: StrictBool = True
+    segmentation: StrictBool = True
 
 
 class CameraParams(SensorParams):

@@ -9,7 +9,7 @@ from __future__ import annotations
 
 from typing import Literal
 
-from pydantic import Field, field_validator, model_validator
+from pydantic import Field, StrictBool, field_validator, model_validator
 
 from catabot.config.base import Seed, Strict
 
@@ -61,7 +61,7 @@ class WaypointParams(Strict):
     mode: Literal["loop", "back_and_forth"] = "back_and_forth"
     speed_mps: float = Field(5.0, gt=0, le=20)
     tolerance_m: float = Field(5.0, gt=0)
-    buoys: bool = True
+    buoys: StrictBool = True
 
     @field_validator("points")
     @classmethod

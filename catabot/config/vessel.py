@@ -11,7 +11,6 @@ the waterline-level reference point on the centreline; SI units, named in the fi
 
 from __future__ import annotations
 
-import json
 from pathlib import Path
 from typing import Annotated, Any, Literal
 
@@ -25,7 +24,7 @@ from pydantic import (
 )
 from pydantic.types import FiniteFloat
 
-from catabot.config.base import ConfigError, FieldProblem, Strict, explain
+from catabot.config.base import ConfigError, FieldProblem, Strict, explain, read_json
 
 BUNDLED_DIR = Path(__file__).parents[1] / "data" / "vessels"
 
@@ -190,18 +189,7 @@ def bundled_vessel_names() -> list[str]:
 def load_vessel_model(ref: str, *, base_dir: Path | None = None) -> VesselModel:
     """Load a vessel model by bundled name or JSON path (relative to `base_dir` if given)."""
     path = _resolve(ref, base_dir)
-    try:
-        text = path.read_text(encoding="utf-8")
-    except OSError as exc:
-        raise VesselModelError(
-            f"vessel model '{ref}': cannot read {path}: {exc.strerror}"
-        ) from None
-    try:
-        data = json.loads(text)
-    except json.JSONDecodeError as exc:
-        raise VesselModelError(
-            f"vessel model '{ref}': invalid JSON at line {exc.lineno} column {exc.colno}: {exc.msg}"
-        ) from None
+    data = read_json(path, what=f"vessel model '{ref}':", error=VesselModelError)
     return parse_vessel_model(data, source=ref)
 
 

@@ -12,8 +12,9 @@ from pathlib import Path
 from catabot.bus.session import Connection, SessionError, add_connection_args, open_session
 from catabot.config.load import json_schema, load_scenario
 from catabot.errors import CataBotError
-from catabot.run import launcher
+from catabot.run import conduct, launcher
 from catabot.run.generate import add_arguments as add_generate_arguments
+from catabot.run.generate import generate
 from catabot.world.world import World
 
 
@@ -32,8 +33,6 @@ def _run(args: argparse.Namespace) -> int:
 
 def _service(args: argparse.Namespace, rest: list[str]) -> int:
     if args.name == "conductor":
-        from catabot.run import conduct
-
         return conduct.main(rest)
     module = launcher.SERVICE_MODULES.get(args.name)
     if module is None:
@@ -71,8 +70,6 @@ def _scenario(args: argparse.Namespace) -> int:
             sys.stdout.write(text)
         return 0
     if args.action == "generate":
-        from catabot.run.generate import generate
-
         return generate(args)
     try:  # what `catabot run` checks before it starts anything, no less
         world = World.resolve(load_scenario(args.file))

@@ -70,6 +70,7 @@ def main(argv: list[str] | None = None) -> int:
     quiet_gc()
     for sig in (signal.SIGINT, signal.SIGTERM):
         signal.signal(sig, lambda *_: conductor.stop("interrupted"))
+    emit("ready")  # from now on a stop ends the run cleanly (the launcher holds one till then)
 
     def progress(p: Progress) -> None:
         # Without its launcher the run has no one to report to: end it cleanly (services

@@ -7,12 +7,14 @@ JSON lines, and turns the end of the run into a summary and an exit code.
 
 from __future__ import annotations
 
+import contextlib
 import json
 import signal
 import subprocess
 import sys
 import threading
 import time
+from collections.abc import Iterator
 from dataclasses import dataclass
 from datetime import datetime
 from pathlib import Path
@@ -23,6 +25,7 @@ from catabot.config.load import load_scenario, parse_scenario
 from catabot.config.scenario import Scenario
 from catabot.errors import CataBotError
 from catabot.run.progress import ProgressBar
+from catabot.run.summary import summarise
 from catabot.world.world import World
 
 SERVICE_MODULES = {
@@ -104,27 +107,60 @@ def run(opts: RunOptions) -> int:
         print(f"catabot run: {exc}", file=sys.stderr)
         return 2
     scenario = world.scenario
-    run_dir = make_run_dir(opts.out, scenario)
-    cond_flags, svc_flags = _endpoints(opts)
-    print(
-        f"run folder: {run_dir}\nzenoh: clients connect to {svc_flags[1]} (world "
-        f"{scenario.name!r}, keys catabot/{scenario.name}/...)",
-        flush=True,
-    )
-    scen = str(run_dir / "scenario.json")
-    conductor = _spawn(
-        ["catabot.run.conduct", "--scenario", scen, *cond_flags],
-        run_dir / "log" / "conductor.log",
-        stdout_pipe=True,
-    )
-    services = {
-        name: _spawn(
-            [SERVICE_MODULES[name], "--scenario", scen, "--run-dir", str(run_dir), *svc_flags],
-            run_dir / "log" / f"{name}.log",
+    stops = Stops()
+    with stops.installed():  # from before the first process starts
+        run_dir = make_run_dir(opts.out, scenario)
+        cond_flags, svc_flags = _endpoints(opts)
+        print(
+            f"run folder: {run_dir}\nzenoh: clients connect to {svc_flags[1]} (world "
+            f"{scenario.name!r}, keys catabot/{scenario.name}/...)",
+            flush=True,
         )
-        for name in world.services
-    }
-    return Supervisor(scenario, run_dir, conductor, services, quiet=opts.quiet).wait()
+        scen = str(run_dir / "scenario.json")
+        stops.conductor = conductor = _spawn(
+            ["catabot.run.conduct", "--scenario", scen, *cond_flags],
+            run_dir / "log" / "conductor.log",
+            stdout_pipe=True,
+        )
+        services = {
+            name: _spawn(
+                [SERVICE_MODULES[name], "--scenario", scen, "--run-dir", str(run_dir), *svc_flags],
+                run_dir / "log" / f"{name}.log",
+            )
+            for name in world.services
+        }
+        return Supervisor(scenario, run_dir, conductor, services, stops, quiet=opts.quiet).wait()
+
+
+class Stops:
+    """Ctrl-C, SIGTERM and SIGHUP all end the run cleanly through the conductor (a launcher
+    killed by its shell or a process manager must leave no orphans ticking). A request is
+    held until the conductor says it is ready: a signal before its handlers are set would
+    kill it outright."""
+
+    def __init__(self) -> None:
+        self.requested = False
+        self.ready = threading.Event()
+        self.conductor: subprocess.Popen[str] | None = None
+
+    @contextlib.contextmanager
+    def installed(self) -> Iterator[None]:
+        signals = (signal.SIGINT, signal.SIGTERM, signal.SIGHUP)
+        previous = {sig: signal.signal(sig, self._on_signal) for sig in signals}
+        try:
+            yield
+        finally:
+            for sig, handler in previous.items():
+                signal.signal(sig, handler)
+
+    def _on_signal(self, *_: object) -> None:
+        self.requested = True
+        self.forward()
+
+    def forward(self) -> None:
+        """Pass a held request to the conductor once it takes signals."""
+        if self.requested and self.ready.is_set() and self.conductor is not None:
+            self.conductor.send_signal(signal.SIGINT)
 
 
 class Supervisor:
@@ -136,28 +172,19 @@ class Supervisor:
         run_dir: Path,
         conductor: subprocess.Popen[str],
         services: dict[str, subprocess.Popen[str]],
+        stops: Stops,
         *,
         quiet: bool,
     ) -> None:
         self.scenario, self.run_dir = scenario, run_dir
-        self.conductor, self.services = conductor, services
+        self.conductor, self.services, self.stops = conductor, services, stops
         self.bar = ProgressBar(scenario.duration_ns, enabled=not quiet)
         self.result: dict[str, object] = {}
+        self.stopped: set[str] = set()  # services the launcher had to stop
 
     def wait(self) -> int:
-        """Ctrl-C, SIGTERM and SIGHUP all end the run cleanly through the conductor: a
-        launcher killed by its shell or a process manager must not leave orphans ticking."""
-        stops = (signal.SIGINT, signal.SIGTERM, signal.SIGHUP)
-        previous = {
-            sig: signal.signal(sig, lambda *_: self.conductor.send_signal(signal.SIGINT))
-            for sig in stops
-        }
-        try:
-            self._read_conductor()
-            self._reap_services(timeout_s=15.0)
-        finally:
-            for sig, handler in previous.items():
-                signal.signal(sig, handler)
+        self._read_conductor()
+        self._reap_services(timeout_s=self._reap_timeout())
         return self._summary()
 
     def _read_conductor(self) -> None:
@@ -181,17 +208,28 @@ class Supervisor:
                 event = json.loads(line)
             except json.JSONDecodeError:
                 continue
-            if event.get("kind") == "progress":
+            if event.get("kind") == "ready":
+                self.stops.ready.set()
+                self.stops.forward()
+            elif event.get("kind") == "progress":
                 self.bar.update(event)
             elif event.get("kind") == "result":
                 self.result = event
 
+    def _reap_timeout(self) -> float:
+        """Services end by themselves after the conductor's End (15 s allows their last
+        flush); a service still starting when an interrupted run ended never joined, so it
+        never hears the End: it is stopped at once, and not blamed (`self.stopped`)."""
+        joined = int(self.result.get("ticks_done", 0)) > 0  # type: ignore[call-overload]
+        return 15.0 if joined or self.result.get("reason") != "interrupted" else 1.0
+
     def _reap_services(self, *, timeout_s: float) -> None:
         limit = time.monotonic() + timeout_s
-        for proc in self.services.values():
+        for name, proc in self.services.items():
             try:
                 proc.wait(timeout=max(limit - time.monotonic(), 0.1))
             except subprocess.TimeoutExpired:
+                self.stopped.add(name)
                 proc.terminate()
                 try:
                     proc.wait(timeout=3)
@@ -200,12 +238,11 @@ class Supervisor:
                     proc.wait()
 
     def _summary(self) -> int:
-        from catabot.run.summary import summarise
-
         return summarise(
             self.scenario,
             self.run_dir,
             self.result,
             self.conductor.returncode,
             {n: p.returncode for n, p in self.services.items()},
+            stopped=self.stopped,
         )

@@ -41,12 +41,16 @@ def summarise(
     result: Mapping[str, object],
     conductor_code: int | None,
     service_codes: Mapping[str, int | None],
+    *,
+    stopped: set[str] | frozenset[str] = frozenset(),
 ) -> int:
     ticks = int(result.get("ticks_done", 0))  # type: ignore[call-overload]
     wall = float(result.get("wall_s", 0.0))  # type: ignore[arg-type]
     sim_s = ticks * scenario.dt_ns / 1e9
     error = str(result.get("error", "") or "")
-    failed = {n: c for n, c in service_codes.items() if c not in (0, None)}
+    interrupted = result.get("reason") == "interrupted" or conductor_code == 130
+    unjoined = stopped if interrupted and not ticks else set()  # stopped while still starting
+    failed = {n: c for n, c in service_codes.items() if c not in (0, None) and n not in unjoined}
     if not result:
         error = error or f"the conductor ended without a result ({describe_exit(conductor_code)})"
     elif not error and failed:
@@ -66,17 +70,16 @@ def summarise(
         f"{ticks} ticks, {sim_s:.2f} s simulated in {wall:.2f} s "
         f"({ticks / max(wall, 1e-9):.0f} ticks/s, real-time factor {rtf:.1f})"
     )
-    for name, code in service_codes.items():
-        if code not in (0, None):
-            print(
-                f"  {name}: {describe_exit(code)} (see {run_dir / 'log' / (name + '.log')})",
-                file=sys.stderr,
-            )
+    for name in sorted(unjoined):
+        print(f"  {name}: stopped by catabot run before it joined", file=sys.stderr)
+    for name, code in failed.items():
+        log = run_dir / "log" / f"{name}.log"
+        print(f"  {name}: {describe_exit(code)} (see {log})", file=sys.stderr)
     print(f"run folder: {run_dir}")
     if error:
         print(f"run failed: {error}", file=sys.stderr)
         return 1
-    if result.get("reason") == "interrupted" or conductor_code == 130:
+    if interrupted:
         print("run interrupted; files are complete up to the last tick", file=sys.stderr)
         return 130
     return 0

@@ -35,6 +35,7 @@ from catabot.config.scenario import (
     services,
 )
 from catabot.config.vessel import VesselModel, load_vessel_model
+from catabot.world.environment.current import CurrentField
 from catabot.world.placement import resolve_poses
 from catabot.world.streams import Streams
 from catabot.world.terrain import Terrain, load_terrain
@@ -87,10 +88,11 @@ class MountedSensor:
         return self.config.typed_params()
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, eq=False)  # compared by identity: it holds arrays and meshes
 class World:
     scenario: Scenario  # with every start pose resolved
     terrain: Terrain | None
+    current: CurrentField  # the water current, its map read once
     bodies: tuple[Body, ...]
     traffic: TrafficPlan
     sensors: tuple[MountedSensor, ...]
@@ -99,6 +101,7 @@ class World:
     def resolve(cls, scenario: Scenario) -> World:
         """Everything a run needs from its scenario; ScenarioError names what cannot run."""
         terrain = _terrain(scenario)
+        current = CurrentField.from_config(scenario.water.current)
         scenario = resolve_poses(scenario, terrain)
         plan = plan_traffic(scenario, terrain)
         bodies = _bodies(scenario, plan)
@@ -108,7 +111,7 @@ class World:
             for v in scenario.vessels
             for s in v.sensors
         )
-        return cls(scenario, terrain, bodies, plan, sensors)
+        return cls(scenario, terrain, current, bodies, plan, sensors)
 
     @cached_property
     def keys(self) -> Keys:

@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-from catabot.world.environment.current import CurrentField
 from catabot.world.environment.wind import WindField
 from catabot.world.waves import WaveField
 from catabot.world.world import World
@@ -20,7 +19,7 @@ def build_world(world: World) -> PhysicsWorld:
         water_density=scenario.water.density_kg_m3,
         waves=WaveField(scenario.water.waves, scenario.seed),
         terrain=world.terrain,
-        current=CurrentField.from_config(scenario.water.current),
+        current=world.current,
         wind=WindField(scenario.wind, seed=scenario.seed),
         buoys=[(b.id, (b.pose.x_m, b.pose.y_m)) for b in buoys],
         buoy_model=buoys[0].model if buoys else None,

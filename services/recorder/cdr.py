@@ -76,8 +76,7 @@ class _Layout:
 
 
 def _stamp(stamp_ns: int) -> tuple[int, int]:
-    """builtin_interfaces/Time (sec, nanosec); floor division keeps nanosec >= 0, as
-    `ros2_msgdefs.stamp` does."""
+    """builtin_interfaces/Time (sec, nanosec), as `ros2_msgdefs.stamp` gives it."""
     return divmod(stamp_ns, NS_PER_S)
 
 
@@ -110,7 +109,7 @@ def odometry_encoder(
     """CDR encoder of `nav_msgs/msg/Odometry` for one pair of frame ids.
 
     Pose in `frame_id`, twist in `child_frame_id`; the covariances are zero and the
-    accelerations have no place in Odometry (see `ros2_msgdefs.odometry`, the same mapping).
+    accelerations have no place in Odometry (they are in the CSV of the same stream).
     """
     pack = odometry_packer(frame_id, child_frame_id)
 

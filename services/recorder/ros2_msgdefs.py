@@ -8,10 +8,7 @@ ROS and Foxglove Studio or `ros2 bag` read the file as native `nav_msgs/msg/Odom
 
 from __future__ import annotations
 
-from typing import Any
-
 from catabot.bus.clock import NS_PER_S
-from catabot.bus.messages import VesselState
 
 ODOMETRY = "nav_msgs/msg/Odometry"
 WORLD_FRAME = "map"
@@ -108,40 +105,8 @@ Quaternion rotation
 )
 """`tf2_msgs/msg/TFMessage`: every body's frame in `map`, one message a tick on `/tf`."""
 
-_ZERO_COVARIANCE = [0.0] * 36  # unknown covariance; the simulator has the exact state
-
-
-def _xyz(v: tuple[float, ...]) -> dict[str, float]:
-    return {"x": v[0], "y": v[1], "z": v[2]}
-
 
 def stamp(stamp_ns: int) -> dict[str, int]:
     """builtin_interfaces/Time from simulated nanoseconds (floor division keeps nanosec >= 0)."""
     sec, nanosec = divmod(stamp_ns, NS_PER_S)
     return {"sec": sec, "nanosec": nanosec}
-
-
-def odometry(state: VesselState, child_frame_id: str, stamp_ns: int) -> dict[str, Any]:
-    """A VesselState as Odometry: pose in `map`, twist in the body frame (`child_frame_id`).
-
-    The accelerations have no place in Odometry; they are in the CSV of the same stream.
-    """
-    x, y, z, w = state.orientation
-    return {
-        "header": {"stamp": stamp(stamp_ns), "frame_id": WORLD_FRAME},
-        "child_frame_id": child_frame_id,
-        "pose": {
-            "pose": {
-                "position": _xyz(state.position),
-                "orientation": {"x": x, "y": y, "z": z, "w": w},
-            },
-            "covariance": _ZERO_COVARIANCE,
-        },
-        "twist": {
-            "twist": {
-                "linear": _xyz(state.linear_velocity),
-                "angular": _xyz(state.angular_velocity),
-            },
-            "covariance": _ZERO_COVARIANCE,
-        },
-    }

@@ -39,6 +39,7 @@ from services.sensors.common import (
     rows_of,
 )
 from services.sensors.cull import cone_pairs, sphere_pairs
+from services.sensors.slab import slab
 from services.sensors.terrain_cast import TerrainCaster
 from services.sensors.water import calm_hits, wave_hits
 
@@ -266,7 +267,7 @@ class Scene:
         rel = rows_of(o, ray_i) - take(self._pos, body_i, axis=0)
         ob = np.einsum("pji,pj->pi", rot, rel)  # R^T (o - p)
         db = np.einsum("pji,pj->pi", rot, take(d, ray_i, axis=0))
-        t, face_b = _slab(ob, db, take(self._lo, body_i, axis=0), take(self._hi, body_i, axis=0))
+        t, face_b = slab(ob, db, take(self._lo, body_i, axis=0), take(self._hi, body_i, axis=0))
         ok = np.flatnonzero((t <= max_range) & (t < take(rng, ray_i)))
         ray_i, body_i, t = take(ray_i, ok), take(body_i, ok), take(t, ok)
         face = np.einsum("pij,pj->pi", take(rot, ok, axis=0), take(face_b, ok, axis=0))
@@ -331,27 +332,3 @@ def _rays(origins: np.ndarray, directions: np.ndarray) -> tuple[F64, F64]:
         return o, d / norm[:, None]
     d /= norm[:, None]  # a fresh float64 copy made above
     return o, d
-
-
-def _slab(ob: F64, db: F64, lo: F64, hi: F64) -> tuple[F64, F64]:
-    """Entry distance of rays (body frame) into boxes lo..hi (inf if missed or behind), and
-    the outward normal of the entry face (body frame). A ray starting inside hits at 0.
-    Worked per axis on (3, P) copies: reductions over a trailing axis of 3 are slow."""
-    obt, dbt = ob.T.copy(), db.T.copy()
-    with np.errstate(divide="ignore", invalid="ignore"):
-        inv = 1.0 / dbt
-        t1, t2 = (lo.T - obt) * inv, (hi.T - obt) * inv
-    t1[np.isnan(t1)] = -np.inf  # parallel ray on a face plane: not limiting
-    t2[np.isnan(t2)] = np.inf
-    near, far = np.minimum(t1, t2), np.maximum(t1, t2)
-    axis = (near[1] > near[0]).astype(np.intp)  # the first axis of the largest entry
-    t_in = np.maximum(near[0], near[1])
-    axis[near[2] > t_in] = 2
-    t_in = np.maximum(t_in, near[2])
-    t_out = np.minimum(np.minimum(far[0], far[1]), far[2])
-    hit = (t_in <= t_out) & (t_out >= 0.0)
-    t = np.where(hit, np.maximum(t_in, 0.0), np.inf)
-    face = np.zeros_like(ob)
-    rows = np.arange(ob.shape[0])
-    face[rows, axis] = -np.sign(dbt[axis, rows])
-    return t, face

@@ -8,7 +8,7 @@ from typing import Any
 
 from conftest import basic_scenario, catabot, csv_rows, only_run_dir, scenario_file
 
-from services.recorder.mcap_sink import read_mcap_messages
+from services.recorder.mcap_read import read_mcap_messages
 
 
 def _scenario() -> dict[str, Any]:

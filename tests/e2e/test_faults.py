@@ -29,7 +29,7 @@ from catabot.bus.keys import Keys
 from catabot.bus.messages import ThrustCmd
 from catabot.bus.session import Connection, free_port, open_session
 from catabot.config.scenario import ClockConfig
-from services.recorder.mcap_sink import read_mcap_messages
+from services.recorder.mcap_read import read_mcap_messages
 
 HERE = Path(__file__).parent
 
@@ -51,7 +51,7 @@ def _assert_readable(run: Path) -> int:
 def test_sigkill_of_a_service_ends_the_run_naming_it(tmp_path: Path, out: Path) -> None:
     proc = start("run", str(_long(tmp_path)), "--out", str(out), "--quiet")
     wait_for_line(proc, "zenoh:")
-    time.sleep(2.0)
+    _wait_for_rows(out, 20)
     os.kill(service_pid(proc.pid, "services.physics"), signal.SIGKILL)
     killed = time.monotonic()
     _, err = proc.communicate(timeout=30)
@@ -145,7 +145,7 @@ def test_ctrl_c_ends_every_process_with_complete_files(
     """Ctrl-C, and a SIGTERM from a shell or a process manager, end the run cleanly."""
     proc = start("run", str(_long(tmp_path)), "--out", str(out), "--quiet")
     wait_for_line(proc, "zenoh:")
-    time.sleep(2.0)
+    _wait_for_rows(out, 20)
     children = psutil.Process(proc.pid).children(recursive=True)
     proc.send_signal(sig)
     _, err = proc.communicate(timeout=30)
@@ -159,12 +159,35 @@ def test_ctrl_c_ends_every_process_with_complete_files(
         assert make_reader(f).get_summary() is not None, "MCAP closed with a summary"
 
 
+def _wait_for_rows(out: Path, rows: int, limit_s: float = 30.0) -> None:
+    """Until the run has recorded `rows` states (it has started, whatever the machine's load)."""
+    end = time.monotonic() + limit_s
+    while time.monotonic() < end:
+        states = list(out.glob("*/vessel.ego.state.csv"))
+        if states and len(states[0].read_bytes().splitlines()) > rows:
+            return
+        time.sleep(0.1)
+    raise AssertionError(f"no {rows} states recorded in {limit_s} s")
+
+
+def test_a_stop_before_the_services_join_ends_the_run_cleanly(tmp_path: Path, out: Path) -> None:
+    """Ctrl-C while the services are still starting: exit 130, nobody blamed, no orphans."""
+    proc = start("run", str(_long(tmp_path)), "--out", str(out), "--quiet")
+    wait_for_line(proc, "zenoh:")
+    children = psutil.Process(proc.pid).children(recursive=True)
+    proc.send_signal(signal.SIGINT)
+    _, err = proc.communicate(timeout=30)
+    assert proc.returncode == 130, err
+    assert "failed" not in err and "Traceback" not in err
+    assert not [c for c in children if c.is_running() and c.status() != psutil.STATUS_ZOMBIE]
+
+
 def test_killed_launcher_leaves_no_orphans(tmp_path: Path, out: Path) -> None:
     """SIGKILL of `catabot run` (no handler runs): the conductor finds its stdout gone at
     the next progress line and ends the run, so every service flushes and exits."""
     proc = start("run", str(_long(tmp_path)), "--out", str(out), "--quiet")
     wait_for_line(proc, "zenoh:")
-    time.sleep(2.0)
+    _wait_for_rows(out, 20)
     children = psutil.Process(proc.pid).children(recursive=True)
     proc.kill()
     proc.communicate(timeout=10)

@@ -7,7 +7,7 @@ from pathlib import Path
 import numpy as np
 from conftest import basic_scenario, catabot, csv_rows, only_run_dir, scenario_file
 
-from services.recorder.mcap_sink import read_mcap_messages
+from services.recorder.mcap_read import read_mcap_messages
 
 
 def test_lidar_in_rain_is_recorded_as_point_clouds(tmp_path: Path, out: Path) -> None:

@@ -21,7 +21,7 @@ from conftest import (
 )
 
 from catabot.config.vessel import load_vessel_model
-from services.recorder.mcap_sink import read_mcap_messages
+from services.recorder.mcap_read import read_mcap_messages
 
 
 def test_default_run_writes_run_folder_and_floats_at_archimedes_draft(out: Path) -> None:

@@ -10,10 +10,10 @@ from conftest import basic_scenario, catabot, csv_rows, only_run_dir, scenario_f
 
 from catabot.config.terrain import TerrainConfig
 from catabot.world.terrain import load_terrain
+from tests.paths import BAY, SHARED_DATA
 
-SHARED = Path(__file__).resolve().parents[3] / "shared" / "data" / "elevation"
+SHARED = SHARED_DATA / "elevation"
 RIVER = SHARED / "new-york-river.png"
-BAY = Path(__file__).resolve().parents[2] / "catabot" / "data" / "terrain" / "bay.png"
 
 
 def _bay(**vessel: object) -> dict[str, object]:
@@ -63,3 +63,31 @@ def test_vessel_without_pose_starts_in_the_new_york_river(tmp_path: Path, out: P
     assert abs(pose["x_m"] - w / 2) < 400 and abs(pose["y_m"] - h / 2) < 400
     rows = csv_rows(run / "vessel.ego.state.csv")
     assert len(rows) == 201
+
+
+@pytest.mark.skipif(not RIVER.is_file(), reason="needs ../shared/data/elevation")
+def test_an_original_settings_config_runs_on_its_terrain_with_radar(
+    tmp_path: Path, out: Path
+) -> None:
+    """The original's SettingsConfig.json with terrainFromFile: robot_0 starts in the river
+    (not at (0, 0) in open water), the radar runs and its minimap is written."""
+    (tmp_path / "New York River Elevation.png").symlink_to(RIVER)
+    settings = {
+        "radarActive": True, "lidarActive": False, "imuActive": True, "minimapActive": True,
+        "rainIntensity": 0.0, "screenshotsSaveToFile": False, "screenshotsColorActive": False,
+        "screenshotsSegmentationActive": False, "screenshotsDepthActive": False,
+        "screenshotsNormalActive": False, "robotControlType": "Keyboard",
+        "boatControlType": "Circles", "boatsNumberActive": 0, "gpsLatitude": 40.7003,
+        "gpsLongitude": -74.017, "terrainFromFile": True, "terrainHeightMin": -35.0,
+        "terrainHeightMax": 60.0, "terrainPixelScale": 5.0,
+        "terrainPathToElevationFile": "New York River Elevation.png",
+    }  # fmt: skip
+    path = scenario_file(tmp_path, settings, "SettingsConfig.json")
+    result = catabot("run", str(path), "--duration", "2.1", "--out", str(out), "--quiet")
+    assert result.returncode == 0, result.stderr
+    run = only_run_dir(out)
+    x, y = (float(v) for v in csv_rows(run / "vessel.robot_0.state.csv")[1][2:4])
+    terrain = load_terrain(TerrainConfig(elevation_image=str(RIVER)))
+    assert (x, y) != (0.0, 0.0) and terrain.depth(x, y) > 1.0
+    assert len(csv_rows(run / "sensor.robot_0.radar.csv")) > 10
+    assert list((run / "dataset" / "robot_0.radar").glob("ppi_*.png"))

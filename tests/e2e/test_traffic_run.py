@@ -18,8 +18,8 @@ from catabot.config.load import load_scenario
 from catabot.config.scenario import ClockConfig
 from catabot.world.terrain import load_terrain
 from catabot.world.world import World
+from tests.paths import BAY
 
-BAY = Path(__file__).resolve().parents[2] / "catabot" / "data" / "terrain" / "bay.png"
 CIRCLE_RATE = math.radians(15.0)  # 5 m/s on the default 19.1 m circle
 
 

@@ -11,9 +11,9 @@ from pathlib import Path
 import pytest
 
 from catabot.bus.session import free_port
+from tests.paths import REPO
 
 pytestmark = pytest.mark.timeout(180)
-REPO = Path(__file__).resolve().parents[2]
 EXAMPLES = REPO / "examples"
 
 

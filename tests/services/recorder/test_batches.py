@@ -11,7 +11,8 @@ from catabot.bus.messages import BodyStates, TwistBatch, TwistCmd, VesselState
 from services.recorder import cdr, json_schemas, ros2_msgdefs
 from services.recorder.batches import BatchFormatter, Block
 from services.recorder.csv_sink import CsvSink, RecorderError
-from services.recorder.mcap_sink import McapSink, read_mcap_messages
+from services.recorder.mcap_read import read_mcap_messages
+from services.recorder.mcap_sink import McapSink
 
 IDS = ("ego", "boat_000", "buoy_0")
 BOATS = ("boat_000",)

@@ -12,7 +12,8 @@ from mcap_ros2.decoder import DecoderFactory
 
 from catabot.bus.messages import Message, ThrustCmd, TwistCmd, VesselState
 from services.recorder.csv_sink import CsvSink, RecorderError
-from services.recorder.mcap_sink import McapSink, read_mcap_messages
+from services.recorder.mcap_read import read_mcap_messages
+from services.recorder.mcap_sink import McapSink
 
 STATE = "vessel/ego/state"
 THRUST = "vessel/ego/cmd/thrust"

@@ -19,7 +19,7 @@ from catabot.bus.clock import Stream
 from catabot.bus.inbox import Inputs
 from catabot.bus.messages import Ack, GpsFix, Tick
 from catabot.bus.participant import Participant
-from tests.catabot.lockstep_world import DT_NS, Member, Step, World, _fix
+from tests.catabot.bus.lockstep_world import DT_NS, Member, Step, World, _fix
 
 # -- (a) the happy path -------------------------------------------------------------------
 

@@ -230,8 +230,8 @@ def test_sensor_rate_3_hz_refused() -> None:
 
 def test_sensor_period_not_a_whole_number_of_ns() -> None:
     data = _base()
-    data["dt_ns"] = 333_333_333  # 3 Hz is then one tick, but 1/3 s is no whole number of ns
-    data["vessels"][0]["sensors"] = [{"name": "imu", "type": "imu", "rate_hz": 3.0}]
+    data["dt_ns"] = 33_333_333  # 30 Hz is then one tick, but 1/30 s is no whole number of ns
+    data["vessels"][0]["sensors"] = [{"name": "imu", "type": "imu", "rate_hz": 30.0}]
     msg = _error(data)
     assert "vessels.0.sensors.0.rate_hz (ego/imu)" in msg
     assert "not a whole number of ns" in msg

@@ -13,8 +13,9 @@ from pydantic import ValidationError
 
 from catabot.config.terrain import TerrainConfig, TerrainError
 from catabot.world.terrain import MAX_MESH_TRIANGLES, Terrain, load_terrain
+from tests.paths import NEW_YORK_RIVER
 
-REAL_IMAGE = Path("/work/shared/data/elevation/new-york-river.png")
+REAL_IMAGE = NEW_YORK_RIVER
 LO, HI, MPP = -35.0, 60.0, 5.0
 # 3 rows x 4 columns, row 0 = north; the bright pixel is the top-left one.
 PIXELS = np.array([[255, 10, 20, 30], [40, 50, 60, 70], [80, 90, 100, 0]], dtype=np.uint8)

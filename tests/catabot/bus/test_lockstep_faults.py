@@ -13,7 +13,7 @@ from catabot.bus.clock import Policy, Stream
 from catabot.bus.inbox import Inputs
 from catabot.bus.messages import Tick, VesselState
 from catabot.bus.participant import Participant
-from tests.catabot.lockstep_world import Step, World, _fix, _state
+from tests.catabot.bus.lockstep_world import Step, World, _fix, _state
 
 # -- (c) deadline -------------------------------------------------------------------------
 

@@ -4,7 +4,7 @@ from collections.abc import Iterator
 
 import pytest
 
-from tests.catabot.lockstep_world import World
+from tests.catabot.bus.lockstep_world import World
 
 
 @pytest.fixture

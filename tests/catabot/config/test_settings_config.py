@@ -13,6 +13,7 @@ from catabot.config.load import load_scenario, parse_scenario
 from catabot.config.scenario import ScenarioError
 from catabot.config.settings_config import is_settings_config
 from catabot.world.world import World
+from tests.paths import BAY
 
 # The original CataBotSim defaults (reference/anchors.md).
 ORIGINAL_DEFAULTS: dict[str, Any] = {
@@ -178,7 +179,7 @@ def test_screenshots_become_a_camera_with_those_outputs() -> None:
 
 
 def test_terrain_from_file_is_read_relative_to_the_settings_file(tmp_path: Path) -> None:
-    bay = Path(__file__).resolve().parents[2] / "catabot" / "data" / "terrain" / "bay.png"
+    bay = BAY
     (tmp_path / "maps").mkdir()
     (tmp_path / "maps" / "river.png").write_bytes(bay.read_bytes())
     data = _settings(

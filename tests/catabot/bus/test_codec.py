@@ -23,7 +23,7 @@ from catabot.bus.messages import (
 )
 
 # -- messages -----------------------------------------------------------------------------
-from tests.catabot.codec_samples import DTYPES, SAMPLES, _body, _payload, _root, _same
+from tests.catabot.bus.codec_samples import DTYPES, SAMPLES, _body, _payload, _root, _same
 
 
 def test_samples_cover_every_message_type() -> None:

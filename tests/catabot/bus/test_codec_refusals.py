@@ -20,7 +20,7 @@ from catabot.bus.messages import (
 )
 
 # -- refusals -----------------------------------------------------------------------------
-from tests.catabot.codec_samples import SAMPLES, _body, _payload
+from tests.catabot.bus.codec_samples import SAMPLES, _body, _payload
 
 
 def _ext(header: object, raw: bytes = b"", *, hlen: int | None = None) -> bytes:
