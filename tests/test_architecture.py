@@ -15,6 +15,7 @@ LAYERS = {  # what each part of the library may import from the project, besides
     "catabot.config": {"catabot.errors", "catabot.bus"},
     "catabot.world": {"catabot.errors", "catabot.bus", "catabot.config"},
     "catabot.run": {"catabot.errors", "catabot.bus", "catabot.config", "catabot.world"},
+    "catabot.ros2": {"catabot.errors", "catabot.bus", "catabot.config", "catabot.world"},
 }
 PROJECT = ("catabot", "services")
 

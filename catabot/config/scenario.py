@@ -30,6 +30,7 @@ from catabot.config.base import (
     unique,
 )
 from catabot.config.environment import CurrentConfig, RainConfig, WindConfig
+from catabot.config.ros import GATEWAY, RosConfig, check_ros
 from catabot.config.sensors import SENSOR_TYPES
 from catabot.config.terrain import TerrainConfig
 from catabot.config.traffic import TrafficConfig
@@ -187,11 +188,17 @@ class Scenario(Strict):
     vessels: list[VesselConfig] = Field(min_length=1)
     traffic: TrafficConfig = TrafficConfig()
     recording: RecordingConfig = RecordingConfig()
+    ros: RosConfig | None = Field(None, description="the ROS 2 gateway (services/ros)")
 
     @field_validator("vessels")
     @classmethod
     def _unique_ids(cls, vessels: list[VesselConfig]) -> list[VesselConfig]:
         return unique(vessels, attr="id", what="vessel ids")
+
+    @model_validator(mode="after")
+    def _ros_names(self) -> Scenario:
+        check_ros(self.ros, self.vessels, self.traffic.boat_ids)
+        return self
 
     @property
     def duration_ns(self) -> int:
@@ -213,6 +220,8 @@ def check_rates(scenario: Scenario) -> None:
             rate_in_ticks(vessel.controller.rate_hz, scenario.dt_ns, where=where)
     if scenario.traffic.count:
         guidance_period_ticks(scenario)
+    if scenario.ros is not None and scenario.ros.clock_hz is not None:
+        rate_in_ticks(scenario.ros.clock_hz, scenario.dt_ns, where="ros.clock_hz")
     try:
         scenario.ticks  # noqa: B018 - validates duration against dt
     except ClockError as exc:
@@ -245,12 +254,17 @@ def services(scenario: Scenario) -> list[str]:
         names.append("traffic")
     if scenario.recording.csv or scenario.recording.mcap:
         names.append("recorder")
+    if scenario.ros is not None:
+        names.append(GATEWAY)
     return names
 
 
 def participants(scenario: Scenario) -> list[str]:
-    """Every stepping participant of the run: services, then external ones (named in
+    """Every stepping participant of the run: services (the ROS gateway only with
+    `ros.lockstep`: otherwise it observes), then external ones (named in
     `clock.external_participants` or as a vessel's controller), each once."""
+    observer = scenario.ros is not None and not scenario.ros.lockstep
+    stepping = [s for s in services(scenario) if not (observer and s == GATEWAY)]
     controllers = [v.controller.participant for v in scenario.vessels if v.controller]
     external = dict.fromkeys([*scenario.clock.external_participants, *controllers])
-    return services(scenario) + [n for n in external if n not in services(scenario)]
+    return stepping + [n for n in external if n not in stepping]

@@ -88,6 +88,10 @@ class BoatOverride(Strict):
     points: list[Point] | None = None
 
 
+def boat_id(index: int) -> str:
+    return f"boat_{index:03d}"
+
+
 class TrafficConfig(Strict):
     count: int = Field(0, ge=0, le=500)
     models: list[ModelWeight] = [ModelWeight()]
@@ -113,6 +117,11 @@ class TrafficConfig(Strict):
         description="extra ticks before physics applies a boat's set-point (autopilot latency); "
         "lets physics step ahead of the traffic service; 0 = the one-tick minimum",
     )
+
+    @property
+    def boat_ids(self) -> list[str]:
+        """The boats' ids, in `TwistBatch` order: they name keys, files and ROS topics."""
+        return [boat_id(i) for i in range(self.count)]
 
     @field_validator("models")
     @classmethod

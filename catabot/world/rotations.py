@@ -92,3 +92,23 @@ def rpy(roll_deg: float, pitch_deg: float, yaw_deg: float) -> Array:
     ry = np.array([[cp, 0.0, sp], [0.0, 1.0, 0.0], [-sp, 0.0, cp]])
     rx = np.array([[1.0, 0.0, 0.0], [0.0, cr, -sr], [0.0, sr, cr]])
     return rz @ ry @ rx
+
+
+def quaternion_of_matrix(rot: Array) -> tuple[float, float, float, float]:
+    """The unit quaternion (x, y, z, w, w >= 0) of a rotation matrix (Shepperd's method:
+    the largest of the four candidates is computed first, so no square root goes near 0)."""
+    m = np.asarray(rot, dtype=np.float64)
+    trace = float(m[0, 0] + m[1, 1] + m[2, 2])
+    diag = [float(m[i, i]) for i in range(3)]
+    if trace >= max(diag):
+        s = 2.0 * math.sqrt(1.0 + trace)
+        q = ((m[2, 1] - m[1, 2]) / s, (m[0, 2] - m[2, 0]) / s, (m[1, 0] - m[0, 1]) / s, s / 4)
+    else:
+        i = diag.index(max(diag))
+        j, k = (i + 1) % 3, (i + 2) % 3
+        s = 2.0 * math.sqrt(1.0 + m[i, i] - m[j, j] - m[k, k])
+        v = [0.0, 0.0, 0.0]
+        v[i], v[j], v[k] = s / 4, (m[j, i] + m[i, j]) / s, (m[k, i] + m[i, k]) / s
+        q = (v[0], v[1], v[2], (m[k, j] - m[j, k]) / s)
+    x, y, z, w = (float(c) for c in q)
+    return (-x, -y, -z, -w) if w < 0 else (x, y, z, w)

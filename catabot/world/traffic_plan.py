@@ -16,7 +16,14 @@ import numpy as np
 
 from catabot.config.scenario import BuoyConfig, Pose, Scenario, ScenarioError
 from catabot.config.terrain import TerrainError
-from catabot.config.traffic import BEHAVIOURS, BoatOverride, Point, Region, TrafficConfig
+from catabot.config.traffic import (
+    BEHAVIOURS,
+    BoatOverride,
+    Point,
+    Region,
+    TrafficConfig,
+    boat_id,
+)
 from catabot.config.vessel import VesselModel, load_vessel_model
 from catabot.world import seeding
 from catabot.world.placement import CLEARANCE_M, footprint_m, keel_depth_m
@@ -46,10 +53,6 @@ class Boat:
 class TrafficPlan:
     boats: tuple[Boat, ...]
     buoys: tuple[BuoyConfig, ...]
-
-
-def boat_id(index: int) -> str:
-    return f"boat_{index:03d}"
 
 
 def plan_traffic(scenario: Scenario, terrain: Terrain | None) -> TrafficPlan:

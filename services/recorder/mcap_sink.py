@@ -1,7 +1,9 @@
-"""`run.mcap`: every stream as an MCAP channel (DESIGN.md §7).
+"""`run.mcap` (ROS 2 only) and `run.extra.mcap` (the rest, JSON) (DESIGN.md §7).
 
-States are ROS 2 `nav_msgs/msg/Odometry`, LiDAR scans `sensor_msgs/msg/PointCloud2` (CDR); other
-messages are JSON with a JSON Schema from their dataclass, so Foxglove Studio opens every channel.
+`run.mcap` has the `ros2` profile and only CDR channels with `ros2msg` schemas from
+rosbags' Jazzy store (catabot/ros2/types.py), so rosbags' `AnyReader`, `ros2 bag` and
+Foxglove read it as a ROS 2 bag. What has no ROS 2 type (camera boxes and labels, or any
+future message without a conversion) goes to `run.extra.mcap`: JSON with a JSON Schema.
 
 Why it is written this way:
 - Unchunked records, and bytes reach the file only in `flush()` (once per tick): a recorder
@@ -15,10 +17,8 @@ from __future__ import annotations
 
 import io
 import json
-import struct
 import typing
 from collections.abc import Sequence
-from dataclasses import dataclass
 from pathlib import Path
 from typing import Any, BinaryIO
 
@@ -27,16 +27,11 @@ from mcap.well_known import MessageEncoding, SchemaEncoding
 from mcap.writer import LIBRARY_IDENTIFIER
 from numpy.typing import NDArray
 
-from catabot.bus.messages import CameraFrame, LidarScan, Message, VesselState
-from services.recorder import cdr, images, json_schemas, pointcloud, ros2_msgdefs
+from catabot.ros2 import types
 from services.recorder.csv_sink import RecorderError
 from services.recorder.mcap_writer import McapWriter
 
-_ROS2 = {  # messages written as ROS 2 types: (type name, msgdef)
-    VesselState: (ros2_msgdefs.ODOMETRY, ros2_msgdefs.ODOMETRY_MSGDEF),
-    LidarScan: (pointcloud.POINTCLOUD2, pointcloud.POINTCLOUD2_MSGDEF),
-    CameraFrame: (images.IMAGE, images.IMAGE_MSGDEF),  # one channel per output: images.py
-}
+ROS2 = "ros2"  # the profile of run.mcap
 
 
 class _TickBuffer(io.BufferedIOBase):
@@ -72,146 +67,110 @@ class _TickBuffer(io.BufferedIOBase):
         super().close()
 
 
-@dataclass
-class _Channel:
-    """A registered channel and how its messages become bytes (its sequence numbers are the
-    writer's message counts: `McapWriter.written`)."""
-
-    id: int
-    cls: type[Message]
-    encode: typing.Callable[[Message, int], bytes]
-
-
 class McapSink:
-    """Writes every stream to one MCAP file; `flush()` once per tick, `close()` at the end."""
+    """Writes one MCAP file: `flush()` once per tick, `close()` at the end. With the `ros2`
+    profile every channel is CDR of a ROS 2 type; without a profile (`run.extra.mcap`) JSON."""
 
-    def __init__(self, path: Path) -> None:
+    def __init__(self, path: Path, *, profile: str = ROS2) -> None:
+        self.profile = profile
         self._out = _TickBuffer(Path(path))
-        # profile "": channels mix CDR and JSON. The file is valid from the first byte on.
         self._writer = McapWriter(
-            typing.cast(BinaryIO, self._out), profile="", library=f"catabot {LIBRARY_IDENTIFIER}"
+            typing.cast(BinaryIO, self._out),
+            profile=profile,
+            library=f"catabot {LIBRARY_IDENTIFIER}",
         )
-        self._out.flush()
-        self._schemas: dict[type[Message] | str, int] = {}  # by message class or ROS 2 type
-        self._channels: dict[str, _Channel] = {}
-        self._groups: dict[tuple[tuple[str, ...], type[Message]], NDArray[np.uint16]] = {}
+        self._out.flush()  # the file is valid from the first byte on
+        self._schemas: dict[str, int] = {}
+        self._channels: dict[str, tuple[int, str]] = {}  # topic -> (channel id, schema name)
+        self._groups: dict[tuple[tuple[str, ...], str], NDArray[np.uint16]] = {}
         self._closed = False
 
-    def write(self, stream: str, msg: Message, *, stamp_ns: int) -> None:
-        """Add one message to channel `/<stream>`, stamped with simulated time."""
-        chan = self._channel(stream, type(msg))
-        try:
-            data = chan.encode(msg, stamp_ns)
-        except (ValueError, TypeError, IndexError, struct.error) as exc:
-            raise RecorderError(f"{stream}: cannot encode {type(msg).__name__}: {exc}") from exc
-        self._add([chan.id], stamp_ns, [data])
+    def write(self, topic: str, typename: str, data: bytes, *, stamp_ns: int) -> None:
+        """One CDR message of `typename` on `topic`, stamped with simulated time."""
+        self._add([self._ros2(topic, typename)], stamp_ns, [data])
 
     def write_block(
-        self,
-        streams: Sequence[str],
-        cls: type[Message],
-        payloads: Sequence[bytes],
-        *,
-        stamp_ns: int,
+        self, topics: Sequence[str], typename: str, payloads: Sequence[bytes], *, stamp_ns: int
     ) -> None:
-        """`payloads[i]`, already encoded as the channel of `cls` expects, on `streams[i]`:
-        the batch path (`services/recorder/batches.py`), one write for a whole tick."""
-        if not streams:
-            return
-        ids = self._group(streams, cls)
-        sequences = self._next_sequences(ids).tolist()
-        self._writer.add_messages(ids.tolist(), sequences, stamp_ns, payloads)
+        """`payloads[i]` on `topics[i]`, one write for a whole tick."""
+        if topics:
+            ids = self._group(topics, typename)
+            self._writer.add_messages(
+                ids.tolist(), self._sequences(ids).tolist(), stamp_ns, payloads
+            )
 
     def write_matrix(
-        self, streams: Sequence[str], cls: type[Message], payloads: Any, *, stamp_ns: int
+        self, topics: Sequence[str], typename: str, payloads: Any, *, stamp_ns: int
     ) -> None:
-        """`payloads` (k, L) bytes, row i on `streams[i]`: equal-length payloads (Odometry
-        of bodies with equally long ids) go into the file as one block."""
-        if not streams:
-            return
-        ids = self._group(streams, cls)
-        self._writer.add_block(ids, self._next_sequences(ids), stamp_ns, payloads)
+        """`payloads` (k, L) bytes, row i on `topics[i]`: equal-length payloads (Odometry of
+        bodies with equally long frame ids, Twists) go into the file as one block."""
+        if topics:
+            ids = self._group(topics, typename)
+            self._writer.add_block(ids, self._sequences(ids), stamp_ns, payloads)
 
-    def _group(self, streams: Sequence[str], cls: type[Message]) -> NDArray[np.uint16]:
-        """The channel ids of `streams`, looked up once: a batch names the same streams every
-        tick (per-stream work in every tick was a loop over 100 boats)."""
+    def write_json(
+        self, topic: str, schema_name: str, schema: dict[str, Any], data: bytes, *, stamp_ns: int
+    ) -> None:
+        """A JSON message with its JSON Schema (the extras file only)."""
+        if self.profile == ROS2:
+            raise RecorderError(f"{topic}: JSON has no place in a ros2 MCAP (run.extra.mcap)")
+        chan = self._channels.get(topic)
+        if chan is None:
+            text = json.dumps(schema, separators=(",", ":")).encode()
+            sid = self._schema(schema_name, SchemaEncoding.JSONSchema, text)
+            chan = self._register(topic, MessageEncoding.JSON, sid, schema_name)
+        self._check(topic, chan, schema_name)
+        self._add([chan[0]], stamp_ns, [data])
+
+    def _ros2(self, topic: str, typename: str) -> int:
+        if self.profile != ROS2:
+            raise RecorderError(f"{topic}: CDR belongs in run.mcap")
+        chan = self._channels.get(topic)
+        if chan is None:
+            sid = self._schema(typename, SchemaEncoding.ROS2, types.msgdef(typename).encode())
+            chan = self._register(topic, MessageEncoding.CDR, sid, typename)
+        self._check(topic, chan, typename)
+        return chan[0]
+
+    def _schema(self, name: str, encoding: str, data: bytes) -> int:
+        if name not in self._schemas:
+            self._schemas[name] = self._writer.register_schema(name, encoding, data)
+        return self._schemas[name]
+
+    def _register(self, topic: str, encoding: str, sid: int, name: str) -> tuple[int, str]:
         if self._closed:
-            raise RecorderError(f"{streams[0]}: the MCAP sink is closed")
-        group = (tuple(streams), cls)
+            raise RecorderError(f"{topic}: the MCAP sink is closed")
+        chan = (self._writer.register_channel(topic, encoding, sid), name)
+        self._channels[topic] = chan
+        return chan
+
+    def _check(self, topic: str, chan: tuple[int, str], name: str) -> None:
+        if self._closed:
+            raise RecorderError(f"{topic}: the MCAP sink is closed")
+        if chan[1] != name:
+            raise RecorderError(f"{topic}: a {name} on a channel of {chan[1]}; not written")
+
+    def _group(self, topics: Sequence[str], typename: str) -> NDArray[np.uint16]:
+        """The channel ids of `topics`, looked up once: a batch names the same topics every
+        tick (per-topic work in every tick was a loop over 100 boats)."""
+        group = (tuple(topics), typename)
         ids = self._groups.get(group)
         if ids is None:
-            if len(set(streams)) != len(streams):
-                raise RecorderError(f"a stream appears twice in one block: {list(streams)}")
-            ids = np.array([self._channel(stream, cls).id for stream in streams], np.uint16)
+            if len(set(topics)) != len(topics):
+                raise RecorderError(f"a topic appears twice in one block: {list(topics)}")
+            ids = np.array([self._ros2(t, typename) for t in topics], np.uint16)
             self._groups[group] = ids
+        elif self._closed:
+            raise RecorderError(f"{topics[0]}: the MCAP sink is closed")
         return ids
 
-    def _next_sequences(self, ids: NDArray[np.uint16]) -> NDArray[np.int64]:
+    def _sequences(self, ids: NDArray[np.uint16]) -> NDArray[np.int64]:
         """Each channel's next sequence number (ids are distinct): its messages so far."""
         return self._writer.written(ids)
 
     def _add(self, ids: list[int], stamp_ns: int, payloads: list[bytes]) -> None:
-        sequences = self._next_sequences(np.array(ids, np.uint16))
+        sequences = self._sequences(np.array(ids, np.uint16))
         self._writer.add_messages(ids, sequences.tolist(), stamp_ns, payloads)
-
-    def write_ros2(
-        self, stream: str, type_name: str, msgdef: str, data: bytes, *, stamp_ns: int
-    ) -> None:
-        """A message already in CDR, of a ROS 2 type no bus message maps to (`/tf`)."""
-        if self._closed:
-            raise RecorderError(f"{stream}: the MCAP sink is closed")
-        chan = self._channels.get(stream)
-        if chan is None:
-            if type_name not in self._schemas:
-                sid = self._writer.register_schema(type_name, SchemaEncoding.ROS2, msgdef.encode())
-                self._schemas[type_name] = sid
-            topic = "/" + stream.strip("/")
-            cid = self._writer.register_channel(
-                topic, MessageEncoding.CDR, self._schemas[type_name]
-            )
-            chan = self._channels[stream] = _Channel(cid, _Encoded, _already_encoded)
-        elif chan.cls is not _Encoded:
-            raise RecorderError(f"{stream}: a {type_name} on a channel of {chan.cls.__name__}")
-        self._add([chan.id], stamp_ns, [data])
-
-    def _channel(self, stream: str, cls: type[Message]) -> _Channel:
-        if self._closed:
-            raise RecorderError(f"{stream}: the MCAP sink is closed")
-        chan = self._channels.get(stream) or self._register(stream, cls)
-        if cls is not chan.cls:
-            raise RecorderError(
-                f"{stream}: a {cls.__name__} sample on a channel of {chan.cls.__name__}; "
-                "not written"
-            )
-        return chan
-
-    def _register(self, stream: str, cls: type[Message]) -> _Channel:
-        if cls is VesselState:
-            encoding, encode = MessageEncoding.CDR, _odometry_encoder(_vessel_of(stream))
-        elif cls is LidarScan:
-            encoding, encode = MessageEncoding.CDR, pointcloud.pointcloud_encoder(stream)
-        elif cls is CameraFrame:
-            encoding, encode = MessageEncoding.CDR, images.image_encoder(stream)
-        else:
-            encoding, encode = MessageEncoding.JSON, _json_encoder
-        topic = "/" + stream.strip("/")
-        channel_id = self._writer.register_channel(topic, encoding, self._schema(cls))
-        chan = _Channel(channel_id, cls, encode)
-        self._channels[stream] = chan
-        return chan
-
-    def _schema(self, cls: type[Message]) -> int:
-        if cls not in self._schemas:
-            if cls in _ROS2:
-                name, msgdef = _ROS2[cls]
-                sid = self._writer.register_schema(name, SchemaEncoding.ROS2, msgdef.encode())
-            else:
-                text = json.dumps(json_schemas.json_schema(cls), separators=(",", ":")).encode()
-                sid = self._writer.register_schema(
-                    json_schemas.schema_name(cls), SchemaEncoding.JSONSchema, text
-                )
-            self._schemas[cls] = sid
-        return self._schemas[cls]
 
     def flush(self) -> None:
         """Put every record written so far into the file (call once per tick)."""
@@ -233,36 +192,3 @@ class McapSink:
 
     def __exit__(self, *exc: object) -> None:
         self.close()
-
-
-def _vessel_of(stream: str) -> str:
-    """`vessel/<id>/state` -> `<id>`, the Odometry child frame (the body frame)."""
-    parts = stream.strip("/").split("/")
-    if len(parts) == 3 and parts[0] == "vessel" and parts[2] == "state":
-        return parts[1]
-    raise RecorderError(f"{stream}: a VesselState stream must be named vessel/<id>/state")
-
-
-def _odometry_encoder(vessel: str) -> typing.Callable[[Message, int], bytes]:
-    """CDR encoder of one vessel's Odometry (mcap_ros2's writer always chunks, so we write
-    our own unchunked records; cdr.py packs the same bytes as mcap_ros2's dynamic serializer
-    at a fraction of its cost per message)."""
-    odometry = cdr.odometry_encoder(ros2_msgdefs.WORLD_FRAME, vessel)
-
-    def encode(msg: Message, stamp_ns: int) -> bytes:
-        assert isinstance(msg, VesselState)
-        return odometry(msg, stamp_ns)
-
-    return encode
-
-
-class _Encoded(Message):
-    """Marks a channel fed with bytes already in its encoding (`write_ros2`)."""
-
-
-def _already_encoded(msg: Message, stamp_ns: int) -> bytes:
-    raise RecorderError("this channel takes bytes already encoded (McapSink.write_ros2)")
-
-
-def _json_encoder(msg: Message, stamp_ns: int) -> bytes:
-    return json_schemas.encode(msg)

@@ -16,16 +16,15 @@ from collections.abc import Callable
 from typing import Any
 
 from catabot.bus.inbox import Inputs
-from catabot.bus.messages import BodyStates, CameraFrame, End, Message, Tick, TwistBatch
+from catabot.bus.messages import BodyStates, End, Message, Tick, TwistBatch
 from catabot.bus.participant import Participant
+from catabot.ros2.convert import Converter
 from catabot.run.service import Built, ServiceContext, run_service
-from services.recorder import images
 from services.recorder.batches import BatchFormatter, Block
 from services.recorder.csv_sink import CsvSink, RecorderError
 from services.recorder.dataset import Dataset
-from services.recorder.mcap_sink import McapSink
+from services.recorder.mcap_recording import McapRecording
 from services.recorder.metrics import Metrics
-from services.recorder.ros2_msgdefs import TF_MESSAGE, TF_MSGDEF
 
 log = logging.getLogger("recorder")
 FLUSH_EVERY_S = 0.1
@@ -36,12 +35,13 @@ class Recorder:
         rec = ctx.scenario.recording
         ctx.run_dir.mkdir(parents=True, exist_ok=True)
         self.keys = ctx.keys
-        self.csv = CsvSink(ctx.run_dir) if rec.csv else None
-        self.mcap = McapSink(ctx.run_dir / "run.mcap") if rec.mcap else None
         world = ctx.world
+        convert = Converter(world, ctx.scenario.ros)  # the gateway's topics and frames
+        self.csv = CsvSink(ctx.run_dir) if rec.csv else None
+        self.mcap = McapRecording(ctx.run_dir, convert) if rec.mcap else None
         self.dataset = Dataset(ctx.run_dir / "dataset", world)
         streams = [*world.streams.lockstep(), *world.streams.commands]
-        self.batches = BatchFormatter(world.body_ids, world.boat_ids, vessels=len(world.vessels))
+        self.batches = BatchFormatter(convert)
         self.metrics = Metrics([v.id for v in world.vessels])
         self.run_dir = ctx.run_dir
         self._flushed_at = 0.0
@@ -73,47 +73,20 @@ class Recorder:
             if self.csv is not None:
                 self.csv.write_lines(block.streams, block.cls, block.lines)
             if self.mcap is not None:
-                self._write_payloads(block)
+                self.mcap.block(block)
         except (RecorderError, OSError) as exc:
             log.error("not recorded: %s", exc)
         return True
-
-    def _write_payloads(self, block: Block) -> None:
-        assert self.mcap is not None
-        if block.tf is not None:
-            self.mcap.write_ros2("tf", TF_MESSAGE, TF_MSGDEF, block.tf, stamp_ns=block.stamp_ns)
-        for rows, matrix in block.groups:
-            streams = [block.streams[i] for i in rows.tolist()]
-            self.mcap.write_matrix(streams, block.cls, matrix, stamp_ns=block.stamp_ns)
-        if not block.payloads:
-            return
-        pairs = list(zip(block.streams, block.payloads, strict=True))
-        bad = [stream for stream, payload in pairs if payload is None]
-        if bad:
-            log.error("not recorded in MCAP (non-finite): %s", bad)
-        good = [(stream, payload) for stream, payload in pairs if payload is not None]
-        streams, payloads = [s for s, _ in good], [p for _, p in good]
-        self.mcap.write_block(streams, block.cls, payloads, stamp_ns=block.stamp_ns)
 
     def _write(self, stream: str, msg: Message) -> None:
         try:
             if self.csv is not None:
                 self.csv.write(stream, msg)
             if self.mcap is not None:
-                self._write_mcap(stream, msg)
+                self.mcap.message(stream, msg)
             self.dataset.write(stream, msg)
         except (RecorderError, OSError, ValueError) as exc:
             log.error("not recorded: %s", exc)
-
-    def _write_mcap(self, stream: str, msg: Message) -> None:
-        """One channel per stream; a camera gets one Image channel per output instead."""
-        assert self.mcap is not None
-        stamp_ns = int(getattr(msg, "stamp_ns", 0))
-        if isinstance(msg, CameraFrame):
-            for output in images.outputs(msg):
-                self.mcap.write(f"{stream}/{output}", msg, stamp_ns=stamp_ns)
-        else:
-            self.mcap.write(stream, msg, stamp_ns=stamp_ns)
 
     def _flush(self) -> None:
         """Whole ticks to disk, at most every `FLUSH_EVERY_S` of wall time (and at the end):

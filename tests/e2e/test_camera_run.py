@@ -25,7 +25,7 @@ def _scenario() -> dict[str, Any]:
 
 
 def _files(run: Path) -> dict[str, bytes]:
-    paths = [*sorted(p for p in (run / "dataset").rglob("*") if p.is_file()), run / "run.mcap"]
+    paths = [*sorted(p for p in (run / "dataset").rglob("*") if p.is_file()), *run.glob("*.mcap")]
     return {str(p.relative_to(run)): p.read_bytes() for p in paths}
 
 
@@ -42,9 +42,12 @@ def test_camera_and_radar_run_writes_dataset_and_mcap(tmp_path: Path, out: Path)
     assert any(o["class"] == "vessel" for line in lines for o in line["objects"])
     assert sorted(p.name for p in (run / "dataset" / "ego.radar").glob("ppi_*.png"))
     topics = {m.topic: m.schema_name for m in read_mcap_messages(run / "run.mcap")}
-    assert topics["/sensor/ego/cam/color"] == "sensor_msgs/msg/Image"
-    assert topics["/sensor/ego/cam/depth"] == "sensor_msgs/msg/Image"
-    assert topics["/sensor/ego/radar"] == "catabot.RadarSweep"
+    for output in ("image_raw", "depth", "segmentation", "instance", "normals", "camera_info"):
+        assert topics[f"/ego/cam/{output}"].startswith("sensor_msgs/msg/")
+    assert topics["/ego/radar/points"] == "sensor_msgs/msg/PointCloud2"
+    assert topics["/ego/radar/ppi"] == "sensor_msgs/msg/Image"
+    extra = read_mcap_messages(run / "run.extra.mcap")
+    assert [m.decoded["tick"] for m in extra if m.topic == "/ego/cam/labels"] == [0, 50]
     header, *rows = csv_rows(run / "sensor.ego.cam.csv")
     assert header[:2] == ["stamp_ns", "tick"] and "objects" in header and len(rows) == 2
 

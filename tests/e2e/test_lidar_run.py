@@ -18,7 +18,7 @@ def test_lidar_in_rain_is_recorded_as_point_clouds(tmp_path: Path, out: Path) ->
     assert result.returncode == 0, result.stderr
     run = only_run_dir(out)
     messages = read_mcap_messages(run / "run.mcap")
-    clouds = [m for m in messages if m.topic == "/sensor/ego/lidar"]
+    clouds = [m for m in messages if m.topic == "/ego/lidar/points"]
     assert len(clouds) == 10
     assert {m.schema_name for m in clouds} == {"sensor_msgs/msg/PointCloud2"}
     cloud = clouds[0].decoded
@@ -35,5 +35,5 @@ def test_lidar_in_rain_is_recorded_as_point_clouds(tmp_path: Path, out: Path) ->
     tf = [m for m in messages if m.topic == "/tf"]
     assert len(tf) == len(rows[1:]) * 10 and tf[0].schema_name == "tf2_msgs/msg/TFMessage"
     frames = [t.child_frame_id for t in tf[-1].decoded.transforms]
-    assert "ego" in frames and "b1" in frames  # every body's frame; buoys only there
-    assert "/vessel/b1/state" not in {m.topic for m in messages}
+    assert "ego/base_link" in frames and "b1/base_link" in frames  # buoys only there
+    assert "/b1/odom" not in {m.topic for m in messages}

@@ -55,7 +55,7 @@ def test_default_run_writes_run_folder_and_floats_at_archimedes_draft(out: Path)
     assert abs(metrics["final_position_m"][0] - float(data[-1][2])) < 1e-9
     assert metrics["distance_m"] >= float(data[-1][2])
     topics = {m.topic for m in read_mcap_messages(run / "run.mcap")}
-    assert "/vessel/ego/state" in topics
+    assert {"/ego/odom", "/tf"} <= topics
     cpu = json.loads((run / "log" / "run.json").read_text())["cpu_s"]
     assert set(cpu) == {"physics", "sensors", "recorder"} and all(s > 0 for s in cpu.values())
 

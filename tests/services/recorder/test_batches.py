@@ -8,14 +8,28 @@ import numpy as np
 import pytest
 
 from catabot.bus.messages import BodyStates, TwistBatch, TwistCmd, VesselState
-from services.recorder import cdr, json_schemas, ros2_msgdefs
+from catabot.config.load import parse_scenario
+from catabot.ros2 import cdr, cdr_more, types
+from catabot.ros2.convert import Converter
+from catabot.world.world import World
 from services.recorder.batches import BatchFormatter, Block
 from services.recorder.csv_sink import CsvSink, RecorderError
 from services.recorder.mcap_read import read_mcap_messages
 from services.recorder.mcap_sink import McapSink
 
+WORLD = World.resolve(
+    parse_scenario(
+        {"name": "b", "vessels": [{"id": "ego"}], "traffic": {"count": 1},
+         "buoys": [{"id": "buoy_0", "x_m": 50.0, "y_m": 0.0}]}
+    )
+)  # fmt: skip
 IDS = ("ego", "boat_000", "buoy_0")
 BOATS = ("boat_000",)
+assert WORLD.body_ids == IDS and WORLD.boat_ids == BOATS
+
+
+def _formatter() -> BatchFormatter:
+    return BatchFormatter(Converter(WORLD))
 
 
 def _states(tick: int) -> BodyStates:
@@ -38,7 +52,7 @@ def _csv_by_message(tmp: Path, stream: str, msgs: list[VesselState] | list[Twist
 
 
 def test_states_block_equals_the_per_message_rows(tmp_path: Path) -> None:
-    fmt = BatchFormatter(IDS, BOATS, vessels=2)
+    fmt = _formatter()
     batches = [_states(k) for k in range(3)]
     with CsvSink(tmp_path / "block") as sink:
         for batch in batches:
@@ -48,13 +62,15 @@ def test_states_block_equals_the_per_message_rows(tmp_path: Path) -> None:
         rows = [b.row(i) for b in batches]
         expected = _csv_by_message(tmp_path / vid, f"vessel/{vid}/state", rows)
         assert (tmp_path / "block" / f"vessel.{vid}.state.csv").read_text() == expected
-        odometry = cdr.odometry_encoder(ros2_msgdefs.WORLD_FRAME, vid)
+        odometry = cdr.odometry_encoder("map", f"{vid}/base_link")
         payload = _payloads(fmt.states(batches[2])).get(i)
         assert payload == (odometry(rows[2], batches[2].stamp_ns) if i < 2 else None)  # buoy: /tf
-    tf = cdr.TfBatch("map", IDS).encode(
+    frames = [f"{b}/base_link" for b in IDS]
+    tf = cdr.TfBatch("map", frames).encode(
         batches[2].stamp_ns, batches[2].position, batches[2].orientation
     )
     assert fmt.states(batches[2]).tf == tf
+    assert fmt.states(batches[2]).topics == ("/ego/odom", "/boat_000/odom")
 
 
 def _payloads(block: Block) -> dict[int, bytes]:
@@ -64,26 +80,27 @@ def _payloads(block: Block) -> dict[int, bytes]:
     }
 
 
-def test_twist_block_equals_the_per_message_csv_and_json(tmp_path: Path) -> None:
-    fmt = BatchFormatter(IDS, BOATS, vessels=2)
+def test_twist_block_equals_the_per_message_csv_and_twist(tmp_path: Path) -> None:
+    fmt = _formatter()
     block = fmt.twists(_twists(4))
     msg = TwistCmd(1.5, -0.1, 4, 40_000_000)
     assert block.streams == ("vessel/boat_000/cmd/twist",)
-    assert block.payloads == [json_schemas.encode(msg)]
+    assert block.topics == ("/boat_000/cmd_vel",) and block.typename == types.TWIST
+    assert _payloads(block) == {0: cdr_more.twist(1.5, -0.1)}
     with CsvSink(tmp_path / "block") as sink:
         sink.write_lines(block.streams, block.cls, block.lines)
     expected = _csv_by_message(tmp_path / "one", "vessel/boat_000/cmd/twist", [msg])
     assert (tmp_path / "block" / "vessel.boat_000.cmd.twist.csv").read_text() == expected
 
 
-def test_non_finite_set_point_has_a_csv_row_but_no_json() -> None:
-    block = BatchFormatter(IDS, BOATS, vessels=2).twists(_twists(1, surge=float("nan")))
-    assert block.payloads == [None]
+def test_non_finite_set_point_is_recorded_as_it_is() -> None:
+    block = _formatter().twists(_twists(1, surge=float("nan")))
+    assert _payloads(block) == {0: cdr_more.twist(float("nan"), -0.1)}  # CDR has NaN
     assert block.lines[0].split(",")[2] == "nan"
 
 
 def test_batches_of_other_vessels_are_refused() -> None:
-    fmt = BatchFormatter(IDS, BOATS, vessels=2)
+    fmt = _formatter()
     moved = _states(0)
     other = BodyStates(0, 0, ("a", "b", "c"), *moved.arrays())
     with pytest.raises(ValueError, match="expected"):
@@ -104,19 +121,19 @@ def test_block_on_a_stream_of_another_type_is_refused(tmp_path: Path) -> None:
 
 
 def test_mcap_blocks_read_back_as_odometry_and_refuse_another_type(tmp_path: Path) -> None:
-    fmt = BatchFormatter(IDS, BOATS, vessels=2)
+    fmt = _formatter()
     with McapSink(tmp_path / "run.mcap") as sink:
         for tick in range(2):
             block = fmt.states(_states(tick))
             for rows, matrix in block.groups:
-                streams = [block.streams[i] for i in rows.tolist()]
-                sink.write_matrix(streams, VesselState, matrix, stamp_ns=block.stamp_ns)
-        with pytest.raises(RecorderError, match="TwistCmd sample on a channel of VesselState"):
-            sink.write_matrix(streams, TwistCmd, matrix, stamp_ns=0)
-        with pytest.raises(RecorderError, match="a tf2_msgs/msg/TFMessage on a channel of"):
-            sink.write_ros2(streams[0], "tf2_msgs/msg/TFMessage", "", b"", stamp_ns=0)
+                topics = [block.topics[i] for i in rows.tolist()]
+                sink.write_matrix(topics, block.typename, matrix, stamp_ns=block.stamp_ns)
+        with pytest.raises(RecorderError, match="a geometry_msgs/msg/Twist on a channel of nav"):
+            sink.write_matrix(topics, types.TWIST, matrix, stamp_ns=0)
+        with pytest.raises(RecorderError, match="appears twice"):
+            sink.write_matrix([topics[0], topics[0]], types.ODOMETRY, matrix, stamp_ns=0)
     msgs = read_mcap_messages(tmp_path / "run.mcap")
     assert len(msgs) == 2 * 2  # two vessels (the buoy has no Odometry channel)
-    ego = [m for m in msgs if m.topic == "/vessel/ego/state"]
+    ego = [m for m in msgs if m.topic == "/ego/odom"]
     assert [m.sequence for m in ego] == [0, 1]
     assert ego[1].decoded.pose.pose.position.x == _states(1).position[0, 0]

@@ -1,19 +1,26 @@
-"""CSV and MCAP sinks: units in headers, byte-identical repeats, kill-safe MCAP."""
+"""CSV and MCAP sinks: units in headers, byte-identical repeats, kill-safe MCAP that is a ROS 2
+bag (profile ros2, CDR only), JSON only in the extras file."""
 
 from __future__ import annotations
 
-import json
+import math
 import shutil
 from pathlib import Path
 
 import pytest
 from mcap.reader import make_reader
 from mcap_ros2.decoder import DecoderFactory
+from rosbags.highlevel import AnyReader
+from rosbags.typesys import Stores, get_typestore
 
 from catabot.bus.messages import Message, ThrustCmd, TwistCmd, VesselState
+from catabot.ros2 import cdr, cdr_more, types
+from catabot.ros2.convert import thrust
 from services.recorder.csv_sink import CsvSink, RecorderError
 from services.recorder.mcap_read import read_mcap_messages
 from services.recorder.mcap_sink import McapSink
+
+ROSBAGS = get_typestore(Stores.ROS2_JAZZY)
 
 STATE = "vessel/ego/state"
 THRUST = "vessel/ego/cmd/thrust"
@@ -51,13 +58,21 @@ def _record_csv(directory: Path, ticks: int = 5) -> None:
             sink.flush()
 
 
+ODOM, TWIST_TOPIC, THRUST_TOPIC = "/ego/odom", "/ego/cmd_vel", "/ego/thrust"
+ODOMETRY = cdr.odometry_encoder("map", "ego/base_link")
+
+
 def _record_mcap(path: Path, ticks: int = 5, *, close: bool = True) -> McapSink:
+    """Per tick an Odometry, a Twist and a thrust array, as the recorder writes them."""
     sink = McapSink(path)
-    samples = _samples(ticks)
-    for i, (stream, msg) in enumerate(samples):
-        sink.write(stream, msg, stamp_ns=(i // 3) * DT)
-        if i % 3 == 2:
-            sink.flush()
+    for k in range(ticks):
+        stamp = k * DT
+        sink.write(ODOM, types.ODOMETRY, ODOMETRY(_state(k), stamp), stamp_ns=stamp)
+        sink.write(THRUST_TOPIC, types.FLOAT64_ARRAY, thrust((0.1 * k, -0.1 * k)), stamp_ns=stamp)
+        sink.write(
+            TWIST_TOPIC, types.TWIST, cdr_more.twist(1.0 / 3.0, float("nan")), stamp_ns=stamp
+        )
+        sink.flush()
     if close:
         sink.close()
     return sink
@@ -119,58 +134,49 @@ def test_mcap_is_byte_identical_for_identical_writes(tmp_path: Path) -> None:
     assert (tmp_path / "a.mcap").read_bytes() == (tmp_path / "b.mcap").read_bytes()
 
 
-def test_mcap_reads_back_with_ros2_and_json(tmp_path: Path) -> None:
+def test_mcap_is_a_ros2_bag_that_rosbags_and_mcap_ros2_read(tmp_path: Path) -> None:
     path = tmp_path / "run.mcap"
     _record_mcap(path, ticks=4)
     with open(path, "rb") as f:
         reader = make_reader(f, decoder_factories=[DecoderFactory()])
         summary = reader.get_summary()
         assert summary is not None and summary.statistics is not None
+        assert reader.get_header().profile == "ros2"
         assert summary.statistics.message_count == 12
         assert summary.statistics.message_end_time == 3 * DT
-        schemas = {s.name: s.encoding for s in summary.schemas.values()}
-        assert schemas == {
-            "nav_msgs/msg/Odometry": "ros2msg",
-            "catabot.ThrustCmd": "jsonschema",
-            "catabot.TwistCmd": "jsonschema",
+        assert {s.name: s.encoding for s in summary.schemas.values()} == {
+            types.ODOMETRY: "ros2msg",
+            types.FLOAT64_ARRAY: "ros2msg",
+            types.TWIST: "ros2msg",
         }
-        for s in summary.schemas.values():
-            if s.encoding == "jsonschema":
-                assert json.loads(s.data)["type"] == "object"
-        for schema, channel, message in reader.iter_messages(log_time_order=False):
-            assert message.log_time == message.publish_time
-            if channel.message_encoding == "json":
-                body = json.loads(message.data)
-                assert set(body) >= {"tick", "stamp_ns"}
-            else:
-                assert schema is not None and channel.topic == "/" + STATE
-        f.seek(0)
-        reader = make_reader(f, decoder_factories=[DecoderFactory()])
-        odoms = [m.decoded_message for m in reader.iter_decoded_messages(topics=["/" + STATE])]
-    assert len(odoms) == 4
+        assert {c.message_encoding for c in summary.channels.values()} == {"cdr"}
+        odoms = [m.decoded_message for m in reader.iter_decoded_messages(topics=[ODOM])]
     last = odoms[-1]
-    assert last.header.frame_id == "map" and last.child_frame_id == "ego"
+    assert len(odoms) == 4 and last.child_frame_id == "ego/base_link"
     assert (last.header.stamp.sec, last.header.stamp.nanosec) == (0, 3 * DT)
-    assert last.pose.pose.position.y == pytest.approx(0.6)
-    assert last.twist.twist.angular.z == 0.1
+    assert last.pose.pose.position.y == pytest.approx(0.6) and last.twist.twist.angular.z == 0.1
+    with AnyReader([path], default_typestore=ROSBAGS) as bag:
+        decoded = [(c.topic, bag.deserialize(raw, c.msgtype)) for c, _, raw in bag.messages()]
+    assert len(decoded) == 12
+    assert [list(m.data) for t, m in decoded if t == THRUST_TOPIC][1] == [0.1, -0.1]
 
 
 def test_read_helper_on_finished_file(tmp_path: Path) -> None:
     path = tmp_path / "run.mcap"
     _record_mcap(path, ticks=3)
     msgs = read_mcap_messages(path)
-    assert [m.topic for m in msgs[:3]] == ["/" + STATE, "/" + THRUST, "/" + TWIST]
-    assert len(msgs) == 9
-    assert msgs[1].decoded == {"thrust": [0.0, -0.0], "tick": 0, "stamp_ns": 0}
-    assert msgs[2].decoded["yaw_rate"] is None  # NaN has no JSON form
-    assert msgs[3].decoded.child_frame_id == "ego"
-    assert [m.sequence for m in msgs if m.topic == "/" + THRUST] == [0, 1, 2]
+    assert [m.topic for m in msgs[:3]] == [ODOM, THRUST_TOPIC, TWIST_TOPIC]
+    assert len(msgs) == 9 and msgs[2].schema_name == types.TWIST
+    assert list(msgs[1].decoded.data) == [0.0, -0.0]
+    assert math.isnan(msgs[2].decoded.angular.z)  # CDR keeps NaN (JSON had none)
+    assert msgs[3].decoded.child_frame_id == "ego/base_link"
+    assert [m.sequence for m in msgs if m.topic == THRUST_TOPIC] == [0, 1, 2]
 
 
 def test_truncated_mcap_reads_up_to_last_flush(tmp_path: Path) -> None:
     path = tmp_path / "run.mcap"
     sink = _record_mcap(path, ticks=4, close=False)
-    sink.write(STATE, _state(4), stamp_ns=4 * DT)  # written but not flushed: lost on a kill
+    sink.write(ODOM, types.ODOMETRY, ODOMETRY(_state(4), 4 * DT), stamp_ns=4 * DT)  # not flushed
     killed = tmp_path / "killed.mcap"
     shutil.copyfile(path, killed)  # the bytes a SIGKILL would leave behind
     msgs = read_mcap_messages(killed)
@@ -193,25 +199,28 @@ def test_torn_tail_is_ignored(tmp_path: Path) -> None:
     assert read_mcap_messages(tmp_path / "empty.mcap") == []
 
 
-def test_mcap_refuses_type_change_and_bad_state_stream(tmp_path: Path) -> None:
-    with McapSink(tmp_path / "run.mcap") as sink:
-        sink.write(THRUST, ThrustCmd(thrust=(0.1,), tick=0, stamp_ns=0), stamp_ns=0)
-        with pytest.raises(RecorderError, match="vessel/ego/cmd/thrust"):
-            sink.write(THRUST, TwistCmd(surge=1.0, yaw_rate=0.0), stamp_ns=0)
-        with pytest.raises(RecorderError, match="vessel/<id>/state"):
-            sink.write("env/state", _state(0), stamp_ns=0)
+def test_mcap_refuses_a_type_change_json_and_writes_after_close(tmp_path: Path) -> None:
+    sink = McapSink(tmp_path / "run.mcap")
+    sink.write(THRUST_TOPIC, types.FLOAT64_ARRAY, thrust((0.1,)), stamp_ns=0)
+    with pytest.raises(RecorderError, match="a geometry_msgs/msg/Twist on a channel of std_msgs"):
+        sink.write(THRUST_TOPIC, types.TWIST, cdr_more.twist(1.0, 0.0), stamp_ns=0)
+    with pytest.raises(RecorderError, match="JSON has no place in a ros2 MCAP"):
+        sink.write_json("/x", "s", {}, b"{}", stamp_ns=0)
+    sink.close()
+    with pytest.raises(RecorderError, match="closed"):
+        sink.write(THRUST_TOPIC, types.FLOAT64_ARRAY, thrust((0.1,)), stamp_ns=0)
 
 
-def test_mcap_refuses_malformed_state(tmp_path: Path) -> None:
-    bad = VesselState(
-        tick=0,
-        stamp_ns=0,
-        position=(1.0, 2.0),
-        orientation=(0.0, 0.0, 0.0, 1.0),
-        linear_velocity=(0.0, 0.0, 0.0),
-        angular_velocity=(0.0, 0.0, 0.0),
-        linear_acceleration=(0.0, 0.0, 0.0),
-        angular_acceleration=(0.0, 0.0, 0.0),
+def test_extras_are_json_with_a_schema(tmp_path: Path) -> None:
+    schema = {"title": "catabot.Note", "type": "object"}
+    with McapSink(tmp_path / "run.extra.mcap", profile="") as sink:
+        sink.write_json("/ego/cam/labels", "catabot.Note", schema, b'{"a":1}', stamp_ns=5)
+        with pytest.raises(RecorderError, match=r"CDR belongs in run\.mcap"):
+            sink.write(ODOM, types.ODOMETRY, ODOMETRY(_state(0), 0), stamp_ns=0)
+    (msg,) = read_mcap_messages(tmp_path / "run.extra.mcap")
+    assert (msg.topic, msg.schema_name, msg.decoded, msg.log_time) == (
+        "/ego/cam/labels",
+        "catabot.Note",
+        {"a": 1},
+        5,
     )
-    with McapSink(tmp_path / "run.mcap") as sink, pytest.raises(RecorderError, match=STATE):
-        sink.write(STATE, bad, stamp_ns=0)

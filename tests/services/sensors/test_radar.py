@@ -11,8 +11,8 @@ from pydantic import ValidationError
 from catabot.bus.messages import CLASS_VESSEL, RadarSweep, VesselState
 from catabot.config.sensors import RadarParams
 from catabot.config.waves import WaveConfig
+from catabot.ros2.ppi import Ppi
 from catabot.world.waves import WaveField
-from services.recorder.ppi import Ppi
 from services.sensors.mount import Mount
 from services.sensors.radar import RadarModel
 from services.sensors.scene import Body, Scene

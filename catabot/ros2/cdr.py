@@ -1,11 +1,12 @@
-"""Hand-written little-endian CDR (XCDR1) encoders for the ROS 2 messages of `run.mcap`.
+"""Hand-written little-endian CDR (XCDR1) encoders for the busiest ROS 2 messages.
 
-Why not `mcap_ros2`'s dynamic serializer: it walks the message definition field by field for
-every message (~50-130 us an Odometry), which with 100+ vessels costs tens of milliseconds a
-tick. Every field of Odometry and everything of PointCloud2 but three integers and the data is
+Why not a generic serializer (rosbags', mcap_ros2's): they walk the message definition field
+by field for every message (~20 us an Imu, ~50-130 us an Odometry, 1.6 ms a 640 x 480 image),
+which with 100+ vessels costs milliseconds a tick in the recorder and in the gateway alike.
+Every field of Odometry and everything of PointCloud2 but three integers and the data is
 fixed once the frame ids are known, so each encoder compiles one `struct.Struct` up front and
-packs a message in one call. The bytes are identical to the dynamic serializer's
-(tests/services/recorder/test_cdr.py), so readers and earlier recordings see no difference.
+packs a message in one call. The bytes are those of rosbags' `serialize_cdr`, pinned in
+tests/catabot/ros2/test_cdr.py (our bytes decode with it and re-encode to themselves).
 
 CDR rules used here: a 4-byte encapsulation header (CDR_LE) precedes the data; alignment is
 relative to the start of the data after it; a primitive of size n is aligned to n; a string is
@@ -29,7 +30,7 @@ _COVARIANCE = 36  # float64[36], all zero: the simulator knows the exact state
 _FLOAT64 = 8
 
 
-class _Layout:
+class Layout:
     """Builds a little-endian `struct` format while tracking the CDR offset for alignment.
 
     The offset counts from the start of the data after the encapsulation header, which is the
@@ -75,12 +76,12 @@ class _Layout:
         return struct.Struct(self.format)
 
 
-def _stamp(stamp_ns: int) -> tuple[int, int]:
-    """builtin_interfaces/Time (sec, nanosec), as `ros2_msgdefs.stamp` gives it."""
+def stamp(stamp_ns: int) -> tuple[int, int]:
+    """builtin_interfaces/Time (sec, nanosec), as `types.stamp` gives it."""
     return divmod(stamp_ns, NS_PER_S)
 
 
-def _header(layout: _Layout, frame_id: str) -> tuple[int, bytes]:
+def header(layout: Layout, frame_id: str) -> tuple[int, bytes]:
     """std_msgs/Header: the stamp (packed per message) and the constant frame id."""
     layout.add("i", 4)  # stamp.sec
     layout.add("I", 4)  # stamp.nanosec
@@ -91,8 +92,8 @@ def _odometry_struct(
     frame_id: str, child_frame_id: str
 ) -> tuple[struct.Struct, tuple[object, ...]]:
     """The Odometry format for two frame ids and the constant pack arguments after the stamp."""
-    layout = _Layout()
-    frame = _header(layout, frame_id)
+    layout = Layout()
+    frame = header(layout, frame_id)
     child = layout.string(child_frame_id)
     for _ in range(7):  # pose.pose: position xyz, orientation xyzw
         layout.add("d", _FLOAT64)
@@ -129,7 +130,7 @@ def odometry_packer(
     pack = compiled.pack
 
     def encode(stamp_ns: int, values: typing.Sequence[float]) -> bytes:
-        sec, nanosec = _stamp(stamp_ns)
+        sec, nanosec = stamp(stamp_ns)
         return pack(ENCAPSULATION, sec, nanosec, *frames, *values)
 
     return encode
@@ -141,7 +142,7 @@ def _point_fields(fields: Iterable[Mapping[str, typing.Any]]) -> bytes:
     Every item starts with a 4-aligned string length and holds no 8-byte type, so the bytes
     are the same at any 4-aligned offset and can be built once.
     """
-    layout = _Layout()
+    layout = Layout()
     items = list(fields)
     args: list[object] = [ENCAPSULATION, len(items)]
     layout.add("I", 4)  # sequence length
@@ -157,8 +158,8 @@ def _point_fields(fields: Iterable[Mapping[str, typing.Any]]) -> bytes:
 def _pointcloud2_head(frame_id: str, fields_cdr: bytes) -> tuple[struct.Struct, tuple[object, ...]]:
     """The PointCloud2 format from the header up to the data length, and its constant
     arguments: frame, height 1, then (width), fields, is_bigendian False, point_step."""
-    layout = _Layout()
-    frame = _header(layout, frame_id)
+    layout = Layout()
+    frame = header(layout, frame_id)
     layout.add("I", 4)  # height
     layout.add("I", 4)  # width (per message)
     layout.raw(len(fields_cdr))  # starts 4-aligned, which _point_fields needs
@@ -182,7 +183,7 @@ def pointcloud2_encoder(
     pack = compiled.pack
 
     def encode(data: typing.Any, width: int, stamp_ns: int) -> bytes:
-        sec, nanosec = _stamp(stamp_ns)
+        sec, nanosec = stamp(stamp_ns)
         view = memoryview(data).cast("B")
         head = pack(
             ENCAPSULATION, sec, nanosec, *frame, 1, width, fields_cdr,
@@ -231,13 +232,13 @@ class OdometryBatch:
         `McapWriter.add_block` writes without touching a message on its own."""
         if values.shape != (self.size, 13):
             raise ValueError(f"odometry values of shape {values.shape}, not ({self.size}, 13)")
-        stamp = np.frombuffer(_STAMP.pack(*_stamp(stamp_ns)), np.uint8)
+        when = np.frombuffer(_STAMP.pack(*stamp(stamp_ns)), np.uint8)
         out = []
         for rows, template in self._groups:
             block = template.copy()
             pose = block.shape[1] - _ODOMETRY_TAIL
             twist = pose + (7 + _COVARIANCE) * _FLOAT64
-            block[:, 4:12] = stamp
+            block[:, 4:12] = when
             block[:, pose : pose + 56] = _bytes(values[rows, :7])
             block[:, twist : twist + 48] = _bytes(values[rows, 7:])
             out.append((rows, block))
@@ -256,13 +257,13 @@ class TfBatch:
     found once."""
 
     def __init__(self, frame_id: str, child_frame_ids: typing.Sequence[str]) -> None:
-        layout, args = _Layout(), [ENCAPSULATION, len(child_frame_ids)]
+        layout, args = Layout(), [ENCAPSULATION, len(child_frame_ids)]
         layout.add("I", 4)  # sequence length
         stamps, poses = [], []
         for child in child_frame_ids:
             layout.align(4)
             stamps.append(layout.offset)
-            frame = _header(layout, frame_id)
+            frame = header(layout, frame_id)
             name = layout.string(child)
             layout.align(_FLOAT64)
             poses.append(layout.offset)
@@ -283,7 +284,7 @@ class TfBatch:
                 f"for {self.size} bodies"
             )
         data = self._template.copy()
-        stamp = np.frombuffer(_STAMP.pack(*_stamp(stamp_ns)), np.uint8)
-        data[self._stamp_at] = np.tile(stamp, self.size)
+        when = np.frombuffer(_STAMP.pack(*stamp(stamp_ns)), np.uint8)
+        data[self._stamp_at] = np.tile(when, self.size)
         data[self._pose_at] = _bytes(np.concatenate((position, orientation), axis=1)).ravel()
         return data.tobytes()
