@@ -33,6 +33,7 @@ class Connection:
     connect: tuple[str, ...] = ()
     listen: tuple[str, ...] = field(default_factory=lambda: ("tcp/127.0.0.1:0",))
     mode: str = "peer"
+    timestamping: bool = False  # Zenoh's advanced publishers (a cache for late joiners) need it
 
     def config(self) -> zenoh.Config:
         if self.mode not in MODES:
@@ -43,6 +44,8 @@ class Connection:
         cfg.insert_json5("connect/endpoints", json.dumps(list(self.connect)))
         listen = [] if self.mode == "client" else list(self.listen)
         cfg.insert_json5("listen/endpoints", json.dumps(listen))
+        if self.timestamping:
+            cfg.insert_json5("timestamping/enabled", "true")
         return cfg
 
 

@@ -183,12 +183,14 @@ def _radar(names: Names, sensor: MountedSensor) -> Convert:
     return convert
 
 
-_NORMALS = np.rint((np.arange(-128, 128) / 127.0 + 1.0) * 127.5).clip(0, 255).astype(np.uint8)
+_AS_INT8 = np.arange(256, dtype=np.uint8).view(np.int8).astype(np.float64)
+_NORMALS = np.rint((_AS_INT8 / 127.0 + 1.0) * 127.5).clip(0, 255).astype(np.uint8)
+"""rgb8 of each int8 normal component, indexed by its byte: a table look-up a pixel."""
 
 
 def normals_rgb(normals: np.ndarray) -> np.ndarray:
-    """int8 normals x 127 as rgb8 (n + 1) / 2, by table: the dataset PNGs' mapping."""
-    return np.take(_NORMALS, normals.view(np.uint8) ^ np.uint8(128))
+    """int8 normals x 127 as rgb8 (n + 1) / 2, the dataset PNGs' mapping."""
+    return np.take(_NORMALS, normals.view(np.uint8))
 
 
 _PIXELS = {  # topic suffix -> the frame's array, with the encoding's dtype

@@ -33,6 +33,7 @@ SERVICE_MODULES = {
     "sensors": "services.sensors",
     "traffic": "services.traffic",
     "recorder": "services.recorder",
+    "ros": "services.ros",
 }
 
 

@@ -16,8 +16,9 @@ import signal
 import sys
 import time
 from collections.abc import Callable
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from pathlib import Path
+from typing import Protocol
 
 import zenoh
 
@@ -25,7 +26,7 @@ from catabot.bus.blas import single_thread_blas
 from catabot.bus.clock import ClockError
 from catabot.bus.keys import Keys
 from catabot.bus.messages import End
-from catabot.bus.participant import EndFn, Participant, StepFn
+from catabot.bus.participant import EndFn, StepFn
 from catabot.bus.scheduling import batch_scheduling
 from catabot.bus.session import (
     add_connection_args,
@@ -62,7 +63,14 @@ class ServiceContext:
         return self.world.participants
 
 
-Built = tuple[Participant, StepFn, EndFn | None]
+class Runner(Protocol):
+    """What runs a service to the end of the run: a lockstep `Participant`, or an observer
+    that steps on what it receives (services/ros)."""
+
+    def run(self, step: StepFn, on_end: EndFn | None = None) -> End: ...
+
+
+Built = tuple[Runner, StepFn, EndFn | None]
 BuildFn = Callable[[ServiceContext], Built]
 
 
@@ -113,8 +121,11 @@ def _write_usage(name: str, run_dir: Path, cpu_s: float) -> None:
     (run_dir / "log" / f"{name}.usage.json").write_text(json.dumps({"cpu_s": round(cpu_s, 3)}))
 
 
-def run_service(name: str, build: BuildFn, argv: list[str] | None = None) -> int:
-    """Run one stepping service to the end of the run; returns the process exit code."""
+def run_service(
+    name: str, build: BuildFn, argv: list[str] | None = None, *, timestamping: bool = False
+) -> int:
+    """Run one stepping service to the end of the run; returns the process exit code.
+    `timestamping`: the session stamps samples (Zenoh's advanced publishers need it)."""
     args = service_parser(name).parse_args(argv)
     setup_logging()
     single_thread_blas()  # idle BLAS threads spin on the cores other services need
@@ -122,7 +133,7 @@ def run_service(name: str, build: BuildFn, argv: list[str] | None = None) -> int
     try:
         batch_scheduling()  # before Zenoh starts its threads, so that they inherit it
         world = World.resolve(load_scenario(args.scenario))  # the same in every process
-        session = open_session(connection_from_args(args))
+        session = open_session(replace(connection_from_args(args), timestamping=timestamping))
     except CataBotError as exc:
         log.error("%s: %s", name, exc)
         return 2

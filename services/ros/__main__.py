@@ -1,0 +1,5 @@
+import sys
+
+from services.ros.service import main
+
+sys.exit(main())

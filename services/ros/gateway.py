@@ -1,0 +1,229 @@
+"""The gateway's work at each step: the world out as ROS 2 topics, ROS commands in.
+
+Out (catabot/ros2: the recorder's conversion): every vessel's `odom`, `/tf` a tick, sensor
+topics, `/clock`, and once, latched, `/tf_static` and `/buoys`. Nothing is converted for a
+topic nobody subscribes to. `/clock` is the newest state's stamp (observer) or the tick's
+(lockstep), every tick or at `ros.clock_hz`.
+
+In: a command for a vessel whose controller is this gateway (`controller.participant:
+"ros"`, `ros.lockstep: true`) is held and published on its clocked stream at the next
+controller tick, tagged with it, so physics applies it at the same tick on every run (the
+`vessels[].controller` mechanism, DESIGN.md §8). Any other command is published at once,
+free-running (tick -1): physics applies it at its next tick boundary.
+"""
+
+from __future__ import annotations
+
+import logging
+import time
+from collections.abc import Callable
+from dataclasses import dataclass, replace
+
+import zenoh
+
+from catabot.bus import codec
+from catabot.bus.clock import Stream
+from catabot.bus.inbox import Inputs
+from catabot.bus.messages import BodyStates, Message, ThrustCmd, Tick, TwistCmd
+from catabot.bus.session import BLOCK
+from catabot.config.ros import GATEWAY, RosConfig
+from catabot.config.scenario import rate_in_ticks
+from catabot.ros2 import types
+from catabot.ros2.convert import Converter
+from catabot.ros2.convert_sensors import Out
+from catabot.ros2.names import CLOCK, TF
+from catabot.world.world import World
+from services.ros.inbound import Command, Inbound
+from services.ros.wire import LATCHED, Outlet, Wire
+
+log = logging.getLogger("ros.gateway")
+KINDS = {"twist": "cmd_vel", "thrust": "thrust"}  # controller.command -> ROS command
+
+
+@dataclass
+class Control:
+    """A vessel this gateway drives in the lockstep: its clocked stream and last command."""
+
+    stream: Stream
+    command: str  # the ROS command that feeds it: cmd_vel or thrust
+    last: Message
+    fresh: Message | None = None
+
+
+class Gateway:
+    """Converts and publishes what the world produces; routes what ROS commands.
+    `publish`: how a clocked command goes out (the lockstep participant's publish)."""
+
+    def __init__(
+        self,
+        world: World,
+        ros: RosConfig,
+        session: zenoh.Session,
+        publish: Callable[[str, Message], None] | None = None,
+        on_command: Callable[[], None] = lambda: None,
+    ) -> None:
+        self.world, self.ros, self.keys = world, ros, world.keys
+        self.convert = convert = Converter(world, ros, boats=ros.traffic)
+        self.wire = wire = Wire(session, ros)
+        self.odom = [Outlet(wire, topic, types.ODOMETRY) for topic in convert.odom_topics]
+        self.tf = Outlet(wire, TF, types.TF)
+        self.clock = Outlet(wire, CLOCK, types.CLOCK)
+        self.clock_every = _period(world, ros)
+        self.sensors = {
+            world.keys.relative(s.key): [
+                Outlet(wire, topic, kind) for topic, kind in convert.names.sensor_topics(s)
+            ]
+            for s in world.sensors
+        }
+        self.outlets = {o.topic: o for outlets in self.sensors.values() for o in outlets}
+        self.latched = [self._latch(out) for out in (convert.static_tf(), convert.buoys()) if out]
+        vessels = [v for v in world.vessels if ros.traffic or v.kind == "vessel"]
+        self.inbound = Inbound(wire, convert.names, vessels, ros, on_command)
+        self._session, self._publish = session, publish
+        self._free: dict[str, zenoh.Publisher] = {}
+        self.controls = _controls(world)
+
+    def _latch(self, out: Out) -> Outlet:
+        """A topic sent once and kept for late subscribers (/tf_static, /buoys)."""
+        outlet = Outlet(self.wire, out.topic, out.type, LATCHED)
+        outlet.put(out.data)
+        return outlet
+
+    # -- out -----------------------------------------------------------------------------
+
+    def publish(self, inputs: Inputs, *, clock_from_states: bool) -> None:
+        """Everything in `inputs` that someone subscribes to; `clock_from_states`: /clock
+        follows each state's stamp (the observer, which sees no ticks)."""
+        states = self.keys.world_states()
+        for batch in inputs.get(states, []):
+            if isinstance(batch, BodyStates):
+                self._states(batch)
+                if clock_from_states:
+                    self.tick_clock(batch.tick + 1, batch.stamp_ns)  # stamped t_(k+1)
+        for key, msgs in inputs.items():
+            if key != states:
+                self._sensor(self.keys.relative(key), msgs)
+
+    def _states(self, batch: BodyStates) -> None:
+        watched = [i for i, outlet in enumerate(self.odom) if outlet.watched]
+        try:
+            self.world.check_rows(batch)  # from the bus: maybe not this world's bodies
+            if watched:
+                payloads = self.convert.odometry(batch)
+                for i in watched:
+                    self.odom[i].put(payloads[i])
+            if self.tf.watched:
+                self.tf.put(self.convert.tf(batch))
+        except ValueError as exc:
+            log.error("not published: %s", exc)
+
+    def _sensor(self, stream: str, msgs: list[Message]) -> None:
+        if not any(outlet.watched for outlet in self.sensors.get(stream, [])):
+            return  # nobody listens: not even converted
+        for msg in msgs:
+            try:
+                outs = self.convert.sensor(stream, msg)
+            except ValueError as exc:
+                log.error("not published: %s", exc)
+                continue
+            for out in outs:
+                self.outlets[out.topic].put(out.data)
+
+    def tick_clock(self, tick: int, stamp_ns: int, *, force: bool = False) -> None:
+        if (force or tick % self.clock_every == 0) and self.clock.watched:
+            self.clock.put(self.convert.clock(stamp_ns).data)
+
+    # -- in ------------------------------------------------------------------------------
+
+    def takes_commands(self, tick: Tick) -> bool:
+        """Whether a vessel this gateway controls takes a command at `tick` (then /clock
+        goes out whatever `ros.clock_hz`: the stack replies to it)."""
+        return any(tick.tick % (c.stream.period or 1) == 0 for c in self.controls.values())
+
+    def commands(self, tick: Tick | None = None) -> None:
+        """Route the commands received so far. At a tick where a vessel this gateway
+        controls takes a command, publish it clocked, waiting (tick > 0) for the ROS
+        stack's reply to this tick's /clock for up to `ros.reply_timeout_s`."""
+        for cmd in self.inbound.take():
+            self._route(cmd)
+        if tick is None:
+            return
+        if tick.tick == 0 and self.controls:
+            self._await_stack()
+        for vessel, control in self.controls.items():
+            if tick.tick % (control.stream.period or 1):
+                continue
+            if tick.tick > 0 and control.fresh is None:
+                self._await(vessel, control, tick)
+            msg = control.fresh or control.last
+            control.last, control.fresh = msg, None
+            assert self._publish is not None, "a lockstep gateway publishes its controls"
+            self._publish(control.stream.key, replace(msg, tick=tick.tick, stamp_ns=tick.stamp_ns))  # type: ignore[call-arg]
+
+    def _route(self, cmd: Command) -> None:
+        control = self.controls.get(cmd.vessel)
+        if control is not None and cmd.name == control.command:
+            control.fresh = cmd.message  # the newest since the last controller tick
+            return
+        key = {
+            "cmd_vel": self.keys.cmd_twist,
+            "thrust": self.keys.cmd_thrust,
+            "waypoints": self.keys.cmd_waypoints,
+        }[cmd.name](cmd.vessel)
+        publisher = self._free.get(key)
+        if publisher is None:
+            publisher = self._free[key] = self._session.declare_publisher(
+                key, congestion_control=BLOCK
+            )
+        publisher.put(codec.encode(cmd.message))
+
+    def _await_stack(self) -> None:
+        """Before the first command: wait for a /clock subscriber, the stack that answers
+        (a clock sent before its subscription is known would reach nobody)."""
+        deadline = time.monotonic() + self.ros.reply_timeout_s
+        while not self.clock.watched and time.monotonic() < deadline:
+            time.sleep(0.01)
+        if not self.clock.watched:
+            log.warning("nobody subscribes to /clock: the controlled vessels get no command")
+
+    def _await(self, vessel: str, control: Control, tick: Tick) -> None:
+        deadline = time.monotonic() + self.ros.reply_timeout_s
+        while control.fresh is None:
+            left = deadline - time.monotonic()
+            if left <= 0:
+                log.warning(
+                    "no %s for %s at tick %d within %g s: the last one holds (this run is "
+                    "no longer reproducible)", control.command, vessel, tick.tick,
+                    self.ros.reply_timeout_s,
+                )  # fmt: skip
+                return
+            for cmd in self.inbound.wait(left):
+                self._route(cmd)
+
+    def close(self) -> None:
+        self.inbound.close()
+        self.wire.close()
+
+
+def _period(world: World, ros: RosConfig) -> int:
+    """/clock every this many ticks."""
+    if ros.clock_hz is None:
+        return 1
+    return rate_in_ticks(ros.clock_hz, world.scenario.dt_ns, where="ros.clock_hz")
+
+
+def _controls(world: World) -> dict[str, Control]:
+    """The vessels whose controller is this gateway, with a neutral first command."""
+    out = {}
+    for stream in world.streams.controls:
+        if stream.producer != GATEWAY:
+            continue
+        vessel = world.body(world.keys.vessel_of(stream.key))
+        assert vessel.controller is not None
+        kind = vessel.controller.command
+        neutral: Message = (
+            TwistCmd(0.0, 0.0) if kind == "twist"
+            else ThrustCmd(tuple(0.0 for _ in vessel.model.thrusters))
+        )  # fmt: skip
+        out[vessel.id] = Control(stream, KINDS[kind], neutral)
+    return out

@@ -1,0 +1,139 @@
+"""Commands from ROS: `cmd_vel`, `thrust` and `waypoints` of every vessel, in every
+convention of the gateway.
+
+One wildcard subscriber per convention and command (`**/cmd_vel`, and its rmw_zenoh form
+with the Twist type and hash) instead of one per vessel: with 100 boats that is 6 instead of
+600. Each vessel's command topics are still announced (graph tokens), so ROS tools list them
+and the bridge creates its DDS readers. Callbacks only queue the sample (no Zenoh call and no
+decoding on Zenoh's threads); the gateway decodes on its own thread. A sample on an unknown
+topic, a malformed payload or a value out of range is logged at most once per topic per
+second and ignored.
+"""
+
+from __future__ import annotations
+
+import logging
+import queue
+import time
+from collections.abc import Callable
+from dataclasses import dataclass
+
+import zenoh
+
+from catabot.bus.messages import Message
+from catabot.config.ros import RosConfig
+from catabot.ros2.commands import CommandError, command
+from catabot.ros2.names import COMMANDS, Names
+from catabot.ros2.wire import Convention
+from catabot.world.world import Body
+from services.ros.wire import DATA, Wire
+
+log = logging.getLogger("ros.inbound")
+
+
+class Complaints:
+    """Warnings at most once per topic per `period_s`, with a count of those held back."""
+
+    def __init__(self, period_s: float = 1.0) -> None:
+        self.period_s = period_s
+        self._last: dict[str, float] = {}
+        self._held: dict[str, int] = {}
+
+    def __call__(self, topic: str, problem: str) -> None:
+        now = time.monotonic()
+        if now - self._last.get(topic, -1e9) < self.period_s:
+            self._held[topic] = self._held.get(topic, 0) + 1
+            return
+        held = self._held.pop(topic, 0)
+        more = f" ({held} more since the last report)" if held else ""
+        log.warning("ignored a command on %s: %s%s", topic, problem, more)
+        self._last[topic] = now
+
+
+@dataclass(frozen=True)
+class Command:
+    """A checked command for one vessel: the ROS command name and its bus message."""
+
+    vessel: str
+    name: str  # cmd_vel, thrust, waypoints
+    message: Message
+
+
+@dataclass(frozen=True)
+class _Route:
+    vessel: str
+    name: str
+    topic: str
+    thrusters: int
+
+
+class Inbound:
+    def __init__(
+        self,
+        wire: Wire,
+        names: Names,
+        vessels: list[Body],
+        ros: RosConfig,
+        on_sample: Callable[[], None] = lambda: None,
+    ) -> None:
+        self.ros, self.complain = ros, Complaints()
+        self._samples: queue.SimpleQueue[tuple[str, bytes]] = queue.SimpleQueue()
+        self._on_sample = on_sample
+        self._routes: dict[str, _Route] = {}
+        for vessel in vessels:
+            for name, (topic, typename) in names.command_topics(vessel.id).items():
+                for convention in wire.conventions:
+                    key = wire.key(convention, topic, typename)
+                    self._routes[key] = _Route(vessel.id, name, topic, len(vessel.model.thrusters))
+                    wire.announce(convention, "MS", topic, typename, DATA)
+        self._subscribers = [
+            wire.session.declare_subscriber(_wildcard(wire, convention, name, typename), self._push)
+            for convention in wire.conventions
+            for name, typename in COMMANDS.items()
+        ]
+
+    def _push(self, sample: zenoh.Sample) -> None:
+        self._samples.put((str(sample.key_expr), sample.payload.to_bytes()))
+        self._on_sample()
+
+    def take(self) -> list[Command]:
+        """Every command received so far, checked, in arrival order."""
+        out: list[Command] = []
+        while True:
+            try:
+                key, payload = self._samples.get_nowait()
+            except queue.Empty:
+                return out
+            out += self._checked(key, payload)
+
+    def wait(self, timeout_s: float) -> list[Command]:
+        """The next sample's command (blocking up to `timeout_s`), then all that queued."""
+        try:
+            key, payload = self._samples.get(timeout=max(timeout_s, 0.0))
+        except queue.Empty:
+            return []
+        return [*self._checked(key, payload), *self.take()]
+
+    def _checked(self, key: str, payload: bytes) -> list[Command]:
+        route = self._routes.get(key)
+        if route is None:
+            self.complain(key, "no vessel of this world has that command topic")
+            return []
+        try:
+            msg = command(
+                route.name, payload, thrusters=route.thrusters, defaults=self.ros.waypoints
+            )
+        except CommandError as exc:
+            self.complain(route.topic, str(exc))
+            return []
+        return [Command(route.vessel, route.name, msg)]
+
+    def close(self) -> None:
+        for sub in self._subscribers:
+            sub.undeclare()
+
+
+def _wildcard(wire: Wire, convention: Convention, name: str, typename: str) -> str:
+    """Every key of command `name` in one convention, whatever the namespace (`**` matches
+    no chunk too: the root namespace's `cmd_vel`)."""
+    return wire.key(convention, "/**/" + name, typename)

@@ -1,0 +1,119 @@
+"""The gateway outside the lockstep (the default): a plain subscriber of the world's streams
+that never holds the clock.
+
+The conductor does not wait for an observer, so the simulation runs at its own pace whatever
+ROS does. Zenoh callbacks only append the sample to a bounded queue per key and wake the
+gateway's thread; when the gateway falls behind, the oldest samples of a key are dropped
+(counted, logged) instead of growing memory or pushing back on the publishers. The run ends
+with `clock/end`; a conductor whose token vanishes without one ends it too (ClockError).
+"""
+
+from __future__ import annotations
+
+import logging
+import threading
+import time
+from collections import deque
+from collections.abc import Sequence
+
+import zenoh
+
+from catabot.bus import codec
+from catabot.bus.clock import CONDUCTOR, ClockError, Stream
+from catabot.bus.keys import Keys
+from catabot.bus.messages import BodyStates, CameraFrame, End, LidarScan, Message, Tick
+from catabot.bus.participant import EndFn, StepFn
+
+log = logging.getLogger("ros.observer")
+DEPTH = 100  # samples held per key: a simulated second of states at 10 ms ticks
+BULKY_DEPTH = 4  # LiDAR scans and camera frames are hundreds of kB to megabytes each
+BULKY = (CameraFrame, LidarScan)
+ORPHAN_GRACE_S = 1.0
+WARN_EVERY_S = 1.0
+
+
+class Observer:
+    def __init__(self, session: zenoh.Session, keys: Keys, streams: Sequence[Stream]) -> None:
+        self.keys, self.wake = keys, threading.Event()
+        self._streams = {s.key: s for s in streams}
+        self._held = {
+            s.key: deque[bytes](maxlen=BULKY_DEPTH if s.message in BULKY else DEPTH)
+            for s in streams
+        }
+        self._dropped = dict.fromkeys(self._held, 0)
+        self._warned = dict.fromkeys(self._held, 0.0)
+        self._end: bytes | None = None
+        self._conductor_gone_at = 0.0
+        self._latest = Tick("", -1, 0, 0)
+        self._subs = [session.declare_subscriber(key, self._on_data) for key in self._held]
+        self._subs += [
+            session.declare_subscriber(keys.end(), self._on_end),
+            session.liveliness().declare_subscriber(keys.live(CONDUCTOR), self._on_live),
+        ]
+
+    def _on_data(self, sample: zenoh.Sample) -> None:
+        held = self._held[str(sample.key_expr)]
+        if len(held) == held.maxlen:
+            self._dropped[str(sample.key_expr)] += 1
+        held.append(sample.payload.to_bytes())
+        self.wake.set()
+
+    def _on_end(self, sample: zenoh.Sample) -> None:
+        self._end = sample.payload.to_bytes()
+        self.wake.set()
+
+    def _on_live(self, sample: zenoh.Sample) -> None:
+        if sample.kind == zenoh.SampleKind.DELETE:
+            self._conductor_gone_at = time.monotonic()
+            self.wake.set()
+
+    def run(self, step: StepFn, on_end: EndFn | None = None) -> End:
+        """Hand `step` what arrived, as it arrives, until the run ends."""
+        while True:
+            self.wake.wait(timeout=0.2)
+            self.wake.clear()
+            end = self._ended()
+            if end is not None:
+                if on_end is not None:
+                    on_end(end, self._drain())
+                return end
+            step(self._latest, self._drain())
+
+    def _ended(self) -> End | None:
+        if self._end is not None:
+            try:
+                return codec.decode(self._end, End)
+            except codec.CodecError as exc:
+                log.warning("malformed end of run ignored: %s", exc)
+                self._end = None
+        gone = self._conductor_gone_at
+        if gone and time.monotonic() - gone > ORPHAN_GRACE_S:
+            raise ClockError("ros: the conductor disappeared without ending the run")
+        return None
+
+    def _drain(self) -> dict[str, list[Message]]:
+        """Every held sample, decoded, per key in tick order; malformed ones logged."""
+        out: dict[str, list[Message]] = {}
+        for key, held in self._held.items():
+            msgs = []
+            while held:
+                try:
+                    msgs.append(codec.decode(held.popleft(), self._streams[key].message))
+                except codec.CodecError as exc:
+                    log.warning("dropped a malformed payload on %s: %s", key, exc)
+            if msgs:
+                out[key] = msgs
+                self._note(msgs[-1])
+            now = time.monotonic()
+            if self._dropped[key] and now - self._warned[key] > WARN_EVERY_S:
+                log.warning("fell behind on %s: %d samples dropped", key, self._dropped[key])
+                self._dropped[key], self._warned[key] = 0, now
+        return out
+
+    def _note(self, msg: Message) -> None:
+        if isinstance(msg, BodyStates) and msg.tick >= self._latest.tick:
+            self._latest = Tick("", msg.tick, msg.stamp_ns, 0)
+
+    def close(self) -> None:
+        for sub in self._subs:
+            sub.undeclare()

@@ -1,0 +1,130 @@
+"""The gateway's side of Zenoh: one `Outlet` per ROS topic, in every convention of
+`ros.mode`, with the graph tokens that make `ros2 topic list` show it (catabot/ros2/wire.py
+says what each convention expects).
+
+Outlets put only while someone subscribes to their key (a matching listener keeps that
+known, as physics does for observer outputs): with nobody listening the gateway costs the
+conversion of what it must convert and no put. Puts never block (congestion control DROP):
+a slow ROS subscriber must not hold the simulation. Latched topics (`/tf_static`, `/buoys`)
+are advanced publishers with a cache of one, which both the bridge and rmw_zenoh query for
+their TRANSIENT_LOCAL subscribers, so a late subscriber still gets the message.
+"""
+
+from __future__ import annotations
+
+import time
+from collections.abc import Callable
+from typing import Any
+
+import zenoh
+from zenoh.ext import CacheConfig, declare_advanced_publisher
+
+from catabot.config.ros import RosConfig
+from catabot.ros2.wire import (
+    Convention,
+    Qos,
+    RmwNode,
+    attachment,
+    bridge_key,
+    bridge_token,
+    conventions,
+    gid,
+    rmw_key,
+)
+
+DATA = Qos(depth=10)
+LATCHED = Qos(depth=1, transient_local=True)
+
+
+class Wire:
+    """The gateway's Zenoh presence: its node in the ROS graph and its tokens."""
+
+    def __init__(self, session: zenoh.Session, ros: RosConfig) -> None:
+        self.session, self.ros = session, ros
+        self.conventions = conventions(ros.mode)
+        self.zid = str(session.zid())
+        self.node = RmwNode(ros.domain_id, self.zid, ros.node)
+        self._entities = 0
+        self._tokens: list[Any] = []
+        if Convention.RMW in self.conventions:
+            self._declare(self.node.token())
+
+    def key(self, convention: Convention, topic: str, typename: str) -> str:
+        if convention is Convention.BRIDGE:
+            return bridge_key(topic, self.ros.bridge_namespace)
+        return rmw_key(self.ros.domain_id, topic, typename)
+
+    def announce(
+        self, convention: Convention, kind: str, topic: str, typename: str, qos: Qos
+    ) -> str:
+        """Declare the graph token of a publisher (MP) or subscription (MS); returns it."""
+        if convention is Convention.BRIDGE:
+            key = self.key(convention, topic, typename)
+            token = bridge_token(self.zid, kind, key, typename, qos)
+        else:
+            self._entities += 1
+            token = self.node.entity_token(self._entities, kind, topic, typename, qos)
+        self._declare(token)
+        return token
+
+    def _declare(self, token: str) -> None:
+        self._tokens.append(self.session.liveliness().declare_token(token))
+
+    def close(self) -> None:
+        for token in self._tokens:
+            token.undeclare()
+        self._tokens.clear()
+
+
+class _Route:
+    """One convention's key of an outlet: its publisher and, for rmw_zenoh, the attachment."""
+
+    def __init__(
+        self, wire: Wire, convention: Convention, topic: str, typename: str, qos: Qos
+    ) -> None:
+        key = wire.key(convention, topic, typename)
+        token = wire.announce(convention, "MP", topic, typename, qos)
+        self.gid = gid(token) if convention is Convention.RMW else b""
+        self.sequence = 0
+        if qos.transient_local:
+            self.publisher: Any = declare_advanced_publisher(
+                wire.session, key, cache=CacheConfig(qos.depth), publisher_detection=True
+            )
+            self.matching = True  # always put: the cache must hold the latest
+        else:
+            self.publisher = wire.session.declare_publisher(key)
+            self.matching = bool(self.publisher.matching_status.matching)
+            self.listener = self.publisher.declare_matching_listener(self._on_matching)
+
+    def _on_matching(self, status: Any) -> None:
+        self.matching = bool(status.matching)
+
+    def put(self, data: bytes) -> None:
+        if not self.gid:
+            self.publisher.put(data)
+            return
+        self.sequence += 1
+        self.publisher.put(data, attachment=attachment(self.sequence, time.time_ns(), self.gid))
+
+
+class Outlet:
+    """One ROS topic of one type, published in every convention of the gateway."""
+
+    def __init__(self, wire: Wire, topic: str, typename: str, qos: Qos = DATA) -> None:
+        self.topic, self.type = topic, typename
+        self.routes = [_Route(wire, c, topic, typename, qos) for c in wire.conventions]
+
+    @property
+    def watched(self) -> bool:
+        """Whether anyone subscribes now (or the outlet is latched)."""
+        return any(r.matching for r in self.routes)
+
+    def put(self, data: bytes) -> None:
+        for route in self.routes:
+            if route.matching:
+                route.put(data)
+
+    def put_lazily(self, make: Callable[[], bytes]) -> None:
+        """Put what `make` builds, built only if someone listens."""
+        if self.watched:
+            self.put(make())
