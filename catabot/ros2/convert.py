@@ -23,7 +23,7 @@ from catabot.config.ros import RosConfig
 from catabot.ros2 import types
 from catabot.ros2.cdr import OdometryBatch, TfBatch
 from catabot.ros2.cdr_more import clock, twist, twist_rows
-from catabot.ros2.convert_sensors import Convert, Out, converter
+from catabot.ros2.convert_sensors import Convert, Out, Want, converter, everything
 from catabot.ros2.frames import static_transforms, tf_message
 from catabot.ros2.names import BUOYS, CLOCK, MAP, TF_STATIC, Names
 from catabot.world.world import World
@@ -74,12 +74,13 @@ class Converter:
     def clock(self, stamp_ns: int) -> Out:
         return Out(CLOCK, types.CLOCK, clock(stamp_ns))
 
-    def sensor(self, stream: str, msg: Message) -> list[Out]:
-        """A sensor sample from `sensor/<vessel>/<sensor>`; ValueError if unknown or mistyped."""
+    def sensor(self, stream: str, msg: Message, want: Want = everything) -> list[Out]:
+        """A sensor sample from `sensor/<vessel>/<sensor>` as the topics `want` asks for;
+        ValueError if the stream is unknown or the sample mistyped."""
         convert = self._sensors.get(stream)
         if convert is None:
             raise ValueError(f"{stream}: no sensor of this world publishes there")
-        return convert(msg)
+        return convert(msg, want)
 
     def is_sensor(self, stream: str) -> bool:
         return stream in self._sensors

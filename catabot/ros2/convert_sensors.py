@@ -40,7 +40,15 @@ class Out:
     data: bytes
 
 
-Convert = Callable[[Message], list[Out]]
+Want = Callable[[str], bool]
+"""Which topics to build (the gateway builds only what someone subscribes to)."""
+Convert = Callable[[Message, Want], list[Out]]
+
+
+def everything(topic: str) -> bool:
+    return True
+
+
 FLOAT32, UINT8, UINT16, INT32 = 7, 2, 4, 5  # sensor_msgs/PointField datatypes
 _LIDAR = (("x", "<f4", FLOAT32), ("y", "<f4", FLOAT32), ("z", "<f4", FLOAT32),
           ("intensity", "<f4", FLOAT32), ("ring", "<u2", UINT16), ("label", "u1", UINT8),
@@ -97,8 +105,10 @@ def _imu(names: Names, sensor: MountedSensor) -> Convert:
     encode = imu_encoder(names.sensor_frame(sensor), imu_covariances(sensor))
     topic = names.sensor_topic(sensor, "imu")
 
-    def convert(msg: Message) -> list[Out]:
+    def convert(msg: Message, want: Want) -> list[Out]:
         _expect(msg, ImuSample, sensor)
+        if not want(topic):
+            return []
         m = typing.cast(ImuSample, msg)
         values = (*m.orientation, *m.angular_velocity, *m.linear_acceleration)
         return [Out(topic, types.IMU, encode(m.stamp_ns, values))]
@@ -110,8 +120,10 @@ def _gps(names: Names, sensor: MountedSensor) -> Convert:
     encode = navsatfix_encoder(names.sensor_frame(sensor))
     topic = names.sensor_topic(sensor, "fix")
 
-    def convert(msg: Message) -> list[Out]:
+    def convert(msg: Message, want: Want) -> list[Out]:
         _expect(msg, GpsFix, sensor)
+        if not want(topic):
+            return []
         m = typing.cast(GpsFix, msg)
         values = (m.latitude, m.longitude, m.altitude, m.horizontal_sigma, m.vertical_sigma)
         return [Out(topic, types.NAVSATFIX, encode(m.stamp_ns, values))]
@@ -133,8 +145,10 @@ def _lidar(names: Names, sensor: MountedSensor) -> Convert:
     encode = pointcloud2_encoder(names.sensor_frame(sensor), LIDAR_FIELDS, LIDAR_POINT.itemsize)
     topic = names.sensor_topic(sensor, "points")
 
-    def convert(msg: Message) -> list[Out]:
+    def convert(msg: Message, want: Want) -> list[Out]:
         _expect(msg, LidarScan, sensor)
+        if not want(topic):
+            return []
         scan = typing.cast(LidarScan, msg)
         cloud = lidar_points(scan)
         return [Out(topic, types.POINTCLOUD2, encode(cloud, len(cloud), scan.stamp_ns))]
@@ -169,13 +183,17 @@ def _radar(names: Names, sensor: MountedSensor) -> Convert:
     ppi = Ppi(size_px=p.ppi_size_px, range_m=p.range_m, fade_s=p.fade_s, beam_step_rad=step)
     turn_ns = round(p.rotation_period_s * 1e9)
 
-    def convert(msg: Message) -> list[Out]:
+    def convert(msg: Message, want: Want) -> list[Out]:
+        """Every sweep paints the PPI, wanted or not: it shows the last `fade_s` of them."""
         _expect(msg, RadarSweep, sensor)
         sweep = typing.cast(RadarSweep, msg)
-        echoes = radar_points(sweep, step)
-        out = [Out(points, types.POINTCLOUD2, cloud(echoes, len(echoes), sweep.stamp_ns))]
+        out = []
+        if want(points):
+            echoes = radar_points(sweep, step)
+            out.append(Out(points, types.POINTCLOUD2, cloud(echoes, len(echoes), sweep.stamp_ns)))
         ppi.add(sweep)
-        if (sweep.stamp_ns + period_ns) // turn_ns > sweep.stamp_ns // turn_ns:  # a turn ends
+        turn_ends = (sweep.stamp_ns + period_ns) // turn_ns > sweep.stamp_ns // turn_ns
+        if turn_ends and want(ppi_topic):
             picture = image(ppi.render(sweep.stamp_ns), sweep.stamp_ns)
             out.append(Out(ppi_topic, types.IMAGE, picture))
         return out
@@ -193,6 +211,7 @@ def normals_rgb(normals: np.ndarray) -> np.ndarray:
     return np.take(_NORMALS, normals.view(np.uint8))
 
 
+EMPTY = np.empty(0, np.uint8)
 _PIXELS = {  # topic suffix -> the frame's array, with the encoding's dtype
     "image_raw": lambda f: f.color,
     "depth": lambda f: f.depth.astype("<f4", copy=False),
@@ -229,14 +248,16 @@ def _camera(names: Names, sensor: MountedSensor) -> Convert:
     info = restamper(camera_info(names, sensor))
     info_topic = names.sensor_topic(sensor, "camera_info")
 
-    def convert(msg: Message) -> list[Out]:
+    def convert(msg: Message, want: Want) -> list[Out]:
         _expect(msg, CameraFrame, sensor)
         f = typing.cast(CameraFrame, msg)
         out = []
         for topic, pixels, encode in images:
-            array = pixels(f)
+            array = pixels(f) if want(topic) else EMPTY
             if array.size:  # an output the frame has (all do unless switched off)
                 out.append(Out(topic, types.IMAGE, encode(array, f.stamp_ns)))
-        return [*out, Out(info_topic, types.CAMERA_INFO, info(f.stamp_ns))]
+        if want(info_topic):
+            out.append(Out(info_topic, types.CAMERA_INFO, info(f.stamp_ns)))
+        return out
 
     return convert

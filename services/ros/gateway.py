@@ -82,6 +82,12 @@ class Gateway:
         self._session, self._publish = session, publish
         self._free: dict[str, zenoh.Publisher] = {}
         self.controls = _controls(world)
+        log.info(
+            "publishing %d topics (%s, domain %d), %d vessels take commands, %s",
+            len(self.odom) + len(self.outlets) + len(self.latched) + 2,
+            " and ".join(wire.conventions), ros.domain_id, len(vessels),
+            "in the lockstep" if ros.lockstep else "observing",
+        )  # fmt: skip
 
     def _latch(self, out: Out) -> Outlet:
         """A topic sent once and kept for late subscribers (/tf_static, /buoys)."""
@@ -118,11 +124,12 @@ class Gateway:
             log.error("not published: %s", exc)
 
     def _sensor(self, stream: str, msgs: list[Message]) -> None:
-        if not any(outlet.watched for outlet in self.sensors.get(stream, [])):
-            return  # nobody listens: not even converted
+        """Only the topics someone subscribes to are built (a radar's PPI is painted by
+        every sweep all the same, so it is whole when someone looks)."""
+        wanted = {outlet.topic for outlet in self.sensors.get(stream, []) if outlet.watched}
         for msg in msgs:
             try:
-                outs = self.convert.sensor(stream, msg)
+                outs = self.convert.sensor(stream, msg, wanted.__contains__)
             except ValueError as exc:
                 log.error("not published: %s", exc)
                 continue

@@ -15,6 +15,7 @@ from typing import Any
 import numpy as np
 import zenoh
 from rosbags.typesys import Stores, get_typestore
+from zenoh.ext import HistoryConfig, declare_advanced_subscriber
 
 ROSBAGS = get_typestore(Stores.ROS2_JAZZY)
 T = ROSBAGS.types
@@ -53,8 +54,11 @@ class RosClient:
         self._gid = bytes(range(16))
         self._seq = 0
 
-    def subscribe(self, key: str) -> list[Sample]:
-        """Collect every sample on `key` (a list that fills as they come)."""
+    def subscribe(self, key: str, *, transient_local: bool = False) -> list[Sample]:
+        """Collect every sample on `key` (a list that fills as they come). A TRANSIENT_LOCAL
+        subscriber (/tf_static) also gets what was published before it, from the
+        publisher's cache, as rmw_zenoh and the bridge ask for it: an advanced subscriber
+        with history that detects late publishers."""
         got = self.samples.setdefault(key, [])
 
         def on_sample(sample: zenoh.Sample) -> None:
@@ -64,7 +68,13 @@ class RosClient:
                     Sample(str(sample.key_expr), sample.payload.to_bytes(), att, time.time())
                 )
 
-        self._subs.append(self.session.declare_subscriber(key, on_sample))
+        if transient_local:
+            history = HistoryConfig(detect_late_publishers=True, max_samples=1)
+            self._subs.append(
+                declare_advanced_subscriber(self.session, key, on_sample, history=history)
+            )
+        else:
+            self._subs.append(self.session.declare_subscriber(key, on_sample))
         return got
 
     def put(self, key: str, payload: bytes, *, rmw: bool = False) -> None:
