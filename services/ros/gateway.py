@@ -82,6 +82,9 @@ class Gateway:
         self._session, self._publish = session, publish
         self._free: dict[str, zenoh.Publisher] = {}
         self.controls = _controls(world)
+        self._odom_version = self._wanted_version = -1
+        self._odom_watched: list[int] = []
+        self._wanted_keys: frozenset[str] = frozenset()
         log.info(
             "publishing %d topics (%s, domain %d), %d vessels take commands, %s",
             len(self.odom) + len(self.outlets) + len(self.latched) + 2,
@@ -110,8 +113,29 @@ class Gateway:
             if key != states:
                 self._sensor(self.keys.relative(key), msgs)
 
+    def wanted(self) -> frozenset[str]:
+        """The stream keys some subscribed topic is built from (the observer subscribes to
+        these only): states for odom, /tf and /clock, each sensor for its topics."""
+        if self._wanted_version != self.wire.version:
+            self._wanted_version = self.wire.version
+            odom = any(o.live for o in (*self.odom, self.tf, self.clock))
+            keys = {self.keys.world_states()} if odom else set()
+            for stream, outlets in self.sensors.items():
+                if any(o.live for o in outlets):
+                    keys.add(f"{self.keys.prefix}/{stream}")
+            self._wanted_keys = frozenset(keys)
+        return self._wanted_keys
+
+    def _watched_odom(self) -> list[int]:
+        """Indices of the odom outlets someone subscribes to, found again only when a
+        subscription came or went."""
+        if self._odom_version != self.wire.version:
+            self._odom_version = self.wire.version
+            self._odom_watched = [i for i, outlet in enumerate(self.odom) if outlet.live]
+        return self._odom_watched
+
     def _states(self, batch: BodyStates) -> None:
-        watched = [i for i, outlet in enumerate(self.odom) if outlet.watched]
+        watched = self._watched_odom()
         try:
             self.world.check_rows(batch)  # from the bus: maybe not this world's bodies
             if watched:

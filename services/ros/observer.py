@@ -2,7 +2,9 @@
 that never holds the clock.
 
 The conductor does not wait for an observer, so the simulation runs at its own pace whatever
-ROS does. Zenoh callbacks only append the sample to a bounded queue per key and wake the
+ROS does. It subscribes only to the streams someone on the ROS side wants (`wanted`, asked
+again at every wake-up): with nobody listening it receives nothing and costs the run
+nothing. Zenoh callbacks only append the sample to a bounded queue per key and wake the
 gateway's thread; when the gateway falls behind, the oldest samples of a key are dropped
 (counted, logged) instead of growing memory or pushing back on the publishers. The run ends
 with `clock/end`; a conductor whose token vanishes without one ends it too (ClockError).
@@ -14,7 +16,8 @@ import logging
 import threading
 import time
 from collections import deque
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
+from typing import Any
 
 import zenoh
 
@@ -33,8 +36,17 @@ WARN_EVERY_S = 1.0
 
 
 class Observer:
-    def __init__(self, session: zenoh.Session, keys: Keys, streams: Sequence[Stream]) -> None:
-        self.keys, self.wake = keys, threading.Event()
+    def __init__(
+        self,
+        session: zenoh.Session,
+        keys: Keys,
+        streams: Sequence[Stream],
+        wanted: Callable[[], frozenset[str]],
+        wake: threading.Event,
+    ) -> None:
+        self.keys, self.wake, self.session = keys, wake, session
+        self._wanted = wanted
+        self._data: dict[str, Any] = {}  # key -> subscriber, for the keys wanted now
         self._streams = {s.key: s for s in streams}
         self._held = {
             s.key: deque[bytes](maxlen=BULKY_DEPTH if s.message in BULKY else DEPTH)
@@ -45,8 +57,7 @@ class Observer:
         self._end: bytes | None = None
         self._conductor_gone_at = 0.0
         self._latest = Tick("", -1, 0, 0)
-        self._subs = [session.declare_subscriber(key, self._on_data) for key in self._held]
-        self._subs += [
+        self._subs = [
             session.declare_subscriber(keys.end(), self._on_end),
             session.liveliness().declare_subscriber(keys.live(CONDUCTOR), self._on_live),
         ]
@@ -70,6 +81,7 @@ class Observer:
     def run(self, step: StepFn, on_end: EndFn | None = None) -> End:
         """Hand `step` what arrived, as it arrives, until the run ends."""
         while True:
+            self._subscribe(self._wanted())
             self.wake.wait(timeout=0.2)
             self.wake.clear()
             end = self._ended()
@@ -78,6 +90,13 @@ class Observer:
                     on_end(end, self._drain())
                 return end
             step(self._latest, self._drain())
+
+    def _subscribe(self, wanted: frozenset[str]) -> None:
+        """Subscribe to the streams wanted now, and only to those."""
+        for key in [k for k in self._data if k not in wanted]:
+            self._data.pop(key).undeclare()
+        for key in sorted(wanted - self._data.keys()):
+            self._data[key] = self.session.declare_subscriber(key, self._on_data)
 
     def _ended(self) -> End | None:
         if self._end is not None:
@@ -115,5 +134,5 @@ class Observer:
             self._latest = Tick("", msg.tick, msg.stamp_ns, 0)
 
     def close(self) -> None:
-        for sub in self._subs:
+        for sub in [*self._subs, *self._data.values()]:
             sub.undeclare()

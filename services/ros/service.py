@@ -11,6 +11,7 @@ stack's commands at the same tick on every run (gateway.py).
 from __future__ import annotations
 
 import sys
+import threading
 
 from catabot.bus.inbox import Inputs
 from catabot.bus.messages import End, Tick
@@ -35,8 +36,9 @@ def build(ctx: ServiceContext) -> Built:
             gateway.commands(tick)
 
         return participant, step, _closer(gateway)
-    observer = Observer(ctx.session, ctx.keys, inputs)
-    gateway = Gateway(world, ros, ctx.session, on_command=observer.wake.set)
+    wake = threading.Event()
+    gateway = Gateway(world, ros, ctx.session, on_command=wake.set)
+    observer = Observer(ctx.session, ctx.keys, inputs, gateway.wanted, wake)
 
     def observe(_: Tick, received: Inputs) -> None:
         gateway.publish(received, clock_from_states=True)

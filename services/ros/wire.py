@@ -46,6 +46,7 @@ class Wire:
         self.node = RmwNode(ros.domain_id, self.zid, ros.node)
         self._entities = 0
         self._tokens: list[Any] = []
+        self.version = 0  # counts changes of who subscribes to what (Outlet.live)
         if Convention.RMW in self.conventions:
             self._declare(self.node.token())
 
@@ -77,11 +78,19 @@ class Wire:
 
 
 class _Route:
-    """One convention's key of an outlet: its publisher and, for rmw_zenoh, the attachment."""
+    """One convention's key of an outlet: its publisher and, for rmw_zenoh, the attachment.
+    `on_change` runs (on a Zenoh thread) when a first subscriber comes or the last goes."""
 
     def __init__(
-        self, wire: Wire, convention: Convention, topic: str, typename: str, qos: Qos
+        self,
+        wire: Wire,
+        convention: Convention,
+        topic: str,
+        typename: str,
+        qos: Qos,
+        on_change: Callable[[], None],
     ) -> None:
+        self._on_change = on_change
         key = wire.key(convention, topic, typename)
         token = wire.announce(convention, "MP", topic, typename, qos)
         self.gid = gid(token) if convention is Convention.RMW else b""
@@ -98,6 +107,7 @@ class _Route:
 
     def _on_matching(self, status: Any) -> None:
         self.matching = bool(status.matching)
+        self._on_change()
 
     def put(self, data: bytes) -> None:
         if not self.gid:
@@ -108,23 +118,27 @@ class _Route:
 
 
 class Outlet:
-    """One ROS topic of one type, published in every convention of the gateway."""
+    """One ROS topic of one type, published in every convention of the gateway. `live` (the
+    routes someone subscribes to) is kept by the matching listeners, so a tick asks nothing
+    of Zenoh for a topic nobody watches (101 odometry topics a tick)."""
 
     def __init__(self, wire: Wire, topic: str, typename: str, qos: Qos = DATA) -> None:
-        self.topic, self.type = topic, typename
-        self.routes = [_Route(wire, c, topic, typename, qos) for c in wire.conventions]
+        self.topic, self.type, self.wire = topic, typename, wire
+        self.live: list[_Route] = []
+        self.routes = [
+            _Route(wire, c, topic, typename, qos, self._refresh) for c in wire.conventions
+        ]
+        self._refresh()
+
+    def _refresh(self) -> None:
+        self.live = [r for r in self.routes if r.matching]  # one assignment: thread-safe
+        self.wire.version += 1
 
     @property
     def watched(self) -> bool:
         """Whether anyone subscribes now (or the outlet is latched)."""
-        return any(r.matching for r in self.routes)
+        return bool(self.live)
 
     def put(self, data: bytes) -> None:
-        for route in self.routes:
-            if route.matching:
-                route.put(data)
-
-    def put_lazily(self, make: Callable[[], bytes]) -> None:
-        """Put what `make` builds, built only if someone listens."""
-        if self.watched:
-            self.put(make())
+        for route in self.live:
+            route.put(data)

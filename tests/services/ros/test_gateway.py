@@ -1,0 +1,135 @@
+"""The gateway in process, against a second Zenoh session playing ROS: it wants (subscribes
+to) only the streams someone's topics are built from, puts only to watched keys, routes
+commands to the bus (free-running, or held for a lockstep controller), and complains about
+bad ones at most once a second per topic."""
+
+from __future__ import annotations
+
+import logging
+import time
+from collections.abc import Callable, Iterator
+from typing import Any
+
+import numpy as np
+import pytest
+import zenoh
+from rosbags.typesys import Stores, get_typestore
+
+from catabot.bus import codec
+from catabot.bus.messages import Message, ThrustCmd, Tick, TwistCmd
+from catabot.bus.session import Connection, free_port, open_session
+from catabot.config.load import parse_scenario
+from catabot.world.world import World
+from services.ros.gateway import Gateway
+from services.ros.inbound import Complaints
+from tests.catabot.ros2.world_fixture import scenario
+
+ROSBAGS = get_typestore(Stores.ROS2_JAZZY)
+
+
+def _until(check: Callable[[], bool], limit_s: float = 5.0) -> bool:
+    end = time.monotonic() + limit_s
+    while not check() and time.monotonic() < end:
+        time.sleep(0.02)
+    return check()
+
+
+@pytest.fixture
+def sessions() -> Iterator[tuple[zenoh.Session, zenoh.Session]]:
+    endpoint = f"tcp/127.0.0.1:{free_port()}"
+    ours = open_session(Connection(listen=(endpoint,), timestamping=True))
+    ros = open_session(Connection(connect=(endpoint,)))
+    yield ours, ros
+    ros.close()
+    ours.close()
+
+
+def _twist(x: float) -> bytes:
+    v3 = ROSBAGS.types["geometry_msgs/msg/Vector3"]
+    msg = ROSBAGS.types["geometry_msgs/msg/Twist"](
+        linear=v3(x=x, y=0.0, z=0.0), angular=v3(x=0.0, y=0.0, z=0.0)
+    )
+    return bytes(ROSBAGS.serialize_cdr(msg, "geometry_msgs/msg/Twist"))
+
+
+def test_wants_only_what_someone_subscribes_to(sessions: Any) -> None:
+    ours, ros = sessions
+    world = World.resolve(parse_scenario(scenario(mode="bridge")))
+    gateway = Gateway(world, world.scenario.ros, ours)  # type: ignore[arg-type]
+    try:
+        assert gateway.wanted() == frozenset()
+        sub = ros.declare_subscriber("ego/lidar/points", lambda s: None)
+        lidar = world.keys.sensor("ego", "lidar")
+        assert _until(lambda: gateway.wanted() == {lidar})
+        tf = ros.declare_subscriber("tf", lambda s: None)
+        assert _until(lambda: gateway.wanted() == {lidar, world.keys.world_states()})
+        sub.undeclare()
+        tf.undeclare()
+        assert _until(lambda: gateway.wanted() == frozenset())
+    finally:
+        gateway.close()
+
+
+def test_free_commands_go_to_the_bus_and_bad_ones_are_refused(
+    sessions: Any, caplog: pytest.LogCaptureFixture
+) -> None:
+    ours, ros = sessions
+    world = World.resolve(parse_scenario(scenario(mode="bridge")))
+    got: list[Message] = []
+    key = world.keys.cmd_twist("ego")
+    bus = ros.declare_subscriber(
+        key, lambda s: got.append(codec.decode(s.payload.to_bytes(), TwistCmd))
+    )
+    gateway = Gateway(world, world.scenario.ros, ours)  # type: ignore[arg-type]
+    try:
+        time.sleep(0.3)  # the wildcard subscribers reach the other session
+        with caplog.at_level(logging.WARNING, logger="ros.inbound"):
+            for _ in range(20):
+                ros.put("ego/cmd_vel", b"junk")
+            ros.put("ego/cmd_vel", _twist(1.25))
+            ros.put("nobody/cmd_vel", _twist(1.0))
+            assert _until(lambda: (gateway.commands(), bool(got))[1])
+        assert got == [TwistCmd(surge=1.25, yaw_rate=0.0)]  # tick -1: free-running
+        junk = [r for r in caplog.records if "on /ego/cmd_vel" in r.getMessage()]
+        assert len(junk) == 1 and "not little-endian CDR" in junk[0].getMessage()
+        assert any("nobody/cmd_vel" in r.getMessage() for r in caplog.records)
+    finally:
+        bus.undeclare()
+        gateway.close()
+
+
+def test_a_lockstep_controller_takes_the_reply_to_its_tick(sessions: Any) -> None:
+    ours, ros = sessions
+    data = scenario(mode="bridge", lockstep=True, reply_timeout_s=0.3)
+    data["vessels"][1]["controller"] = {"participant": "ros", "rate_hz": 10, "command": "thrust"}
+    world = World.resolve(parse_scenario(data))
+    sent: list[tuple[str, Message]] = []
+    gateway = Gateway(world, world.scenario.ros, ours, lambda k, m: sent.append((k, m)))  # type: ignore[arg-type]
+    try:
+        gateway.commands(Tick("r", 0, 0, 10_000_000))  # nobody answers tick 0: neutral
+        assert sent == [(world.keys.cmd_thrust("other"), ThrustCmd((0.0, 0.0), 0, 0))]
+        layout = ROSBAGS.types["std_msgs/msg/MultiArrayLayout"](dim=[], data_offset=0)
+        msg = ROSBAGS.types["std_msgs/msg/Float64MultiArray"](
+            layout=layout, data=np.array([0.5, -0.5])
+        )
+        ros.put("other/thrust", bytes(ROSBAGS.serialize_cdr(msg, "std_msgs/msg/Float64MultiArray")))
+        gateway.commands(Tick("r", 5, 50_000_000, 10_000_000))  # not a controller tick
+        assert len(sent) == 1
+        gateway.commands(Tick("r", 10, 100_000_000, 10_000_000))  # waits for the reply
+        assert sent[-1] == (world.keys.cmd_thrust("other"), ThrustCmd((0.5, -0.5), 10, 100_000_000))
+        gateway.commands(Tick("r", 20, 200_000_000, 10_000_000))  # silent: the last holds
+        assert sent[-1][1] == ThrustCmd((0.5, -0.5), 20, 200_000_000)
+    finally:
+        gateway.close()
+
+
+def test_complaints_come_once_a_second_per_topic(caplog: pytest.LogCaptureFixture) -> None:
+    complain = Complaints(period_s=0.2)
+    with caplog.at_level(logging.WARNING, logger="ros.inbound"):
+        for _ in range(5):
+            complain("/a", "bad")
+            complain("/b", "bad")
+        time.sleep(0.25)
+        complain("/a", "bad")
+    messages = [r.getMessage() for r in caplog.records]
+    assert len(messages) == 3 and "(4 more since the last report)" in messages[-1]
