@@ -90,10 +90,13 @@ class RosConfig(Strict):
         return self.namespaces.get(vessel, "/" + vessel)
 
 
-def check_ros(ros: RosConfig | None, vessels: Sequence[Any], boats: Sequence[str]) -> None:
+def check_ros(
+    ros: RosConfig | None, vessels: Sequence[Any], boats: Sequence[str], deadline_s: float
+) -> None:
     """The cross-section rules (FieldProblem names the field): every vessel and sensor name
     is a ROS name (they name topics), namespaces name known vessels and no two vessels share
-    one, and a controller named 'ros' needs the gateway in the lockstep."""
+    one, a controller named 'ros' needs the gateway in the lockstep, and the gateway's wait
+    for a reply ends before the clock's deadline would end the run."""
     for i, vessel in enumerate(vessels):
         c = vessel.controller
         if c is not None and c.participant == GATEWAY and not (ros and ros.lockstep):
@@ -103,6 +106,10 @@ def check_ros(ros: RosConfig | None, vessels: Sequence[Any], boats: Sequence[str
             )
     if ros is None:
         return
+    if ros.lockstep and ros.reply_timeout_s >= deadline_s:
+        raise FieldProblem(
+            "ros.reply_timeout_s", f"must be below clock.deadline_s ({deadline_s} s)"
+        )
     ids = [v.id for v in vessels]
     for i, vessel in enumerate(vessels):
         for j, sensor in enumerate(vessel.sensors):

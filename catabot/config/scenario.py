@@ -197,7 +197,7 @@ class Scenario(Strict):
 
     @model_validator(mode="after")
     def _ros_names(self) -> Scenario:
-        check_ros(self.ros, self.vessels, self.traffic.boat_ids)
+        check_ros(self.ros, self.vessels, self.traffic.boat_ids, self.clock.deadline_s)
         return self
 
     @property

@@ -206,9 +206,14 @@ _NORMALS = np.rint((_AS_INT8 / 127.0 + 1.0) * 127.5).clip(0, 255).astype(np.uint
 """rgb8 of each int8 normal component, indexed by its byte: a table look-up a pixel."""
 
 
+_TABLE = _NORMALS.tobytes()
+
+
 def normals_rgb(normals: np.ndarray) -> np.ndarray:
-    """int8 normals x 127 as rgb8 (n + 1) / 2, the dataset PNGs' mapping."""
-    return np.take(_NORMALS, normals.view(np.uint8))
+    """int8 normals x 127 as rgb8 (n + 1) / 2, the dataset PNGs' mapping (`bytes.translate`
+    is the table look-up: twice as fast as NumPy's, whose indices become int64 first)."""
+    rgb = np.ascontiguousarray(normals).tobytes().translate(_TABLE)
+    return np.frombuffer(rgb, np.uint8).reshape(normals.shape)
 
 
 EMPTY = np.empty(0, np.uint8)

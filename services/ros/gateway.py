@@ -118,10 +118,10 @@ class Gateway:
         these only): states for odom, /tf and /clock, each sensor for its topics."""
         if self._wanted_version != self.wire.version:
             self._wanted_version = self.wire.version
-            odom = any(o.live for o in (*self.odom, self.tf, self.clock))
+            odom = any(o.sends for o in (*self.odom, self.tf, self.clock))
             keys = {self.keys.world_states()} if odom else set()
             for stream, outlets in self.sensors.items():
-                if any(o.live for o in outlets):
+                if any(o.sends for o in outlets):
                     keys.add(f"{self.keys.prefix}/{stream}")
             self._wanted_keys = frozenset(keys)
         return self._wanted_keys
@@ -131,7 +131,7 @@ class Gateway:
         subscription came or went."""
         if self._odom_version != self.wire.version:
             self._odom_version = self.wire.version
-            self._odom_watched = [i for i, outlet in enumerate(self.odom) if outlet.live]
+            self._odom_watched = [i for i, outlet in enumerate(self.odom) if outlet.sends]
         return self._odom_watched
 
     def _states(self, batch: BodyStates) -> None:
@@ -139,9 +139,10 @@ class Gateway:
         try:
             self.world.check_rows(batch)  # from the bus: maybe not this world's bodies
             if watched:
-                payloads = self.convert.odometry(batch)
+                payloads, odom = self.convert.odometry(batch), self.odom
                 for i in watched:
-                    self.odom[i].put(payloads[i])
+                    for send in odom[i].sends:
+                        send(payloads[i])
             if self.tf.watched:
                 self.tf.put(self.convert.tf(batch))
         except ValueError as exc:
@@ -189,7 +190,8 @@ class Gateway:
             msg = control.fresh or control.last
             control.last, control.fresh = msg, None
             assert self._publish is not None, "a lockstep gateway publishes its controls"
-            self._publish(control.stream.key, replace(msg, tick=tick.tick, stamp_ns=tick.stamp_ns))  # type: ignore[call-arg]
+            clocked = replace(msg, tick=tick.tick, stamp_ns=tick.stamp_ns)  # type: ignore[call-arg]
+            self._publish(control.stream.key, clocked)
 
     def _route(self, cmd: Command) -> None:
         control = self.controls.get(cmd.vessel)

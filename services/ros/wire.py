@@ -46,7 +46,7 @@ class Wire:
         self.node = RmwNode(ros.domain_id, self.zid, ros.node)
         self._entities = 0
         self._tokens: list[Any] = []
-        self.version = 0  # counts changes of who subscribes to what (Outlet.live)
+        self.version = 0  # counts changes of who subscribes to what (Outlet.sends)
         if Convention.RMW in self.conventions:
             self._declare(self.node.token())
 
@@ -118,27 +118,29 @@ class _Route:
 
 
 class Outlet:
-    """One ROS topic of one type, published in every convention of the gateway. `live` (the
-    routes someone subscribes to) is kept by the matching listeners, so a tick asks nothing
-    of Zenoh for a topic nobody watches (101 odometry topics a tick)."""
+    """One ROS topic of one type, published in every convention of the gateway. `sends` (a
+    put per route someone subscribes to: the publisher's own for the bridge, one adding the
+    attachment for rmw_zenoh) is kept by the matching listeners, so a tick asks nothing of
+    Zenoh for a topic nobody watches, and a put is one Python call (101 odometry a tick)."""
 
     def __init__(self, wire: Wire, topic: str, typename: str, qos: Qos = DATA) -> None:
         self.topic, self.type, self.wire = topic, typename, wire
-        self.live: list[_Route] = []
+        self.sends: list[Callable[[bytes], None]] = []
         self.routes = [
             _Route(wire, c, topic, typename, qos, self._refresh) for c in wire.conventions
         ]
         self._refresh()
 
     def _refresh(self) -> None:
-        self.live = [r for r in self.routes if r.matching]  # one assignment: thread-safe
+        sends = [(r.put if r.gid else r.publisher.put) for r in self.routes if r.matching]
+        self.sends = sends  # one assignment: the gateway's thread sees the old or the new list
         self.wire.version += 1
 
     @property
     def watched(self) -> bool:
         """Whether anyone subscribes now (or the outlet is latched)."""
-        return bool(self.live)
+        return bool(self.sends)
 
     def put(self, data: bytes) -> None:
-        for route in self.live:
-            route.put(data)
+        for send in self.sends:
+            send(data)

@@ -58,6 +58,7 @@ def test_namespaces_are_canonical(text: str, canonical: str) -> None:
         (_scenario({"domain_id": 300}), "ros.domain_id: must be <= 232"),
         (_scenario({"clock_hz": 30}), "ros.clock_hz"),
         (_scenario({"topics": {}}), "ros.topics: unknown field"),
+        (_scenario({"lockstep": True, "reply_timeout_s": 10}), "below clock.deadline_s"),
     ],
 )  # fmt: skip
 def test_refusals_name_the_field(data: dict[str, Any], message: str) -> None:
