@@ -45,7 +45,7 @@ class Observer:
         wake: threading.Event,
     ) -> None:
         self.keys, self.wake, self.session = keys, wake, session
-        self._wanted = wanted
+        self._wanted, self._pace = wanted, keys.world_states()
         self._data: dict[str, Any] = {}  # key -> subscriber, for the keys wanted now
         self._streams = {s.key: s for s in streams}
         self._held = {
@@ -63,11 +63,15 @@ class Observer:
         ]
 
     def _on_data(self, sample: zenoh.Sample) -> None:
-        held = self._held[str(sample.key_expr)]
+        """Queue the sample; wake the gateway for the states (every tick: the pace), or for
+        anything while the states are not wanted (one wake-up a tick, not one a sample)."""
+        key = str(sample.key_expr)
+        held = self._held[key]
         if len(held) == held.maxlen:
-            self._dropped[str(sample.key_expr)] += 1
+            self._dropped[key] += 1
         held.append(sample.payload.to_bytes())
-        self.wake.set()
+        if key == self._pace or self._pace not in self._data:
+            self.wake.set()
 
     def _on_end(self, sample: zenoh.Sample) -> None:
         self._end = sample.payload.to_bytes()
