@@ -134,9 +134,11 @@ def _until_watched(gateway: Gateway, expected: bool, limit_s: float = 20.0) -> N
         time.sleep(0.05)
 
 
-def full_stack(data: dict[str, Any], folder: Path, listener: bool) -> tuple[float, float]:
+def full_stack(
+    data: dict[str, Any], folder: Path, listener: bool
+) -> tuple[float, dict[str, float]]:
     """The real-time factor of one `catabot run` (and a listener process if asked), and the
-    CPU per tick of all its services together (ms; the listener, the ROS side, not counted)."""
+    CPU per tick of each service (ms; the listener, the ROS side, not counted)."""
     endpoint = f"tcp/127.0.0.1:{free_port()}"
     path = folder / f"{data['name']}.json"
     path.write_text(json.dumps(data))
@@ -150,8 +152,9 @@ def full_stack(data: dict[str, Any], folder: Path, listener: bool) -> tuple[floa
         proc.communicate(timeout=10)
     result = json.loads(next(out.glob("*/log/run.json")).read_text()) if run.returncode == 0 else {}
     if not result:
-        return float("nan"), float("nan")
-    cpu_ms = 1e3 * sum(result["cpu_s"].values()) / max(int(result["ticks"]), 1)
+        return float("nan"), {}
+    ticks = max(int(result["ticks"]), 1)
+    cpu_ms = {name: 1e3 * s / ticks for name, s in result["cpu_s"].items()}
     return float(result["sim_s"] / result["wall_s"]), cpu_ms
 
 
@@ -194,19 +197,20 @@ ROWS = ((100, 0, "100 boats, no perception"), (0, 2, "0 boats, four camera outpu
 def _full_stack_row(
     cases: dict[str, tuple[dict[str, Any], bool]], folder: Path, label: str
 ) -> None:
-    got: dict[str, list[tuple[float, float]]] = {name: [] for name in cases}
+    got: dict[str, list[tuple[float, dict[str, float]]]] = {name: [] for name in cases}
     for _ in range(REPEATS):
         for name, (data, listener) in cases.items():
             got[name].append(full_stack(data, folder, listener))
     base_rtf = statistics.median(r for r, _ in got["without gateway"])
-    base_cpu = statistics.median(c for _, c in got["without gateway"])
+    base_cpu = statistics.median(sum(c.values()) for _, c in got["without gateway"])
     for name, values in got.items():
         rtf = statistics.median(r for r, _ in values)
-        cpu = statistics.median(c for _, c in values)
-        runs = ", ".join(f"{r:.2f}" for r, _ in values)
+        cpu = statistics.median(sum(c.values()) for _, c in values)
+        services = {k: statistics.median(c.get(k, 0.0) for _, c in values) for k in values[0][1]}
+        each = ", ".join(f"{k} {v:.2f}" for k, v in services.items())
         print(
             f"  {label:28s} {name:34s} RTF {rtf:5.2f} ({rtf / base_rtf:4.2f})  CPU "
-            f"{cpu:5.2f} ms/tick ({base_cpu / cpu:4.2f})  RTF runs: {runs}",
+            f"{cpu:5.2f} ms/tick ({base_cpu / cpu:4.2f}: {each})",
             flush=True,
         )
 
