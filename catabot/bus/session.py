@@ -16,6 +16,7 @@ from dataclasses import dataclass, field
 
 import zenoh
 
+from catabot.bus.identity import check_zid
 from catabot.errors import CataBotError
 
 MODES = ("peer", "client", "router")
@@ -33,6 +34,7 @@ class Connection:
     connect: tuple[str, ...] = ()
     listen: tuple[str, ...] = field(default_factory=lambda: ("tcp/127.0.0.1:0",))
     mode: str = "peer"
+    zid: str | None = None  # this session's id (catabot run picks one per process); None: random
 
     def config(self) -> zenoh.Config:
         if self.mode not in MODES:
@@ -43,6 +45,8 @@ class Connection:
         cfg.insert_json5("connect/endpoints", json.dumps(list(self.connect)))
         listen = [] if self.mode == "client" else list(self.listen)
         cfg.insert_json5("listen/endpoints", json.dumps(listen))
+        if self.zid is not None:
+            cfg.insert_json5("id", json.dumps(check_zid(self.zid)))
         return cfg
 
 
@@ -82,8 +86,11 @@ def add_connection_args(parser: argparse.ArgumentParser) -> None:
         help="zenoh endpoint to listen on (default tcp/127.0.0.1:0 in peer mode)",
     )
     parser.add_argument("--mode", choices=MODES, default="peer", help="zenoh session mode")
+    parser.add_argument("--zid", help="this session's Zenoh id (hex; default: random)")
 
 
 def connection_from_args(args: argparse.Namespace) -> Connection:
     listen: Sequence[str] = args.listen or ("tcp/127.0.0.1:0",)
-    return Connection(connect=tuple(args.connect), listen=tuple(listen), mode=args.mode)
+    return Connection(
+        connect=tuple(args.connect), listen=tuple(listen), mode=args.mode, zid=args.zid
+    )

@@ -16,6 +16,7 @@ from dataclasses import asdict
 from catabot.bus.blas import single_thread_blas
 from catabot.bus.clock import Policy
 from catabot.bus.conductor import ClockSpec, Conductor, Progress
+from catabot.bus.identity import add_roster_args
 from catabot.bus.keys import Keys
 from catabot.bus.session import (
     add_connection_args,
@@ -57,6 +58,7 @@ def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(prog="catabot conductor")
     parser.add_argument("--scenario", help="scenario file (default: the bundled default)")
     add_connection_args(parser)
+    add_roster_args(parser)
     args = parser.parse_args(argv)
     single_thread_blas()
     logging.basicConfig(level=logging.INFO, format="%(asctime)s %(name)s %(levelname)s %(message)s")
@@ -66,7 +68,7 @@ def main(argv: list[str] | None = None) -> int:
     except CataBotError as exc:
         emit("result", ticks=0, wall_s=0.0, error=str(exc), dropped=[])
         return 2
-    conductor = Conductor(session, Keys(scenario.name), clock_spec(scenario))
+    conductor = Conductor(session, Keys(scenario.name), clock_spec(scenario), roster=args.roster)
     quiet_gc()
     for sig in (signal.SIGINT, signal.SIGTERM):
         signal.signal(sig, lambda *_: conductor.stop("interrupted"))
@@ -79,7 +81,7 @@ def main(argv: list[str] | None = None) -> int:
             conductor.stop("interrupted")
 
     result = conductor.run(progress)
-    emit("result", **asdict(result))
+    emit("result", **asdict(result), rejected=dict(conductor.rejections.totals))
     if result.error:
         log.error("run ended by a fault: %s", result.error)
     conductor.close()

@@ -19,6 +19,8 @@ from dataclasses import dataclass
 from datetime import datetime
 from pathlib import Path
 
+from catabot.bus.clock import CONDUCTOR
+from catabot.bus.identity import Roster, new_zid
 from catabot.bus.scheduling import requested_policy
 from catabot.bus.session import free_port
 from catabot.config.load import load_scenario, parse_scenario
@@ -89,6 +91,12 @@ def _endpoints(opts: RunOptions) -> tuple[list[str], list[str]]:
     return ["--listen", listen], ["--connect", listen]
 
 
+def _identity(roster: Roster, name: str) -> list[str]:
+    """A process's own session id and everyone's (only these sessions may drive the clock
+    and produce lockstep data: catabot/bus/identity.py)."""
+    return ["--zid", str(roster.zid(name)), "--roster", str(roster)]
+
+
 def _spawn(args: list[str], log_file: Path, *, stdout_pipe: bool = False) -> subprocess.Popen[str]:
     log = log_file.open("w")
     return subprocess.Popen(
@@ -117,14 +125,16 @@ def run(opts: RunOptions) -> int:
             flush=True,
         )
         scen = str(run_dir / "scenario.json")
+        roster = Roster({name: new_zid() for name in (CONDUCTOR, *world.services)})
         stops.conductor = conductor = _spawn(
-            ["catabot.run.conduct", "--scenario", scen, *cond_flags],
+            ["catabot.run.conduct", "--scenario", scen, *cond_flags, *_identity(roster, CONDUCTOR)],
             run_dir / "log" / "conductor.log",
             stdout_pipe=True,
         )
+        common = ["--scenario", scen, "--run-dir", str(run_dir), *svc_flags]
         services = {
             name: _spawn(
-                [SERVICE_MODULES[name], "--scenario", scen, "--run-dir", str(run_dir), *svc_flags],
+                [SERVICE_MODULES[name], *common, *_identity(roster, name)],
                 run_dir / "log" / f"{name}.log",
             )
             for name in world.services

@@ -15,14 +15,15 @@ import os
 import signal
 import sys
 import time
-from collections.abc import Callable
-from dataclasses import dataclass
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass, field
 from pathlib import Path
 
 import zenoh
 
 from catabot.bus.blas import single_thread_blas
-from catabot.bus.clock import ClockError
+from catabot.bus.clock import ClockError, Stream
+from catabot.bus.identity import Roster, add_roster_args
 from catabot.bus.keys import Keys
 from catabot.bus.messages import End
 from catabot.bus.participant import EndFn, Participant, StepFn
@@ -48,6 +49,7 @@ class ServiceContext:
     world: World
     session: zenoh.Session
     run_dir: Path
+    roster: Roster = field(default_factory=Roster)
 
     @property
     def scenario(self) -> Scenario:
@@ -61,6 +63,18 @@ class ServiceContext:
     def peers(self) -> list[str]:
         return self.world.participants
 
+    def participant(self, inputs: Sequence[Stream]) -> Participant:
+        """This service in the lockstep: its inputs, peers, roster and the clock's limits."""
+        return Participant(
+            self.session,
+            self.keys,
+            self.name,
+            inputs=inputs,
+            peers=self.peers,
+            roster=self.roster,
+            limits=self.world.clock_limits,
+        )
+
 
 Built = tuple[Participant, StepFn, EndFn | None]
 BuildFn = Callable[[ServiceContext], Built]
@@ -71,6 +85,7 @@ def service_parser(name: str) -> argparse.ArgumentParser:
     parser.add_argument("--scenario", help="scenario file (default: the bundled default)")
     parser.add_argument("--run-dir", default=".", help="run folder for outputs")
     add_connection_args(parser)
+    add_roster_args(parser)
     return parser
 
 
@@ -126,13 +141,14 @@ def run_service(name: str, build: BuildFn, argv: list[str] | None = None) -> int
     except CataBotError as exc:
         log.error("%s: %s", name, exc)
         return 2
-    ctx = ServiceContext(name, world, session, Path(args.run_dir))
+    ctx = ServiceContext(name, world, session, Path(args.run_dir), args.roster)
     try:
         participant, step, on_end = build(ctx)
         quiet_gc()
         cpu_start = time.process_time()
         end = _profiled(name, ctx.run_dir, lambda: participant.run(step, on_end))
         _write_usage(name, ctx.run_dir, time.process_time() - cpu_start)
+        participant.rejections.write(ctx.run_dir / "log" / f"{name}.rejected.json")
     except ClockError as exc:
         log.error("%s", exc)
         return 3

@@ -20,9 +20,9 @@ from typing import Any, Literal
 
 import numpy as np
 
-from catabot.bus.clock import period_in_ticks
+from catabot.bus.clock import ClockLimits, period_in_ticks
 from catabot.bus.keys import Keys
-from catabot.bus.messages import CLASS_BUOY, CLASS_VESSEL, BodyStates, check_ids
+from catabot.bus.messages import CLASS_BUOY, CLASS_VESSEL, BodyStates
 from catabot.config.scenario import (
     ControllerConfig,
     Pose,
@@ -140,6 +140,12 @@ class World:
     def streams(self) -> Streams:
         return Streams.of(self)
 
+    @cached_property
+    def clock_limits(self) -> ClockLimits:
+        """What participants check every Tick against (catabot/bus/clock.py)."""
+        s = self.scenario
+        return ClockLimits(s.dt_ns, s.ticks, s.clock.window_ticks)
+
     @property
     def participants(self) -> list[str]:
         return participants(self.scenario)
@@ -154,10 +160,6 @@ class World:
     @cached_property
     def _by_id(self) -> dict[str, Body]:
         return {b.id: b for b in self.bodies}
-
-    def check_rows(self, batch: BodyStates) -> None:
-        """Refuse a `BodyStates` whose rows are not this world's bodies, in order."""
-        check_ids("world/states", batch.tick, batch.ids, self.body_ids)
 
     def start_states(self) -> BodyStates:
         """Every body at rest at its start pose (tick -1, t = 0): what physics starts from."""

@@ -17,7 +17,6 @@ from typing import Any
 
 from catabot.bus.inbox import Inputs
 from catabot.bus.messages import BodyStates, CameraFrame, End, Message, Tick, TwistBatch
-from catabot.bus.participant import Participant
 from catabot.run.service import Built, ServiceContext, run_service
 from services.recorder import images
 from services.recorder.batches import BatchFormatter, Block
@@ -45,9 +44,7 @@ class Recorder:
         self.metrics = Metrics([v.id for v in world.vessels])
         self.run_dir = ctx.run_dir
         self._flushed_at = 0.0
-        self.participant = Participant(
-            ctx.session, ctx.keys, ctx.name, inputs=streams, peers=ctx.peers
-        )
+        self.participant = ctx.participant(streams)
 
     def step(self, tick: Tick, inputs: Inputs) -> None:
         for key in sorted(inputs):

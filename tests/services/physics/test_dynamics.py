@@ -191,7 +191,7 @@ def test_missing_file_and_bad_json(tmp_path: Path) -> None:
     with pytest.raises(VesselModelError, match="cannot read"):
         load_vessel_model("nowhere.json", base_dir=tmp_path)
     (tmp_path / "broken.json").write_text("{ not json")
-    with pytest.raises(VesselModelError, match="broken.json: not valid JSON: .*line 1 column 3"):
+    with pytest.raises(VesselModelError, match=r"broken.json: not valid JSON: .*line 1 column 3"):
         load_vessel_model("broken.json", base_dir=tmp_path)
 
 
