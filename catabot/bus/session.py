@@ -20,6 +20,7 @@ from catabot.bus.identity import check_zid
 from catabot.errors import CataBotError
 
 MODES = ("peer", "client", "router")
+LEASE_MS = 2000
 BLOCK = zenoh.CongestionControl.BLOCK  # lockstep data and clock messages are never dropped
 
 
@@ -47,6 +48,10 @@ class Connection:
         cfg.insert_json5("listen/endpoints", json.dumps(listen))
         if self.zid is not None:
             cfg.insert_json5("id", json.dumps(check_zid(self.zid)))
+        # A peer that stops answering (a stopped process, a cut link) is gone after 2 s,
+        # not Zenoh's default 10 s: keep-alives every 0.5 s.
+        cfg.insert_json5("transport/link/tx/lease", str(LEASE_MS))
+        cfg.insert_json5("transport/link/tx/keep_alive", "4")
         return cfg
 
 

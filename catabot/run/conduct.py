@@ -11,6 +11,7 @@ import json
 import logging
 import signal
 import sys
+import threading
 from dataclasses import asdict
 
 from catabot.bus.blas import single_thread_blas
@@ -45,13 +46,25 @@ def clock_spec(scenario: Scenario) -> ClockSpec:
     )
 
 
+_EMIT = threading.Lock()  # the heartbeat thread and the tick loop share stdout
+HEARTBEAT_S = 0.5
+
+
 def emit(kind: str, **fields: object) -> bool:
     """One JSON line on stdout; False once nobody reads it (the launcher is gone)."""
     try:
-        print(json.dumps({"kind": kind, **fields}), flush=True)
+        with _EMIT:
+            sys.stdout.write(json.dumps({"kind": kind, **fields}) + "\n")
+            sys.stdout.flush()
     except (BrokenPipeError, ValueError):  # ValueError: stdout already closed
         return False
     return True
+
+
+def heartbeat(stop: threading.Event) -> None:
+    """`alive` every half second: the launcher takes silence for a hung conductor."""
+    while not stop.wait(HEARTBEAT_S):
+        emit("alive")
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -80,7 +93,10 @@ def main(argv: list[str] | None = None) -> int:
         if not emit("progress", **asdict(p)):
             conductor.stop("interrupted")
 
+    stop = threading.Event()
+    threading.Thread(target=heartbeat, args=(stop,), name="heartbeat", daemon=True).start()
     result = conductor.run(progress)
+    stop.set()
     emit("result", **asdict(result), rejected=dict(conductor.rejections.totals))
     if result.error:
         log.error("run ended by a fault: %s", result.error)

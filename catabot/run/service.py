@@ -129,7 +129,11 @@ def _write_usage(name: str, run_dir: Path, cpu_s: float) -> None:
 
 
 def run_service(name: str, build: BuildFn, argv: list[str] | None = None) -> int:
-    """Run one stepping service to the end of the run; returns the process exit code."""
+    """Run one stepping service to the end of the run; returns the process exit code.
+
+    A fault of the service's own is logged as CRITICAL (what `catabot run` reports as the
+    run's cause); a fault of the clock (the conductor gone, the run ended by a fault
+    elsewhere) as ERROR: it is a consequence, not a cause."""
     args = service_parser(name).parse_args(argv)
     setup_logging()
     single_thread_blas()  # idle BLAS threads spin on the cores other services need
@@ -139,23 +143,33 @@ def run_service(name: str, build: BuildFn, argv: list[str] | None = None) -> int
         world = World.resolve(load_scenario(args.scenario))  # the same in every process
         session = open_session(connection_from_args(args))
     except CataBotError as exc:
-        log.error("%s: %s", name, exc)
+        log.critical("%s", exc)
         return 2
-    ctx = ServiceContext(name, world, session, Path(args.run_dir), args.roster)
+    try:
+        return _serve(ServiceContext(name, world, session, Path(args.run_dir), args.roster), build)
+    finally:
+        session.close()
+
+
+def _serve(ctx: ServiceContext, build: BuildFn) -> int:
     try:
         participant, step, on_end = build(ctx)
         quiet_gc()
         cpu_start = time.process_time()
-        end = _profiled(name, ctx.run_dir, lambda: participant.run(step, on_end))
-        _write_usage(name, ctx.run_dir, time.process_time() - cpu_start)
-        participant.rejections.write(ctx.run_dir / "log" / f"{name}.rejected.json")
+        end = _profiled(ctx.name, ctx.run_dir, lambda: participant.run(step, on_end))
+        _write_usage(ctx.name, ctx.run_dir, time.process_time() - cpu_start)
+        participant.rejections.write(ctx.run_dir / "log" / f"{ctx.name}.rejected.json")
     except ClockError as exc:
         log.error("%s", exc)
         return 3
     except CataBotError as exc:
-        log.error("%s: %s", name, exc)
+        log.critical("%s", exc)
         return 2
-    finally:
-        session.close()
-    log.info("%s: run ended at tick %d (%s) %s", name, end.tick, end.reason, end.error)
+    except OSError as exc:
+        log.critical("%s: %s", exc.filename or "I/O", exc.strerror or exc)
+        return 1
+    except Exception:  # a bug: its traceback in the log, named as the cause
+        log.critical("crashed", exc_info=True)
+        return 1
+    log.info("%s: run ended at tick %d (%s) %s", ctx.name, end.tick, end.reason, end.error)
     return 0
