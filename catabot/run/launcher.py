@@ -100,7 +100,12 @@ def run(opts: RunOptions) -> int:
     scenario = world.scenario
     stops = Stops()
     with stops.installed():  # from before the first process starts
-        run_dir = make_run_dir(opts.out, scenario)
+        try:
+            run_dir = make_run_dir(opts.out, scenario)
+        except OSError as exc:
+            print(f"catabot run: cannot make a run folder in {opts.out}: {exc.strerror}",
+                  file=sys.stderr)  # fmt: skip
+            return 1
         cond_flags, svc_flags = _endpoints(opts)
         print(
             f"run folder: {run_dir}\nzenoh: clients connect to {svc_flags[1]} (world "

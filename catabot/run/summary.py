@@ -91,7 +91,11 @@ def summarise(
         "cpu_s": _usage(run_dir, service_codes),
         "rejected": _rejected(run_dir, service_codes, result),
     }
-    (run_dir / "log" / "run.json").write_text(json.dumps(record, indent=2) + "\n")
+    try:
+        (run_dir / "log" / "run.json").write_text(json.dumps(record, indent=2) + "\n")
+    except OSError as exc:
+        print(f"catabot run: cannot write {run_dir / 'log' / 'run.json'}: {exc.strerror}",
+              file=sys.stderr)  # fmt: skip
     rtf = sim_s / wall if wall > 0 else 0.0
     print(
         f"{ticks} ticks, {sim_s:.2f} s simulated in {wall:.2f} s "

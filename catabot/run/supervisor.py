@@ -63,6 +63,14 @@ class Child:
         self._relay.join(timeout=2.0)
 
 
+def _exits(proc: subprocess.Popen[str], *, within_s: float) -> bool:
+    try:
+        proc.wait(timeout=within_s)
+    except subprocess.TimeoutExpired:
+        return False
+    return True
+
+
 def _open(path: Path) -> IO[str] | None:
     try:
         return path.open("a", encoding="utf-8")
@@ -169,10 +177,11 @@ class Supervisor:
         self.hung.append(why)
 
     def _kill_hung_participants(self) -> None:
-        """Participants the conductor reports as gone or late, whose process still exists."""
+        """Participants the conductor reports as gone or late, whose process still exists a
+        second later (one that is only closing its session is not hung)."""
         error = str(self.result.get("error", ""))
         for name, child in self.services.items():
-            if f"participant {name!r}" in error and child.proc.poll() is None:
+            if f"participant {name!r}" in error and not _exits(child.proc, within_s=1.0):
                 state = {"T": "stopped by a signal", "t": "stopped by a debugger"}.get(
                     child.state(), "alive but not stepping"
                 )

@@ -71,7 +71,7 @@ class Recorder:
                 self.csv.write_lines(block.streams, block.cls, block.lines)
             if self.mcap is not None:
                 self._write_payloads(block)
-        except (RecorderError, OSError) as exc:
+        except RecorderError as exc:  # a disk that fails ends the recording: not caught here
             log.error("not recorded: %s", exc)
         return True
 
@@ -99,7 +99,7 @@ class Recorder:
             if self.mcap is not None:
                 self._write_mcap(stream, msg)
             self.dataset.write(stream, msg)
-        except (RecorderError, OSError, ValueError) as exc:
+        except (RecorderError, ValueError) as exc:  # this sample only; a failing disk ends it
             log.error("not recorded: %s", exc)
 
     def _write_mcap(self, stream: str, msg: Message) -> None:
