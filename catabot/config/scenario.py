@@ -203,11 +203,16 @@ class Scenario(Strict):
 
 
 def check_rates(scenario: Scenario) -> None:
-    """Refuse sensor and guidance rates that are not a whole number of ticks (DESIGN.md §4)."""
+    """Refuse sensor and guidance rates that are not a whole number of ticks (DESIGN.md §4),
+    and sensors too big to sample in memory."""
     for v_index, vessel in enumerate(scenario.vessels):
         for s_index, sensor in enumerate(vessel.sensors):
             where = f"vessels.{v_index}.sensors.{s_index}.rate_hz ({vessel.id}/{sensor.name})"
             rate_in_ticks(sensor.rate_hz, scenario.dt_ns, where=where)
+            problem = sensor.typed_params().memory_problem()
+            if problem:
+                at = f"vessels.{v_index}.sensors.{s_index}.params ({vessel.id}/{sensor.name})"
+                raise ScenarioError(f"{at}: {problem}")
         if vessel.controller is not None:
             where = f"vessels.{v_index}.controller.rate_hz ({vessel.id})"
             rate_in_ticks(vessel.controller.rate_hz, scenario.dt_ns, where=where)

@@ -15,6 +15,7 @@ from catabot.errors import CataBotError
 from catabot.run import conduct, launcher
 from catabot.run.generate import add_arguments as add_generate_arguments
 from catabot.run.generate import generate
+from catabot.run.progress import PlanningProgress
 from catabot.world.world import World
 
 
@@ -72,7 +73,7 @@ def _scenario(args: argparse.Namespace) -> int:
     if args.action == "generate":
         return generate(args)
     try:  # what `catabot run` checks before it starts anything, no less
-        world = World.resolve(load_scenario(args.file))
+        world = World.resolve(load_scenario(args.file), progress=PlanningProgress())
     except CataBotError as exc:
         print(f"catabot scenario validate: {exc}", file=sys.stderr)
         return 2

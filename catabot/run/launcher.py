@@ -19,7 +19,7 @@ from catabot.bus.session import free_port
 from catabot.config.load import load_scenario, parse_scenario
 from catabot.config.scenario import Scenario
 from catabot.errors import CataBotError
-from catabot.run.progress import ProgressBar
+from catabot.run.progress import PlanningProgress, ProgressBar
 from catabot.run.summary import summarise
 from catabot.run.supervisor import Child, Stops, Supervisor
 from catabot.world.world import World
@@ -57,7 +57,7 @@ def prepare(opts: RunOptions) -> World:
         data["duration_s"] = opts.duration_s
     if opts.realtime is not None:
         data["clock"]["realtime_factor"] = opts.realtime
-    world = World.resolve(parse_scenario(data, source="command line"))
+    world = World.resolve(parse_scenario(data, source="command line"), progress=PlanningProgress())
     for name in world.services:
         if name not in SERVICE_MODULES:
             raise LaunchError(f"scenario needs service {name!r}, which this version does not have")

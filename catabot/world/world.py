@@ -39,7 +39,7 @@ from catabot.world.environment.current import CurrentField
 from catabot.world.placement import resolve_poses
 from catabot.world.streams import Streams
 from catabot.world.terrain import Terrain, load_terrain
-from catabot.world.traffic_plan import TrafficPlan, plan_traffic
+from catabot.world.traffic_plan import Progress, TrafficPlan, plan_traffic
 
 BodyKind = Literal["vessel", "boat", "buoy"]
 BUOY_MODEL = "buoy"
@@ -98,12 +98,13 @@ class World:
     sensors: tuple[MountedSensor, ...]
 
     @classmethod
-    def resolve(cls, scenario: Scenario) -> World:
-        """Everything a run needs from its scenario; ScenarioError names what cannot run."""
+    def resolve(cls, scenario: Scenario, *, progress: Progress | None = None) -> World:
+        """Everything a run needs from its scenario; ScenarioError names what cannot run.
+        `progress(k, n)` hears of each planned traffic boat (a long plan's progress)."""
         terrain = _terrain(scenario)
         current = CurrentField.from_config(scenario.water.current)
         scenario = resolve_poses(scenario, terrain)
-        plan = plan_traffic(scenario, terrain)
+        plan = plan_traffic(scenario, terrain, progress)
         bodies = _bodies(scenario, plan)
         keys = Keys(scenario.name)
         sensors = tuple(
