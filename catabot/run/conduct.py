@@ -73,6 +73,8 @@ def main(argv: list[str] | None = None) -> int:
     add_connection_args(parser)
     add_roster_args(parser)
     args = parser.parse_args(argv)
+    stop = threading.Event()  # the heartbeat, from before the session (a login takes a while)
+    threading.Thread(target=heartbeat, args=(stop,), name="heartbeat", daemon=True).start()
     single_thread_blas()
     logging.basicConfig(level=logging.INFO, format="%(asctime)s %(name)s %(levelname)s %(message)s")
     try:
@@ -93,8 +95,6 @@ def main(argv: list[str] | None = None) -> int:
         if not emit("progress", **asdict(p)):
             conductor.stop("interrupted")
 
-    stop = threading.Event()
-    threading.Thread(target=heartbeat, args=(stop,), name="heartbeat", daemon=True).start()
     result = conductor.run(progress)
     stop.set()
     emit("result", **asdict(result), rejected=dict(conductor.rejections.totals))

@@ -15,7 +15,7 @@ from pathlib import Path
 from catabot.bus.clock import CONDUCTOR
 from catabot.bus.identity import Roster, new_zid
 from catabot.bus.scheduling import requested_policy
-from catabot.bus.session import free_port
+from catabot.bus.session import check_endpoint, free_port
 from catabot.config.load import load_scenario, parse_scenario
 from catabot.config.scenario import Scenario
 from catabot.errors import CataBotError
@@ -45,12 +45,15 @@ class RunOptions:
     connect: tuple[str, ...] = ()
     listen: str | None = None
     quiet: bool = False
+    zenoh_configs: Path | None = None  # a folder of <process>.json5 (the secure profile)
 
 
 def prepare(opts: RunOptions) -> World:
     """Everything that can be refused is refused here, before any process starts: the world
     is resolved once (poses, traffic, models, terrain), as every service will resolve it."""
     requested_policy()  # a bad CATABOT_SCHED would stop every service
+    for endpoint in (*opts.connect, *([opts.listen] if opts.listen else [])):
+        check_endpoint(endpoint)
     scenario = load_scenario(opts.scenario)
     data = scenario.model_dump()
     if opts.duration_s is not None:
@@ -85,10 +88,12 @@ def _endpoints(opts: RunOptions) -> tuple[list[str], list[str]]:
     return ["--listen", listen], ["--connect", listen]
 
 
-def _identity(roster: Roster, name: str) -> list[str]:
+def _identity(roster: Roster, name: str, configs: Path | None) -> list[str]:
     """A process's own session id and everyone's (only these sessions may drive the clock
-    and produce lockstep data: catabot/bus/identity.py)."""
-    return ["--zid", str(roster.zid(name)), "--roster", str(roster)]
+    and produce lockstep data: catabot/bus/identity.py), and its Zenoh config file in the
+    secure profile (its own credentials: catabot/run/secure.py)."""
+    own = ["--zenoh-config", str(configs / f"{name}.json5")] if configs else []
+    return ["--zid", str(roster.zid(name)), "--roster", str(roster), *own]
 
 
 def run(opts: RunOptions) -> int:
@@ -112,26 +117,33 @@ def run(opts: RunOptions) -> int:
             f"{scenario.name!r}, keys catabot/{scenario.name}/...)",
             flush=True,
         )
-        scen = str(run_dir / "scenario.json")
-        roster = Roster({name: new_zid() for name in (CONDUCTOR, *world.services)})
-        conductor = Child(
-            CONDUCTOR,
-            ["catabot.run.conduct", "--scenario", scen, *cond_flags, *_identity(roster, CONDUCTOR)],
-            run_dir / "log" / "conductor.log",
-            stdout=True,
-        )
-        stops.conductor = conductor.proc
-        common = ["--scenario", scen, "--run-dir", str(run_dir), *svc_flags]
-        services = {
-            name: Child(
-                name,
-                [SERVICE_MODULES[name], *common, *_identity(roster, name)],
-                run_dir / "log" / f"{name}.log",
-                stdout=False,
-            )
-            for name in world.services
-        }
-        return _watch(scenario, run_dir, Supervisor(conductor, services, stops), quiet=opts.quiet)
+        supervisor = _start(world, run_dir, opts, stops, (cond_flags, svc_flags))
+        return _watch(scenario, run_dir, supervisor, quiet=opts.quiet)
+
+
+def _start(
+    world: World,
+    run_dir: Path,
+    opts: RunOptions,
+    stops: Stops,
+    flags: tuple[list[str], list[str]],
+) -> Supervisor:
+    """The conductor, then every service, each a process with its own session id."""
+    scen = str(run_dir / "scenario.json")
+    roster = Roster({name: new_zid() for name in (CONDUCTOR, *world.services)})
+
+    def child(name: str, module: str, extra: list[str], *, stdout: bool = False) -> Child:
+        identity = _identity(roster, name, opts.zenoh_configs)
+        args = [module, "--scenario", scen, *extra, *identity]
+        return Child(name, args, run_dir / "log" / f"{name}.log", stdout=stdout)
+
+    conductor = child(CONDUCTOR, "catabot.run.conduct", flags[0], stdout=True)
+    stops.conductor = conductor.proc
+    services = {
+        name: child(name, SERVICE_MODULES[name], ["--run-dir", str(run_dir), *flags[1]])
+        for name in world.services
+    }
+    return Supervisor(conductor, services, stops)
 
 
 def _watch(scenario: Scenario, run_dir: Path, supervisor: Supervisor, *, quiet: bool) -> int:

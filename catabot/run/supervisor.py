@@ -25,6 +25,7 @@ from pathlib import Path
 from typing import IO
 
 HANG_S = 3.0  # the conductor's heartbeat is every 0.5 s
+START_S = 60.0  # until its first line (Python's imports on a loaded machine take seconds)
 FAULT_REAP_S = 2.0  # after a fault: End carries the error, services drain for 1 s
 
 
@@ -134,7 +135,8 @@ class Supervisor:
         self.progress: dict[str, object] = {}
         self.stopped: set[str] = set()  # services stopped before they joined an interrupted run
         self.hung: list[str] = []  # processes found hung and killed
-        self._heard = time.monotonic()
+        self._started = time.monotonic()
+        self._heard: float | None = None  # when the conductor last said anything
 
     def wait(self, on_progress: object = None) -> None:
         """Until every process has ended (`on_progress(event)` for the progress lines)."""
@@ -147,13 +149,21 @@ class Supervisor:
             if died and not asked_to_stop and self.conductor.proc.poll() is None:
                 self.conductor.proc.send_signal(signal.SIGTERM)
                 asked_to_stop = True
-            if self.conductor.proc.poll() is None and time.monotonic() - self._heard > HANG_S:
-                self._kill(self.conductor, f"the conductor hung (nothing from it for {HANG_S:g} s)")
+            silent = self._silent()
+            if silent and self.conductor.proc.poll() is None:
+                self._kill(self.conductor, f"the conductor hung (nothing from it for {silent:g} s)")
         self.conductor.proc.wait()
         self._kill_hung_participants()
         self._reap()
         for child in (self.conductor, *self.services.values()):
             child.join()
+
+    def _silent(self) -> float:
+        """How long the conductor has been silent, once that means it hangs (else 0)."""
+        now = time.monotonic()
+        if self._heard is None:
+            return START_S if now - self._started > START_S else 0.0
+        return HANG_S if now - self._heard > HANG_S else 0.0
 
     def _follow(self, on_progress: object) -> None:
         assert self.conductor.proc.stdout is not None
