@@ -19,6 +19,7 @@ from catabot.bus.session import free_port
 from catabot.config.load import load_scenario, parse_scenario
 from catabot.config.scenario import Scenario
 from catabot.errors import CataBotError
+from catabot.run.companions import Viewer, after_run, start_viewer
 from catabot.run.progress import ProgressBar
 from catabot.run.summary import summarise
 from catabot.run.supervisor import Child, Stops, Supervisor
@@ -45,6 +46,7 @@ class RunOptions:
     connect: tuple[str, ...] = ()
     listen: str | None = None
     quiet: bool = False
+    view: str | None = None  # one of VIEW_MODES: the live rerun viewer beside the run
 
 
 def prepare(opts: RunOptions) -> World:
@@ -131,7 +133,23 @@ def run(opts: RunOptions) -> int:
             )
             for name in world.services
         }
-        return _watch(scenario, run_dir, Supervisor(conductor, services, stops), quiet=opts.quiet)
+        viewer = start_viewer(opts.view, run_dir, svc_flags) if opts.view else None
+        if viewer is not None and viewer.url:
+            print(f"rerun web viewer: {viewer.url}", flush=True)
+        code = _watch(scenario, run_dir, Supervisor(conductor, services, stops), quiet=opts.quiet)
+    _close_viewer(viewer)
+    return code
+
+
+def _close_viewer(viewer: Viewer | None) -> None:
+    """The native viewer's feeder ends with the run; the web viewer is served until Ctrl-C
+    when someone is at the terminal (a script's run just ends)."""
+    if viewer is None:
+        return
+    if viewer.url and sys.stdin.isatty():
+        viewer.hold()
+    else:
+        viewer.stop(wait_s=0 if viewer.url else 15)
 
 
 def _watch(scenario: Scenario, run_dir: Path, supervisor: Supervisor, *, quiet: bool) -> int:
@@ -142,11 +160,14 @@ def _watch(scenario: Scenario, run_dir: Path, supervisor: Supervisor, *, quiet: 
     result, cause = dict(supervisor.result), supervisor.cause()
     if cause:
         result["error"] = cause
+    codes = {n: c.proc.returncode for n, c in supervisor.services.items()}
+    if int(result.get("ticks_done", 0)) > 0:  # type: ignore[call-overload]
+        codes |= after_run(scenario, run_dir)  # run.rrd and dataset exports, from the files
     return summarise(
         scenario,
         run_dir,
         result,
         supervisor.conductor.proc.returncode,
-        {n: c.proc.returncode for n, c in supervisor.services.items()},
+        codes,
         stopped=supervisor.stopped,
     )
