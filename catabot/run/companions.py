@@ -25,12 +25,27 @@ VIEWER = "services.viewer"
 DATASETS = "services.datasets"
 
 
+READY_S = 30.0  # the viewer's start-up (imports, a link to the conductor) before services start
+
+
 @dataclass
 class Viewer:
     """The live viewer's process and, for the web viewer, the address to open."""
 
     proc: subprocess.Popen[str]
     url: str | None
+    ready_file: Path
+
+    def wait_ready(self) -> bool:
+        """Until it has subscribed and reached the conductor (so it sees the run from its
+        start and its End), or READY_S: the run starts either way, the view is an extra."""
+        limit = time.monotonic() + READY_S
+        while not self.ready_file.exists() and self.proc.poll() is None:
+            if time.monotonic() > limit:
+                return False
+            time.sleep(0.05)
+        self.ready_file.unlink(missing_ok=True)
+        return self.proc.poll() is None
 
     def stop(self, *, wait_s: float) -> None:
         """Let it finish (it ends after the run's End), then stop it."""
@@ -55,9 +70,12 @@ class Viewer:
         self.stop(wait_s=0)
 
 
-def start_viewer(mode: str, run_dir: Path, svc_flags: list[str]) -> Viewer:
-    """The live viewer of this run, connected like a service; its log in log/viewer.log."""
-    args = [sys.executable, "-m", VIEWER, str(run_dir), *svc_flags]
+def start_viewer(mode: str, run_dir: Path, svc_flags: list[str], *, hold: bool) -> Viewer:
+    """The live viewer of this run, connected like a service; its log in log/viewer.log.
+    `hold`: the web viewer stays up after the run (until the launcher stops it)."""
+    ready = run_dir / "log" / "viewer.ready"
+    args = [sys.executable, "-m", VIEWER, str(run_dir), *svc_flags, "--ready-file", str(ready)]
+    args += [] if hold else ["--no-hold"]
     url = None
     if mode == "web":
         web, grpc = free_port(), free_port()
@@ -65,7 +83,7 @@ def start_viewer(mode: str, run_dir: Path, svc_flags: list[str]) -> Viewer:
         url = f"http://127.0.0.1:{web}/?url=rerun%2Bhttp://127.0.0.1:{grpc}/proxy"
     log = (run_dir / "log" / "viewer.log").open("w")
     proc = subprocess.Popen(args, stdout=log, stderr=log, text=True, start_new_session=True)
-    return Viewer(proc, url)
+    return Viewer(proc, url, ready)
 
 
 def after_run(scenario: Scenario, run_dir: Path) -> dict[str, int]:

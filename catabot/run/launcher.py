@@ -123,6 +123,7 @@ def run(opts: RunOptions) -> int:
             stdout=True,
         )
         stops.conductor = conductor.proc
+        viewer = _viewer(opts, run_dir, svc_flags)
         common = ["--scenario", scen, "--run-dir", str(run_dir), *svc_flags]
         services = {
             name: Child(
@@ -133,12 +134,22 @@ def run(opts: RunOptions) -> int:
             )
             for name in world.services
         }
-        viewer = start_viewer(opts.view, run_dir, svc_flags) if opts.view else None
-        if viewer is not None and viewer.url:
-            print(f"rerun web viewer: {viewer.url}", flush=True)
         code = _watch(scenario, run_dir, Supervisor(conductor, services, stops), quiet=opts.quiet)
     _close_viewer(viewer)
     return code
+
+
+def _viewer(opts: RunOptions, run_dir: Path, svc_flags: list[str]) -> Viewer | None:
+    """The live viewer (`--view`), subscribed before any service starts."""
+    if opts.view is None:
+        return None
+    viewer = start_viewer(opts.view, run_dir, svc_flags, hold=sys.stdin.isatty())
+    if not viewer.wait_ready():
+        print(f"catabot run: the viewer did not start (see {run_dir}/log/viewer.log)",
+              file=sys.stderr)  # fmt: skip
+    elif viewer.url:
+        print(f"rerun web viewer: {viewer.url}", flush=True)
+    return viewer
 
 
 def _close_viewer(viewer: Viewer | None) -> None:
@@ -149,7 +160,7 @@ def _close_viewer(viewer: Viewer | None) -> None:
     if viewer.url and sys.stdin.isatty():
         viewer.hold()
     else:
-        viewer.stop(wait_s=0 if viewer.url else 15)
+        viewer.stop(wait_s=15)  # it ends by itself once the run's End and metrics are in
 
 
 def _watch(scenario: Scenario, run_dir: Path, supervisor: Supervisor, *, quiet: bool) -> int:

@@ -79,9 +79,9 @@ def blueprint(world: World, *, live: bool) -> rrb.Blueprint:
     below = rrb.Horizontal(
         _series("speed", "speed [m/s]"),
         _series("heading", "heading [deg]"),
-        rrb.Vertical(_series("thrust", "thrust"), _series("setpoint", "twist set-points")),
+        rrb.Tabs(_series("thrust", "thrust"), _series("setpoint", "twist set-points")),
     )
-    left = rrb.Vertical(_world_view(world), below, row_shares=[3, 1])
+    left = rrb.Vertical(_world_view(world), below, row_shares=[5, 2])
     tabs = [
         _series("imu_accel", "IMU accel"),
         _series("imu_gyro", "IMU gyro"),
@@ -96,5 +96,5 @@ def blueprint(world: World, *, live: bool) -> rrb.Blueprint:
         rrb.Horizontal(left, right, column_shares=[3, 2]),
         rrb.BlueprintPanel(state="collapsed"),
         rrb.SelectionPanel(state="collapsed"),
-        rrb.TimePanel(timeline=TIMELINE, state="expanded"),
+        rrb.TimePanel(timeline=TIMELINE, state="collapsed"),
     )

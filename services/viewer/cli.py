@@ -43,6 +43,8 @@ def parser() -> argparse.ArgumentParser:
     p.add_argument("--web-port", type=int, default=0, help="web viewer port (default: free)")
     p.add_argument("--grpc-port", type=int, default=0, help="data port (default: free)")
     p.add_argument("--save", metavar="FILE", help="write an .rrd file instead of showing it")
+    p.add_argument("--no-hold", action="store_true", help="web: stop serving when done")
+    p.add_argument("--ready-file", type=Path, help=argparse.SUPPRESS)  # for catabot run
     return p
 
 
@@ -70,32 +72,35 @@ def _world(args: argparse.Namespace) -> World:
     return World.resolve(load_scenario(source))
 
 
-def _live(args: argparse.Namespace) -> int:
+def _live(args: argparse.Namespace) -> rr.RecordingStream:
     world = _world(args)
     session = open_zenoh(connection_from_args(args))
     try:
         view = LiveView(session, world)  # subscribed before anything is logged
         rec = recording(world, args, live=True)
+        if view.linked(session) and args.ready_file is not None:
+            args.ready_file.touch()  # catabot run starts its services now
         run_dir = Path(args.source) if args.source and Path(args.source).is_dir() else None
         end = view.run(rec, run_dir)
         rec.flush()
     finally:
         session.close()
     print(f"run ended: {end.reason}" if end else "stopped before the run ended", flush=True)
-    return 0
+    return rec
 
 
-def _replay(args: argparse.Namespace) -> int:
+def _replay(args: argparse.Namespace) -> rr.RecordingStream:
     run = RecordedRun(args.source)
     rec = recording(run.world, args, live=False)
     replay(run, rec)
     rec.flush()
-    return 0
+    return rec
 
 
-def _serve(args: argparse.Namespace) -> None:
-    """The web viewer lives in this process: keep it up until Ctrl-C or SIGTERM."""
-    if not args.web or args.save:
+def _serve(args: argparse.Namespace, rec: rr.RecordingStream) -> None:
+    """The web viewer lives in this process, its data in `rec`'s server (which closes with
+    `rec`): keep both up until Ctrl-C or SIGTERM."""
+    if not args.web or args.save or args.no_hold:
         return
     print("serving the web viewer until Ctrl-C", flush=True)
     try:
@@ -112,15 +117,15 @@ def main(argv: list[str] | None = None) -> int:
     if not args.connect and args.source is None:
         parser().error("give a RUN_FOLDER to replay, or --connect ENDPOINT to attach to a run")
     try:
-        code = _live(args) if args.connect else _replay(args)
+        rec = _live(args) if args.connect else _replay(args)
     except (CataBotError, SessionError) as exc:
         print(f"catabot view: {exc}", file=sys.stderr)
         return 2
     except OSError as exc:
         print(f"catabot view: {exc.filename or ''} {exc.strerror}", file=sys.stderr)
         return 2
-    _serve(args)
-    return code
+    _serve(args, rec)
+    return 0
 
 
 if __name__ == "__main__":

@@ -33,7 +33,8 @@ from services.viewer.logger import RunLogger
 log = logging.getLogger("viewer")
 FPS = 20.0
 HELD = {"lidar": 2, "camera": 2, "radar": 256, "imu": 1024}  # samples a ring keeps
-METRICS_WAIT_S = 5.0  # the recorder writes metrics.json just after the run's end
+METRICS_WAIT_S = 5.0
+LINK_S = 20.0  # the recorder writes metrics.json just after the run's end
 
 
 class LiveView:
@@ -51,6 +52,17 @@ class LiveView:
         ]
         self._rate: deque[tuple[float, int]] = deque(maxlen=64)  # (wall s, stamp ns)
         self._stamp_ns = 0
+
+    @staticmethod
+    def linked(session: zenoh.Session, timeout_s: float = LINK_S) -> bool:
+        """Whether the session reached a peer or router within `timeout_s`: from then on the
+        subscriptions are known to the run (Zenoh sends declarations in order on each link)."""
+        limit = time.monotonic() + timeout_s
+        while time.monotonic() < limit:
+            if list(session.info.peers_zid()) or list(session.info.routers_zid()):
+                return True
+            time.sleep(0.05)
+        return False
 
     def run(self, rec: rr.RecordingStream, run_dir: Path | None) -> End | None:
         """Log until the run ends (or Ctrl-C); the End, if one came."""

@@ -50,11 +50,11 @@ class RunLogger:
         self.rec.set_time("sim_time", duration=np.timedelta64(int(stamp_ns), "ns"))
 
     def _series_names(self) -> None:
-        names = {
-            "speed": ["speed [m/s]"], "heading": ["heading [deg from north]"],
-            "imu_accel": ["x [m/s²]", "y [m/s²]", "z [m/s²]"],
-            "imu_gyro": ["x [rad/s]", "y [rad/s]", "z [rad/s]"],
-            "lidar": ["returns", "rain returns"],
+        """Line names carry their owner: a view holds one quantity for every owner."""
+        suffixes = {
+            "speed": [""], "heading": [""], "lidar": [" returns", " rain returns"],
+            "imu_accel": [" x [m/s²]", " y [m/s²]", " z [m/s²]"],
+            "imu_gyro": [" x [rad/s]", " y [rad/s]", " z [rad/s]"],
         }  # fmt: skip
         owners: dict[str, list[str]] = {
             "speed": [b.id for b in self.own], "heading": [b.id for b in self.own],
@@ -63,7 +63,7 @@ class RunLogger:
         }  # fmt: skip
         for quantity, who in owners.items():
             for owner in who:
-                lines = rr.SeriesLines(names=names[quantity])
+                lines = rr.SeriesLines(names=[owner + end for end in suffixes[quantity]])
                 self.rec.log(paths.series(quantity, owner), lines, static=True)
         self.rec.log(paths.RTF, rr.SeriesLines(names=["real-time factor"]), static=True)
         self.rec.log(paths.CLOSEST, rr.SeriesLines(names=["closest approach [m]"]), static=True)

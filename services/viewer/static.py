@@ -119,13 +119,13 @@ def _script(rec: rr.RecordingStream, body: Body) -> None:
     step = rr.components.InterpolationMode.StepAfter
     if thrust:
         n = max(len(t) for _, t in thrust)
-        names = [f"thruster {i}" for i in range(n)]
+        names = [f"{body.id} thruster {i}" for i in range(n)]
         rec.log(paths.series("thrust", body.id), rr.SeriesLines(names=names,
                 interpolation_mode=step), static=True)  # fmt: skip
         values = np.array([[*t, *[np.nan] * (n - len(t))] for _, t in thrust])
         _columns(rec, paths.series("thrust", body.id), [t for t, _ in thrust], values)
     if twist:
-        names = ["surge set-point [m/s]", "yaw rate set-point [rad/s]"]
+        names = [f"{body.id} surge [m/s]", f"{body.id} yaw rate [rad/s]"]
         rec.log(paths.series("setpoint", body.id), rr.SeriesLines(names=names,
                 interpolation_mode=step), static=True)  # fmt: skip
         values = np.array([[t.surge_mps, t.yaw_rate_radps] for _, t in twist])
