@@ -86,6 +86,9 @@ def _live(args: argparse.Namespace) -> rr.RecordingStream:
     finally:
         session.close()
     print(f"run ended: {end.reason}" if end else "stopped before the run ended", flush=True)
+    shown = ", ".join(f"{n} {what}" for what, n in sorted(view.shown.items()))
+    cpu = time.process_time()  # every thread of the viewer process, start-up included
+    print(f"shown: {shown or 'nothing'}; viewer CPU {cpu:.1f} s", flush=True)
     return rec
 
 

@@ -16,7 +16,7 @@ import json
 import logging
 import os
 import time
-from collections import deque
+from collections import Counter, deque
 from collections.abc import Callable
 from pathlib import Path
 from typing import Any
@@ -52,6 +52,7 @@ class LiveView:
         ]
         self._rate: deque[tuple[float, int]] = deque(maxlen=64)  # (wall s, stamp ns)
         self._stamp_ns = 0
+        self.shown: Counter[str] = Counter()  # what was drawn: states, each sensor's samples
 
     @staticmethod
     def linked(session: zenoh.Session, timeout_s: float = LINK_S) -> bool:
@@ -85,6 +86,7 @@ class LiveView:
         batch = _newest(self.states, BodyStates)
         if batch is not None:
             logger.states(batch)
+            self.shown["states"] += 1
             self._stamp_ns = batch.stamp_ns
             self._real_time_factor(logger, batch.stamp_ns)
         for sensor, sub in self.sensors:
@@ -95,11 +97,12 @@ class LiveView:
 
     def _sensor(self, logger: RunLogger, sensor: MountedSensor, sub: Any) -> None:
         cls = SENSOR_TYPES[sensor.config.type].message
-        kind = sensor.config.type
+        kind, name = sensor.config.type, f"{sensor.vessel}.{sensor.config.name}"
         if kind in ("lidar", "camera"):
             msg = _newest(sub, cls)
             if msg is None:
                 return
+            self.shown[name] += 1
             if kind == "lidar":
                 logger.lidar(sensor, msg)
             else:
@@ -108,6 +111,7 @@ class LiveView:
             return
         for sample in _all(sub, lambda p, _k: codec.decode(p, cls)):
             (logger.radar if kind == "radar" else logger.imu)(sensor, sample)
+            self.shown[name] += 1
 
     def _real_time_factor(self, logger: RunLogger, stamp_ns: int) -> None:
         now = time.monotonic()
