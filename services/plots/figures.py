@@ -62,7 +62,7 @@ def trajectories(data: RunSeries) -> Figure:
                    label=f"buoys ({len(b)})", zorder=3)  # fmt: skip
     ax.set(xlim=(lo[0], hi[0]), ylim=(lo[1], hi[1]), xlabel="east x [m]", ylabel="north y [m]",
            title=f"Trajectories, {data.t[-1]:.1f} s (o start, ■ end)", aspect="equal")  # fmt: skip
-    ax.legend(loc="upper right", fontsize=8, framealpha=0.85)
+    ax.legend(loc="upper right", fontsize=8, framealpha=0.9, facecolor="#9fb0c0")  # white shows
     return fig
 
 
@@ -153,15 +153,20 @@ def lidar_rain(data: RunSeries) -> Figure | None:
         share.plot(np.full(len(s.t), rate), 100 * fraction, "o", alpha=0.5, color=_color(k),
                    label=f"{owner} ({len(s.t)} scans)")  # fmt: skip
     counts.set(title="LiDAR returns per scan", xlabel="simulated time [s]", ylabel="points")
+    counts.set_ylim(0, counts.get_ylim()[1] * 1.3)  # room for the legend above the lines
     rain = counts.twinx()
     t_end = max(float(s.t[-1]) for s in data.lidar.values())
-    rain.plot([0, t_end], [rate, rate], color="magenta", lw=1.2, label="rain rate")
+    rain.plot([0, t_end], [rate, rate], color="magenta", lw=1.2, label="rain rate [mm/h]")
     rain.set(ylabel="rain rate [mm/h]", ylim=(0, max(50.0, rate * 1.1)))
+    lines = counts.get_legend_handles_labels()
+    more = rain.get_legend_handles_labels()
+    counts.legend(lines[0] + more[0], lines[1] + more[1], fontsize=8, loc="upper right", ncol=2)
     share.set(title="Rain returns against rain rate", xlabel="rain rate [mm/h]",
               ylabel="rain returns [% of returns]", xlim=(-2, 52))  # fmt: skip
+    share.set_ylim(0, max(1.0, share.get_ylim()[1] * 1.2))
+    share.legend(fontsize=8, loc="upper left")
     for ax in (counts, share):
         ax.grid(alpha=0.3)
-        ax.legend(fontsize=8, loc="best")
     return fig
 
 
@@ -190,10 +195,11 @@ def metrics(data: RunSeries) -> Figure | None:
     speed = bars.twinx()
     speed.bar(x + 0.2, top, 0.4, color="#2ca02c", label="top speed [m/s]")
     bars.set(xticks=x, xticklabels=shown, ylabel="distance travelled [m]",
-             title="Navigation metrics (metrics.json)")  # fmt: skip
-    speed.set(ylabel="top speed [m/s]")
-    bars.legend(loc="upper left", fontsize=8)
-    speed.legend(loc="upper right", fontsize=8)
+             title="Navigation metrics (metrics.json)", ylim=(0, max(dist) * 1.3 or 1))  # fmt: skip
+    speed.set(ylabel="top speed [m/s]", ylim=(0, max(top) * 1.3 or 1))
+    handles = [bars.get_legend_handles_labels()[0][0], speed.get_legend_handles_labels()[0][0]]
+    bars.legend(handles, ["distance [m]", "top speed [m/s]"], loc="upper center", ncol=2,
+                fontsize=8)  # fmt: skip
     return fig
 
 
