@@ -73,7 +73,7 @@ class LiveView:
         try:
             while end is None:
                 started = time.monotonic()
-                end = self._take(self.end, End)
+                end = _newest(self.end, End)
                 self._tick(logger)
                 time.sleep(max(0.0, 1.0 / FPS - (time.monotonic() - started)))
         except KeyboardInterrupt:
@@ -121,9 +121,6 @@ class LiveView:
             logger.rtf(stamp_ns, (stamp_ns - stamp0) / 1e9 / (now - wall0))
             while len(self._rate) > 2 and now - self._rate[0][0] > 2.0:
                 self._rate.popleft()
-
-    def _take(self, sub: Any, cls: type[Message]) -> Any:
-        return _newest(sub, cls)
 
 
 def _thrust_only(payload: bytes, key: str) -> tuple[str, tuple[float, ...]] | None:
