@@ -11,6 +11,7 @@ BENCHMARKS = {
     "sensors": "benchmarks.sensors",
     "cameras": "benchmarks.cameras",
     "table2": "benchmarks.table2",
+    "viewer": "benchmarks.viewer",
 }
 
 

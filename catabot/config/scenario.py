@@ -20,6 +20,7 @@ from pydantic import (
 from catabot.bus.clock import NS_PER_S, ClockError, period_in_ticks, ticks_for
 from catabot.config.base import (
     BuoyId,
+    FieldProblem,
     ParticipantName,
     ScenarioError,
     Seed,
@@ -164,7 +165,23 @@ class RecordingConfig(Strict):
     csv: StrictBool = True
     mcap: StrictBool = True
     dataset: StrictBool = Field(True, description="camera frames as PNGs + labels in dataset/")
+    dataset_rate_hz: float | None = Field(
+        None, gt=0, description="camera frames saved to dataset/ per second; null: every frame"
+    )
     ppi: StrictBool = Field(True, description="the radar's PPI (the paper's minimap) in dataset/")
+    rerun: StrictBool = Field(False, description="run.rrd for the rerun viewer, from run.mcap")
+    export: list[Literal["yolo", "coco", "kitti"]] = Field(
+        [], description="datasets converted into export/<format>/ when the run ends"
+    )
+
+    @model_validator(mode="after")
+    def _needs_mcap(self) -> RecordingConfig:
+        """run.rrd and the exports are made from run.mcap after the run."""
+        wanted = [f"export ({', '.join(self.export)})"] if self.export else []
+        wanted += ["rerun"] if self.rerun else []
+        if wanted and not self.mcap:
+            raise FieldProblem(wanted[0].split()[0], "needs recording.mcap: true (made from it)")
+        return self
 
 
 class Scenario(Strict):
@@ -193,6 +210,19 @@ class Scenario(Strict):
     def _unique_ids(cls, vessels: list[VesselConfig]) -> list[VesselConfig]:
         return unique(vessels, attr="id", what="vessel ids")
 
+    @model_validator(mode="after")
+    def _exports_have_sources(self) -> Scenario:
+        """Camera datasets need a camera and dataset/; KITTI scans need a LiDAR."""
+        types = {s.type for v in self.vessels for s in v.sensors}
+        rec = self.recording
+        for fmt in rec.export:
+            need = "lidar" if fmt == "kitti" else "camera"
+            if need not in types:
+                raise FieldProblem("recording.export", f"{fmt!r} needs a {need} on a vessel")
+            if need == "camera" and not rec.dataset:
+                raise FieldProblem("recording.export", f"{fmt!r} needs recording.dataset: true")
+        return self
+
     @property
     def duration_ns(self) -> int:
         return round(self.duration_s * NS_PER_S)
@@ -218,6 +248,10 @@ def check_rates(scenario: Scenario) -> None:
             rate_in_ticks(vessel.controller.rate_hz, scenario.dt_ns, where=where)
     if scenario.traffic.count:
         guidance_period_ticks(scenario)
+    if scenario.recording.dataset_rate_hz is not None:
+        rate_in_ticks(
+            scenario.recording.dataset_rate_hz, scenario.dt_ns, where="recording.dataset_rate_hz"
+        )
     try:
         scenario.ticks  # noqa: B018 - validates duration against dt
     except ClockError as exc:

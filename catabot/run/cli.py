@@ -1,4 +1,5 @@
-"""The `catabot` command: run, service, conductor, router, scenario."""
+"""The `catabot` command: run, service, router, scenario, and the tools over run folders
+(view, dataset, plot)."""
 
 from __future__ import annotations
 
@@ -14,6 +15,7 @@ from catabot.bus.session import Connection, SessionError, add_connection_args, o
 from catabot.config.load import json_schema, load_scenario
 from catabot.errors import CataBotError
 from catabot.run import conduct, launcher, secure
+from catabot.run.companions import VIEW_MODES
 from catabot.run.generate import add_arguments as add_generate_arguments
 from catabot.run.generate import generate
 from catabot.run.progress import PlanningProgress
@@ -38,6 +40,7 @@ def _run(args: argparse.Namespace) -> int:
         listen=args.listen,
         quiet=args.quiet,
         zenoh_configs=configs,
+        view=args.view,
     )
     return launcher.run(opts)
 
@@ -66,6 +69,18 @@ def _service(args: argparse.Namespace, rest: list[str]) -> int:
         return 2
     main = importlib.import_module(f"{module}.service").main
     return int(main(rest))
+
+
+TOOLS = {  # `catabot <tool> ...`: programs over a run folder, each in its own service folder
+    "view": ("services.viewer.cli", "replay a run or attach to one in the rerun viewer"),
+    "dataset": ("services.datasets.cli", "export a run as a YOLO, COCO or KITTI dataset"),
+    "plot": ("services.plots.cli", "plot a run: PNG figures and report.html"),
+}
+
+
+def _tool(args: argparse.Namespace, rest: list[str]) -> int:
+    """Hand the rest of the command line to the tool's own parser (its --help too)."""
+    return int(importlib.import_module(TOOLS[args.command][0]).main(rest))
 
 
 def _router(args: argparse.Namespace) -> int:
@@ -135,6 +150,13 @@ def parser() -> argparse.ArgumentParser:
     )
     run.add_argument("--quiet", action="store_true", help="no progress bar")
     run.add_argument(
+        "--view",
+        nargs="?",
+        const="native",
+        choices=VIEW_MODES,
+        help="show the run live in rerun: the native viewer, or 'web' (served; prints its URL)",
+    )
+    run.add_argument(
         "--secure",
         metavar="DIR",
         help="the secure profile made by `catabot secure init DIR`: TLS, logins, access control",
@@ -157,6 +179,8 @@ def parser() -> argparse.ArgumentParser:
     scen.add_argument("file", nargs="?", help="scenario to validate")
     scen.add_argument("--output", "-o", help="write the schema (or generated scenario) here")
     add_generate_arguments(scen)
+    for name, (_, text) in TOOLS.items():
+        sub.add_parser(name, help=text, add_help=False)
     return p
 
 
@@ -164,6 +188,8 @@ def main(argv: list[str] | None = None) -> int:
     args, rest = parser().parse_known_args(argv)
     if args.command == "service":
         return _service(args, rest)
+    if args.command in TOOLS:
+        return _tool(args, rest)
     if rest:
         parser().error(f"unrecognized arguments: {' '.join(rest)}")
     handlers = {"run": _run, "router": _router, "scenario": _scenario, "secure": _secure}

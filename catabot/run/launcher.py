@@ -19,6 +19,7 @@ from catabot.bus.session import check_endpoint, free_port
 from catabot.config.load import load_scenario, parse_scenario
 from catabot.config.scenario import Scenario
 from catabot.errors import CataBotError
+from catabot.run.companions import Viewer, after_run, start_viewer
 from catabot.run.progress import PlanningProgress, ProgressBar
 from catabot.run.summary import summarise
 from catabot.run.supervisor import Child, Stops, Supervisor
@@ -46,6 +47,7 @@ class RunOptions:
     listen: str | None = None
     quiet: bool = False
     zenoh_configs: Path | None = None  # a folder of <process>.json5 (the secure profile)
+    view: str | None = None  # one of VIEW_MODES: the live rerun viewer beside the run
 
 
 def prepare(opts: RunOptions) -> World:
@@ -92,8 +94,11 @@ def _identity(roster: Roster, name: str, configs: Path | None) -> list[str]:
     """A process's own session id and everyone's (only these sessions may drive the clock
     and produce lockstep data: catabot/bus/identity.py), and its Zenoh config file in the
     secure profile (its own credentials: catabot/run/secure.py)."""
-    own = ["--zenoh-config", str(configs / f"{name}.json5")] if configs else []
-    return ["--zid", str(roster.zid(name)), "--roster", str(roster), *own]
+    return ["--zid", str(roster.zid(name)), "--roster", str(roster), *_login(name, configs)]
+
+
+def _login(name: str, configs: Path | None) -> list[str]:
+    return ["--zenoh-config", str(configs / f"{name}.json5")] if configs else []
 
 
 def run(opts: RunOptions) -> int:
@@ -117,8 +122,10 @@ def run(opts: RunOptions) -> int:
             f"{scenario.name!r}, keys catabot/{scenario.name}/...)",
             flush=True,
         )
-        supervisor = _start(world, run_dir, opts, stops, (cond_flags, svc_flags))
-        return _watch(scenario, run_dir, supervisor, quiet=opts.quiet)
+        supervisor, viewer = _start(world, run_dir, opts, stops, (cond_flags, svc_flags))
+        code = _watch(scenario, run_dir, supervisor, quiet=opts.quiet)
+    _close_viewer(viewer)
+    return code
 
 
 def _start(
@@ -127,8 +134,9 @@ def _start(
     opts: RunOptions,
     stops: Stops,
     flags: tuple[list[str], list[str]],
-) -> Supervisor:
-    """The conductor, then every service, each a process with its own session id."""
+) -> tuple[Supervisor, Viewer | None]:
+    """The conductor, the viewer (it sees the run from tick 0), then every service, each a
+    process with its own session id."""
     scen = str(run_dir / "scenario.json")
     roster = Roster({name: new_zid() for name in (CONDUCTOR, *world.services)})
 
@@ -139,11 +147,36 @@ def _start(
 
     conductor = child(CONDUCTOR, "catabot.run.conduct", flags[0], stdout=True)
     stops.conductor = conductor.proc
+    viewer = _viewer(opts, run_dir, [*flags[1], *_login("viewer", opts.zenoh_configs)])
     services = {
         name: child(name, SERVICE_MODULES[name], ["--run-dir", str(run_dir), *flags[1]])
         for name in world.services
     }
-    return Supervisor(conductor, services, stops)
+    return Supervisor(conductor, services, stops), viewer
+
+
+def _viewer(opts: RunOptions, run_dir: Path, svc_flags: list[str]) -> Viewer | None:
+    """The live viewer (`--view`), subscribed before any service starts."""
+    if opts.view is None:
+        return None
+    viewer = start_viewer(opts.view, run_dir, svc_flags, hold=sys.stdin.isatty())
+    if not viewer.wait_ready():
+        print(f"catabot run: the viewer did not start (see {run_dir}/log/viewer.log)",
+              file=sys.stderr)  # fmt: skip
+    elif viewer.url:
+        print(f"rerun web viewer: {viewer.url}", flush=True)
+    return viewer
+
+
+def _close_viewer(viewer: Viewer | None) -> None:
+    """The native viewer's feeder ends with the run; the web viewer is served until Ctrl-C
+    when someone is at the terminal (a script's run just ends)."""
+    if viewer is None:
+        return
+    if viewer.url and sys.stdin.isatty():
+        viewer.hold()
+    else:
+        viewer.stop(wait_s=15)  # it ends by itself once the run's End and metrics are in
 
 
 def _watch(scenario: Scenario, run_dir: Path, supervisor: Supervisor, *, quiet: bool) -> int:
@@ -154,11 +187,14 @@ def _watch(scenario: Scenario, run_dir: Path, supervisor: Supervisor, *, quiet: 
     result, cause = dict(supervisor.result), supervisor.cause()
     if cause:
         result["error"] = cause
+    codes = {n: c.proc.returncode for n, c in supervisor.services.items()}
+    if int(result.get("ticks_done", 0)) > 0:  # type: ignore[call-overload]
+        codes |= after_run(scenario, run_dir)  # run.rrd and dataset exports, from the files
     return summarise(
         scenario,
         run_dir,
         result,
         supervisor.conductor.proc.returncode,
-        {n: c.proc.returncode for n, c in supervisor.services.items()},
+        codes,
         stopped=supervisor.stopped,
     )

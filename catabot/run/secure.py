@@ -10,7 +10,7 @@ and password, and the router's access control lets each name publish only its ow
 | conductor | clock/tick, clock/end |
 | physics, sensors, traffic, recorder | their own lockstep streams, acks and liveliness token |
 | a lockstep client (`--client`) | vessel/*/cmd/**, its own ack and token |
-| an observer (`--observer`) | nothing: it subscribes only |
+| an observer (`--observer`; always `viewer`, for `--view`) | nothing: it subscribes only |
 
 Everyone may subscribe. The files: a test certificate authority and the router's
 certificate (openssl), `users.txt`, `router.json5`, and one `<name>.json5` per process and
@@ -51,6 +51,7 @@ def init(
     port: int = 7447,
 ) -> list[Path]:  # fmt: skip
     """Every file of the profile in `folder`; the paths written."""
+    observers = [*observers, *(["viewer"] if "viewer" not in observers else [])]  # --view
     names = [*OWN, *(check_name("client", c) for c in clients),
              *(check_name("observer", o) for o in observers)]  # fmt: skip
     if len(set(names)) != len(names):
