@@ -12,6 +12,7 @@ BENCHMARKS = {
     "cameras": "benchmarks.cameras",
     "table2": "benchmarks.table2",
     "ros": "benchmarks.ros",
+    "viewer": "benchmarks.viewer",
 }
 
 

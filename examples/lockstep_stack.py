@@ -44,8 +44,8 @@ def main() -> None:
 
     with session(args) as s:
         stack = Participant(
-            s, world.keys, me.controller.participant,
-            inputs=[world.streams.states], peers=world.participants,
+            s, world.keys, me.controller.participant, inputs=[world.streams.states],
+            peers=world.participants, limits=world.clock_limits,
         )  # fmt: skip
 
         def step(tick: Tick, inputs: Inputs) -> None:

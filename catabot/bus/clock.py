@@ -12,10 +12,12 @@ consumer step up to L ticks ahead of the producer instead of waiting for it ever
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from collections.abc import Callable
+from dataclasses import dataclass, field
 from enum import StrEnum
+from typing import Any
 
-from catabot.bus.messages import Message
+from catabot.bus.messages import Message, Tick
 from catabot.errors import CataBotError
 
 NS_PER_S = 1_000_000_000
@@ -36,13 +38,19 @@ class Policy(StrEnum):
 @dataclass(frozen=True)
 class Stream:
     """A key with one producer and a period in ticks; `period=None` is free-running.
-    `lag`: this consumer's fixed delay in ticks on top of the one tick (clocked only)."""
+    `lag`: this consumer's fixed delay in ticks on top of the one tick (clocked only).
+    `stamp_ticks`: a sample tagged k is stamped (k + stamp_ticks) x dt (states: 1, the state
+    at the end of the tick). `check`: raises ValueError for a sample whose content this
+    world cannot take (rows of other bodies, a thrust for thrusters the vessel lacks), so a
+    bad sample is refused where it arrives, never in the step."""
 
     key: str
     message: type[Message]
     producer: str
     period: int | None = 1
     lag: int = 0
+    stamp_ticks: int = 0
+    check: Callable[[Any], None] | None = field(default=None, compare=False)
 
     def __post_init__(self) -> None:
         if self.lag < 0 or (self.lag and self.period is None):
@@ -64,6 +72,33 @@ class Stream:
     def due_through(self, tick: int) -> int:
         """The last tick <= `tick` at which a sample is due (used at run end)."""
         return self.due_before(tick + 1)
+
+
+@dataclass(frozen=True)
+class ClockLimits:
+    """What a participant knows of the clock from its scenario, to believe a `Tick` only if
+    it could have come from the conductor: the tick length, the run's length, the window."""
+
+    dt_ns: int
+    ticks: int
+    window: int
+
+    def problem(self, tick: Tick, *, next_tick: int, grant: int) -> str:
+        """Why `tick` cannot be a grant of this run ("" if it can). `grant`: the last tick
+        granted so far (-1: none); `next_tick`: the tick this participant steps next."""
+        if tick.dt_ns != self.dt_ns:
+            return f"dt {tick.dt_ns} ns, not {self.dt_ns}"
+        if not 0 <= tick.tick < self.ticks:
+            return f"tick {tick.tick} outside the run's 0..{self.ticks - 1}"
+        if tick.stamp_ns != tick.tick * self.dt_ns:
+            return f"stamp {tick.stamp_ns} ns is not tick x dt"
+        if not 1 <= tick.ack_every <= self.window:
+            return f"ack_every {tick.ack_every} outside 1..{self.window}"
+        if tick.tick < grant:
+            return f"grant {tick.tick} goes back from {grant}"
+        if tick.tick >= next_tick + self.window:  # nobody may run a window ahead of us
+            return f"grant {tick.tick} is past the window ({next_tick} + {self.window})"
+        return ""
 
 
 def ticks_for(duration_ns: int, dt_ns: int) -> int:

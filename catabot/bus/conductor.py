@@ -19,9 +19,12 @@ import zenoh
 
 from catabot.bus import codec
 from catabot.bus.clock import CONDUCTOR, ClockError, Policy
+from catabot.bus.identity import Roster, sender_of
 from catabot.bus.keys import Keys
+from catabot.bus.members import Members
 from catabot.bus.messages import Ack, End, Tick
-from catabot.bus.session import BLOCK
+from catabot.bus.outputs import Outputs
+from catabot.bus.rejections import Rejected, Rejections
 
 log = logging.getLogger("catabot.bus.conductor")
 
@@ -63,21 +66,23 @@ class RunResult:
 
 
 class Conductor:
-    def __init__(self, session: zenoh.Session, keys: Keys, spec: ClockSpec) -> None:
+    def __init__(
+        self, session: zenoh.Session, keys: Keys, spec: ClockSpec, *, roster: Roster | None = None
+    ) -> None:
         self.session, self.keys, self.spec = session, keys, spec
         self.run_id = uuid.uuid4().hex[:12]
         self._created = time.monotonic()
         self.events: queue.SimpleQueue[tuple[str, str, bytes]] = queue.SimpleQueue()
-        self.members: set[str] = set()
+        self._members = Members(keys, roster if roster is not None else Roster())
+        self.rejections = Rejections(log, CONDUCTOR)
         self.dropped: list[str] = []
         self._stop_reason = ""
         self._done = 0  # ticks every active participant has acked
         self._granted = -1  # the last tick granted
         self._acked = {name: -1 for name in spec.participants}
         self._t0 = self._created
-        self._tick_pub = session.declare_publisher(keys.tick(), congestion_control=BLOCK)
-        self._end_pub = session.declare_publisher(keys.end(), congestion_control=BLOCK)
-        self._token = session.liveliness().declare_token(keys.live(CONDUCTOR))
+        self._out = Outputs(session)  # ticks and ends, signed with this session's id
+        self._token = session.liveliness().declare_token(keys.live(CONDUCTOR, str(session.zid())))
         # Acks arrive on a FIFO channel (no Python callback per ack: the hot path); rare
         # events (a participant leaving, a deadline passing, a stop) go to `events`, and the
         # watchdog thread wakes the tick loop by publishing a poke on the conductor's own ack key.
@@ -127,7 +132,7 @@ class Conductor:
             error = str(exc)
         done = self._done  # complete ticks, also when a fault or a stop cut the run short
         reason = self._stop_reason or ("completed" if not error else "fault")
-        self._end_pub.put(codec.encode(End(self.run_id, done - 1, reason, error)))
+        self._out.publish(self.keys.end(), End(self.run_id, done - 1, reason, error))
         wall = time.monotonic() - start
         return RunResult(done, wall, error, list(self.dropped), reason, joined - self._created)
 
@@ -201,7 +206,7 @@ class Conductor:
             self._restart_deadline()
         k, dt = self._granted, self.spec.dt_ns
         tick = Tick(self.run_id, k, k * dt, dt, tuple(self.dropped), self.spec.ack_every)
-        self._tick_pub.put(codec.encode(tick))
+        self._out.publish(self.keys.tick(), tick)
 
     def _await_progress(self) -> None:
         """Wait for an ack or an event, or (paced runs) until the next tick is due, then take
@@ -220,14 +225,27 @@ class Conductor:
         if key == self._poke_key:
             return
         try:
+            name, ack = self._checked_ack(key, sample)
+        except Rejected as exc:
+            self.rejections.add(key, exc)
+            return
+        self._acked[name] = max(self._acked[name], min(ack.tick, self._granted))
+        self._advance()
+
+    def _checked_ack(self, key: str, sample: zenoh.Sample) -> tuple[str, Ack]:
+        """An ack believed only from the session whose token names its participant."""
+        name = self.keys.participant_of(key)
+        if name not in self._acked:
+            raise Rejected("ack of no participant", name)
+        if not self._members.sender_is(name, sender_of(sample)):
+            raise Rejected("ack from a stranger", f"sender {sender_of(sample) or '?'}")
+        try:
             ack = codec.decode(sample.payload.to_bytes(), Ack)
         except codec.CodecError as exc:
-            log.warning("malformed ack on %s: %s", key, exc)
-            return
-        name = self.keys.participant_of(key)
-        if ack.run == self.run_id and name in self._acked:
-            self._acked[name] = max(self._acked[name], min(ack.tick, self._granted))
-            self._advance()
+            raise Rejected("malformed", str(exc)) from None
+        if ack.run != self.run_id or ack.tick < -1:
+            raise Rejected("ack of another run or tick", f"run {ack.run}, tick {ack.tick}")
+        return name, ack
 
     def _advance(self) -> None:
         """Every active participant has acked up to `_done - 1`; restart the deadline on
@@ -273,11 +291,15 @@ class Conductor:
         except queue.Empty:
             return ("late", "", b"")
         kind, key, _ = event
-        if kind == "join":
-            self.members.add(self.keys.participant_of(key))
-        elif kind == "leave":
-            self.members.discard(self.keys.participant_of(key))
+        joined = kind == "join"
+        if kind in ("join", "leave") and self._members.token(key, alive=joined) is None:
+            self.rejections.add(key, Rejected("token contradicts the roster", key))
         return event
+
+    @property
+    def members(self) -> set[str]:
+        """The participants whose token is alive (and bound to them)."""
+        return set(self._members.present)
 
     def close(self) -> None:
         self._closed.set()

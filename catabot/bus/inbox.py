@@ -1,10 +1,17 @@
-"""Samples a participant has received, released in Jacobi order.
+"""Samples a participant has received: checked where they arrive, released in Jacobi order.
 
-A sample tagged tick j is released to the step of tick k only when j < k (j < k - lag
-for a stream read with a lag: `Stream.released_before`); free-running
-samples (tick -1, from clients outside the lockstep) are released at the next step
-after they arrive. Releasing by tick rather than by arrival is what keeps a run
-deterministic when producers race each other on different routes.
+A sample tagged tick j is released to the step of tick k only when j < k (j < k - lag for a
+stream read with a lag: `Stream.released_before`); free-running samples (tick -1, from
+clients outside the lockstep) are released at the next step after they arrive. Releasing
+by tick rather than by arrival is what keeps a run deterministic when producers race each
+other on different routes.
+
+Every check happens in `add`, so nothing a client sends can fail a step: the key must be
+exactly one of the streams (a put on a wildcard reaches every subscriber under the wildcard),
+a clocked sample must come from its producer's session (identity.py), carry a tag the
+clock could have granted and the stamp of that tag, and pass its stream's content check; a
+free-running sample must carry tick -1. A refused sample raises `Rejected`, which the
+participant counts (rejections.py).
 """
 
 from __future__ import annotations
@@ -13,19 +20,28 @@ from collections.abc import Iterable, Mapping, Sequence
 
 from catabot.bus import codec
 from catabot.bus.clock import Stream
+from catabot.bus.identity import Roster
 from catabot.bus.messages import Message
+from catabot.bus.rejections import Rejected
+from catabot.errors import CataBotError
 
 Inputs = Mapping[str, list[Message]]
+MAX_PENDING = 10_000  # samples held while their producer's session is not yet known
 
 
 class Inbox:
-    def __init__(self, streams: Sequence[Stream]) -> None:
+    def __init__(
+        self, streams: Sequence[Stream], *, roster: Roster | None = None, dt_ns: int = 0
+    ) -> None:
         self.streams = {s.key: s for s in streams}
         if len(self.streams) != len(streams):
             raise ValueError("two input streams share one key")
+        self.roster = roster if roster is not None else Roster()
+        self.dt_ns = dt_ns  # 0: stamps are not checked (no clock limits known)
         self.latest = {key: -1 for key in self.streams}
         self.held: dict[str, list[Message]] = {key: [] for key in self.streams}
         self.dropped: set[str] = set()
+        self.pending: list[tuple[str, bytes, str]] = []
         # Only clocked streams can be due (physics has ~300 free-running command keys with
         # 100 boats); only keys holding samples need a look at release.
         self._clocked = [s for s in self.streams.values() if s.period is not None]
@@ -36,15 +52,60 @@ class Inbox:
     def keys(self) -> list[str]:
         return list(self.streams)
 
-    def add(self, key: str, payload: bytes) -> None:
-        """Decode and hold a sample; raises CodecError for a malformed payload."""
-        stream = self.streams[key]
-        msg = codec.decode(payload, stream.message)
+    def add(self, key: str, payload: bytes, *, sender: str = "", horizon: int = 2**62) -> None:
+        """Check, decode and hold a sample; `Rejected` says why one is refused. `horizon`:
+        no tag may reach it (the clock cannot have granted that far)."""
+        stream = self.streams.get(key)
+        if stream is None:
+            raise Rejected("not a stream key", f"{key!r} (a wildcard or another vessel's key)")
+        if stream.period is not None and not self._from_producer(stream, key, payload, sender):
+            return  # held until the producer's session is known
+        msg = _decoded(payload, stream)
         tick = _tick_of(msg)
+        self._check_tag(stream, msg, tick, horizon)
+        _check_content(stream, msg)
         self.held[key].append(msg)
         self._holding.add(key)
-        if tick > self.latest[key]:
-            self.latest[key] = tick
+        self.latest[key] = max(self.latest[key], tick)
+
+    def _from_producer(self, stream: Stream, key: str, payload: bytes, sender: str) -> bool:
+        producer = self.roster.zid(stream.producer)
+        if producer is None:
+            if len(self.pending) >= MAX_PENDING:
+                raise Rejected("producer unknown", f"{stream.producer} has no session yet")
+            self.pending.append((key, payload, sender))
+            return False
+        if sender != producer:
+            raise Rejected(
+                "not from its producer", f"sender {sender or '?'} is not {stream.producer}"
+            )
+        return True
+
+    def retry_pending(self, horizon: int) -> list[tuple[str, Rejected]]:
+        """Samples held for a producer now known: added, or refused (returned with why)."""
+        pending, self.pending, refused = self.pending, [], []
+        for key, payload, sender in pending:
+            try:
+                self.add(key, payload, sender=sender, horizon=horizon)
+            except Rejected as exc:
+                refused.append((key, exc))
+        return refused
+
+    def _check_tag(self, stream: Stream, msg: Message, tick: int, horizon: int) -> None:
+        if stream.period is None:
+            if tick != -1:
+                raise Rejected("tick of a free-running sample", f"tick {tick}, not -1")
+            return
+        if tick < 0 or tick % stream.period or tick >= horizon or tick <= self.latest[stream.key]:
+            raise Rejected(
+                "tag out of the window",
+                f"tick {tick} (period {stream.period}, last {self.latest[stream.key]}, "
+                f"granted below {horizon})",
+            )
+        stamp = getattr(msg, "stamp_ns", None)
+        expected = (tick + stream.stamp_ticks) * self.dt_ns
+        if self.dt_ns and stamp != expected:
+            raise Rejected("stamp of another tick", f"stamp {stamp} ns, tick {tick} has {expected}")
 
     def drop_producers(self, names: Iterable[str]) -> None:
         """Stop waiting for streams of participants the conductor dropped."""
@@ -70,6 +131,22 @@ class Inbox:
             if not self.held[key]:
                 self._holding.discard(key)
         return out
+
+
+def _decoded(payload: bytes, stream: Stream) -> Message:
+    try:
+        return codec.decode(payload, stream.message)
+    except codec.CodecError as exc:
+        raise Rejected("malformed", str(exc)) from None
+
+
+def _check_content(stream: Stream, msg: Message) -> None:
+    if stream.check is None:
+        return
+    try:
+        stream.check(msg)
+    except (ValueError, CataBotError) as exc:
+        raise Rejected("invalid content", str(exc)) from None
 
 
 def _tick_of(msg: Message) -> int:

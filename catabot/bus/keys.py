@@ -59,11 +59,12 @@ class Keys:
     def end(self) -> str:
         return f"{self.prefix}/clock/end"
 
-    def live(self, participant: str) -> str:
-        return f"{self.prefix}/live/{check_name('participant', participant)}"
+    def live(self, participant: str, zid: str) -> str:
+        """A participant's liveliness token: its name and its session's zid (identity.py)."""
+        return f"{self.prefix}/live/{check_name('participant', participant)}/{zid}"
 
     def lives(self) -> str:
-        return f"{self.prefix}/live/*"
+        return f"{self.prefix}/live/*/*"
 
     def vessel_state(self, vessel: str) -> str:
         return f"{self.prefix}/vessel/{check_name('vessel', vessel)}/state"
@@ -115,5 +116,12 @@ class Keys:
         return parts[1]
 
     def participant_of(self, key: str) -> str:
-        """The participant named by the last chunk of an ack or liveliness key."""
+        """The participant named by the last chunk of an ack key."""
         return key.rsplit("/", 1)[-1]
+
+    def member_of(self, key: str) -> tuple[str, str]:
+        """(name, zid) of a liveliness token key `live/<name>/<zid>`; KeyNameError if not one."""
+        parts = self.relative(key).split("/")
+        if len(parts) != 3 or parts[0] != "live":
+            raise KeyNameError(f"key {key!r} is not a liveliness token of world {self.world!r}")
+        return parts[1], parts[2]

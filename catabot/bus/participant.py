@@ -4,8 +4,12 @@ Services write only a `step(tick, inputs)` function; this class owns the protoco
 DESIGN.md §4: membership by a liveliness token, stepping every tick the conductor has
 granted as soon as its inputs are complete (so a fast participant runs ahead of a slow
 one, within the window), Jacobi input release (a sample tagged k is handed over at tick
-k+1, never earlier), acks every few ticks, malformed payloads logged with their key and
-dropped, and a clean end on `clock/end`.
+k+1, never earlier), acks every few ticks, and a clean end on `clock/end`.
+
+Nothing from the bus is believed blindly (identity.py, inbox.py): ticks and ends only from
+the conductor's session and only if the run's clock could have sent them (`ClockLimits`),
+lockstep samples only from their producer's session; refused samples are counted and
+logged without flooding (rejections.py), and none can fail a step.
 """
 
 from __future__ import annotations
@@ -14,24 +18,28 @@ import logging
 import queue
 import time
 from collections.abc import Callable, Sequence
-from typing import Any
 
 import zenoh
 
 from catabot.bus import codec
-from catabot.bus.clock import CONDUCTOR, ClockError, Stream
+from catabot.bus.clock import CONDUCTOR, ClockError, ClockLimits, Stream
+from catabot.bus.identity import Roster, sender_of
 from catabot.bus.inbox import Inbox, Inputs
 from catabot.bus.keys import Keys
-from catabot.bus.messages import Ack, End, Message, Tick
-from catabot.bus.session import BLOCK
+from catabot.bus.members import Members
+from catabot.bus.messages import Ack, End, Tick
+from catabot.bus.outputs import Outputs
+from catabot.bus.rejections import Rejected, Rejections
 
 log = logging.getLogger("catabot.bus.participant")
 ORPHAN_GRACE_S = 0.5
+MAX_HELD_CLOCK = 64  # clock messages held while the conductor's session is not known yet
 StepFn = Callable[[Tick, Inputs], None]
 EndFn = Callable[[End, Inputs], None]
+Event = tuple[str, str, bytes, str]  # kind, key, payload, sender zid
 
 
-class Participant:
+class Participant(Outputs):
     def __init__(
         self,
         session: zenoh.Session,
@@ -41,22 +49,27 @@ class Participant:
         inputs: Sequence[Stream] = (),
         peers: Sequence[str] = (),
         drain_s: float = 5.0,
+        roster: Roster | None = None,
+        limits: ClockLimits | None = None,
     ) -> None:
-        self.session, self.keys, self.name = session, keys, name
-        self.inbox = Inbox(inputs)
+        super().__init__(session)
+        self.keys, self.name = keys, name
+        self.roster = roster if roster is not None else Roster()
+        self.limits = limits
+        self.inbox = Inbox(inputs, roster=self.roster, dt_ns=limits.dt_ns if limits else 0)
+        self.members = Members(keys, self.roster)
+        self.rejections = Rejections(log, name)
         self.peers = set(peers) - {name}
+        self._everyone = self.peers | {name}  # the peers a tick may name as dropped
         self.drain_s = drain_s
         self.next_tick = 0
         self._grant: Tick | None = None
+        self._held_clock: list[Event] = []  # until the conductor's session is known
         self._waiting_since = time.monotonic()  # for the warning about a long wait
-        self.events: queue.SimpleQueue[tuple[str, str, bytes]] = queue.SimpleQueue()
-        self.present: set[str] = set()
+        self.events: queue.SimpleQueue[Event] = queue.SimpleQueue()
         self.run_id = ""
         self._orphaned_at = 0.0
         self._warned_tick = -1
-        self._pubs: dict[str, zenoh.Publisher] = {}
-        self._listeners: dict[str, Any] = {}
-        self._watched: set[str] = set()
         self._subs = [
             session.declare_subscriber(keys.tick(), self._push("tick")),
             session.declare_subscriber(keys.end(), self._push("end")),
@@ -65,69 +78,43 @@ class Participant:
         self._subs += [
             session.declare_subscriber(key, self._push("data")) for key in self.inbox.keys
         ]
-        self._ack = session.declare_publisher(keys.ack(name), congestion_control=BLOCK)
-        self._token = session.liveliness().declare_token(keys.live(name))
+        self._ack = self._publisher(keys.ack(name))
+        self._token = session.liveliness().declare_token(keys.live(name, str(session.zid())))
 
     def _push(self, kind: str) -> Callable[[zenoh.Sample], None]:
         def on_sample(sample: zenoh.Sample) -> None:
-            self.events.put((kind, str(sample.key_expr), sample.payload.to_bytes()))
+            self.events.put(
+                (kind, str(sample.key_expr), sample.payload.to_bytes(), sender_of(sample))
+            )
 
         return on_sample
 
     def _on_live(self, sample: zenoh.Sample) -> None:
         kind = "join" if sample.kind == zenoh.SampleKind.PUT else "leave"
-        self.events.put((kind, self.keys.participant_of(str(sample.key_expr)), b""))
+        self.events.put((kind, str(sample.key_expr), b"", ""))
 
-    def publish(self, key: str, msg: Message) -> None:
-        """Publish an output; lockstep data is never dropped under congestion."""
-        self._publisher(key).put(codec.encode(msg))
-
-    def watched(self, key: str) -> bool:
-        """Whether any subscriber matches `key` now: outputs only observers read can skip
-        their encoding while nobody looks. Kept current by a Zenoh matching listener per
-        key (asking Zenoh each tick cost ~25 us a key under load)."""
-        return bool(self.watched_among([key]))
-
-    def watched_among(self, keys: Sequence[str]) -> list[int]:
-        """Indices of the `keys` someone subscribes to now; one set test a tick while nobody
-        watches (asking key by key cost physics 0.17 ms a tick with 100 boats)."""
-        for key in keys:
-            if key not in self._listeners:
-                self._listen(key)
-        if not self._watched:
-            return []
-        return [i for i, key in enumerate(keys) if key in self._watched]
-
-    def _listen(self, key: str) -> None:
-        pub = self._publisher(key)
-
-        def on_change(status: Any) -> None:
-            (self._watched.add if status.matching else self._watched.discard)(key)
-
-        self._listeners[key] = pub.declare_matching_listener(on_change)
-        on_change(pub.matching_status)  # the listener reports changes only
-
-    def _publisher(self, key: str) -> zenoh.Publisher:
-        pub = self._pubs.get(key)
-        if pub is None:
-            pub = self._pubs[key] = self.session.declare_publisher(key, congestion_control=BLOCK)
-        return pub
+    @property
+    def present(self) -> set[str]:
+        return set(self.members.present)
 
     # -- the loop ------------------------------------------------------------------------
 
     def run(self, step: StepFn, on_end: EndFn | None = None) -> End:
         """Step every granted tick until the conductor ends the run; returns the end message."""
         while True:
-            kind, key, payload = self._next()
-            if kind == "data":
-                self._take_data(key, payload)
-            elif kind == "tick":
-                self._take_tick(payload)
-            elif kind == "end":
-                end = self._take_end(payload)
-                if end is not None:
-                    return self._finish(end, on_end)
+            event = self._next()
+            end = self._take(event)
+            if end is not None:
+                return self._finish(end, on_end)
             self._step_ready(step)
+
+    def _take(self, event: Event) -> End | None:
+        kind, key, payload, sender = event
+        if kind == "data":
+            self._take_data(key, payload, sender)
+        elif kind in ("tick", "end"):
+            return self._take_clock(event)
+        return None
 
     def _step_ready(self, step: StepFn) -> None:
         """Step every granted tick whose inputs are complete, in order, acking every
@@ -140,7 +127,7 @@ class Participant:
             step(self._tick_of(grant, k), self.inbox.release(k))
             self.next_tick = k + 1
             if (k + 1) % grant.ack_every == 0 or k == grant.tick:
-                self._ack.put(codec.encode(Ack(grant.run, k)))
+                self.put(self._ack, codec.encode(Ack(grant.run, k)))
             self._waiting_since = time.monotonic()
 
     @staticmethod
@@ -148,53 +135,100 @@ class Participant:
         stamp = grant.stamp_ns - (grant.tick - k) * grant.dt_ns
         return Tick(grant.run, k, stamp, grant.dt_ns, grant.dropped, grant.ack_every)
 
-    def _next(self) -> tuple[str, str, bytes]:
+    def _next(self) -> Event:
         """The next event; an End may trail the conductor's token, so allow it a grace."""
         if self._orphaned_at and time.monotonic() - self._orphaned_at > ORPHAN_GRACE_S:
             raise ClockError(f"{self.name}: the conductor disappeared without ending the run")
         try:
             event = self.events.get(timeout=0.1 if self._orphaned_at else 1.0)
         except queue.Empty:
-            return ("idle", "", b"")
-        kind, who, _ = event
-        if kind == "join":
-            self.present.add(who)
-        elif kind == "leave":
-            self.present.discard(who)
-            if who == CONDUCTOR:
-                self._orphaned_at = time.monotonic()
+            return ("idle", "", b"", "")
+        if event[0] in ("join", "leave"):
+            self._membership(event[0], event[1])
         return event
 
-    def _take_data(self, key: str, payload: bytes) -> None:
-        try:
-            self.inbox.add(key, payload)
-        except codec.CodecError as exc:
-            log.warning("%s: dropped malformed payload on %s: %s", self.name, key, exc)
+    def _membership(self, kind: str, key: str) -> None:
+        name = self.members.token(key, alive=kind == "join")
+        if name is None:
+            self.rejections.add(key, Rejected("token contradicts the roster", key))
+        elif kind == "leave" and name == CONDUCTOR:
+            self._orphaned_at = time.monotonic()
+        elif kind == "join":
+            self._retry_held(name)
 
-    def _take_tick(self, payload: bytes) -> None:
+    def _retry_held(self, name: str) -> None:
+        """Samples and clock messages held until `name`'s session was known."""
+        for key, rejected in self.inbox.retry_pending(self._horizon()):
+            self.rejections.add(key, rejected)
+        if name == CONDUCTOR:
+            held, self._held_clock = self._held_clock, []
+            for event in held:
+                self.events.put(event)  # taken again, in order, now that the sender is known
+
+    def _horizon(self) -> int:
+        """No sample may be tagged at or past this: the clock cannot have granted it."""
+        if self.limits is None:
+            return 2**62
+        return min(self.next_tick + self.limits.window, self.limits.ticks)
+
+    def _take_data(self, key: str, payload: bytes, sender: str) -> None:
         try:
-            tick = codec.decode(payload, Tick)
+            self.inbox.add(key, payload, sender=sender, horizon=self._horizon())
+        except Rejected as exc:
+            self.rejections.add(key, exc)
+
+    def _take_clock(self, event: Event) -> End | None:
+        """A Tick or End, believed only from the conductor's session (held until that is
+        known: before tick 0 nothing from an unknown sender is adopted)."""
+        kind, key, payload, sender = event
+        if self.roster.zid(CONDUCTOR) is None:
+            if len(self._held_clock) < MAX_HELD_CLOCK:
+                self._held_clock.append(event)
+            return None
+        try:
+            if not self.members.sender_is(CONDUCTOR, sender):
+                raise Rejected("clock message from a stranger", f"sender {sender or '?'}")
+            if kind == "tick":
+                self._take_tick(codec.decode(payload, Tick))
+                return None
+            return self._checked_end(codec.decode(payload, End))
         except codec.CodecError as exc:
-            log.warning("%s: malformed tick: %s", self.name, exc)
-            return
-        if not self.run_id:
-            self.run_id = tick.run
-        if tick.run != self.run_id:
-            return
+            self.rejections.add(key, Rejected("malformed", str(exc)))
+        except Rejected as exc:
+            self.rejections.add(key, exc)
+        return None
+
+    def _take_tick(self, tick: Tick) -> None:
+        if self.run_id and tick.run != self.run_id:
+            raise Rejected("tick of another run", tick.run)
+        problem = self._tick_problem(tick)
+        if problem:
+            raise Rejected("tick the clock cannot send", problem)
+        self.run_id = tick.run
         self.inbox.drop_producers(tick.dropped)
         self.peers -= set(tick.dropped)  # a dropped peer that crashed will never be present
-        if self._grant is None or tick.tick >= self._grant.tick:
-            if self._grant is None or self.next_tick > self._grant.tick:
-                self._waiting_since = time.monotonic()  # it had run dry: a wait begins
-            self._grant = tick  # grants only grow; a repeat carries a new dropped list
+        if self._grant is None or self.next_tick > self._grant.tick:
+            self._waiting_since = time.monotonic()  # it had run dry: a wait begins
+        self._grant = tick  # grants only grow (checked); a repeat carries a new dropped list
 
-    def _take_end(self, payload: bytes) -> End | None:
-        try:
-            end = codec.decode(payload, End)
-        except codec.CodecError as exc:
-            log.warning("%s: malformed end: %s", self.name, exc)
-            return None
-        return end if not self.run_id or end.run == self.run_id else None
+    def _tick_problem(self, tick: Tick) -> str:
+        grant = self._grant.tick if self._grant is not None else -1
+        if self.limits is not None:
+            problem = self.limits.problem(tick, next_tick=self.next_tick, grant=grant)
+            if problem:
+                return problem
+        if tick.ack_every < 1:
+            return f"ack_every {tick.ack_every}"
+        unknown = set(tick.dropped) - self._everyone
+        return f"drops unknown participants {sorted(unknown)}" if unknown else ""
+
+    def _checked_end(self, end: End) -> End:
+        if self.run_id and end.run != self.run_id:
+            raise Rejected("end of another run", end.run)
+        granted = self._grant.tick if self._grant is not None else -1
+        if not -1 <= end.tick <= granted:
+            raise Rejected("end the clock cannot send", f"tick {end.tick}, granted {granted}")
+        return end
 
     def _ready(self, tick: int) -> bool:
         """Peers seen (so they know our subscriptions) and every due input arrived."""
@@ -217,11 +251,11 @@ class Participant:
         limit = time.monotonic() + (self.drain_s if not end.error else 1.0)
         while self.inbox.missing(end.tick + 1) and time.monotonic() < limit:
             try:
-                kind, key, payload = self.events.get(timeout=max(limit - time.monotonic(), 0))
+                event = self.events.get(timeout=max(limit - time.monotonic(), 0))
             except queue.Empty:
                 break
-            if kind == "data":
-                self._take_data(key, payload)
+            if event[0] == "data":
+                self._take_data(event[1], event[2], event[3])
         if self.inbox.missing(end.tick + 1):
             log.warning(
                 "%s: run ended without samples from %s", self.name, self.inbox.missing(end.tick + 1)

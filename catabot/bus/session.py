@@ -10,15 +10,20 @@ from __future__ import annotations
 
 import argparse
 import json
+import os
+import re
 import socket
-from collections.abc import Sequence
-from dataclasses import dataclass, field
+from dataclasses import dataclass
+from pathlib import Path
 
 import zenoh
 
+from catabot.bus.identity import check_zid
 from catabot.errors import CataBotError
 
 MODES = ("peer", "client", "router")
+LEASE_MS = 2000
+LOOPBACK = "tcp/127.0.0.1:0"
 BLOCK = zenoh.CongestionControl.BLOCK  # lockstep data and clock messages are never dropped
 
 
@@ -28,25 +33,76 @@ class SessionError(CataBotError, RuntimeError):
 
 @dataclass(frozen=True)
 class Connection:
-    """Where a program's Zenoh session listens and what it connects to."""
+    """Where a program's Zenoh session listens and what it connects to.
+
+    `file` (or the ZENOH_CONFIG environment variable) is a Zenoh config file (JSON5): TLS,
+    credentials, a router's access control (the secure profile: deploy/secure/). With one,
+    CataBot changes only what its flags set (mode, connect, listen, zid); without one, the
+    embedded defaults: peer mode on loopback, no multicast scouting, a 2 s link lease."""
 
     connect: tuple[str, ...] = ()
-    listen: tuple[str, ...] = field(default_factory=lambda: ("tcp/127.0.0.1:0",))
-    mode: str = "peer"
+    listen: tuple[str, ...] = ()  # none given: tcp/127.0.0.1:0 in peer mode, without a file
+    mode: str | None = None  # None: the file's, else peer
+    zid: str | None = None  # this session's id (catabot run picks one per process); None: random
+    file: str | None = None
     timestamping: bool = False  # Zenoh's advanced publishers (a cache for late joiners) need it
 
     def config(self) -> zenoh.Config:
-        if self.mode not in MODES:
+        if self.mode is not None and self.mode not in MODES:
             raise SessionError(f"zenoh mode {self.mode!r} is not one of {', '.join(MODES)}")
-        cfg = zenoh.Config()
-        cfg.insert_json5("mode", json.dumps(self.mode))
-        cfg.insert_json5("scouting/multicast/enabled", "false")
-        cfg.insert_json5("connect/endpoints", json.dumps(list(self.connect)))
-        listen = [] if self.mode == "client" else list(self.listen)
-        cfg.insert_json5("listen/endpoints", json.dumps(listen))
+        for endpoint in (*self.connect, *self.listen):
+            check_endpoint(endpoint)
+        path = self.file or os.environ.get("ZENOH_CONFIG") or None
+        cfg = _from_file(path) if path else _embedded(self.mode or "peer")
+        if self.mode is not None:
+            cfg.insert_json5("mode", json.dumps(self.mode))
+        if self.connect:
+            cfg.insert_json5("connect/endpoints", json.dumps(list(self.connect)))
+        if self.listen or (self.mode == "client" and not path):
+            listen = [] if self.mode == "client" else list(self.listen)
+            cfg.insert_json5("listen/endpoints", json.dumps(listen))
+        if self.zid is not None:
+            cfg.insert_json5("id", json.dumps(check_zid(self.zid)))
         if self.timestamping:
             cfg.insert_json5("timestamping/enabled", "true")
         return cfg
+
+
+def _embedded(mode: str) -> zenoh.Config:
+    cfg = zenoh.Config()
+    cfg.insert_json5("mode", json.dumps(mode))
+    cfg.insert_json5("scouting/multicast/enabled", "false")
+    cfg.insert_json5("connect/endpoints", "[]")
+    cfg.insert_json5("listen/endpoints", json.dumps([] if mode == "client" else [LOOPBACK]))
+    # A peer that stops answering (a stopped process, a cut link) is gone after 2 s, not
+    # Zenoh's default 10 s: keep-alives every 0.5 s.
+    cfg.insert_json5("transport/link/tx/lease", str(LEASE_MS))
+    cfg.insert_json5("transport/link/tx/keep_alive", "4")
+    return cfg
+
+
+def _from_file(path: str) -> zenoh.Config:
+    if not Path(path).is_file():
+        raise SessionError(f"zenoh config file {path!r} does not exist")
+    try:
+        return zenoh.Config.from_file(path)
+    except Exception as exc:
+        raise SessionError(f"zenoh config file {path}: {exc}") from None
+
+
+_ENDPOINT = re.compile(r"^(tcp|udp|tls|quic|ws)/(\[[0-9a-fA-F:.]+\]|[A-Za-z0-9_.\-]+):(\d{1,5})$")
+
+
+def check_endpoint(endpoint: str) -> str:
+    """A Zenoh endpoint `proto/host:port` (tcp, udp, tls, quic, ws), refused with a clear
+    message before any process starts (Zenoh's own error comes from deep inside, late)."""
+    m = _ENDPOINT.match(endpoint)
+    if m is None or int(m.group(3)) > 65535:
+        raise SessionError(
+            f"zenoh endpoint {endpoint!r}: use proto/host:port with proto tcp, udp, tls, quic "
+            "or ws, e.g. tcp/127.0.0.1:7447"
+        )
+    return endpoint
 
 
 def open_session(conn: Connection) -> zenoh.Session:
@@ -54,8 +110,9 @@ def open_session(conn: Connection) -> zenoh.Session:
         return zenoh.open(conn.config())
     except Exception as exc:
         raise SessionError(
-            f"cannot open zenoh (mode {conn.mode}, connect {list(conn.connect)}, "
-            f"listen {list(conn.listen)}): {exc}"
+            f"cannot open zenoh (mode {conn.mode or 'peer'}, connect {list(conn.connect)}, "
+            f"listen {list(conn.listen)}, config {conn.file or os.environ.get('ZENOH_CONFIG')}): "
+            f"{exc}"
         ) from None
 
 
@@ -84,9 +141,20 @@ def add_connection_args(parser: argparse.ArgumentParser) -> None:
         metavar="ENDPOINT",
         help="zenoh endpoint to listen on (default tcp/127.0.0.1:0 in peer mode)",
     )
-    parser.add_argument("--mode", choices=MODES, default="peer", help="zenoh session mode")
+    parser.add_argument("--mode", choices=MODES, help="zenoh session mode (default: peer)")
+    parser.add_argument("--zid", help="this session's Zenoh id (hex; default: random)")
+    parser.add_argument(
+        "--zenoh-config",
+        metavar="FILE",
+        help="a Zenoh config file (TLS, credentials; default: $ZENOH_CONFIG, if set)",
+    )
 
 
 def connection_from_args(args: argparse.Namespace) -> Connection:
-    listen: Sequence[str] = args.listen or ("tcp/127.0.0.1:0",)
-    return Connection(connect=tuple(args.connect), listen=tuple(listen), mode=args.mode)
+    return Connection(
+        connect=tuple(args.connect),
+        listen=tuple(args.listen),
+        mode=args.mode,
+        zid=args.zid,
+        file=args.zenoh_config,
+    )

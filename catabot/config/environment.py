@@ -14,7 +14,7 @@ from __future__ import annotations
 import math
 from typing import Annotated, Literal
 
-from pydantic import Field, model_validator
+from pydantic import Field, field_validator, model_validator
 
 from catabot.config.base import ConfigError, Strict
 from catabot.config.geometry import polygon_area, polygon_self_intersects
@@ -22,6 +22,10 @@ from catabot.config.geometry import polygon_area, polygon_self_intersects
 Vec2 = tuple[float, float]
 NonNegative = Annotated[float, Field(ge=0)]
 Positive = Annotated[float, Field(gt=0)]
+MAX_CURRENT_MPS = 10.0  # the fastest tidal races run at about 10 m/s (Saltstraumen)
+MAX_WIND_MPS = 80.0  # above the strongest hurricanes' sustained winds
+WindSpeed = Annotated[float, Field(ge=0, le=MAX_WIND_MPS)]
+GustStd = Annotated[float, Field(ge=0, le=MAX_WIND_MPS / 4)]
 
 
 class EnvironmentConfigError(ConfigError):
@@ -47,7 +51,7 @@ class CurrentMapConfig(Strict):
     path: Annotated[str, Field(min_length=1)]
     origin_m: Vec2 = (0.0, 0.0)
     spacing_m: Positive
-    scale_mps: Positive | None = None
+    scale_mps: Annotated[float, Field(gt=0, le=MAX_CURRENT_MPS)] | None = None
     outside: Literal["edge", "zero"] = "edge"
 
 
@@ -56,6 +60,15 @@ class CurrentConfig(Strict):
 
     velocity_mps: Vec2 = (0.0, 0.0)
     map: CurrentMapConfig | None = None
+
+    @field_validator("velocity_mps")
+    @classmethod
+    def _plausible(cls, v: Vec2) -> Vec2:
+        if math.hypot(*v) > MAX_CURRENT_MPS:
+            raise ValueError(
+                f"a current of {math.hypot(*v):g} m/s; at most {MAX_CURRENT_MPS:g} m/s"
+            )
+        return v
 
 
 class WindZone(Strict):
@@ -72,9 +85,9 @@ class WindZone(Strict):
     center_m: Vec2 | None = None
     radius_m: Positive | None = None
     vertices_m: list[Vec2] | None = None
-    speed_mps: NonNegative
+    speed_mps: WindSpeed
     toward_rad: float = 0.0
-    gust_std_mps: NonNegative | None = None
+    gust_std_mps: GustStd | None = None
 
     @model_validator(mode="after")
     def _shape_fields(self) -> WindZone:
@@ -112,9 +125,9 @@ class WindConfig(Strict):
     Air density sets the wind force (0.5 rho_a V^2 A C).
     """
 
-    speed_mps: NonNegative = 0.0
+    speed_mps: WindSpeed = 0.0
     toward_rad: float = 0.0
-    gust_std_mps: NonNegative = 0.0
+    gust_std_mps: GustStd = 0.0
     gust_time_constant_s: Positive = 2.0
     air_density_kg_m3: Positive = 1.225
     zones: list[WindZone] = Field(default_factory=list)

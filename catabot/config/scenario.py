@@ -20,6 +20,7 @@ from pydantic import (
 from catabot.bus.clock import NS_PER_S, ClockError, period_in_ticks, ticks_for
 from catabot.config.base import (
     BuoyId,
+    FieldProblem,
     ParticipantName,
     ScenarioError,
     Seed,
@@ -165,7 +166,23 @@ class RecordingConfig(Strict):
     csv: StrictBool = True
     mcap: StrictBool = True
     dataset: StrictBool = Field(True, description="camera frames as PNGs + labels in dataset/")
+    dataset_rate_hz: float | None = Field(
+        None, gt=0, description="camera frames saved to dataset/ per second; null: every frame"
+    )
     ppi: StrictBool = Field(True, description="the radar's PPI (the paper's minimap) in dataset/")
+    rerun: StrictBool = Field(False, description="run.rrd for the rerun viewer, from run.mcap")
+    export: list[Literal["yolo", "coco", "kitti"]] = Field(
+        [], description="datasets converted into export/<format>/ when the run ends"
+    )
+
+    @model_validator(mode="after")
+    def _needs_mcap(self) -> RecordingConfig:
+        """run.rrd and the exports are made from run.mcap after the run."""
+        wanted = [f"export ({', '.join(self.export)})"] if self.export else []
+        wanted += ["rerun"] if self.rerun else []
+        if wanted and not self.mcap:
+            raise FieldProblem(wanted[0].split()[0], "needs recording.mcap: true (made from it)")
+        return self
 
 
 class Scenario(Strict):
@@ -200,6 +217,19 @@ class Scenario(Strict):
         check_ros(self.ros, self.vessels, self.traffic.boat_ids, self.clock.deadline_s)
         return self
 
+    @model_validator(mode="after")
+    def _exports_have_sources(self) -> Scenario:
+        """Camera datasets need a camera and dataset/; KITTI scans need a LiDAR."""
+        types = {s.type for v in self.vessels for s in v.sensors}
+        rec = self.recording
+        for fmt in rec.export:
+            need = "lidar" if fmt == "kitti" else "camera"
+            if need not in types:
+                raise FieldProblem("recording.export", f"{fmt!r} needs a {need} on a vessel")
+            if need == "camera" and not rec.dataset:
+                raise FieldProblem("recording.export", f"{fmt!r} needs recording.dataset: true")
+        return self
+
     @property
     def duration_ns(self) -> int:
         return round(self.duration_s * NS_PER_S)
@@ -210,11 +240,16 @@ class Scenario(Strict):
 
 
 def check_rates(scenario: Scenario) -> None:
-    """Refuse sensor and guidance rates that are not a whole number of ticks (DESIGN.md §4)."""
+    """Refuse sensor and guidance rates that are not a whole number of ticks (DESIGN.md §4),
+    and sensors too big to sample in memory."""
     for v_index, vessel in enumerate(scenario.vessels):
         for s_index, sensor in enumerate(vessel.sensors):
             where = f"vessels.{v_index}.sensors.{s_index}.rate_hz ({vessel.id}/{sensor.name})"
             rate_in_ticks(sensor.rate_hz, scenario.dt_ns, where=where)
+            problem = sensor.typed_params().memory_problem()
+            if problem:
+                at = f"vessels.{v_index}.sensors.{s_index}.params ({vessel.id}/{sensor.name})"
+                raise ScenarioError(f"{at}: {problem}")
         if vessel.controller is not None:
             where = f"vessels.{v_index}.controller.rate_hz ({vessel.id})"
             rate_in_ticks(vessel.controller.rate_hz, scenario.dt_ns, where=where)
@@ -222,6 +257,10 @@ def check_rates(scenario: Scenario) -> None:
         guidance_period_ticks(scenario)
     if scenario.ros is not None and scenario.ros.clock_hz is not None:
         rate_in_ticks(scenario.ros.clock_hz, scenario.dt_ns, where="ros.clock_hz")
+    if scenario.recording.dataset_rate_hz is not None:
+        rate_in_ticks(
+            scenario.recording.dataset_rate_hz, scenario.dt_ns, where="recording.dataset_rate_hz"
+        )
     try:
         scenario.ticks  # noqa: B018 - validates duration against dt
     except ClockError as exc:

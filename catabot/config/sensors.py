@@ -16,8 +16,16 @@ from catabot.config.base import Strict
 Vec3 = tuple[float, float, float]
 
 
+SENSOR_MEMORY_BUDGET = 2 * 2**30  # bytes one sensor may take while it samples
+BYTES_PER_PIXEL = 200  # a camera frame's peak in the whole stack: cast, outputs, message, copies
+
+
 class SensorParams(Strict):
     """Base of a sensor's parameters: strict, frozen, finite."""
+
+    def memory_problem(self) -> str:
+        """Why one sample would not fit in `SENSOR_MEMORY_BUDGET` ("" when it fits)."""
+        return ""
 
 
 class ImuParams(SensorParams):
@@ -86,6 +94,17 @@ class CameraParams(SensorParams):
     occluded_fraction: float = Field(
         0.3, ge=0, le=1, description="occluded when visible px < fraction x projected box"
     )
+
+    def memory_problem(self) -> str:
+        need = self.width * self.height * BYTES_PER_PIXEL
+        if need <= SENSOR_MEMORY_BUDGET:
+            return ""
+        most = SENSOR_MEMORY_BUDGET // BYTES_PER_PIXEL / 1e6
+        return (
+            f"a {self.width} x {self.height} camera needs about {need / 1e9:.1f} GB a frame, "
+            f"over the {SENSOR_MEMORY_BUDGET / 2**30:g} GiB a sensor may take: at most about "
+            f"{most:.1f} million pixels (3840 x 2160 fits)"
+        )
 
 
 class LidarParams(SensorParams):

@@ -18,7 +18,7 @@ import typing
 
 import numpy as np
 
-from catabot.bus.messages import BodyStates, Message, ThrustCmd, TwistBatch, TwistCmd
+from catabot.bus.messages import BodyStates, Message, ThrustCmd, TwistBatch, TwistCmd, check_ids
 from catabot.config.ros import RosConfig
 from catabot.ros2 import types
 from catabot.ros2.cdr import OdometryBatch, TfBatch
@@ -49,7 +49,7 @@ class Converter:
     def odometry_groups(self, batch: BodyStates) -> list[tuple[np.ndarray, np.ndarray]]:
         """The Odometry payloads as (indices into `odom_topics`, (k, L) byte matrix) groups,
         one per payload length (OdometryBatch). Raises ValueError for other bodies."""
-        self.world.check_rows(batch)
+        check_ids("world/states", batch.tick, batch.ids, self.world.body_ids)
         values = np.concatenate(batch.arrays()[:4], axis=1)[self.odom_rows]
         return self._odometry.encode_groups(batch.stamp_ns, values)
 

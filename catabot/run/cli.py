@@ -1,10 +1,12 @@
-"""The `catabot` command: run, service, conductor, router, scenario."""
+"""The `catabot` command: run, service, router, scenario, and the tools over run folders
+(view, dataset, plot)."""
 
 from __future__ import annotations
 
 import argparse
 import importlib
 import json
+import os
 import sys
 import time
 from pathlib import Path
@@ -12,23 +14,49 @@ from pathlib import Path
 from catabot.bus.session import Connection, SessionError, add_connection_args, open_session
 from catabot.config.load import json_schema, load_scenario
 from catabot.errors import CataBotError
-from catabot.run import conduct, launcher
+from catabot.run import conduct, launcher, secure
+from catabot.run.companions import VIEW_MODES
 from catabot.run.generate import add_arguments as add_generate_arguments
 from catabot.run.generate import generate
+from catabot.run.progress import PlanningProgress
 from catabot.world.world import World
 
 
 def _run(args: argparse.Namespace) -> int:
+    connect, configs = tuple(args.connect), None
+    if args.secure:  # every process a client of the profile's router, with its own login
+        configs = Path(args.secure)
+        try:
+            connect = connect or (secure.router_endpoint(configs),)
+        except CataBotError as exc:
+            print(f"catabot run: {exc}", file=sys.stderr)
+            return 2
     opts = launcher.RunOptions(
         scenario=args.scenario,
         duration_s=args.duration,
         realtime=args.realtime,
         out=Path(args.out),
-        connect=tuple(args.connect),
+        connect=connect,
         listen=args.listen,
         quiet=args.quiet,
+        zenoh_configs=configs,
+        view=args.view,
     )
     return launcher.run(opts)
+
+
+def _secure(args: argparse.Namespace) -> int:
+    try:
+        files = secure.init(
+            Path(args.folder), clients=args.client, observers=args.observer, host=args.host,
+            port=args.port,
+        )  # fmt: skip
+    except CataBotError as exc:
+        print(f"catabot secure: {exc}", file=sys.stderr)
+        return 2
+    print(f"secure profile in {args.folder}: {len(files)} files; start its router with\n"
+          f"  catabot router --zenoh-config {Path(args.folder) / 'router.json5'}")  # fmt: skip
+    return 0
 
 
 def _service(args: argparse.Namespace, rest: list[str]) -> int:
@@ -43,16 +71,31 @@ def _service(args: argparse.Namespace, rest: list[str]) -> int:
     return int(main(rest))
 
 
+TOOLS = {  # `catabot <tool> ...`: programs over a run folder, each in its own service folder
+    "view": ("services.viewer.cli", "replay a run or attach to one in the rerun viewer"),
+    "dataset": ("services.datasets.cli", "export a run as a YOLO, COCO or KITTI dataset"),
+    "plot": ("services.plots.cli", "plot a run: PNG figures and report.html"),
+}
+
+
+def _tool(args: argparse.Namespace, rest: list[str]) -> int:
+    """Hand the rest of the command line to the tool's own parser (its --help too)."""
+    return int(importlib.import_module(TOOLS[args.command][0]).main(rest))
+
+
 def _router(args: argparse.Namespace) -> int:
-    listen = tuple(args.listen) or ("tcp/0.0.0.0:7447",)
+    """A Zenoh router on loopback unless told where (`--listen tcp/0.0.0.0:7447` for other
+    machines), or as a config file says (`--zenoh-config`: TLS, credentials, access control)."""
+    config = args.zenoh_config or os.environ.get("ZENOH_CONFIG")
+    listen = tuple(args.listen) or (() if config else ("tcp/127.0.0.1:7447",))
+    conn = Connection(connect=tuple(args.connect), listen=listen, mode="router", file=config)
     try:
-        session = open_session(
-            Connection(connect=tuple(args.connect), listen=listen, mode="router")
-        )
+        session = open_session(conn)
     except SessionError as exc:
         print(f"catabot router: {exc}", file=sys.stderr)
         return 2
-    print(f"zenoh router listening on {', '.join(listen)} (Ctrl-C to stop)", flush=True)
+    where = ", ".join(listen) or f"the endpoints of {config}"
+    print(f"zenoh router listening on {where} (Ctrl-C to stop)", flush=True)
     try:
         while True:
             time.sleep(3600)
@@ -72,7 +115,7 @@ def _scenario(args: argparse.Namespace) -> int:
     if args.action == "generate":
         return generate(args)
     try:  # what `catabot run` checks before it starts anything, no less
-        world = World.resolve(load_scenario(args.file))
+        world = World.resolve(load_scenario(args.file), progress=PlanningProgress())
     except CataBotError as exc:
         print(f"catabot scenario validate: {exc}", file=sys.stderr)
         return 2
@@ -106,6 +149,27 @@ def parser() -> argparse.ArgumentParser:
         help="embedded mesh endpoint (default tcp/127.0.0.1:<free port>)",
     )
     run.add_argument("--quiet", action="store_true", help="no progress bar")
+    run.add_argument(
+        "--view",
+        nargs="?",
+        const="native",
+        choices=VIEW_MODES,
+        help="show the run live in rerun: the native viewer, or 'web' (served; prints its URL)",
+    )
+    run.add_argument(
+        "--secure",
+        metavar="DIR",
+        help="the secure profile made by `catabot secure init DIR`: TLS, logins, access control",
+    )
+    sec = sub.add_parser("secure", help="the secure profile: certificates, logins, access control")
+    sec.add_argument("action", choices=["init"])
+    sec.add_argument("folder", help="where to write the profile's files")
+    sec.add_argument("--client", action="append", default=[], help="a client that may command")
+    sec.add_argument("--observer", action="append", default=[], help="a client that only reads")
+    sec.add_argument(
+        "--host", default="localhost", help="the router's host name (default localhost)"
+    )
+    sec.add_argument("--port", type=int, default=7447, help="the router's TLS port (default 7447)")
     svc = sub.add_parser("service", help="run one service (conductor, physics, ...) alone")
     svc.add_argument("name")
     rtr = sub.add_parser("router", help="run a zenoh router for distributed runs")
@@ -115,6 +179,8 @@ def parser() -> argparse.ArgumentParser:
     scen.add_argument("file", nargs="?", help="scenario to validate")
     scen.add_argument("--output", "-o", help="write the schema (or generated scenario) here")
     add_generate_arguments(scen)
+    for name, (_, text) in TOOLS.items():
+        sub.add_parser(name, help=text, add_help=False)
     return p
 
 
@@ -122,9 +188,11 @@ def main(argv: list[str] | None = None) -> int:
     args, rest = parser().parse_known_args(argv)
     if args.command == "service":
         return _service(args, rest)
+    if args.command in TOOLS:
+        return _tool(args, rest)
     if rest:
         parser().error(f"unrecognized arguments: {' '.join(rest)}")
-    handlers = {"run": _run, "router": _router, "scenario": _scenario}
+    handlers = {"run": _run, "router": _router, "scenario": _scenario, "secure": _secure}
     return handlers[args.command](args)
 
 

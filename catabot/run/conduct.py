@@ -11,11 +11,13 @@ import json
 import logging
 import signal
 import sys
+import threading
 from dataclasses import asdict
 
 from catabot.bus.blas import single_thread_blas
 from catabot.bus.clock import Policy
 from catabot.bus.conductor import ClockSpec, Conductor, Progress
+from catabot.bus.identity import add_roster_args
 from catabot.bus.keys import Keys
 from catabot.bus.session import (
     add_connection_args,
@@ -44,20 +46,35 @@ def clock_spec(scenario: Scenario) -> ClockSpec:
     )
 
 
+_EMIT = threading.Lock()  # the heartbeat thread and the tick loop share stdout
+HEARTBEAT_S = 0.5
+
+
 def emit(kind: str, **fields: object) -> bool:
     """One JSON line on stdout; False once nobody reads it (the launcher is gone)."""
     try:
-        print(json.dumps({"kind": kind, **fields}), flush=True)
+        with _EMIT:
+            sys.stdout.write(json.dumps({"kind": kind, **fields}) + "\n")
+            sys.stdout.flush()
     except (BrokenPipeError, ValueError):  # ValueError: stdout already closed
         return False
     return True
+
+
+def heartbeat(stop: threading.Event) -> None:
+    """`alive` every half second: the launcher takes silence for a hung conductor."""
+    while not stop.wait(HEARTBEAT_S):
+        emit("alive")
 
 
 def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(prog="catabot conductor")
     parser.add_argument("--scenario", help="scenario file (default: the bundled default)")
     add_connection_args(parser)
+    add_roster_args(parser)
     args = parser.parse_args(argv)
+    stop = threading.Event()  # the heartbeat, from before the session (a login takes a while)
+    threading.Thread(target=heartbeat, args=(stop,), name="heartbeat", daemon=True).start()
     single_thread_blas()
     logging.basicConfig(level=logging.INFO, format="%(asctime)s %(name)s %(levelname)s %(message)s")
     try:
@@ -66,7 +83,7 @@ def main(argv: list[str] | None = None) -> int:
     except CataBotError as exc:
         emit("result", ticks=0, wall_s=0.0, error=str(exc), dropped=[])
         return 2
-    conductor = Conductor(session, Keys(scenario.name), clock_spec(scenario))
+    conductor = Conductor(session, Keys(scenario.name), clock_spec(scenario), roster=args.roster)
     quiet_gc()
     for sig in (signal.SIGINT, signal.SIGTERM):
         signal.signal(sig, lambda *_: conductor.stop("interrupted"))
@@ -79,7 +96,8 @@ def main(argv: list[str] | None = None) -> int:
             conductor.stop("interrupted")
 
     result = conductor.run(progress)
-    emit("result", **asdict(result))
+    stop.set()
+    emit("result", **asdict(result), rejected=dict(conductor.rejections.totals))
     if result.error:
         log.error("run ended by a fault: %s", result.error)
     conductor.close()

@@ -7,25 +7,22 @@ JSON lines, and turns the end of the run into a summary and an exit code.
 
 from __future__ import annotations
 
-import contextlib
-import json
-import signal
-import subprocess
 import sys
-import threading
-import time
-from collections.abc import Iterator
 from dataclasses import dataclass
 from datetime import datetime
 from pathlib import Path
 
+from catabot.bus.clock import CONDUCTOR
+from catabot.bus.identity import Roster, new_zid
 from catabot.bus.scheduling import requested_policy
-from catabot.bus.session import free_port
+from catabot.bus.session import check_endpoint, free_port
 from catabot.config.load import load_scenario, parse_scenario
 from catabot.config.scenario import Scenario
 from catabot.errors import CataBotError
-from catabot.run.progress import ProgressBar
+from catabot.run.companions import Viewer, after_run, start_viewer
+from catabot.run.progress import PlanningProgress, ProgressBar
 from catabot.run.summary import summarise
+from catabot.run.supervisor import Child, Stops, Supervisor
 from catabot.world.world import World
 
 SERVICE_MODULES = {
@@ -50,19 +47,23 @@ class RunOptions:
     connect: tuple[str, ...] = ()
     listen: str | None = None
     quiet: bool = False
+    zenoh_configs: Path | None = None  # a folder of <process>.json5 (the secure profile)
+    view: str | None = None  # one of VIEW_MODES: the live rerun viewer beside the run
 
 
 def prepare(opts: RunOptions) -> World:
     """Everything that can be refused is refused here, before any process starts: the world
     is resolved once (poses, traffic, models, terrain), as every service will resolve it."""
     requested_policy()  # a bad CATABOT_SCHED would stop every service
+    for endpoint in (*opts.connect, *([opts.listen] if opts.listen else [])):
+        check_endpoint(endpoint)
     scenario = load_scenario(opts.scenario)
     data = scenario.model_dump()
     if opts.duration_s is not None:
         data["duration_s"] = opts.duration_s
     if opts.realtime is not None:
         data["clock"]["realtime_factor"] = opts.realtime
-    world = World.resolve(parse_scenario(data, source="command line"))
+    world = World.resolve(parse_scenario(data, source="command line"), progress=PlanningProgress())
     for name in world.services:
         if name not in SERVICE_MODULES:
             raise LaunchError(f"scenario needs service {name!r}, which this version does not have")
@@ -90,15 +91,15 @@ def _endpoints(opts: RunOptions) -> tuple[list[str], list[str]]:
     return ["--listen", listen], ["--connect", listen]
 
 
-def _spawn(args: list[str], log_file: Path, *, stdout_pipe: bool = False) -> subprocess.Popen[str]:
-    log = log_file.open("w")
-    return subprocess.Popen(
-        [sys.executable, "-m", *args],
-        stdout=subprocess.PIPE if stdout_pipe else log,
-        stderr=log,
-        text=True,
-        start_new_session=True,  # Ctrl-C reaches the launcher only; it ends the run cleanly
-    )
+def _identity(roster: Roster, name: str, configs: Path | None) -> list[str]:
+    """A process's own session id and everyone's (only these sessions may drive the clock
+    and produce lockstep data: catabot/bus/identity.py), and its Zenoh config file in the
+    secure profile (its own credentials: catabot/run/secure.py)."""
+    return ["--zid", str(roster.zid(name)), "--roster", str(roster), *_login(name, configs)]
+
+
+def _login(name: str, configs: Path | None) -> list[str]:
+    return ["--zenoh-config", str(configs / f"{name}.json5")] if configs else []
 
 
 def run(opts: RunOptions) -> int:
@@ -110,140 +111,91 @@ def run(opts: RunOptions) -> int:
     scenario = world.scenario
     stops = Stops()
     with stops.installed():  # from before the first process starts
-        run_dir = make_run_dir(opts.out, scenario)
+        try:
+            run_dir = make_run_dir(opts.out, scenario)
+        except OSError as exc:
+            print(f"catabot run: cannot make a run folder in {opts.out}: {exc.strerror}",
+                  file=sys.stderr)  # fmt: skip
+            return 1
         cond_flags, svc_flags = _endpoints(opts)
         print(
             f"run folder: {run_dir}\nzenoh: clients connect to {svc_flags[1]} (world "
             f"{scenario.name!r}, keys catabot/{scenario.name}/...)",
             flush=True,
         )
-        scen = str(run_dir / "scenario.json")
-        stops.conductor = conductor = _spawn(
-            ["catabot.run.conduct", "--scenario", scen, *cond_flags],
-            run_dir / "log" / "conductor.log",
-            stdout_pipe=True,
-        )
-        services = {
-            name: _spawn(
-                [SERVICE_MODULES[name], "--scenario", scen, "--run-dir", str(run_dir), *svc_flags],
-                run_dir / "log" / f"{name}.log",
-            )
-            for name in world.services
-        }
-        return Supervisor(scenario, run_dir, conductor, services, stops, quiet=opts.quiet).wait()
+        supervisor, viewer = _start(world, run_dir, opts, stops, (cond_flags, svc_flags))
+        code = _watch(scenario, run_dir, supervisor, quiet=opts.quiet)
+    _close_viewer(viewer)
+    return code
 
 
-class Stops:
-    """Ctrl-C, SIGTERM and SIGHUP all end the run cleanly through the conductor (a launcher
-    killed by its shell or a process manager must leave no orphans ticking). A request is
-    held until the conductor says it is ready: a signal before its handlers are set would
-    kill it outright."""
+def _start(
+    world: World,
+    run_dir: Path,
+    opts: RunOptions,
+    stops: Stops,
+    flags: tuple[list[str], list[str]],
+) -> tuple[Supervisor, Viewer | None]:
+    """The conductor, the viewer (it sees the run from tick 0), then every service, each a
+    process with its own session id."""
+    scen = str(run_dir / "scenario.json")
+    roster = Roster({name: new_zid() for name in (CONDUCTOR, *world.services)})
 
-    def __init__(self) -> None:
-        self.requested = False
-        self.ready = threading.Event()
-        self.conductor: subprocess.Popen[str] | None = None
+    def child(name: str, module: str, extra: list[str], *, stdout: bool = False) -> Child:
+        identity = _identity(roster, name, opts.zenoh_configs)
+        args = [module, "--scenario", scen, *extra, *identity]
+        return Child(name, args, run_dir / "log" / f"{name}.log", stdout=stdout)
 
-    @contextlib.contextmanager
-    def installed(self) -> Iterator[None]:
-        signals = (signal.SIGINT, signal.SIGTERM, signal.SIGHUP)
-        previous = {sig: signal.signal(sig, self._on_signal) for sig in signals}
-        try:
-            yield
-        finally:
-            for sig, handler in previous.items():
-                signal.signal(sig, handler)
-
-    def _on_signal(self, *_: object) -> None:
-        self.requested = True
-        self.forward()
-
-    def forward(self) -> None:
-        """Pass a held request to the conductor once it takes signals."""
-        if self.requested and self.ready.is_set() and self.conductor is not None:
-            self.conductor.send_signal(signal.SIGINT)
+    conductor = child(CONDUCTOR, "catabot.run.conduct", flags[0], stdout=True)
+    stops.conductor = conductor.proc
+    viewer = _viewer(opts, run_dir, [*flags[1], *_login("viewer", opts.zenoh_configs)])
+    services = {
+        name: child(name, SERVICE_MODULES[name], ["--run-dir", str(run_dir), *flags[1]])
+        for name in world.services
+    }
+    return Supervisor(conductor, services, stops), viewer
 
 
-class Supervisor:
-    """Watches the processes of one run until all have ended."""
+def _viewer(opts: RunOptions, run_dir: Path, svc_flags: list[str]) -> Viewer | None:
+    """The live viewer (`--view`), subscribed before any service starts."""
+    if opts.view is None:
+        return None
+    viewer = start_viewer(opts.view, run_dir, svc_flags, hold=sys.stdin.isatty())
+    if not viewer.wait_ready():
+        print(f"catabot run: the viewer did not start (see {run_dir}/log/viewer.log)",
+              file=sys.stderr)  # fmt: skip
+    elif viewer.url:
+        print(f"rerun web viewer: {viewer.url}", flush=True)
+    return viewer
 
-    def __init__(
-        self,
-        scenario: Scenario,
-        run_dir: Path,
-        conductor: subprocess.Popen[str],
-        services: dict[str, subprocess.Popen[str]],
-        stops: Stops,
-        *,
-        quiet: bool,
-    ) -> None:
-        self.scenario, self.run_dir = scenario, run_dir
-        self.conductor, self.services, self.stops = conductor, services, stops
-        self.bar = ProgressBar(scenario.duration_ns, enabled=not quiet)
-        self.result: dict[str, object] = {}
-        self.stopped: set[str] = set()  # services the launcher had to stop
 
-    def wait(self) -> int:
-        self._read_conductor()
-        self._reap_services(timeout_s=self._reap_timeout())
-        return self._summary()
+def _close_viewer(viewer: Viewer | None) -> None:
+    """The native viewer's feeder ends with the run; the web viewer is served until Ctrl-C
+    when someone is at the terminal (a script's run just ends)."""
+    if viewer is None:
+        return
+    if viewer.url and sys.stdin.isatty():
+        viewer.hold()
+    else:
+        viewer.stop(wait_s=15)  # it ends by itself once the run's End and metrics are in
 
-    def _read_conductor(self) -> None:
-        """Follow the conductor's lines; stop it if a service dies before it notices."""
-        reader = threading.Thread(target=self._follow, daemon=True)
-        reader.start()
-        stopped = False
-        while reader.is_alive():
-            reader.join(timeout=0.1)
-            died = [n for n, p in self.services.items() if p.poll() not in (None, 0)]
-            if died and not stopped and self.conductor.poll() is None:
-                self.conductor.send_signal(signal.SIGTERM)
-                stopped = True
-        self.conductor.wait()
-        self.bar.close()
 
-    def _follow(self) -> None:
-        assert self.conductor.stdout is not None
-        for line in self.conductor.stdout:
-            try:
-                event = json.loads(line)
-            except json.JSONDecodeError:
-                continue
-            if event.get("kind") == "ready":
-                self.stops.ready.set()
-                self.stops.forward()
-            elif event.get("kind") == "progress":
-                self.bar.update(event)
-            elif event.get("kind") == "result":
-                self.result = event
-
-    def _reap_timeout(self) -> float:
-        """Services end by themselves after the conductor's End (15 s allows their last
-        flush); a service still starting when an interrupted run ended never joined, so it
-        never hears the End: it is stopped at once, and not blamed (`self.stopped`)."""
-        joined = int(self.result.get("ticks_done", 0)) > 0  # type: ignore[call-overload]
-        return 15.0 if joined or self.result.get("reason") != "interrupted" else 1.0
-
-    def _reap_services(self, *, timeout_s: float) -> None:
-        limit = time.monotonic() + timeout_s
-        for name, proc in self.services.items():
-            try:
-                proc.wait(timeout=max(limit - time.monotonic(), 0.1))
-            except subprocess.TimeoutExpired:
-                self.stopped.add(name)
-                proc.terminate()
-                try:
-                    proc.wait(timeout=3)
-                except subprocess.TimeoutExpired:
-                    proc.kill()
-                    proc.wait()
-
-    def _summary(self) -> int:
-        return summarise(
-            self.scenario,
-            self.run_dir,
-            self.result,
-            self.conductor.returncode,
-            {n: p.returncode for n, p in self.services.items()},
-            stopped=self.stopped,
-        )
+def _watch(scenario: Scenario, run_dir: Path, supervisor: Supervisor, *, quiet: bool) -> int:
+    """Progress while the run goes, then the summary and the exit code."""
+    bar = ProgressBar(scenario.duration_ns, enabled=not quiet)
+    supervisor.wait(bar.update)
+    bar.close()
+    result, cause = dict(supervisor.result), supervisor.cause()
+    if cause:
+        result["error"] = cause
+    codes = {n: c.proc.returncode for n, c in supervisor.services.items()}
+    if int(result.get("ticks_done", 0)) > 0:  # type: ignore[call-overload]
+        codes |= after_run(scenario, run_dir)  # run.rrd and dataset exports, from the files
+    return summarise(
+        scenario,
+        run_dir,
+        result,
+        supervisor.conductor.proc.returncode,
+        codes,
+        stopped=supervisor.stopped,
+    )

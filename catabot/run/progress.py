@@ -39,3 +39,19 @@ class ProgressBar:
     def close(self) -> None:
         if self.enabled and self.tty and self.shown:
             sys.stderr.write("\n")
+
+
+class PlanningProgress:
+    """`(k, n)` from a long traffic plan, shown at most once a second after the first (a plan
+    of hundreds of boats with many waypoints takes a while, and silence looks like a hang)."""
+
+    def __init__(self, *, after_s: float = 1.0) -> None:
+        self.start = time.monotonic()
+        self.next = self.start + after_s
+
+    def __call__(self, done: int, total: int) -> None:
+        now = time.monotonic()
+        if now >= self.next or (done == total and self.next > self.start + 1.0):
+            sys.stderr.write(f"planning traffic: {done}/{total} boats ({now - self.start:.0f} s)\n")
+            sys.stderr.flush()
+            self.next = now + 1.0

@@ -15,18 +15,20 @@ import os
 import signal
 import sys
 import time
-from collections.abc import Callable
-from dataclasses import dataclass, replace
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import Protocol
 
 import zenoh
 
 from catabot.bus.blas import single_thread_blas
-from catabot.bus.clock import ClockError
+from catabot.bus.clock import ClockError, Stream
+from catabot.bus.identity import Roster, add_roster_args
 from catabot.bus.keys import Keys
 from catabot.bus.messages import End
-from catabot.bus.participant import EndFn, StepFn
+from catabot.bus.participant import EndFn, Participant, StepFn
+from catabot.bus.rejections import Rejections
 from catabot.bus.scheduling import batch_scheduling
 from catabot.bus.session import (
     add_connection_args,
@@ -49,6 +51,7 @@ class ServiceContext:
     world: World
     session: zenoh.Session
     run_dir: Path
+    roster: Roster = field(default_factory=Roster)
 
     @property
     def scenario(self) -> Scenario:
@@ -62,10 +65,24 @@ class ServiceContext:
     def peers(self) -> list[str]:
         return self.world.participants
 
+    def participant(self, inputs: Sequence[Stream]) -> Participant:
+        """This service in the lockstep: its inputs, peers, roster and the clock's limits."""
+        return Participant(
+            self.session,
+            self.keys,
+            self.name,
+            inputs=inputs,
+            peers=self.peers,
+            roster=self.roster,
+            limits=self.world.clock_limits,
+        )
+
 
 class Runner(Protocol):
     """What runs a service to the end of the run: a lockstep `Participant`, or an observer
     that steps on what it receives (services/ros)."""
+
+    rejections: Rejections  # what it refused, written to log/<name>.rejected.json
 
     def run(self, step: StepFn, on_end: EndFn | None = None) -> End: ...
 
@@ -79,6 +96,7 @@ def service_parser(name: str) -> argparse.ArgumentParser:
     parser.add_argument("--scenario", help="scenario file (default: the bundled default)")
     parser.add_argument("--run-dir", default=".", help="run folder for outputs")
     add_connection_args(parser)
+    add_roster_args(parser)
     return parser
 
 
@@ -125,7 +143,11 @@ def run_service(
     name: str, build: BuildFn, argv: list[str] | None = None, *, timestamping: bool = False
 ) -> int:
     """Run one stepping service to the end of the run; returns the process exit code.
-    `timestamping`: the session stamps samples (Zenoh's advanced publishers need it)."""
+
+    A fault of the service's own is logged as CRITICAL (what `catabot run` reports as the
+    run's cause); a fault of the clock (the conductor gone, the run ended by a fault
+    elsewhere) as ERROR: it is a consequence, not a cause. `timestamping`: the session stamps
+    samples (Zenoh's advanced publishers need it)."""
     args = service_parser(name).parse_args(argv)
     setup_logging()
     single_thread_blas()  # idle BLAS threads spin on the cores other services need
@@ -135,22 +157,33 @@ def run_service(
         world = World.resolve(load_scenario(args.scenario))  # the same in every process
         session = open_session(replace(connection_from_args(args), timestamping=timestamping))
     except CataBotError as exc:
-        log.error("%s: %s", name, exc)
+        log.critical("%s", exc)
         return 2
-    ctx = ServiceContext(name, world, session, Path(args.run_dir))
+    try:
+        return _serve(ServiceContext(name, world, session, Path(args.run_dir), args.roster), build)
+    finally:
+        session.close()
+
+
+def _serve(ctx: ServiceContext, build: BuildFn) -> int:
     try:
         participant, step, on_end = build(ctx)
         quiet_gc()
         cpu_start = time.process_time()
-        end = _profiled(name, ctx.run_dir, lambda: participant.run(step, on_end))
-        _write_usage(name, ctx.run_dir, time.process_time() - cpu_start)
+        end = _profiled(ctx.name, ctx.run_dir, lambda: participant.run(step, on_end))
+        _write_usage(ctx.name, ctx.run_dir, time.process_time() - cpu_start)
+        participant.rejections.write(ctx.run_dir / "log" / f"{ctx.name}.rejected.json")
     except ClockError as exc:
         log.error("%s", exc)
         return 3
     except CataBotError as exc:
-        log.error("%s: %s", name, exc)
+        log.critical("%s", exc)
         return 2
-    finally:
-        session.close()
-    log.info("%s: run ended at tick %d (%s) %s", name, end.tick, end.reason, end.error)
+    except OSError as exc:
+        log.critical("%s: %s", exc.filename or "I/O", exc.strerror or exc)
+        return 1
+    except Exception:  # a bug: its traceback in the log, named as the cause
+        log.critical("crashed", exc_info=True)
+        return 1
+    log.info("%s: run ended at tick %d (%s) %s", ctx.name, end.tick, end.reason, end.error)
     return 0

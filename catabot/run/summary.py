@@ -35,6 +35,32 @@ def _usage(run_dir: Path, services: Mapping[str, object]) -> dict[str, float]:
     return out
 
 
+def _rejected(
+    run_dir: Path, services: Mapping[str, object], result: Mapping[str, object]
+) -> dict[str, dict[str, int]]:
+    """Inputs each process refused, by reason (log/<service>.rejected.json, the conductor's
+    in its result line)."""
+    out: dict[str, dict[str, int]] = {}
+    conductor = result.get("rejected")
+    if isinstance(conductor, dict) and conductor:
+        out["conductor"] = {str(k): int(v) for k, v in conductor.items()}
+    for name in services:
+        path = run_dir / "log" / f"{name}.rejected.json"
+        with contextlib.suppress(OSError, ValueError):
+            out[name] = {str(k): int(v) for k, v in json.loads(path.read_text()).items()}
+    return out
+
+
+def _print_rejected(rejected: Mapping[str, Mapping[str, int]], run_dir: Path) -> None:
+    if not rejected:
+        return
+    parts = [
+        f"{name} {sum(r.values())} ({', '.join(f'{k} {v}' for k, v in r.items())})"
+        for name, r in rejected.items()
+    ]
+    print(f"refused inputs: {'; '.join(parts)} (see {run_dir / 'log'})", file=sys.stderr)
+
+
 def summarise(
     scenario: Scenario,
     run_dir: Path,
@@ -63,8 +89,13 @@ def summarise(
         "reason": result.get("reason", ""),
         "services": dict(service_codes),
         "cpu_s": _usage(run_dir, service_codes),
+        "rejected": _rejected(run_dir, service_codes, result),
     }
-    (run_dir / "log" / "run.json").write_text(json.dumps(record, indent=2) + "\n")
+    try:
+        (run_dir / "log" / "run.json").write_text(json.dumps(record, indent=2) + "\n")
+    except OSError as exc:
+        print(f"catabot run: cannot write {run_dir / 'log' / 'run.json'}: {exc.strerror}",
+              file=sys.stderr)  # fmt: skip
     rtf = sim_s / wall if wall > 0 else 0.0
     print(
         f"{ticks} ticks, {sim_s:.2f} s simulated in {wall:.2f} s "
@@ -75,6 +106,7 @@ def summarise(
     for name, code in failed.items():
         log = run_dir / "log" / f"{name}.log"
         print(f"  {name}: {describe_exit(code)} (see {log})", file=sys.stderr)
+    _print_rejected(record["rejected"], run_dir)
     print(f"run folder: {run_dir}")
     if error:
         print(f"run failed: {error}", file=sys.stderr)

@@ -20,6 +20,7 @@ from catabot.bus.messages import (
 )
 from catabot.config.scenario import guidance_period_ticks, rate_in_ticks
 from catabot.config.sensors import SENSOR_TYPES
+from catabot.world import checks
 
 if TYPE_CHECKING:
     from catabot.world.world import Body, World
@@ -41,12 +42,14 @@ class Streams:
     def of(cls, world: World) -> Streams:
         keys, vessels = world.keys, world.vessels
         commands = [s for v in vessels for s in _commands(world, v)]
-        batch = None
-        if world.boat_ids:
-            period = guidance_period_ticks(world.scenario)
-            batch = Stream(keys.world_twists(), TwistBatch, "traffic", period)
         return cls(
-            states=Stream(keys.world_states(), BodyStates, "physics"),
+            states=Stream(
+                keys.world_states(),
+                BodyStates,
+                "physics",
+                stamp_ticks=1,  # the state at the end of the tick
+                check=checks.body_states(world.body_ids),
+            ),
             vessel_states=tuple(
                 Stream(keys.vessel_state(v.id), VesselState, "physics") for v in vessels
             ),
@@ -56,10 +59,8 @@ class Streams:
             ),
             commands=tuple(s for s in commands if s.period is None),
             controls=tuple(s for s in commands if s.period is not None),
-            waypoints=tuple(
-                Stream(keys.cmd_waypoints(v.id), WaypointsCmd, EXTERNAL, None) for v in vessels
-            ),
-            twist_batch=batch,
+            waypoints=tuple(_waypoints(world, v) for v in vessels),
+            twist_batch=_twist_batch(world),
         )
 
     def lockstep(self) -> list[Stream]:
@@ -78,13 +79,32 @@ def _commands(world: World, vessel: Body) -> list[Stream]:
     its controller drives, which is clocked (the controller is its producer)."""
     keys, c = world.keys, vessel.controller
     out = []
-    for kind, key, message in (
-        ("thrust", keys.cmd_thrust(vessel.id), ThrustCmd),
-        ("twist", keys.cmd_twist(vessel.id), TwistCmd),
+    for kind, key, message, check in (
+        (
+            "thrust",
+            keys.cmd_thrust(vessel.id),
+            ThrustCmd,
+            checks.thrust(len(vessel.model.thrusters)),
+        ),
+        ("twist", keys.cmd_twist(vessel.id), TwistCmd, checks.twist),
     ):
         if c is not None and c.command == kind:
             period = rate_in_ticks(c.rate_hz, world.scenario.dt_ns, where=key)
-            out.append(Stream(key, message, c.participant, period))
+            out.append(Stream(key, message, c.participant, period, check=check))
         else:
-            out.append(Stream(key, message, EXTERNAL, None))
+            out.append(Stream(key, message, EXTERNAL, None, check=check))
     return out
+
+
+def _waypoints(world: World, vessel: Body) -> Stream:
+    key = world.keys.cmd_waypoints(vessel.id)
+    return Stream(key, WaypointsCmd, EXTERNAL, None, check=checks.waypoints)
+
+
+def _twist_batch(world: World) -> Stream | None:
+    """The traffic service's set-points for every boat, one batch a guidance period."""
+    if not world.boat_ids:
+        return None
+    period = guidance_period_ticks(world.scenario)
+    check = checks.twist_batch(world.boat_ids)
+    return Stream(world.keys.world_twists(), TwistBatch, "traffic", period, check=check)

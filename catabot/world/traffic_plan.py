@@ -7,9 +7,8 @@ name "traffic" only (DESIGN.md §2), so adding a sensor does not move a boat.
 
 from __future__ import annotations
 
-import itertools
 import math
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 
 import numpy as np
@@ -26,10 +25,13 @@ from catabot.config.traffic import (
 )
 from catabot.config.vessel import VesselModel, load_vessel_model
 from catabot.world import seeding
+from catabot.world.clearance import Discs, Rows, clear, densify, off_rings
 from catabot.world.placement import CLEARANCE_M, footprint_m, keel_depth_m
 from catabot.world.terrain import Terrain
 
 TRIES = 2000
+PATH_DRAWS = 5000  # random paths per boat before the plan is refused
+MAX_BUOY_COVER = 0.05
 
 
 @dataclass(frozen=True)
@@ -55,47 +57,83 @@ class TrafficPlan:
     buoys: tuple[BuoyConfig, ...]
 
 
-def plan_traffic(scenario: Scenario, terrain: Terrain | None) -> TrafficPlan:
+Progress = Callable[[int, int], None]  # (boats planned, boats in all)
+
+
+def plan_traffic(
+    scenario: Scenario, terrain: Terrain | None, progress: Progress | None = None
+) -> TrafficPlan:
     """The plan of a scenario whose vessels all have poses (World.resolve calls it once)."""
     if scenario.traffic.count == 0:
         return TrafficPlan((), ())
-    return Planner(scenario, terrain).plan()
+    return Planner(scenario, terrain, progress).plan()
 
 
 class Planner:
     """Draws boats one by one; a boat that finds no free deep water in TRIES draws is an error."""
 
-    def __init__(self, scenario: Scenario, terrain: Terrain | None) -> None:
+    def __init__(
+        self, scenario: Scenario, terrain: Terrain | None, progress: Progress | None = None
+    ) -> None:
         self.cfg: TrafficConfig = scenario.traffic
-        self.terrain = terrain
+        self.terrain, self.progress = terrain, progress
+        self._path_draws = 0  # paths drawn for the current boat
         seed = scenario.seed if self.cfg.seed is None else self.cfg.seed
         self.rng = seeding.rng(seed, "traffic")
         self._models: dict[str, VesselModel] = {}
-        self.placed = _Rows(3)  # vessels' starts: x, y, footprint radius
+        self.placed = Discs()  # vessels' starts: x, y, footprint radius
         for v in scenario.vessels:
             assert v.pose is not None
             self.placed.add(v.pose.x_m, v.pose.y_m, footprint_m(self._model(v.model)))
         self.buoy_r = footprint_m(self._model("buoy"))
         # Buoys are moored: a boat must not start on one, nor circle through one every lap.
-        self.marks = _Rows(3)  # buoys: x, y, footprint radius
+        self.marks = Discs()  # buoys: x, y, footprint radius
         for b in scenario.buoys:
             self.marks.add(b.x_m, b.y_m, self.buoy_r)
-        self.rings = _Rows(4)  # circling boats: centre x, y, radius, hull footprint
+        self.rings = Rows(4)  # circling boats: centre x, y, radius, hull footprint
         self.footprints: dict[str, float] = {}  # by model, as drawn
         self.overrides = {b.index: b for b in self.cfg.boats}
+        self._check_room()
+
+    def _check_room(self) -> None:
+        """Refuse at once a traffic whose waypoint buoys cannot all be laid clear of each
+        other: each buoy keeps others out of a disc of radius 2 r + clearance, and once
+        those discs cover 5% of the region a path of many points almost never lands clear
+        (planning would run for minutes, then fail)."""
+        w, mix = self.cfg.waypoints, self.cfg.behaviour_mix
+        if w.points is not None or not w.buoys:
+            return
+        share = mix.get("waypoints", 0.0) / sum(mix.values())
+        buoys = self.cfg.count * share * w.count
+        width, height = w.region.size_m
+        covered = buoys * math.pi * (2 * self.buoy_r + CLEARANCE_M) ** 2 / (width * height)
+        if covered > MAX_BUOY_COVER:
+            raise ScenarioError(
+                f"traffic: about {buoys:.0f} waypoint buoys ({self.cfg.count} boats x "
+                f"{share:.0%} on waypoints x {w.count} points) in a {width:g} x {height:g} m "
+                f"region would keep {covered:.0%} of it; at most {MAX_BUOY_COVER:.0%}: use "
+                "fewer points or boats, a larger traffic.waypoints.region, or buoys: false"
+            )
 
     def plan(self) -> TrafficPlan:
-        boats = tuple(self._boat(i) for i in range(self.cfg.count))
+        boats = tuple(self._planned(i) for i in range(self.cfg.count))
         buoys: list[BuoyConfig] = []
-        laid = _Rows(3)
+        laid = Discs()
         for b in boats:
             if b.behaviour != "waypoints" or not self.cfg.waypoints.buoys:
                 continue
             for k, (x, y) in enumerate(b.path):  # a point several paths share (given
-                if _clear(np.array([(x, y)]), self.buoy_r, laid.array):  # points): one buoy
+                if laid.clear_of(np.array([(x, y)]), self.buoy_r):  # points): one buoy
                     buoys.append(BuoyConfig(id=f"{b.id}_wp{k}", x_m=x, y_m=y))
                     laid.add(x, y, self.buoy_r)
         return TrafficPlan(boats, tuple(buoys))
+
+    def _planned(self, index: int) -> Boat:
+        self._path_draws = 0
+        boat = self._boat(index)
+        if self.progress is not None:
+            self.progress(index + 1, self.cfg.count)
+        return boat
 
     def _boat(self, index: int) -> Boat:
         over = self.overrides.get(index, BoatOverride(index=index))
@@ -132,6 +170,13 @@ class Planner:
         p = np.asarray(weights, dtype=np.float64)
         return names[int(self.rng.choice(len(names), p=p / p.sum()))]
 
+    def _points(self, region: Region, count: int) -> list[Point]:
+        """`count` points drawn as `_point` draws them one by one (x then y, in order)."""
+        cx, cy = self._centre(region)
+        w, h = region.size_m
+        xy = self.rng.uniform((-w / 2, -h / 2), (w / 2, h / 2), size=(count, 2))
+        return [(float(cx + x), float(cy + y)) for x, y in xy.tolist()]
+
     def _point(self, region: Region) -> Point:
         cx, cy = self._centre(region)
         w, h = region.size_m
@@ -150,7 +195,7 @@ class Planner:
     def _free(self, x: float, y: float, radius: float, draft: float) -> bool:
         """Clear of every vessel and buoy placed so far, and in water deep enough for the hull."""
         here = np.array([(x, y)])
-        if not (_clear(here, radius, self.placed.array) and _clear(here, radius, self.marks.array)):
+        if not (self.placed.clear_of(here, radius) and self.marks.clear_of(here, radius)):
             return False
         if self.terrain is None:
             return True
@@ -178,10 +223,10 @@ class Planner:
         points, r = np.array(path, dtype=np.float64).reshape(-1, 2), self.buoy_r
         own = np.array([(boat.pose.x_m, boat.pose.y_m, self.footprints[boat.model])])
         return (
-            _clear(points, r, self.placed.array)
-            and _clear(points, r, self.marks.array)
-            and _clear(points, r, own)
-            and _off_rings(points, r, self.rings.array)
+            self.placed.clear_of(points, r)
+            and self.marks.clear_of(points, r)
+            and clear(points, r, own)
+            and off_rings(points, r, self.rings.array)
         )
 
     def _behave(
@@ -208,7 +253,7 @@ class Planner:
             return None
         ring = (cx, cy, radius, self.footprints[base.model])
         marks = self.marks.array
-        if not _off_rings(marks[:, :2], marks[:, 2], np.array([ring])):
+        if not off_rings(marks[:, :2], marks[:, 2], np.array([ring])):
             return None
         self.rings.add(*ring)
         return Boat(base.id, base.model, p, "circle", c.speed_mps, (cx, cy), radius, direction)
@@ -217,15 +262,22 @@ class Planner:
         w = self.cfg.waypoints
         given = points or w.points
         for _ in range(1 if given else 50):
+            self._path_draws += 1
+            if self._path_draws > PATH_DRAWS:
+                raise ScenarioError(
+                    f"traffic: no path of {w.count} waypoints clear of land, buoys and other "
+                    f"boats' tracks for {base.id} in {PATH_DRAWS} draws: use fewer points or "
+                    "boats, or a larger traffic.waypoints.region"
+                )
             path = (
                 [(float(q[0]), float(q[1])) for q in given]
                 if given
-                else [self._point(w.region) for _ in range(w.count)]
+                else self._points(w.region, w.count)
             )
             track = np.array([(base.pose.x_m, base.pose.y_m), *path])
             if not given and not self._buoys_clear(path, base):
                 continue
-            if self._wet(*_densify(track, loop=w.mode == "loop")):
+            if self._wet(*densify(track, loop=w.mode == "loop")):
                 if w.buoys:
                     for x, y in path:
                         self.marks.add(x, y, self.buoy_r)
@@ -235,51 +287,3 @@ class Planner:
                     loop=w.mode == "loop", tolerance_m=w.tolerance_m,
                 )  # fmt: skip
         return None
-
-
-class _Rows:
-    """Rows added one at a time, read as one array: the planner tests every draw against
-    all of them (1300 buoys with 500 boats). Storage doubles when full, so an add is O(1)."""
-
-    def __init__(self, width: int) -> None:
-        self._data = np.zeros((16, width))
-        self._count = 0
-
-    def add(self, *row: float) -> None:
-        if self._count == len(self._data):
-            self._data = np.concatenate((self._data, np.zeros_like(self._data)))
-        self._data[self._count] = row
-        self._count += 1
-
-    @property
-    def array(self) -> np.ndarray:
-        return self._data[: self._count]
-
-
-def _clear(points: np.ndarray, r: float | np.ndarray, discs: np.ndarray) -> bool:
-    """Footprints of radius r at points (K, 2) clear of discs (M, 3: x, y, radius)."""
-    gap = np.hypot(points[:, None, 0] - discs[:, 0], points[:, None, 1] - discs[:, 1])
-    return not bool((gap <= np.reshape(r, (-1, 1)) + discs[:, 2] + CLEARANCE_M).any())
-
-
-def _off_rings(points: np.ndarray, r: float | np.ndarray, rings: np.ndarray) -> bool:
-    """Footprints at points (K, 2) clear of what boats circling rings (M, 4: centre x, y,
-    radius, hull footprint) sweep."""
-    d = np.hypot(points[:, None, 0] - rings[:, 0], points[:, None, 1] - rings[:, 1])
-    reach = np.reshape(r, (-1, 1)) + rings[:, 3] + CLEARANCE_M
-    return not bool((np.abs(d - rings[:, 2]) <= reach).any())
-
-
-def _densify(
-    track: np.ndarray, *, loop: bool, step_m: float = 5.0
-) -> tuple[np.ndarray, np.ndarray]:
-    """Points every `step_m` along a polyline (closed back to its second point if looping)."""
-    if loop:
-        track = np.vstack([track, track[1:2]])
-    parts = [track[:1]]
-    for a, b in itertools.pairwise(track):
-        n = max(int(np.hypot(*(b - a)) / step_m), 1)
-        t = np.linspace(0, 1, n + 1)[1:, None]
-        parts.append(a + t * (b - a))
-    pts = np.vstack(parts)
-    return pts[:, 0], pts[:, 1]

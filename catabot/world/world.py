@@ -20,9 +20,9 @@ from typing import Any, Literal
 
 import numpy as np
 
-from catabot.bus.clock import period_in_ticks
+from catabot.bus.clock import ClockLimits, period_in_ticks
 from catabot.bus.keys import Keys
-from catabot.bus.messages import CLASS_BUOY, CLASS_VESSEL, BodyStates, check_ids
+from catabot.bus.messages import CLASS_BUOY, CLASS_VESSEL, BodyStates
 from catabot.config.scenario import (
     ControllerConfig,
     Pose,
@@ -39,7 +39,7 @@ from catabot.world.environment.current import CurrentField
 from catabot.world.placement import resolve_poses
 from catabot.world.streams import Streams
 from catabot.world.terrain import Terrain, load_terrain
-from catabot.world.traffic_plan import TrafficPlan, plan_traffic
+from catabot.world.traffic_plan import Progress, TrafficPlan, plan_traffic
 
 BodyKind = Literal["vessel", "boat", "buoy"]
 BUOY_MODEL = "buoy"
@@ -98,12 +98,13 @@ class World:
     sensors: tuple[MountedSensor, ...]
 
     @classmethod
-    def resolve(cls, scenario: Scenario) -> World:
-        """Everything a run needs from its scenario; ScenarioError names what cannot run."""
+    def resolve(cls, scenario: Scenario, *, progress: Progress | None = None) -> World:
+        """Everything a run needs from its scenario; ScenarioError names what cannot run.
+        `progress(k, n)` hears of each planned traffic boat (a long plan's progress)."""
         terrain = _terrain(scenario)
         current = CurrentField.from_config(scenario.water.current)
         scenario = resolve_poses(scenario, terrain)
-        plan = plan_traffic(scenario, terrain)
+        plan = plan_traffic(scenario, terrain, progress)
         bodies = _bodies(scenario, plan)
         keys = Keys(scenario.name)
         sensors = tuple(
@@ -140,6 +141,12 @@ class World:
     def streams(self) -> Streams:
         return Streams.of(self)
 
+    @cached_property
+    def clock_limits(self) -> ClockLimits:
+        """What participants check every Tick against (catabot/bus/clock.py)."""
+        s = self.scenario
+        return ClockLimits(s.dt_ns, s.ticks, s.clock.window_ticks)
+
     @property
     def participants(self) -> list[str]:
         return participants(self.scenario)
@@ -154,10 +161,6 @@ class World:
     @cached_property
     def _by_id(self) -> dict[str, Body]:
         return {b.id: b for b in self.bodies}
-
-    def check_rows(self, batch: BodyStates) -> None:
-        """Refuse a `BodyStates` whose rows are not this world's bodies, in order."""
-        check_ids("world/states", batch.tick, batch.ids, self.body_ids)
 
     def start_states(self) -> BodyStates:
         """Every body at rest at its start pose (tick -1, t = 0): what physics starts from."""

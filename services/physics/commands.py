@@ -21,7 +21,6 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
-from catabot.bus import codec
 from catabot.bus.clock import NS_PER_S
 from catabot.bus.messages import Message, ThrustCmd, TwistBatch, TwistCmd, WaypointsCmd
 from catabot.config.scenario import ScriptStep
@@ -84,12 +83,8 @@ class CommandBook:
         return thrust, rows, target[rows]
 
     def take_batch(self, batch: TwistBatch, expected: tuple[str, ...]) -> None:
-        """The traffic service's set-points: every boat with finite values adopts its own."""
-        try:
-            batch.check(expected)
-        except ValueError as exc:
-            log.error("refused %s", exc)
-            return
+        """The traffic service's set-points (rows and shapes checked on arrival): every boat
+        with finite values adopts its own, the others keep their previous order."""
         rows = self._rows_of(expected)
         ok = np.isfinite(batch.surge) & np.isfinite(batch.yaw_rate)
         self.set_point[rows[ok], 0] = batch.surge[ok]
@@ -104,28 +99,20 @@ class CommandBook:
             self._batch_rows = (boats, np.array([self.row[b] for b in boats], dtype=np.intp))
         return self._batch_rows[1]
 
-    def take(self, vessel: str, key: str, msgs: list[Message]) -> None:
-        """Adopt the newest valid command from the bus; refuse non-finite ones loudly."""
+    def take(self, vessel: str, msgs: list[Message]) -> None:
+        """Adopt the newest command from the bus (checked on arrival: one finite value per
+        thruster, a finite twist: catabot/world/checks.py). A lockstep twist (tick >= 0) is a
+        set-point; an outside command (tick -1) takes the vessel over."""
         for msg in msgs:
             if isinstance(msg, WaypointsCmd):
                 self.external.pop(vessel, None)  # handed back (to traffic or the script)
-            elif isinstance(msg, TwistCmd) and msg.tick >= 0 and codec.finite(msg.surge):
-                if codec.finite(msg.yaw_rate):
-                    self.set_point[self.row[vessel]] = (msg.surge, msg.yaw_rate)
-                    self.has_set_point[self.row[vessel]] = True
-            elif isinstance(msg, ThrustCmd) and len(msg.thrust) != self.thrusters[vessel]:
-                log.error(
-                    "refused command on %s: %d values for %d thrusters",
-                    key,
-                    len(msg.thrust),
-                    self.thrusters[vessel],
-                )
-            elif isinstance(msg, ThrustCmd) and codec.finite(msg.thrust):
+            elif isinstance(msg, TwistCmd) and msg.tick >= 0:
+                self.set_point[self.row[vessel]] = (msg.surge, msg.yaw_rate)
+                self.has_set_point[self.row[vessel]] = True
+            elif isinstance(msg, ThrustCmd):
                 self.external[vessel] = Order(thrust=msg.thrust)
-            elif isinstance(msg, TwistCmd) and codec.finite((msg.surge, msg.yaw_rate)):
+            elif isinstance(msg, TwistCmd):
                 self.external[vessel] = Order(twist=(msg.surge, msg.yaw_rate))
-            else:
-                log.error("refused command on %s: non-finite value in %s", key, msg)
 
 
 def _place(

@@ -14,7 +14,6 @@ import numpy as np
 
 from catabot.bus.inbox import Inputs
 from catabot.bus.messages import BodyStates, Message, Tick, TwistBatch, VesselState
-from catabot.bus.participant import Participant
 from catabot.run.service import Built, ServiceContext, run_service
 from services.physics.commands import CommandBook
 from services.physics.control import TwistControllerBank
@@ -50,16 +49,14 @@ class PhysicsService:
         self.streams += streams.twist_batches(lag=delay)
         self.body_ids = world.body_ids
         self.state_keys = [s.key for s in streams.vessel_states]
-        self.participant = Participant(
-            ctx.session, ctx.keys, ctx.name, inputs=self.streams, peers=ctx.peers
-        )
+        self.participant = ctx.participant(self.streams)
 
     def step(self, tick: Tick, inputs: Inputs) -> None:
         for key, msgs in inputs.items():
             if key == self.twists_key:
                 self._take_twists(msgs[-1])
             else:
-                self.book.take(self.vessel_of[key], key, msgs)
+                self.book.take(self.vessel_of[key], msgs)
         self._apply_orders(tick.stamp_ns)
         self.world.step()
         self._publish(tick)

@@ -29,6 +29,7 @@ from catabot.world import rotations
 from catabot.world.environment import CurrentField, WindField
 from catabot.world.terrain import Terrain
 from catabot.world.waves import WaveField
+from services.physics.diverged import check_finite, check_state
 from services.physics.fleet import Fleet, buoy_bodies
 from services.physics.grounding import Grounding
 from services.physics.hydro import (
@@ -126,6 +127,7 @@ class PhysicsWorld:
         )
         self._read_state()
         self._acc_w = np.zeros((len(models), 6))
+        self._last_loads: dict[str, Array] = {}  # this step's loads by kind, for `diverged`
 
     # --- public API -----------------------------------------------------------------
 
@@ -179,7 +181,8 @@ class PhysicsWorld:
         self._thrusters.set_commands(rows, np.clip(commands, -1.0, 1.0))
 
     def step(self) -> None:
-        """Advance every vessel by dt: compute all forces vectorised, apply, step DART."""
+        """Advance every vessel by dt: compute all forces vectorised, apply, step DART.
+        `PhysicsDiverged` names the body and the load when a state stops being finite."""
         self._thrusters.advance()
         wrench_b = self._body_wrench()
         # Body-frame [F, M] about the origin -> DART's world-frame [M, F] generalized forces.
@@ -187,9 +190,12 @@ class PhysicsWorld:
         moment_w = np.einsum("nij,nj->ni", self._rot, wrench_b[:, 3:])
         generalized = np.concatenate([moment_w, force_w], axis=1)
         if self._ground is not None:
-            generalized += self._ground.generalized_forces(
+            contact = self._ground.generalized_forces(
                 self._rot, self._pos, self._vel_w, generalized
             )
+            generalized += contact
+            self._last_loads["terrain contact"] = contact[:, [3, 4, 5, 0, 1, 2]]  # as [F, M]
+        check_finite(self._ids, self._last_loads, generalized, self.time_s)
         self._fleet.set_forces(generalized)
         vel_before = self._vel_w
         self._world.step()
@@ -197,6 +203,7 @@ class PhysicsWorld:
         self._loads.advance(self._dt)  # gusts: one draw per step, whatever else happens
         self._read_state()
         self._acc_w = (self._vel_w - vel_before) / self._dt
+        check_state(self._ids, self._pos, self._vel_w, self._last_loads, self.time_s)
 
     def state_arrays(self) -> KinematicsArrays:
         """Every vessel's state as stacked arrays (copies), rows in `vessel_ids` order."""
@@ -278,8 +285,8 @@ class PhysicsWorld:
             x, y, z = self._pos.T
             water_w = water_w + self._waves.velocity(x, y, z, self.time_s)
         current_b = np.einsum("nij,nj->ni", rot_t, water_w)
-        base = (
-            buoyancy_wrench(
+        loads = self._last_loads = {
+            "buoyancy": buoyancy_wrench(
                 self._columns,
                 self._rot,
                 self._pos,
@@ -287,11 +294,15 @@ class PhysicsWorld:
                 gravity=self._g,
                 time_s=self.time_s,
                 surface=self._surface,
-            )
-            + damping_wrench(nu, self._lin, self._quad, current_b)
-            + self._thrusters.wrench()
-        )  # then wind, moorings and added mass (which needs every other load):
-        return self._loads.total(self._rot, self._pos, nu, self._current_w, base)
+            ),
+            "damping": damping_wrench(nu, self._lin, self._quad, current_b),
+            "thrust": self._thrusters.wrench(),
+        }
+        base = loads["buoyancy"] + loads["damping"] + loads["thrust"]
+        # then wind, moorings and added mass (which needs every other load):
+        total = self._loads.total(self._rot, self._pos, nu, self._current_w, base)
+        loads["wind, moorings and added mass"] = total - base
+        return total
 
 
 def _check_setup(

@@ -2,19 +2,23 @@
 
 Rows are held in memory and reach the file only in `flush()`, which the recorder calls once
 per tick: a run killed at any moment therefore leaves whole rows of whole ticks on disk,
-never a half-written line. The header is taken from the first sample of each stream, so a
-sample of another shape (a different number of thrusters, another message type) is refused
-with `RecorderError` instead of silently shifting columns under the header.
+never a half-written line. A write that fails (a full disk) is undone: the file is cut back
+to its last complete flush, and `DiskError` names the file. The header is taken from the
+first sample of each stream, so a sample of another shape (a different number of thrusters,
+another message type) is refused with `RecorderError` instead of silently shifting columns
+under the header.
 """
 
 from __future__ import annotations
 
+import contextlib
 import csv
 import io
+import os
 from collections.abc import Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import TextIO
+from typing import BinaryIO
 
 from catabot.bus.messages import Message
 from catabot.errors import CataBotError
@@ -33,15 +37,42 @@ def stream_filename(stream: str, suffix: str) -> str:
     return name + suffix
 
 
+class DiskError(CataBotError):
+    """A file could not be written (disk full, I/O error): the recording cannot go on (not a
+    `RecorderError`, which refuses one sample and goes on)."""
+
+
 @dataclass
 class _CsvFile:
-    """One open CSV file, its header shape and the rows not yet written."""
+    """One open CSV file, its header shape, the rows not yet written and the bytes written
+    by complete flushes."""
 
     stream: str
-    handle: TextIO
+    handle: BinaryIO
     cls: type[Message]
     width: int
     pending: list[str] = field(default_factory=list)
+    size: int = 0
+
+    def flush(self) -> None:
+        data = "".join(self.pending).encode("utf-8")
+        self.pending.clear()
+        write_whole(self.handle, data, self.size)
+        self.size += len(data)
+
+
+def write_whole(handle: BinaryIO, data: bytes, size: int) -> None:
+    """All of `data` at offset `size` of an unbuffered file, or nothing: a partial write is
+    cut back off, so the file never ends in a torn row or record."""
+    view = memoryview(data)
+    try:
+        while view:
+            view = view[handle.write(view) or 0 :]
+    except OSError as exc:
+        with contextlib.suppress(OSError):
+            os.ftruncate(handle.fileno(), size)
+            handle.seek(size)
+        raise DiskError(f"cannot write {handle.name}: {exc.strerror or exc}") from None
 
 
 def _line(cells: list[str]) -> str:
@@ -115,9 +146,8 @@ class CsvSink:
         path = self.path(stream)
         if any(o.handle.name == str(path) for o in self._files.values()):
             raise RecorderError(f"{stream}: file {path.name} is already used by another stream")
-        handle = open(path, "w", newline="", encoding="utf-8")  # noqa: SIM115
-        out = _CsvFile(stream, handle, cls, len(header))
-        handle.write(_line(header))
+        handle = open(path, "wb", buffering=0)  # noqa: SIM115 - closed by close()
+        out = _CsvFile(stream, handle, cls, len(header), [_line(header)])
         self._files[stream] = out
         return out
 
@@ -125,9 +155,7 @@ class CsvSink:
         """Write the rows queued since the last call and flush every file (once per tick)."""
         for out in self._files.values():
             if out.pending:
-                out.handle.write("".join(out.pending))
-                out.pending.clear()
-                out.handle.flush()
+                out.flush()
 
     def close(self) -> None:
         """Flush and close every file; further writes are refused."""

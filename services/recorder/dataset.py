@@ -2,12 +2,15 @@
 
 Layout (one folder per sensor, `<vessel>.<sensor>`):
 - cameras: `<tick>_color.png` (RGB), `<tick>_depth.png` (16-bit grey, millimetres along the
-  optical axis; 0 = no return or beyond 65.535 m), `<tick>_normals.png` (RGB = (n + 1) / 2 in
+  optical axis; 0 = no return or beyond 65.535 m) and `<tick>_depth.npy` (float32 metres, inf =
+  no return: the exact values), `<tick>_normals.png` (RGB = (n + 1) / 2 in
   the optical frame z forward, x right, y down), `<tick>_class.png` (8-bit class ids of
   `LABEL_CLASSES`: 0 none, 1 water, 2 terrain, 3 vessel, 4 buoy) and `<tick>_instance.png`
   (16-bit), for the outputs that are on, plus one `labels.jsonl` line per frame with its boxes;
+  every frame, or with `recording.dataset_rate_hz` the first frame of each of its periods;
 - radars: `ppi_<tick>.png`, the north-up PPI (services/recorder/ppi.py) once per antenna turn.
 PNGs are written with fixed settings and no time chunk, so the same run gives the same bytes.
+`catabot.run.recorded_camera` reads this layout back (dataset export, replay).
 """
 
 from __future__ import annotations
@@ -62,6 +65,11 @@ def labels(frame: CameraFrame, files: dict[str, str]) -> dict[str, Any]:
     }
 
 
+def save_npy(path: Path, values: np.ndarray) -> None:
+    """One `.npy` (its header holds only dtype, order and shape: same array, same bytes)."""
+    np.save(path, np.ascontiguousarray(values), allow_pickle=False)
+
+
 class Dataset:
     """Writes the dataset of every camera and radar of a scenario under `root`."""
 
@@ -69,6 +77,11 @@ class Dataset:
         self.root = root
         recording = world.scenario.recording
         self.cameras = recording.dataset
+        rate = recording.dataset_rate_hz
+        self.every = 1 if rate is None else max(1, round(1e9 / rate / world.scenario.dt_ns))
+        self.camera_period = {  # ticks between two frames of each camera stream
+            world.keys.relative(s.key): s.period for s in world.sensors if s.config.type == "camera"
+        }
         self.radar: dict[str, tuple[RadarParams, int]] = {
             world.keys.relative(s.key): (s.params, s.config.period_ns)
             for s in world.sensors
@@ -83,10 +96,16 @@ class Dataset:
         return path
 
     def write(self, stream: str, msg: Message) -> None:
-        if isinstance(msg, CameraFrame) and self.cameras:
+        if isinstance(msg, CameraFrame) and self.cameras and self._due(stream, msg.tick):
             self._camera(stream, msg)
         elif isinstance(msg, RadarSweep) and stream in self.radar:
             self._radar(stream, msg)
+
+    def _due(self, stream: str, tick: int) -> bool:
+        """Whether a frame is saved: it is the first at or after a dataset period's start
+        (a boundary lies in (tick - camera period, tick]), so any rate works with any camera."""
+        period = self.camera_period.get(stream, 1)
+        return tick // self.every > (tick - period) // self.every
 
     def _camera(self, stream: str, frame: CameraFrame) -> None:
         folder, stem = self.folder(stream), f"{frame.tick:08d}"
@@ -104,6 +123,9 @@ class Dataset:
             if pixels.size:
                 files[name] = f"{stem}_{name}.png"
                 save_png(folder / files[name], pixels)
+        if frame.depth.size:
+            files["depth_m"] = f"{stem}_depth.npy"
+            save_npy(folder / files["depth_m"], frame.depth.astype(np.float32, copy=False))
         with open(folder / "labels.jsonl", "a", encoding="utf-8") as out:
             out.write(json.dumps(labels(frame, files), separators=(",", ":")) + "\n")
 

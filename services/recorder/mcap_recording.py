@@ -8,8 +8,9 @@ Topics of `run.mcap` (namespaces as `ros.namespaces`, default `/<vessel id>`):
 `/<ns>/cmd_vel` and `/<ns>/thrust` (commands and the boats' set-points), and per sensor
 `/<ns>/<sensor>/imu`, `fix`, `points`, `ppi`, `image_raw`, `depth`, `segmentation`,
 `instance`, `normals`, `camera_info`. `run.extra.mcap` (only when needed): each camera's
-`/<ns>/<camera>/labels` (its boxes, the dataset's labels.jsonl record) and any message a
-future stream sends without a ROS 2 form (`/<stream>`, JSON of the whole message).
+`/<ns>/<camera>/labels` (its boxes, the dataset's labels.jsonl record), each radar's polar
+sweeps (`/sensor/<vessel>/<radar>`: bins, azimuths, heading; the replay reads them) and any
+message a future stream sends without a ROS 2 form (`/<stream>`, JSON of the whole message).
 """
 
 from __future__ import annotations
@@ -18,7 +19,7 @@ import json
 from pathlib import Path
 from typing import Any
 
-from catabot.bus.messages import CameraFrame, Message, ThrustCmd, TwistCmd
+from catabot.bus.messages import CameraFrame, Message, RadarSweep, ThrustCmd, TwistCmd
 from catabot.ros2 import types
 from catabot.ros2.convert import Converter
 from catabot.ros2.names import TF
@@ -76,14 +77,20 @@ class McapRecording:
                 self.mcap.write(out.topic, out.type, out.data, stamp_ns=stamp_ns)
             if isinstance(msg, CameraFrame):
                 self._labels(stream, msg)
+            elif isinstance(msg, RadarSweep):  # PointCloud2 keeps neither the bins nor heading
+                self._json(stream, msg, stamp_ns)
         elif isinstance(msg, TwistCmd | ThrustCmd) and stream.startswith("vessel/"):
             out = self.convert.command(stream.split("/")[1], msg)
             self.mcap.write(out.topic, out.type, out.data, stamp_ns=stamp_ns)
         else:
-            schema = json_schemas.json_schema(type(msg))
-            data = json_schemas.encode(msg)
-            self.extra().write_json("/" + stream, str(schema["title"]), schema, data,
-                                    stamp_ns=stamp_ns)  # fmt: skip
+            self._json(stream, msg, stamp_ns)
+
+    def _json(self, stream: str, msg: Message, stamp_ns: int) -> None:
+        """The whole message as JSON on `/<stream>` of run.extra.mcap."""
+        schema = json_schemas.json_schema(type(msg))
+        data = json_schemas.encode(msg)
+        self.extra().write_json("/" + stream, str(schema["title"]), schema, data,
+                                stamp_ns=stamp_ns)  # fmt: skip
 
     def _labels(self, stream: str, frame: CameraFrame) -> None:
         record: dict[str, Any] = labels(frame, {})

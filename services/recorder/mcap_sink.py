@@ -28,19 +28,21 @@ from mcap.writer import LIBRARY_IDENTIFIER
 from numpy.typing import NDArray
 
 from catabot.ros2 import types
-from services.recorder.csv_sink import RecorderError
+from services.recorder.csv_sink import RecorderError, write_whole
 from services.recorder.mcap_writer import McapWriter
 
 ROS2 = "ros2"  # the profile of run.mcap
 
 
 class _TickBuffer(io.BufferedIOBase):
-    """A write-only file whose bytes reach the disk only on flush (tick-atomic records)."""
+    """A write-only file whose bytes reach the disk only on flush (tick-atomic records); a
+    flush that fails (a full disk) is cut back off, so the file ends with a whole record."""
 
     def __init__(self, path: Path) -> None:
         super().__init__()
-        self._file = open(path, "wb")  # noqa: SIM115
+        self._file = open(path, "wb", buffering=0)  # noqa: SIM115
         self._pending = bytearray()
+        self._size = 0  # bytes of complete flushes
 
     def writable(self) -> bool:
         return True
@@ -50,15 +52,15 @@ class _TickBuffer(io.BufferedIOBase):
         return len(data)
 
     def tell(self) -> int:
-        return self._file.tell() + len(self._pending)
+        return self._size + len(self._pending)
 
     def flush(self) -> None:
-        if self._file.closed:
+        if self._file.closed or not self._pending:
             return  # IOBase.close() flushes once more after our file is closed
-        if self._pending:
-            self._file.write(self._pending)
-            self._pending.clear()
-        self._file.flush()
+        data = bytes(self._pending)
+        self._pending.clear()
+        write_whole(self._file, data, self._size)
+        self._size += len(data)
 
     def close(self) -> None:
         if not self._file.closed:

@@ -17,7 +17,6 @@ from typing import Any
 
 from catabot.bus.inbox import Inputs
 from catabot.bus.messages import BodyStates, End, Message, Tick, TwistBatch
-from catabot.bus.participant import Participant
 from catabot.ros2.convert import Converter
 from catabot.run.service import Built, ServiceContext, run_service
 from services.recorder.batches import BatchFormatter, Block
@@ -45,9 +44,7 @@ class Recorder:
         self.metrics = Metrics([v.id for v in world.vessels])
         self.run_dir = ctx.run_dir
         self._flushed_at = 0.0
-        self.participant = Participant(
-            ctx.session, ctx.keys, ctx.name, inputs=streams, peers=ctx.peers
-        )
+        self.participant = ctx.participant(streams)
 
     def step(self, tick: Tick, inputs: Inputs) -> None:
         for key in sorted(inputs):
@@ -74,7 +71,7 @@ class Recorder:
                 self.csv.write_lines(block.streams, block.cls, block.lines)
             if self.mcap is not None:
                 self.mcap.block(block)
-        except (RecorderError, OSError) as exc:
+        except RecorderError as exc:  # a disk that fails ends the recording: not caught here
             log.error("not recorded: %s", exc)
         return True
 
@@ -85,7 +82,7 @@ class Recorder:
             if self.mcap is not None:
                 self.mcap.message(stream, msg)
             self.dataset.write(stream, msg)
-        except (RecorderError, OSError, ValueError) as exc:
+        except (RecorderError, ValueError) as exc:  # this sample only; a failing disk ends it
             log.error("not recorded: %s", exc)
 
     def _flush(self) -> None:

@@ -24,7 +24,7 @@ import zenoh
 from catabot.bus import codec
 from catabot.bus.clock import Stream
 from catabot.bus.inbox import Inputs
-from catabot.bus.messages import BodyStates, Message, ThrustCmd, Tick, TwistCmd
+from catabot.bus.messages import BodyStates, Message, ThrustCmd, Tick, TwistCmd, check_ids
 from catabot.bus.session import BLOCK
 from catabot.config.ros import GATEWAY, RosConfig
 from catabot.config.scenario import rate_in_ticks
@@ -137,7 +137,7 @@ class Gateway:
     def _states(self, batch: BodyStates) -> None:
         watched = self._watched_odom()
         try:
-            self.world.check_rows(batch)  # from the bus: maybe not this world's bodies
+            check_ids("world/states", batch.tick, batch.ids, self.world.body_ids)
             if watched:
                 payloads, odom = self.convert.odometry(batch), self.odom
                 for i in watched:

@@ -8,6 +8,11 @@ nothing. Zenoh callbacks only append the sample to a bounded queue per key and w
 gateway's thread; when the gateway falls behind, the oldest samples of a key are dropped
 (counted, logged) instead of growing memory or pushing back on the publishers. The run ends
 with `clock/end`; a conductor whose token vanishes without one ends it too (ClockError).
+
+Like every process on the bus it believes nothing for its key alone (DESIGN.md §4a): a
+sample must arrive on exactly one of its streams, from that stream's producer's session when
+the roster names it, decode, and pass the stream's content check; an `End` must come from
+the conductor's session. Refusals are counted (`rejections`), never raised into the gateway.
 """
 
 from __future__ import annotations
@@ -23,9 +28,12 @@ import zenoh
 
 from catabot.bus import codec
 from catabot.bus.clock import CONDUCTOR, ClockError, Stream
+from catabot.bus.identity import Roster, sender_of
 from catabot.bus.keys import Keys
 from catabot.bus.messages import BodyStates, CameraFrame, End, LidarScan, Message, Tick
 from catabot.bus.participant import EndFn, StepFn
+from catabot.bus.rejections import Rejected, Rejections
+from catabot.errors import CataBotError
 
 log = logging.getLogger("ros.observer")
 DEPTH = 100  # samples held per key: a simulated second of states at 10 ms ticks
@@ -43,8 +51,12 @@ class Observer:
         streams: Sequence[Stream],
         wanted: Callable[[], frozenset[str]],
         wake: threading.Event,
+        *,
+        roster: Roster | None = None,
     ) -> None:
         self.keys, self.wake, self.session = keys, wake, session
+        self.roster = roster if roster is not None else Roster()
+        self.rejections = Rejections(log, "ros")
         self._wanted, self._pace = wanted, keys.world_states()
         self._data: dict[str, Any] = {}  # key -> subscriber, for the keys wanted now
         self._streams = {s.key: s for s in streams}
@@ -55,18 +67,28 @@ class Observer:
         self._dropped = dict.fromkeys(self._held, 0)
         self._warned = dict.fromkeys(self._held, 0.0)
         self._end: bytes | None = None
+        self._refused: list[tuple[str, Rejected]] = []  # from Zenoh's threads, counted here
         self._conductor_gone_at = 0.0
         self._latest = Tick("", -1, 0, 0)
         self._subs = [
             session.declare_subscriber(keys.end(), self._on_end),
-            session.liveliness().declare_subscriber(keys.live(CONDUCTOR), self._on_live),
+            session.liveliness().declare_subscriber(
+                keys.live(CONDUCTOR, self.roster.zid(CONDUCTOR) or "*"), self._on_live
+            ),
         ]
 
     def _on_data(self, sample: zenoh.Sample) -> None:
         """Queue the sample; wake the gateway for the states (every tick: the pace), or for
         anything while the states are not wanted (one wake-up a tick, not one a sample)."""
         key = str(sample.key_expr)
-        held = self._held[key]
+        held = self._held.get(key)
+        if held is None:
+            self._refused.append((key, Rejected("not a stream key", repr(key))))
+            return
+        producer = self.roster.zid(self._streams[key].producer)
+        if producer is not None and sender_of(sample) != producer:
+            self._refused.append((key, Rejected("not from its producer", sender_of(sample))))
+            return
         if len(held) == held.maxlen:
             self._dropped[key] += 1
         held.append(sample.payload.to_bytes())
@@ -74,6 +96,10 @@ class Observer:
             self.wake.set()
 
     def _on_end(self, sample: zenoh.Sample) -> None:
+        conductor = self.roster.zid(CONDUCTOR)
+        if conductor is not None and sender_of(sample) != conductor:
+            self._refused.append((str(sample.key_expr), Rejected("end not from the conductor")))
+            return
         self._end = sample.payload.to_bytes()
         self.wake.set()
 
@@ -117,13 +143,15 @@ class Observer:
     def _drain(self) -> dict[str, list[Message]]:
         """Every held sample, decoded, per key in tick order; malformed ones logged."""
         out: dict[str, list[Message]] = {}
+        while self._refused:
+            self.rejections.add(*self._refused.pop(0))
         for key, held in self._held.items():
             msgs = []
             while held:
                 try:
-                    msgs.append(codec.decode(held.popleft(), self._streams[key].message))
-                except codec.CodecError as exc:
-                    log.warning("dropped a malformed payload on %s: %s", key, exc)
+                    msgs.append(_checked(held.popleft(), self._streams[key]))
+                except Rejected as exc:
+                    self.rejections.add(key, exc)
             if msgs:
                 out[key] = msgs
                 self._note(msgs[-1])
@@ -134,9 +162,23 @@ class Observer:
         return out
 
     def _note(self, msg: Message) -> None:
+        """The newest states give the gateway its tick (an observer gets no `Tick`)."""
         if isinstance(msg, BodyStates) and msg.tick >= self._latest.tick:
             self._latest = Tick("", msg.tick, msg.stamp_ns, 0)
 
     def close(self) -> None:
         for sub in [*self._subs, *self._data.values()]:
             sub.undeclare()
+
+
+def _checked(payload: bytes, stream: Stream) -> Message:
+    """The sample decoded and through its stream's content check, or `Rejected`."""
+    try:
+        msg = codec.decode(payload, stream.message)
+        if stream.check is not None:
+            stream.check(msg)
+    except codec.CodecError as exc:
+        raise Rejected("malformed", str(exc)) from None
+    except (ValueError, CataBotError) as exc:
+        raise Rejected("invalid content", str(exc)) from None
+    return msg

@@ -15,7 +15,7 @@ import threading
 
 from catabot.bus.inbox import Inputs
 from catabot.bus.messages import End, Tick
-from catabot.bus.participant import EndFn, Participant
+from catabot.bus.participant import EndFn
 from catabot.config.ros import GATEWAY, RosConfig
 from catabot.run.service import Built, ServiceContext, run_service
 from services.ros.gateway import Gateway
@@ -27,7 +27,7 @@ def build(ctx: ServiceContext) -> Built:
     world = ctx.world
     inputs = [world.streams.states, *world.streams.sensors]
     if ros.lockstep:
-        participant = Participant(ctx.session, ctx.keys, GATEWAY, inputs=inputs, peers=ctx.peers)
+        participant = ctx.participant(inputs)
         gateway = Gateway(world, ros, ctx.session, publish=participant.publish)
 
         def step(tick: Tick, received: Inputs) -> None:
@@ -38,7 +38,7 @@ def build(ctx: ServiceContext) -> Built:
         return participant, step, _closer(gateway)
     wake = threading.Event()
     gateway = Gateway(world, ros, ctx.session, on_command=wake.set)
-    observer = Observer(ctx.session, ctx.keys, inputs, gateway.wanted, wake)
+    observer = Observer(ctx.session, ctx.keys, inputs, gateway.wanted, wake, roster=ctx.roster)
 
     def observe(_: Tick, received: Inputs) -> None:
         gateway.publish(received, clock_from_states=True)

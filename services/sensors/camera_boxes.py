@@ -144,7 +144,7 @@ def candidate_rays(corners_cam: F64, cam: Pinhole) -> tuple[NDArray[np.intp], ND
     lo = np.clip(np.floor(rect[:, :2]) - 1, 0, size)
     hi = np.clip(np.ceil(rect[:, 2:]) + 2, 0, size)
     keep = np.isfinite(rect).all(axis=1) & (hi > lo).all(axis=1)
-    lo, hi = lo.astype(np.intp, copy=False), hi.astype(np.intp, copy=False)
+    lo, hi = np.nan_to_num(lo).astype(np.intp), np.nan_to_num(hi).astype(np.intp)  # NaN: dropped
     rays, bodies = [], []
     for k in np.flatnonzero(keep).tolist():
         (x0, y0), (x1, y1) = lo[k], hi[k]

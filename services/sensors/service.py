@@ -14,7 +14,6 @@ from dataclasses import dataclass
 
 from catabot.bus.inbox import Inputs
 from catabot.bus.messages import BodyStates, Message, Tick, VesselState
-from catabot.bus.participant import Participant
 from catabot.config.sensors import SENSOR_TYPES
 from catabot.run.service import Built, ServiceContext, run_service
 from catabot.world.waves import WaveField
@@ -47,14 +46,11 @@ class SensorsService:
             )
             for s in world.sensors
         ]
-        self.world = world
         self.carrier_rows = sorted({m.row for m in self.mounted})
         self.batch = world.start_states()
         self.states = self._carriers(self.batch)
         self.states_key = ctx.keys.world_states()
-        self.participant = Participant(
-            ctx.session, ctx.keys, ctx.name, inputs=[world.streams.states], peers=ctx.peers
-        )
+        self.participant = ctx.participant([world.streams.states])
 
     def step(self, tick: Tick, inputs: Inputs) -> None:
         batches = inputs.get(self.states_key)
@@ -77,8 +73,7 @@ class SensorsService:
     def _take(self, batch: Message) -> None:
         """The batch for the scene (every pose from its arrays) and the carriers' rows as
         `VesselState` (what sensors sample)."""
-        assert isinstance(batch, BodyStates)
-        self.world.check_rows(batch)
+        assert isinstance(batch, BodyStates)  # of this world's rows: checked on arrival
         self.batch = batch
         self.states = self._carriers(batch)
 

@@ -13,22 +13,16 @@ that path instead, and `mode="release"` restores the scenario behaviour.
 
 from __future__ import annotations
 
-import logging
 import sys
 
 import numpy as np
 
-from catabot.bus import codec
 from catabot.bus.inbox import Inputs
 from catabot.bus.messages import BodyStates, Message, Tick, TwistBatch, WaypointsCmd
-from catabot.bus.participant import Participant
 from catabot.config.scenario import guidance_period_ticks
 from catabot.run.service import Built, ServiceContext, run_service
 from catabot.world import rotations
 from services.traffic.behaviours import Behaviours
-
-log = logging.getLogger("traffic")
-MODES = ("loop", "back_and_forth", "release")
 
 
 class TrafficService:
@@ -43,19 +37,12 @@ class TrafficService:
         self.pos = np.array([(b.pose.x_m, b.pose.y_m) for b in boats], dtype=np.float64)
         self.yaw = np.array([b.pose.yaw_rad for b in boats], dtype=np.float64)
         self.vel = np.zeros((n, 2))
-        self.world = world
         self.states_key = ctx.keys.world_states()
         self.boat_rows = np.array([world.body(vid).row for vid in self.ids], dtype=np.intp)
         waypoints = [s for s in world.streams.waypoints if ctx.keys.vessel_of(s.key) in self.row]
         self.twists_key = ctx.keys.world_twists()
         self.period = guidance_period_ticks(ctx.scenario)
-        self.participant = Participant(
-            ctx.session,
-            ctx.keys,
-            ctx.name,
-            inputs=[world.streams.states, *waypoints],
-            peers=ctx.peers,
-        )
+        self.participant = ctx.participant([world.streams.states, *waypoints])
 
     def step(self, tick: Tick, inputs: Inputs) -> None:
         guide = tick.tick % self.period == 0
@@ -67,7 +54,7 @@ class TrafficService:
             i = self.row[self.keys.vessel_of(key)]
             for msg in msgs:
                 if isinstance(msg, WaypointsCmd):
-                    self._take_waypoints(i, key, msg)
+                    self._take_waypoints(i, msg)
         if guide:
             self._guide(tick)
 
@@ -78,27 +65,19 @@ class TrafficService:
 
     def _take_states(self, batch: Message) -> None:
         """The boats' rows of the batch, all at once."""
-        assert isinstance(batch, BodyStates)
-        self.world.check_rows(batch)
+        assert isinstance(batch, BodyStates)  # of this world's rows: checked on arrival
         rows = self.boat_rows
         self.pos = batch.position[rows, :2].copy()
         self.yaw = rotations.yaw_of_quaternions(batch.orientation[rows])
         self.vel = batch.linear_velocity[rows, :2].copy()
 
-    def _take_waypoints(self, i: int, key: str, msg: WaypointsCmd) -> None:
-        """Adopt a path from outside, or release the boat; refuse malformed ones loudly."""
+    def _take_waypoints(self, i: int, msg: WaypointsCmd) -> None:
+        """Adopt a path from outside, or release the boat (paths are checked on arrival:
+        catabot/world/checks.py)."""
         if msg.mode == "release":
             self.behaviours.release(i)
             return
-        pts = msg.points
-        if msg.mode not in MODES or len(pts) < 2 or len(pts) % 2 or not codec.finite(pts):
-            log.error("refused waypoints on %s: need an even number of finite values "
-                      "x0, y0, x1, ... and mode in %s (got %s)", key, MODES, msg)  # fmt: skip
-            return
-        if not (codec.finite((msg.speed, msg.tolerance)) and msg.speed > 0 and msg.tolerance > 0):
-            log.error("refused waypoints on %s: speed and tolerance must be > 0", key)
-            return
-        points = np.array(pts, dtype=np.float64).reshape(-1, 2)
+        points = np.array(msg.points, dtype=np.float64).reshape(-1, 2)
         self.behaviours.set_path(i, points, msg.speed, loop=msg.mode == "loop", tol=msg.tolerance)
 
 

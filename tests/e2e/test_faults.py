@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import json
 import math
 import os
 import signal
@@ -230,7 +231,11 @@ def test_malformed_and_non_finite_commands_are_logged_and_survived(
             time.sleep(0.2)
     _, err = proc.communicate(timeout=60)
     assert proc.returncode == 0, err
-    log = (only_run_dir(out) / "log" / "physics.log").read_text()
-    assert f"malformed payload on {key}" in log
-    assert log.count("non-finite") == 2
-    assert "1 values for 2 thrusters" in log
+    run = only_run_dir(out)
+    log = (run / "log" / "physics.log").read_text()
+    assert f"refused a sample on {key}: malformed" in log
+    assert f"refused a sample on {key}: invalid content" in log  # then counted, not repeated
+    for service in ("physics", "recorder"):  # every subscriber refuses them where they arrive
+        counts = json.loads((run / "log" / f"{service}.rejected.json").read_text())
+        assert counts == {"invalid content": 3, "malformed": 1}
+    assert json.loads((run / "log" / "run.json").read_text())["rejected"]["physics"] == counts

@@ -12,7 +12,12 @@ from pathlib import Path
 import numpy as np
 from numpy.typing import NDArray
 
-from catabot.config.environment import CurrentConfig, CurrentMapConfig, CurrentMapError
+from catabot.config.environment import (
+    MAX_CURRENT_MPS,
+    CurrentConfig,
+    CurrentMapConfig,
+    CurrentMapError,
+)
 
 Array = NDArray[np.float64]
 IMAGE_SUFFIXES = (".png", ".bmp", ".tif", ".tiff")
@@ -164,4 +169,9 @@ def _checked_grid(grid: Array, what: str) -> Array:
     if bad.size:
         j, i, c = (int(v) for v in bad[0])
         raise CurrentMapError(f"current map {what}: value at row {j}, col {i}, comp {c} not finite")
+    fastest = float(np.hypot(g[..., 0], g[..., 1]).max())
+    if fastest > MAX_CURRENT_MPS:
+        raise CurrentMapError(
+            f"current map {what}: {fastest:g} m/s somewhere; at most {MAX_CURRENT_MPS:g} m/s"
+        )
     return np.ascontiguousarray(g)

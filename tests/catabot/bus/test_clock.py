@@ -6,10 +6,11 @@ import pytest
 
 from catabot.bus import codec
 from catabot.bus.clock import ClockError, Policy, Stream, period_in_ticks, ticks_for
-from catabot.bus.codec import CodecError
+from catabot.bus.identity import Roster
 from catabot.bus.inbox import Inbox
 from catabot.bus.keys import Keys
 from catabot.bus.messages import GpsFix, ImuSample, ThrustCmd, VesselState
+from catabot.bus.rejections import Rejected
 
 KEYS = Keys("w")
 STATE = KEYS.vessel_state("ego")
@@ -32,14 +33,23 @@ def _cmd(value: float) -> bytes:
     return codec.encode(ThrustCmd(thrust=(value, value)))
 
 
+ZIDS = {"physics": "a1", "sensors": "b2", "p": "c3"}  # each producer's session
+
+
 def _inbox() -> Inbox:
     return Inbox(
         [
             Stream(STATE, VesselState, "physics", 1),
             Stream(GPS, GpsFix, "sensors", 10),
             Stream(CMD, ThrustCmd, "external", None),
-        ]
+        ],
+        roster=Roster(ZIDS),
     )
+
+
+def _add(inbox: Inbox, key: str, payload: bytes) -> None:
+    """Add a sample as its producer's session sends it."""
+    inbox.add(key, payload, sender=ZIDS.get(inbox.streams[key].producer, ""))
 
 
 # -- Stream -------------------------------------------------------------------------------
@@ -128,7 +138,7 @@ def test_period_in_ticks_errors(period: int) -> None:
 
 def test_jacobi_release() -> None:
     inbox = _inbox()
-    inbox.add(STATE, _state(0))
+    _add(inbox, STATE, _state(0))
     assert inbox.release(0) == {}  # tagged 0: not for the step of tick 0
     out = inbox.release(1)
     assert list(out) == [STATE] and [m.tick for m in out[STATE]] == [0]
@@ -137,16 +147,16 @@ def test_jacobi_release() -> None:
 
 def test_release_holds_samples_of_the_current_and_later_ticks() -> None:
     inbox = _inbox()
-    for k in (3, 1, 2, 4):
-        inbox.add(STATE, _state(k))
+    for k in (1, 2, 3, 4):
+        _add(inbox, STATE, _state(k))
     assert [m.tick for m in inbox.release(3)[STATE]] == [1, 2]  # oldest first
     assert [m.tick for m in inbox.release(5)[STATE]] == [3, 4]
 
 
 def test_free_samples_are_released_at_the_next_step() -> None:
     inbox = _inbox()
-    inbox.add(CMD, _cmd(0.5))
-    inbox.add(CMD, _cmd(0.7))
+    _add(inbox, CMD, _cmd(0.5))
+    _add(inbox, CMD, _cmd(0.7))
     assert inbox.missing(0) == []
     out = inbox.release(0)
     assert [m.thrust for m in out[CMD]] == [(0.5, 0.5), (0.7, 0.7)]  # arrival order
@@ -157,29 +167,29 @@ def test_missing_follows_the_periods() -> None:
     inbox = _inbox()
     assert inbox.missing(0) == []  # nothing is due before tick 0
     assert inbox.missing(1) == [STATE, GPS]
-    inbox.add(STATE, _state(0))
+    _add(inbox, STATE, _state(0))
     assert inbox.missing(1) == [GPS]
-    inbox.add(GPS, _gps(0))
+    _add(inbox, GPS, _gps(0))
     assert inbox.missing(1) == []
-    inbox.add(STATE, _state(1))
+    _add(inbox, STATE, _state(1))
     assert inbox.missing(2) == []  # gps is next due at 10
     for k in range(2, 10):
-        inbox.add(STATE, _state(k))
+        _add(inbox, STATE, _state(k))
     assert inbox.missing(10) == []
     assert inbox.missing(11) == [STATE, GPS]
-    inbox.add(STATE, _state(10))
-    inbox.add(GPS, _gps(10))
+    _add(inbox, STATE, _state(10))
+    _add(inbox, GPS, _gps(10))
     assert inbox.missing(11) == []
 
 
 def test_a_lagged_stream_is_due_and_released_lag_ticks_later() -> None:
     lagged = Stream(STATE, VesselState, "physics", 1, lag=3)
     assert [lagged.due_before(k) for k in (0, 3, 4, 5, 10)] == [-1, -1, 0, 1, 6]
-    inbox = Inbox([lagged])
+    inbox = Inbox([lagged], roster=Roster(ZIDS))
     assert inbox.missing(3) == []  # nothing due yet: the consumer steps ahead of physics
     assert inbox.missing(4) == [STATE]
     for k in range(6):
-        inbox.add(STATE, _state(k))
+        _add(inbox, STATE, _state(k))
     assert inbox.release(3) == {}
     assert [m.tick for m in inbox.release(5)[STATE]] == [0, 1]  # tagged < 5 - 3
     assert [m.tick for m in inbox.release(9)[STATE]] == [2, 3, 4, 5]
@@ -191,10 +201,14 @@ def test_a_lag_must_be_non_negative_and_on_a_clocked_stream(lag: int, period: in
         Stream(STATE, VesselState, "physics", period, lag=lag)
 
 
-def test_a_late_old_sample_does_not_lower_the_mark() -> None:
+def test_a_late_or_repeated_sample_is_refused_and_keeps_the_mark() -> None:
+    """One producer publishes a key in tick order: an older or repeated tag is a forgery or
+    a replay, never data."""
     inbox = _inbox()
-    inbox.add(STATE, _state(5))
-    inbox.add(STATE, _state(2))
+    _add(inbox, STATE, _state(5))
+    for old in (2, 5):
+        with pytest.raises(Rejected, match="tag out of the window"):
+            _add(inbox, STATE, _state(old))
     assert inbox.latest[STATE] == 5
     assert STATE not in inbox.missing(6)
 
@@ -210,13 +224,13 @@ def test_dropped_producers_are_not_waited_for() -> None:
 
 def test_malformed_payloads_raise_and_leave_the_inbox_unchanged() -> None:
     inbox = _inbox()
-    inbox.add(STATE, _state(0))
+    _add(inbox, STATE, _state(0))
     before = ({k: list(v) for k, v in inbox.held.items()}, dict(inbox.latest))
     for payload in (b"\xc1junk", b"", _gps(3), _state(4)[:-3]):
-        with pytest.raises(CodecError):
-            inbox.add(STATE, payload)
-    with pytest.raises(CodecError):
-        inbox.add(GPS, codec.encode(ImuSample(1, 1, (0, 0, 0, 1), (0, 0, 0), (0, 0, 0))))
+        with pytest.raises(Rejected, match="malformed"):
+            _add(inbox, STATE, payload)
+    with pytest.raises(Rejected, match="malformed"):
+        _add(inbox, GPS, codec.encode(ImuSample(1, 1, (0, 0, 0, 1), (0, 0, 0), (0, 0, 0))))
     assert ({k: list(v) for k, v in inbox.held.items()}, dict(inbox.latest)) == before
     assert inbox.missing(1) == [GPS]
 

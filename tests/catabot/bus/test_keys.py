@@ -17,8 +17,8 @@ def test_every_builder_matches_the_design_table() -> None:
     assert k.ack("physics") == "catabot/harbour/clock/ack/physics"
     assert k.acks() == "catabot/harbour/clock/ack/*"
     assert k.end() == "catabot/harbour/clock/end"
-    assert k.live("sensors") == "catabot/harbour/live/sensors"
-    assert k.lives() == "catabot/harbour/live/*"
+    assert k.live("sensors", "a1b2") == "catabot/harbour/live/sensors/a1b2"
+    assert k.lives() == "catabot/harbour/live/*/*"
     assert k.vessel_state("ego") == "catabot/harbour/vessel/ego/state"
     assert k.vessel_states() == "catabot/harbour/vessel/*/state"
     assert k.cmd_thrust("ego") == "catabot/harbour/vessel/ego/cmd/thrust"
@@ -53,7 +53,7 @@ def test_world_name_refused(name: str) -> None:
         ("vessel", lambda k, n: k.sensor(n, "imu")),
         ("sensor", lambda k, n: k.sensor("ego", n)),
         ("participant", lambda k, n: k.ack(n)),
-        ("participant", lambda k, n: k.live(n)),
+        ("participant", lambda k, n: k.live(n, "a1b2")),
         ("config", lambda k, n: k.config(n)),
     ],
 )
@@ -89,8 +89,10 @@ def test_relative() -> None:
 def test_participant_of() -> None:
     k = Keys("w")
     assert k.participant_of(k.ack("physics")) == "physics"
-    assert k.participant_of(k.live("recorder")) == "recorder"
-    assert k.participant_of(k.live("conductor")) == "conductor"
+    assert k.member_of(k.live("recorder", "a1b2")) == ("recorder", "a1b2")
+    assert k.member_of(k.live("conductor", "ff")) == ("conductor", "ff")
+    with pytest.raises(KeyNameError, match="not a liveliness token"):
+        k.member_of(k.ack("physics"))
 
 
 def test_vessel_of_reads_the_vessel_id_back_from_a_key() -> None:

@@ -116,7 +116,7 @@ def test_consumer_waits_for_a_late_sample(world: World) -> None:
 
     def send_late(tick: int) -> None:
         sent[tick] = time.monotonic()
-        publisher.put(codec.encode(_fix(tick)))
+        world.members["prod"].participant.publish(key, _fix(tick))  # signed, as its producer
 
     def produce(tick: Tick, _inputs: Inputs) -> None:
         if tick.tick % 2 == 0:
@@ -125,7 +125,6 @@ def test_consumer_waits_for_a_late_sample(world: World) -> None:
             timer.start()
 
     key, cons = _producer_consumer(world, produce)
-    publisher = world.members["prod"].session.declare_publisher(key)
     step_at: dict[int, float] = {}
     cons.user_step = lambda tick, _inputs: step_at.__setitem__(tick.tick, time.monotonic())
     result = world.run(["prod", "cons"], 12, deadline_s=2.0, start_timeout_s=5.0)
@@ -134,7 +133,6 @@ def test_consumer_waits_for_a_late_sample(world: World) -> None:
     for m in world.members.values():
         m.join()
         assert m.error is None
-    publisher.undeclare()
     assert result.error == "" and result.ticks_done == 12
     _check_jacobi(cons, key, 12)
     for j, t in sent.items():

@@ -64,15 +64,18 @@ def test_per_vessel_states_are_for_observers_only() -> None:
     assert not lockstep & {KEYS.vessel_state("ego"), KEYS.vessel_state("buoy")}
 
 
-def test_check_rows_refuses_a_changed_row_order() -> None:
-    def batch(ids: tuple[str, ...]) -> BodyStates:
-        z3, z4 = np.zeros((len(ids), 3)), np.zeros((len(ids), 4))
+def test_the_states_stream_refuses_other_rows_or_shapes() -> None:
+    def batch(ids: tuple[str, ...], n: int | None = None) -> BodyStates:
+        z3, z4 = np.zeros((n or len(ids), 3)), np.zeros((n or len(ids), 4))
         return BodyStates(0, 0, ids, z3, z4, z3, z3, z3, z3)
 
-    world = _world()
-    world.check_rows(batch(("ego", "buoy")))
+    check = _world().streams.states.check
+    assert check is not None
+    check(batch(("ego", "buoy")))
     with pytest.raises(ValueError, match="expected"):
-        world.check_rows(batch(("buoy", "ego")))
+        check(batch(("buoy", "ego")))
+    with pytest.raises(ValueError, match=r"position is float64 \(3, 3\), not float64 \(2, 3\)"):
+        check(batch(("ego", "buoy"), n=3))
 
 
 def test_rows_are_vessels_then_boats_then_buoys() -> None:

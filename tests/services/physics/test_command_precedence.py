@@ -6,8 +6,6 @@ from catabot.bus.messages import ThrustCmd, TwistCmd, WaypointsCmd
 from services.physics.commands import CommandBook, Order
 from tests.services.physics.helpers import vessels
 
-KEY = "catabot/w/vessel/boat_000/cmd/twist"
-
 
 def _book() -> CommandBook:
     return CommandBook(vessels({"id": "boat_000"}))
@@ -15,17 +13,17 @@ def _book() -> CommandBook:
 
 def test_traffic_set_points_drive_a_boat_until_an_external_command_takes_it() -> None:
     book = _book()
-    book.take("boat_000", KEY, [TwistCmd(5.0, 0.26, tick=0)])
+    book.take("boat_000", [TwistCmd(5.0, 0.26, tick=0)])
     assert book.order("boat_000", 0) == Order(twist=(5.0, 0.26))
-    book.take("boat_000", KEY, [TwistCmd(1.0, 0.0, tick=-1), TwistCmd(5.0, 0.3, tick=1)])
+    book.take("boat_000", [TwistCmd(1.0, 0.0, tick=-1), TwistCmd(5.0, 0.3, tick=1)])
     assert book.order("boat_000", 0) == Order(twist=(1.0, 0.0))  # the set-point waits
-    book.take("boat_000", KEY, [ThrustCmd((0.2, 0.2))])
+    book.take("boat_000", [ThrustCmd((0.2, 0.2))])
     assert book.order("boat_000", 0) == Order(thrust=(0.2, 0.2))
 
 
 def test_a_waypoints_command_hands_the_boat_back() -> None:
     book = _book()
-    book.take("boat_000", KEY, [TwistCmd(5.0, 0.26, tick=3), TwistCmd(0.0, 0.0, tick=-1)])
+    book.take("boat_000", [TwistCmd(5.0, 0.26, tick=3), TwistCmd(0.0, 0.0, tick=-1)])
     release = WaypointsCmd(points=(), speed=0.0, tolerance=0.0, mode="release")
-    book.take("boat_000", KEY.replace("twist", "waypoints"), [release])
+    book.take("boat_000", [release])
     assert book.order("boat_000", 0) == Order(twist=(5.0, 0.26))

@@ -12,6 +12,7 @@ import pytest
 
 from catabot.config.vessel import VesselModel, VesselModelError, load_vessel_model
 from catabot.world import rotations
+from services.physics.diverged import PhysicsDiverged
 from services.physics.hydro import (
     Columns,
     buoyancy_wrench,
@@ -191,7 +192,7 @@ def test_missing_file_and_bad_json(tmp_path: Path) -> None:
     with pytest.raises(VesselModelError, match="cannot read"):
         load_vessel_model("nowhere.json", base_dir=tmp_path)
     (tmp_path / "broken.json").write_text("{ not json")
-    with pytest.raises(VesselModelError, match="broken.json: not valid JSON: .*line 1 column 3"):
+    with pytest.raises(VesselModelError, match=r"broken.json: not valid JSON: .*line 1 column 3"):
         load_vessel_model("broken.json", base_dir=tmp_path)
 
 
@@ -252,3 +253,17 @@ def test_thruster_first_order_lag(catabot: VesselModel) -> None:
     run(world, catabot.thrusters[0].time_constant_s)
     gain = 1.0 - math.exp(-1.0)
     assert np.allclose(world.thruster_forces("cb"), [36.0 * gain, -28.0 * gain], rtol=1e-9)
+
+
+def test_a_state_that_stops_being_finite_is_named_with_its_load(catabot: VesselModel) -> None:
+    """A thruster's force made infinite (as a bug or a corrupt model would): the step raises
+    naming the body and the load, instead of a NaN spreading to every body and sensor."""
+    world = PhysicsWorld([("ego", catabot, (0.0, 0.0, 0.0, 0.0))], dt_s=0.01)
+    world.step()
+    world._thrusters.max_forward_n[0, 0] = np.inf
+    world.set_thrust("ego", [1.0, 1.0])
+    with pytest.raises(PhysicsDiverged) as info:
+        for _ in range(5):
+            world.step()
+    assert str(info.value).startswith("body 'ego': a load on it is not finite at t = 0.01 s")
+    assert "the largest load on it in that step was thrust" in str(info.value)

@@ -1,0 +1,46 @@
+"""Inputs a process refused, logged without flooding and counted for the run's summary.
+
+A buggy client can send a bad sample a hundred times a second: each (key, reason) is logged
+at most once a second with the count since the last line, totals are kept per reason, and
+`write` leaves them in `log/<process>.rejected.json` for `catabot run`'s summary.
+"""
+
+from __future__ import annotations
+
+import json
+import logging
+import time
+from collections import Counter
+from pathlib import Path
+
+
+class Rejected(Exception):
+    """A sample refused where it arrived: `reason` is short (counted), `detail` is logged."""
+
+    def __init__(self, reason: str, detail: str = "") -> None:
+        super().__init__(f"{reason}: {detail}" if detail else reason)
+        self.reason, self.detail = reason, detail
+
+
+class Rejections:
+    def __init__(self, log: logging.Logger, who: str, *, every_s: float = 1.0) -> None:
+        self.log, self.who, self.every_s = log, who, every_s
+        self.totals: Counter[str] = Counter()
+        self._since: Counter[tuple[str, str]] = Counter()
+        self._last: dict[tuple[str, str], float] = {}
+
+    def add(self, key: str, rejected: Rejected) -> None:
+        self.totals[rejected.reason] += 1
+        item = (key, rejected.reason)
+        self._since[item] += 1
+        now = time.monotonic()
+        if now - self._last.get(item, -self.every_s) >= self.every_s:
+            count = self._since.pop(item)
+            more = f" ({count} since the last report)" if count > 1 else ""
+            self.log.warning("%s: refused a sample on %s: %s%s", self.who, key, rejected, more)
+            self._last[item] = now
+
+    def write(self, path: Path) -> None:
+        """Totals by reason (nothing is written when nothing was refused)."""
+        if self.totals:
+            path.write_text(json.dumps(dict(sorted(self.totals.items())), indent=2) + "\n")

@@ -1,0 +1,260 @@
+"""A recorded run read back as what was on the bus: the one reader of run folders.
+
+The viewer's replay, `run.rrd`, the dataset export and the plots all read a finished run
+folder through this module, so the mapping from the recorder's files back to bus messages
+(DESIGN.md §7: which MCAP channel holds which stream, in which encoding) is written once.
+Sources: `scenario.json` (resolved into the same `World` the run had), `run.mcap` (a ROS 2
+bag with the gateway's topics, catabot/ros2/names.py: body poses from `/tf`, vessel twists
+from each `odom`, LiDAR `points`, camera `image_raw` and `depth`, IMU `imu`, commands
+`thrust` and `cmd_vel`), `run.extra.mcap` (JSON of what has no ROS 2 form: the radar's polar
+sweeps) and `dataset/` (camera labels: `recorded_camera.py`).
+"""
+
+from __future__ import annotations
+
+import base64
+import json
+from collections.abc import Iterator
+from dataclasses import dataclass
+from functools import cached_property
+from pathlib import Path
+from typing import Any, TypeVar
+
+import numpy as np
+from mcap.records import Schema
+from mcap_ros2.decoder import DecoderFactory
+from numpy.typing import NDArray
+
+from catabot.bus.fields import FieldSpec, fields_of
+from catabot.bus.messages import BodyStates, ImuSample, LidarScan, Message, ThrustCmd
+from catabot.config.load import load_scenario
+from catabot.config.ros import RosConfig
+from catabot.errors import CataBotError
+from catabot.ros2.names import TF, Names
+from catabot.run import cdr_columns
+from catabot.run.mcap_index import Channel, McapIndex
+from catabot.world.world import MountedSensor, World
+
+M = TypeVar("M", bound=Message)
+IMAGE_TOPICS = {"color": "image_raw"}  # a camera output -> its topic, where they differ
+_POINT_TYPES = {1: "i1", 2: "u1", 3: "<i2", 4: "<u2", 5: "<i4", 6: "<u4", 7: "<f4", 8: "<f8"}
+
+
+class RunFolderError(CataBotError, ValueError):
+    """A folder that is not a (complete enough) run folder for what was asked of it."""
+
+
+@dataclass(frozen=True)
+class StateTrack:
+    """Every body's pose at every recorded tick, and each vessel's body-frame twist.
+
+    `position` (T, N, 3) and `orientation` (T, N, 4) come from `/tf` (every body, buoys
+    included); `twist` (T, N, 6) linear + angular from each vessel's Odometry, NaN for buoys
+    (no Odometry is recorded for them). Accelerations are not in the MCAP (the CSVs have them).
+    """
+
+    ids: tuple[str, ...]
+    stamp_ns: NDArray[np.int64]
+    position: NDArray[np.float64]
+    orientation: NDArray[np.float64]
+    twist: NDArray[np.float64]
+
+    def __len__(self) -> int:
+        return len(self.stamp_ns)
+
+    def batch(self, i: int, dt_ns: int) -> BodyStates:
+        """Tick i as the `BodyStates` it was recorded from (accelerations NaN: not recorded)."""
+        nan = np.full((len(self.ids), 3), np.nan)
+        stamp = int(self.stamp_ns[i])
+        twist = self.twist[i]
+        return BodyStates(
+            stamp // dt_ns - 1, stamp, self.ids, self.position[i], self.orientation[i],
+            twist[:, :3], twist[:, 3:], nan, nan,
+        )  # fmt: skip
+
+
+class RecordedRun:
+    """One run folder: its world, and its streams read back on demand."""
+
+    def __init__(self, folder: str | Path) -> None:
+        self.folder = Path(folder)
+        if not self.folder.is_dir():
+            raise RunFolderError(f"{self.folder}: no such run folder")
+        scenario = self.folder / "scenario.json"
+        if not scenario.is_file():
+            raise RunFolderError(f"{self.folder}: not a run folder (it has no scenario.json)")
+        self.world = World.resolve(load_scenario(scenario))
+        self.names = Names(self.world, self.world.scenario.ros or RosConfig())  # the recorder's
+        self._ros2 = DecoderFactory()
+
+    @property
+    def dt_ns(self) -> int:
+        return self.world.scenario.dt_ns
+
+    @cached_property
+    def mcap(self) -> McapIndex:
+        path = self.folder / "run.mcap"
+        if not path.is_file():
+            raise RunFolderError(
+                f"{self.folder}: no run.mcap (recorded with recording.mcap false?); "
+                "replay, export and plots read it"
+            )
+        return McapIndex(path)
+
+    @cached_property
+    def extra(self) -> McapIndex | None:
+        path = self.folder / "run.extra.mcap"
+        return McapIndex(path) if path.is_file() else None
+
+    def topic(self, topic: str) -> Channel | None:
+        """A channel of run.mcap by its ROS 2 topic (`self.names` spells them)."""
+        return self.mcap.channel(topic)
+
+    def stream(self, sensor: MountedSensor) -> str:
+        return self.world.keys.relative(sensor.key)
+
+    def metrics(self) -> dict[str, Any] | None:
+        path = self.folder / "metrics.json"
+        return json.loads(path.read_text()) if path.is_file() else None
+
+    def states(self) -> StateTrack:
+        """Every body's recorded state (see `StateTrack`)."""
+        tf = self.mcap.channel(TF)
+        rows = self.mcap.rows(tf) if tf is not None else None
+        if tf is None or rows is None:
+            raise RunFolderError(f"{self.folder}: run.mcap has no readable /tf channel")
+        poses = cdr_columns.tf_poses(rows)
+        ids = self.world.body_ids
+        frames = [self.names.base_link(b) for b in ids]
+        if sorted(poses.frames) != sorted(frames):
+            raise RunFolderError(f"{self.folder}: /tf frames are not this scenario's bodies")
+        order = np.array([poses.frames.index(f) for f in frames], dtype=np.intp)
+        pose = poses.pose[:, order]
+        stamps = np.asarray(tf.stamps, dtype=np.int64)
+        twist = np.full((len(stamps), len(ids), 6), np.nan)
+        for row, body in enumerate(self.world.vessels):
+            self._fill_twist(twist[:, row], stamps, body.id)
+        return StateTrack(ids, stamps, pose[..., :3], pose[..., 3:], twist)
+
+    def _fill_twist(self, out: NDArray[np.float64], stamps: NDArray[np.int64], vid: str) -> None:
+        chan = self.topic(self.names.odom(vid))
+        rows = self.mcap.rows(chan) if chan is not None else None
+        if chan is None or rows is None:
+            return
+        own = np.asarray(chan.stamps, dtype=np.int64)
+        at = np.searchsorted(stamps, own)
+        found = (at < len(stamps)) & (stamps[np.minimum(at, len(stamps) - 1)] == own)
+        out[at[found]] = cdr_columns.odometry(rows, what=chan.topic).twist[found]
+
+    def messages(self, stream: str, cls: type[M]) -> Iterator[M]:
+        """The samples of a stream with no ROS 2 form (a radar's sweeps), from
+        run.extra.mcap's JSON (topic `/<stream>`), as `cls`."""
+        chan = self.extra.channel("/" + stream.strip("/")) if self.extra else None
+        for i in range(len(chan) if chan is not None else 0):
+            assert chan is not None and self.extra is not None
+            yield from_json(cls, json.loads(self.extra.payload(chan, i)))
+
+    def thrust(self, vessel: str) -> Iterator[tuple[int, ThrustCmd]]:
+        """(stamp_ns, command) of every thrust command the vessel was given (`thrust`)."""
+        chan = self.topic(self.names.topic(vessel, "thrust"))
+        for i in range(len(chan) if chan is not None else 0):
+            assert chan is not None
+            values = tuple(float(v) for v in self.ros2(chan, i).data)
+            yield chan.stamps[i], ThrustCmd(values)
+
+    def imu(self, sensor: MountedSensor) -> Iterator[ImuSample]:
+        """Every sample of an IMU from its sensor_msgs/Imu (`<sensor>/imu`)."""
+        chan = self.topic(self.names.sensor_topic(sensor, "imu"))
+        for i in range(len(chan) if chan is not None else 0):
+            assert chan is not None
+            m, stamp = self.ros2(chan, i), chan.stamps[i]
+            q, w, a = m.orientation, m.angular_velocity, m.linear_acceleration
+            yield ImuSample(stamp // self.dt_ns, stamp, (q.x, q.y, q.z, q.w), (w.x, w.y, w.z),
+                            (a.x, a.y, a.z))  # fmt: skip
+
+    def ros2(self, chan: Channel, i: int) -> Any:
+        """Message i of a CDR channel, decoded by mcap_ros2 (PointCloud2, Image)."""
+        schema = Schema(
+            id=chan.id, name=chan.schema_name, encoding=chan.schema_encoding, data=chan.schema_data
+        )
+        decoder = self._ros2.decoder_for(chan.encoding, schema)
+        if decoder is None:
+            raise RunFolderError(f"{chan.topic}: no decoder for {chan.schema_name!r}")
+        return decoder(self.mcap.payload(chan, i))
+
+    def lidar_scans(self, sensor: MountedSensor) -> Iterator[LidarScan]:
+        """Every scan of a LiDAR, labels included (no range image: the MCAP has returns)."""
+        chan = self.topic(self.names.sensor_topic(sensor, "points"))
+        for i in range(len(chan) if chan is not None else 0):
+            assert chan is not None
+            yield scan_of(self.ros2(chan, i), chan.stamps[i], self.dt_ns)
+
+    def images(self, sensor: MountedSensor, output: str) -> Iterator[tuple[int, np.ndarray]]:
+        """(stamp_ns, pixels) of one camera output in the MCAP (`color` rgb8 from `image_raw`,
+        `depth` 32FC1, ...)."""
+        chan = self.topic(self.names.sensor_topic(sensor, IMAGE_TOPICS.get(output, output)))
+        for i in range(len(chan) if chan is not None else 0):
+            assert chan is not None
+            yield chan.stamps[i], image_of(self.ros2(chan, i))
+
+
+def scan_of(cloud: Any, stamp_ns: int, dt_ns: int) -> LidarScan:
+    """A PointCloud2 of the recorder's layout (convert_sensors.py) as the LidarScan it came from;
+    fields are found by name, so their order and offsets may change."""
+    kinds = {f.name: (f.offset, _POINT_TYPES[f.datatype]) for f in cloud.fields}
+    missing = {"x", "y", "z", "intensity", "label", "rain", "instance"} - set(kinds)
+    if missing:
+        raise RunFolderError(f"point cloud without field(s) {sorted(missing)}")
+    names = list(kinds)
+    dtype = np.dtype(
+        {"names": names, "formats": [kinds[n][1] for n in names],
+         "offsets": [kinds[n][0] for n in names], "itemsize": cloud.point_step}
+    )  # fmt: skip
+    pts = np.frombuffer(bytes(cloud.data), dtype=dtype, count=cloud.width * cloud.height)
+    ring = pts["ring"].astype(np.uint16) if "ring" in kinds else np.zeros(len(pts), np.uint16)
+    return LidarScan(
+        tick=stamp_ns // dt_ns,
+        stamp_ns=stamp_ns,
+        points=np.stack([pts["x"], pts["y"], pts["z"]], axis=1).astype(np.float32),
+        intensity=pts["intensity"].astype(np.float32),
+        ring=ring,
+        cls=pts["label"].astype(np.uint8),
+        instance=pts["instance"].astype(np.int32),
+        is_rain=pts["rain"].astype(bool),
+        range_image=np.empty((0, 0), np.float32),
+    )
+
+
+def image_of(msg: Any) -> np.ndarray:
+    """A sensor_msgs/Image (rgb8, mono8, 32FC1, 16UC1) as a NumPy array."""
+    kinds = {"rgb8": ("u1", 3), "mono8": ("u1", 1), "32FC1": ("<f4", 1), "16UC1": ("<u2", 1)}
+    if msg.encoding not in kinds:
+        raise RunFolderError(f"image encoding {msg.encoding!r} not read (known: {list(kinds)})")
+    dtype, channels = kinds[msg.encoding]
+    width = msg.width * channels
+    rows = np.frombuffer(bytes(msg.data), dtype=np.uint8).reshape(msg.height, msg.step)
+    pixels = rows[:, : width * np.dtype(dtype).itemsize].copy().view(dtype)
+    return pixels.reshape(msg.height, msg.width, channels) if channels > 1 else pixels
+
+
+def from_json(cls: type[M], record: dict[str, Any]) -> M:
+    """A message from the recorder's JSON (json_schemas.py): null floats are NaN, arrays
+    `{dtype, shape, data}` in base64."""
+    values = {f.name: _value(f, record.get(f.name)) for f in fields_of(cls) if f.name in record}
+    try:
+        return cls(**values)
+    except TypeError as exc:
+        raise RunFolderError(f"a recorded {cls.__name__} lacks fields: {exc}") from None
+
+
+def _value(spec: FieldSpec, value: Any) -> Any:
+    if spec.kind == "array":
+        data = base64.b64decode(value["data"])
+        return np.frombuffer(data, dtype=np.dtype(value["dtype"])).reshape(value["shape"])
+    if spec.kind == "vector":
+        return tuple(np.nan if v is None else float(v) for v in value)
+    if spec.kind == "names":
+        return tuple(value)
+    if spec.kind == "float":
+        return np.nan if value is None else float(value)
+    return value

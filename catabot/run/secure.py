@@ -1,0 +1,178 @@
+"""`catabot secure init DIR`: the secure profile's files, for one router and every process.
+
+On an open Zenoh network anyone may publish anything; CataBot's own checks (catabot/bus/
+identity.py) catch clients that state who they are, not one that lies. The secure profile
+closes that: every process is a client of one router over TLS, logs in with its own user
+and password, and the router's access control lets each name publish only its own keys:
+
+| who | may publish (under catabot/<world>/) |
+|---|---|
+| conductor | clock/tick, clock/end |
+| physics, sensors, traffic, recorder | their own lockstep streams, acks and liveliness token |
+| a lockstep client (`--client`) | vessel/*/cmd/**, its own ack and token |
+| an observer (`--observer`; always `viewer`, for `--view`) | nothing: it subscribes only |
+
+Everyone may subscribe. The files: a test certificate authority and the router's
+certificate (openssl), `users.txt`, `router.json5`, and one `<name>.json5` per process and
+client (`catabot run --secure DIR`, `--zenoh-config DIR/<name>.json5` for a client).
+"""
+
+from __future__ import annotations
+
+import json
+import secrets
+import shutil
+import subprocess
+from pathlib import Path
+from typing import Any
+
+from catabot.bus.clock import CONDUCTOR
+from catabot.bus.keys import check_name
+from catabot.bus.session import LEASE_MS
+from catabot.errors import CataBotError
+
+OWN = {  # keys each process may put besides its ack and its liveliness token
+    CONDUCTOR: ["clock/tick", "clock/end"],
+    "physics": ["world/states", "vessel/*/state"],
+    "sensors": ["sensor/**"],
+    "traffic": ["world/cmd/twist"],
+    "recorder": [],
+}
+COMMANDS = ["vessel/*/cmd/**"]
+READ = ["declare_subscriber", "declare_liveliness_subscriber", "liveliness_query", "query"]
+
+
+class SecureError(CataBotError, RuntimeError):
+    """The secure profile's files could not be made."""
+
+
+def init(
+    folder: Path, *, clients: list[str], observers: list[str], host: str = "localhost",
+    port: int = 7447,
+) -> list[Path]:  # fmt: skip
+    """Every file of the profile in `folder`; the paths written."""
+    observers = [*observers, *(["viewer"] if "viewer" not in observers else [])]  # --view
+    names = [*OWN, *(check_name("client", c) for c in clients),
+             *(check_name("observer", o) for o in observers)]  # fmt: skip
+    if len(set(names)) != len(names):
+        raise SecureError(f"names must differ from each other and from {', '.join(OWN)}")
+    folder = folder.resolve()  # the config files name the certificates from anywhere
+    folder.mkdir(parents=True, exist_ok=True)
+    _certificates(folder, host)
+    users = {name: secrets.token_urlsafe(18) for name in ["router", *names]}
+    (folder / "users.txt").write_text("".join(f"{u}:{p}\n" for u, p in users.items()))
+    (folder / "users.txt").chmod(0o600)
+    endpoint = f"tls/{host}:{port}"
+    written = [folder / "users.txt", _write(folder / "router.json5", _router(folder, endpoint,
+               users, clients, observers))]  # fmt: skip
+    for name in names:
+        written.append(_write(folder / f"{name}.json5", _session(folder, endpoint, name, users)))
+    return written
+
+
+def _certificates(folder: Path, host: str) -> None:
+    """A test CA and the router's certificate (for a real deployment, your own PKI)."""
+    if shutil.which("openssl") is None:
+        raise SecureError("openssl is needed to make the test certificates (apt install openssl)")
+    ext = folder / "router.ext"
+    ext.write_text(f"subjectAltName=DNS:{host},DNS:localhost,IP:127.0.0.1\n")
+    steps = [
+        ["req", "-x509", "-newkey", "rsa:2048", "-nodes", "-keyout", "ca.key", "-out", "ca.pem",
+         "-days", "3650", "-subj", "/CN=catabot-test-ca"],
+        ["req", "-newkey", "rsa:2048", "-nodes", "-keyout", "router.key", "-out", "router.csr",
+         "-subj", f"/CN={host}"],
+        ["x509", "-req", "-in", "router.csr", "-CA", "ca.pem", "-CAkey", "ca.key",
+         "-CAcreateserial", "-out", "router.pem", "-days", "3650", "-extfile", "router.ext"],
+    ]  # fmt: skip
+    for step in steps:
+        done = subprocess.run(["openssl", *step], cwd=folder, capture_output=True, text=True)
+        if done.returncode != 0:
+            raise SecureError(f"openssl {step[0]}: {done.stderr.strip()[-300:]}")
+    for scratch in ("router.ext", "router.csr", "ca.srl"):
+        (folder / scratch).unlink(missing_ok=True)
+    for secret in ("ca.key", "router.key"):
+        (folder / secret).chmod(0o600)
+
+
+def _router(
+    folder: Path, endpoint: str, users: dict[str, str], clients: list[str], observers: list[str]
+) -> dict[str, Any]:
+    return {
+        "mode": "router",
+        "listen": {"endpoints": [endpoint]},
+        "scouting": {"multicast": {"enabled": False}},
+        "transport": {
+            "link": {
+                "tls": {
+                    "listen_private_key": str(folder / "router.key"),
+                    "listen_certificate": str(folder / "router.pem"),
+                },
+                "tx": {"lease": LEASE_MS, "keep_alive": 4},
+            },
+            "auth": {
+                "usrpwd": {
+                    "user": "router",
+                    "password": users["router"],
+                    "dictionary_file": str(folder / "users.txt"),
+                }
+            },
+        },
+        "access_control": _acl([*OWN, *clients], clients, observers),
+    }
+
+
+def _acl(writers: list[str], clients: list[str], observers: list[str]) -> dict[str, Any]:
+    """Default deny; everyone may subscribe and receive; each writer its own keys."""
+    everyone = [*writers, *observers]
+    rules: list[dict[str, Any]] = [
+        _rule("read", READ, ["ingress", "egress"], ["catabot/**"]),
+        _rule("receive", ["put", "delete", "liveliness_token"], ["egress"], ["catabot/**"]),
+    ]
+    policies = [{"rules": ["read", "receive"], "subjects": ["everyone"]}]
+    subjects = [{"id": "everyone", "usernames": everyone}]
+    for name in writers:
+        keys = [*OWN.get(name, COMMANDS if name in clients else []), f"clock/ack/{name}"]
+        rules.append(_rule(f"{name}-puts", ["put"], ["ingress"], [f"catabot/*/{k}" for k in keys]))
+        rules.append(_rule(f"{name}-token", ["liveliness_token"], ["ingress", "egress"],
+                           [f"catabot/*/live/{name}/*"]))  # fmt: skip
+        subjects.append({"id": name, "usernames": [name]})
+        policies.append({"rules": [f"{name}-puts", f"{name}-token"], "subjects": [name]})
+    return {"enabled": True, "default_permission": "deny", "rules": rules,
+            "subjects": subjects, "policies": policies}  # fmt: skip
+
+
+def _rule(rule_id: str, messages: list[str], flows: list[str], keys: list[str]) -> dict[str, Any]:
+    return {"id": rule_id, "permission": "allow", "messages": messages, "flows": flows,
+            "key_exprs": keys}  # fmt: skip
+
+
+def _session(folder: Path, endpoint: str, name: str, users: dict[str, str]) -> dict[str, Any]:
+    return {
+        "mode": "client",
+        "connect": {"endpoints": [endpoint]},
+        "scouting": {"multicast": {"enabled": False}},
+        "transport": {
+            "link": {
+                "tls": {"root_ca_certificate": str(folder / "ca.pem")},
+                "tx": {"lease": LEASE_MS, "keep_alive": 4},
+            },
+            "auth": {"usrpwd": {"user": name, "password": users[name]}},
+        },
+    }
+
+
+def _write(path: Path, config: dict[str, Any]) -> Path:
+    path.write_text(json.dumps(config, indent=2) + "\n")
+    path.chmod(0o600)  # it holds a password
+    return path
+
+
+def router_endpoint(folder: Path) -> str:
+    """The endpoint the profile's router listens on (what `catabot run --secure` connects to)."""
+    try:
+        config = json.loads((folder / "router.json5").read_text())
+        return str(config["listen"]["endpoints"][0])
+    except (OSError, ValueError, KeyError, IndexError) as exc:
+        raise SecureError(
+            f"{folder}: no secure profile here ({exc}); see catabot secure init"
+        ) from None

@@ -1,0 +1,230 @@
+"""Watching the processes of one run until all have ended, and saying truthfully how it ended.
+
+- Each process's stderr comes through `catabot run` into its log (`Child`): when the log
+  cannot be written (a full disk), its lines go to the console instead of being lost, and
+  a process's CRITICAL line (its own fatal fault: a disk full, a crash) is kept as a cause.
+- The conductor says it is alive every half second (`catabot/run/conduct.py`); silence for
+  `HANG_S` means it hangs (stopped, wedged): it is killed, and the run reported as such.
+- A participant the conductor reports as gone or late whose process still exists hangs: it
+  is killed at once (a stopped process ignores SIGTERM), and named as hung.
+- After a fault, services get `End` with the error and a second or two to flush; whatever
+  is left is killed, so `catabot run` returns within the deadline plus a couple of seconds.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import json
+import signal
+import subprocess
+import sys
+import threading
+import time
+from collections.abc import Iterator
+from pathlib import Path
+from typing import IO
+
+HANG_S = 3.0  # the conductor's heartbeat is every 0.5 s
+START_S = 60.0  # until its first line (Python's imports on a loaded machine take seconds)
+FAULT_REAP_S = 2.0  # after a fault: End carries the error, services drain for 1 s
+
+
+class Child:
+    """One process of the run, its stderr relayed into its log by a thread."""
+
+    def __init__(self, name: str, args: list[str], log_path: Path, *, stdout: bool) -> None:
+        self.name, self.log_path = name, log_path
+        self.proc = subprocess.Popen(
+            [sys.executable, "-m", *args],
+            stdout=subprocess.PIPE if stdout else subprocess.DEVNULL,
+            stderr=subprocess.PIPE,
+            text=True,
+            start_new_session=True,  # Ctrl-C reaches the launcher only; it ends the run cleanly
+        )
+        self.fatal = ""  # the first CRITICAL line: the process's own fatal fault
+        self.fatal_at = 0.0
+        self._relay = threading.Thread(target=self._copy_stderr, daemon=True)
+        self._relay.start()
+
+    def _copy_stderr(self) -> None:
+        assert self.proc.stderr is not None
+        log = _open(self.log_path)
+        for line in self.proc.stderr:
+            if " CRITICAL " in line and not self.fatal:
+                self.fatal, self.fatal_at = line.split(" CRITICAL ", 1)[1].strip(), time.monotonic()
+            log = _write(log, line, self)
+
+    def state(self) -> str:
+        """The Linux scheduler's state letter of the process ('T': stopped), or ''."""
+        with contextlib.suppress(OSError, IndexError):
+            return Path(f"/proc/{self.proc.pid}/stat").read_text().rsplit(")", 1)[1].split()[0]
+        return ""
+
+    def join(self) -> None:
+        self._relay.join(timeout=2.0)
+
+
+def _exits(proc: subprocess.Popen[str], *, within_s: float) -> bool:
+    try:
+        proc.wait(timeout=within_s)
+    except subprocess.TimeoutExpired:
+        return False
+    return True
+
+
+def _open(path: Path) -> IO[str] | None:
+    try:
+        return path.open("a", encoding="utf-8")
+    except OSError as exc:
+        print(f"catabot run: cannot write {path} ({exc.strerror}); its lines follow here",
+              file=sys.stderr)  # fmt: skip
+        return None
+
+
+def _write(log: IO[str] | None, line: str, child: Child) -> IO[str] | None:
+    """Into the log while it can be written, else to the console (named)."""
+    if log is not None:
+        try:
+            log.write(line)
+            log.flush()
+            return log
+        except OSError as exc:
+            print(f"catabot run: {child.log_path}: {exc.strerror}; {child.name}'s lines follow "
+                  "here", file=sys.stderr)  # fmt: skip
+    sys.stderr.write(f"[{child.name}] {line}")
+    return None
+
+
+class Stops:
+    """Ctrl-C, SIGTERM and SIGHUP all end the run cleanly through the conductor (a launcher
+    killed by its shell or a process manager must leave no orphans ticking). A request is
+    held until the conductor says it is ready: a signal before its handlers are set would
+    kill it outright."""
+
+    def __init__(self) -> None:
+        self.requested = False
+        self.ready = threading.Event()
+        self.conductor: subprocess.Popen[str] | None = None
+
+    @contextlib.contextmanager
+    def installed(self) -> Iterator[None]:
+        signals = (signal.SIGINT, signal.SIGTERM, signal.SIGHUP)
+        previous = {sig: signal.signal(sig, self._on_signal) for sig in signals}
+        try:
+            yield
+        finally:
+            for sig, handler in previous.items():
+                signal.signal(sig, handler)
+
+    def _on_signal(self, *_: object) -> None:
+        self.requested = True
+        self.forward()
+
+    def forward(self) -> None:
+        """Pass a held request to the conductor once it takes signals."""
+        if self.requested and self.ready.is_set() and self.conductor is not None:
+            self.conductor.send_signal(signal.SIGINT)
+
+
+class Supervisor:
+    """Follows the conductor's lines, watches every process, ends hung ones, finds the cause."""
+
+    def __init__(self, conductor: Child, services: dict[str, Child], stops: Stops) -> None:
+        self.conductor, self.services, self.stops = conductor, services, stops
+        self.result: dict[str, object] = {}
+        self.progress: dict[str, object] = {}
+        self.stopped: set[str] = set()  # services stopped before they joined an interrupted run
+        self.hung: list[str] = []  # processes found hung and killed
+        self._started = time.monotonic()
+        self._heard: float | None = None  # when the conductor last said anything
+
+    def wait(self, on_progress: object = None) -> None:
+        """Until every process has ended (`on_progress(event)` for the progress lines)."""
+        reader = threading.Thread(target=self._follow, args=(on_progress,), daemon=True)
+        reader.start()
+        asked_to_stop = False
+        while reader.is_alive():
+            reader.join(timeout=0.1)
+            died = [n for n, c in self.services.items() if c.proc.poll() not in (None, 0)]
+            if died and not asked_to_stop and self.conductor.proc.poll() is None:
+                self.conductor.proc.send_signal(signal.SIGTERM)
+                asked_to_stop = True
+            silent = self._silent()
+            if silent and self.conductor.proc.poll() is None:
+                self._kill(self.conductor, f"the conductor hung (nothing from it for {silent:g} s)")
+        self.conductor.proc.wait()
+        self._kill_hung_participants()
+        self._reap()
+        for child in (self.conductor, *self.services.values()):
+            child.join()
+
+    def _silent(self) -> float:
+        """How long the conductor has been silent, once that means it hangs (else 0)."""
+        now = time.monotonic()
+        if self._heard is None:
+            return START_S if now - self._started > START_S else 0.0
+        return HANG_S if now - self._heard > HANG_S else 0.0
+
+    def _follow(self, on_progress: object) -> None:
+        assert self.conductor.proc.stdout is not None
+        for line in self.conductor.proc.stdout:
+            self._heard = time.monotonic()
+            try:
+                event = json.loads(line)
+            except json.JSONDecodeError:
+                continue
+            kind = event.get("kind")
+            if kind == "ready":
+                self.stops.ready.set()
+                self.stops.forward()
+            elif kind == "progress" and callable(on_progress):
+                on_progress(event)
+            elif kind == "result":
+                self.result = event
+
+    def _kill(self, child: Child, why: str) -> None:
+        child.proc.kill()  # SIGKILL: a stopped process does not take SIGTERM
+        self.hung.append(why)
+
+    def _kill_hung_participants(self) -> None:
+        """Participants the conductor reports as gone or late, whose process still exists a
+        second later (one that is only closing its session is not hung)."""
+        error = str(self.result.get("error", ""))
+        for name, child in self.services.items():
+            if f"participant {name!r}" in error and not _exits(child.proc, within_s=1.0):
+                state = {"T": "stopped by a signal", "t": "stopped by a debugger"}.get(
+                    child.state(), "alive but not stepping"
+                )
+                self._kill(child, f"participant {name!r} hung ({state}): {error}")
+
+    def _reap(self) -> None:
+        """Services end by themselves after the conductor's End (15 s allows the recorder's
+        last flush of a clean end; a second or two after a fault); one still starting when an
+        interrupted run ended never heard the End: stopped at once, and not blamed."""
+        ticks = int(self.result.get("ticks_done", 0))  # type: ignore[call-overload]
+        unjoined = self.result.get("reason") == "interrupted" and ticks == 0
+        faulted = bool(self.result.get("error")) or bool(self.hung) or not self.result
+        timeout = 1.0 if unjoined else FAULT_REAP_S if faulted else 15.0
+        limit = time.monotonic() + timeout
+        for name, child in self.services.items():
+            try:
+                child.proc.wait(timeout=max(limit - time.monotonic(), 0.1))
+            except subprocess.TimeoutExpired:
+                if unjoined:
+                    self.stopped.add(name)
+                child.proc.terminate()
+                try:
+                    child.proc.wait(timeout=1.0)
+                except subprocess.TimeoutExpired:
+                    child.proc.kill()
+                    child.proc.wait()
+
+    def cause(self) -> str:
+        """The first fault: a process's own fatal error, a hung process, else the conductor's."""
+        fatal = [c for c in (self.conductor, *self.services.values()) if c.fatal]
+        if fatal:
+            first = min(fatal, key=lambda c: c.fatal_at)
+            return f"{first.name}: {first.fatal}"
+        if self.hung:
+            return self.hung[0]
+        return str(self.result.get("error", "") or "")

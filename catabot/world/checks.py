@@ -1,0 +1,83 @@
+"""What each stream of a world may carry, checked where a sample arrives (`Stream.check`).
+
+The codec has already checked every field's type; these check what only the world knows
+(which bodies, how many thrusters) and values the services cannot use (a NaN command, a
+path with an odd number of coordinates). A sample that fails is refused and counted by the
+receiving participant (catabot/bus/inbox.py), so no step ever sees it.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from typing import Any
+
+import numpy as np
+
+from catabot.bus.codec import finite
+from catabot.bus.messages import (
+    BodyStates,
+    ThrustCmd,
+    TwistBatch,
+    TwistCmd,
+    WaypointsCmd,
+    check_ids,
+)
+
+Check = Callable[[Any], None]
+PATH_MODES = ("loop", "back_and_forth", "release")
+
+
+def body_states(ids: tuple[str, ...]) -> Check:
+    """Every body of the world, in its rows, with arrays of the right shapes."""
+
+    def check(msg: BodyStates) -> None:
+        check_ids("world/states", msg.tick, msg.ids, ids)
+        n = len(ids)
+        for name, width in (("position", 3), ("orientation", 4), ("linear_velocity", 3)):
+            value = getattr(msg, name)
+            if value.shape != (n, width) or value.dtype != np.float64:
+                raise ValueError(
+                    f"{name} is {value.dtype} {value.shape}, not float64 ({n}, {width})"
+                )
+        for value in msg.arrays()[3:]:
+            if value.shape != (n, 3):
+                raise ValueError(f"a velocity or acceleration array is {value.shape}, not ({n}, 3)")
+
+    return check
+
+
+def twist_batch(boats: tuple[str, ...]) -> Check:
+    def check(msg: TwistBatch) -> None:
+        msg.check(boats)
+
+    return check
+
+
+def thrust(thrusters: int) -> Check:
+    """One finite value per thruster (values beyond -1..1 are clamped by physics)."""
+
+    def check(msg: ThrustCmd) -> None:
+        if len(msg.thrust) != thrusters:
+            raise ValueError(f"{len(msg.thrust)} values for {thrusters} thrusters")
+        if not finite(msg.thrust):
+            raise ValueError(f"a thrust value is not finite: {msg.thrust}")
+
+    return check
+
+
+def twist(msg: TwistCmd) -> None:
+    if not finite((msg.surge, msg.yaw_rate)):
+        raise ValueError(f"surge {msg.surge} m/s, yaw rate {msg.yaw_rate} rad/s: not finite")
+
+
+def waypoints(msg: WaypointsCmd) -> None:
+    """A release, or a path of finite points x0, y0, x1, y1, ... with speed and tolerance > 0."""
+    if msg.mode not in PATH_MODES:
+        raise ValueError(f"mode {msg.mode!r} is not one of {PATH_MODES}")
+    if msg.mode == "release":
+        return
+    pts = msg.points
+    if len(pts) < 2 or len(pts) % 2 or not finite(pts):
+        raise ValueError("points: need x0, y0, x1, ...: an even number of finite values")
+    if not (finite((msg.speed, msg.tolerance)) and msg.speed > 0 and msg.tolerance > 0):
+        raise ValueError(f"speed {msg.speed} and tolerance {msg.tolerance} must be > 0")

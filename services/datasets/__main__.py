@@ -1,0 +1,5 @@
+import sys
+
+from services.datasets.cli import main
+
+sys.exit(main())

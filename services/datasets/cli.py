@@ -1,0 +1,77 @@
+"""`catabot dataset export RUN_FOLDER --format yolo|coco|kitti -o OUT_DIR`.
+
+Converts a recorded run after the fact: camera datasets from the run's `dataset/` (labelled
+frames), LiDAR scans from its `run.mcap`. `catabot run` calls the same program when the
+scenario asks for `recording.export`. Exit codes: 0 written, 2 refused (no such run folder,
+no camera or LiDAR, an OUT_DIR that is not empty, a bad option), with one line saying why.
+"""
+
+from __future__ import annotations
+
+import argparse
+import sys
+from collections.abc import Callable
+from pathlib import Path
+
+from catabot.errors import CataBotError
+from catabot.run.recorded import RecordedRun
+from services.datasets import coco, kitti, yolo
+
+FORMATS: dict[str, Callable[..., str]] = {
+    "yolo": yolo.export,
+    "coco": coco.export,
+    "kitti": kitti.export,
+}
+
+
+def parser() -> argparse.ArgumentParser:
+    p = argparse.ArgumentParser(prog="catabot dataset", description=__doc__.split("\n")[0])
+    sub = p.add_subparsers(dest="action", required=True)
+    exp = sub.add_parser("export", help="convert a recorded run into a training dataset")
+    exp.add_argument("run", help="the run folder (runs/<world>-<time>)")
+    exp.add_argument("--format", "-f", required=True, choices=list(FORMATS))
+    exp.add_argument("--output", "-o", required=True, help="folder to write (new or empty)")
+    exp.add_argument(
+        "--val-fraction", type=float, default=0.2, help="share of validation (default 0.2)"
+    )
+    exp.add_argument(
+        "--split-block-s", type=float, default=None,
+        help="simulated seconds that go to train or val together (default: 10, or a tenth "
+        "of the run if shorter)",
+    )  # fmt: skip
+    return p
+
+
+def _check(args: argparse.Namespace, p: argparse.ArgumentParser) -> Path:
+    if not 0.0 <= args.val_fraction <= 1.0:
+        p.error(f"--val-fraction must be in [0, 1] (got {args.val_fraction})")
+    if args.split_block_s is not None and not args.split_block_s > 0:
+        p.error(f"--split-block-s must be > 0 (got {args.split_block_s})")
+    out = Path(args.output)
+    if out.exists() and (not out.is_dir() or any(out.iterdir())):
+        p.error(f"--output {out} exists and is not an empty folder")
+    return out
+
+
+def main(argv: list[str] | None = None) -> int:
+    p = parser()
+    args = p.parse_args(argv)
+    out = _check(args, p)
+    try:
+        run = RecordedRun(args.run)
+        out.mkdir(parents=True, exist_ok=True)
+        summary = FORMATS[args.format](
+            run, out, val_fraction=args.val_fraction, block_s=args.split_block_s
+        )
+    except CataBotError as exc:
+        print(f"catabot dataset export: {exc}", file=sys.stderr)
+        return 2
+    except OSError as exc:
+        print(f"catabot dataset export: {exc.filename or out}: {exc.strerror}", file=sys.stderr)
+        return 2
+    print(f"{args.format} dataset in {out}: {summary}")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,43 @@
+"""The train/val split of an exported dataset: seeded, so one run always splits the same way.
+
+Neighbouring frames of one camera are near-duplicates, so frames are split in blocks of
+simulated time, not one by one: a frame-by-frame split would put almost the same picture in
+both sets and make the validation score meaningless. A block is `block_s` long (default: 10 s,
+or a tenth of the frames' time span if that is shorter, so a short run still gives both
+sets). Each block draws u from its own generator, `seeding.rng(seed, "dataset/split/<block>")`
+(DESIGN.md §2), and goes to val when u < `val_fraction`; with two blocks or more neither set
+stays empty (the block with the smallest u goes to val, the largest to train).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+
+from catabot.world import seeding
+
+DEFAULT_BLOCK_S = 10.0
+
+
+def block_ns(stamps_ns: Sequence[int], block_s: float | None) -> int:
+    """The block length: as given, else 10 s or a tenth of the span, whichever is shorter."""
+    if block_s is not None:
+        return max(1, round(block_s * 1e9))
+    span = max(stamps_ns, default=0) - min(stamps_ns, default=0)
+    return max(1, min(round(DEFAULT_BLOCK_S * 1e9), span // 10))
+
+
+def split(
+    stamps_ns: Sequence[int], *, seed: int, val_fraction: float, block_s: float | None = None
+) -> list[str]:
+    """ "train" or "val" for each frame stamp."""
+    length = block_ns(stamps_ns, block_s)
+    blocks = [int(s // length) for s in stamps_ns]
+    draws = {b: float(seeding.rng(seed, f"dataset/split/{b}").random()) for b in set(blocks)}
+    val = {b for b, u in draws.items() if u < val_fraction}
+    if len(draws) >= 2:
+        ordered = sorted(draws, key=lambda b: (draws[b], b))
+        if not val and val_fraction > 0:
+            val = {ordered[0]}
+        if val == set(draws) and val_fraction < 1:
+            val.discard(ordered[-1])
+    return ["val" if b in val else "train" for b in blocks]

@@ -1,0 +1,5 @@
+import sys
+
+from services.plots.cli import main
+
+sys.exit(main())

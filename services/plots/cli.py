@@ -1,0 +1,59 @@
+"""`catabot plot RUN_FOLDER [-o OUT_DIR]`: PNG figures and `report.html` of a recorded run.
+
+Trajectories over the terrain with the traffic and buoys, speed and heading, thrust and
+twist commands, IMU series, LiDAR returns and rain returns against the rain rate, and the
+navigation metrics; written to OUT_DIR (default RUN_FOLDER/plots). Exit codes: 0 written,
+2 refused (no such run folder, no run.mcap), with one line saying why.
+"""
+
+from __future__ import annotations
+
+import argparse
+import sys
+from pathlib import Path
+
+from catabot.errors import CataBotError
+from catabot.run.recorded import RecordedRun
+from services.plots import report, series
+from services.plots.figures import FIGURES
+
+PNG = {"Software": None}  # no version string: the same run gives the same bytes
+
+
+def parser() -> argparse.ArgumentParser:
+    p = argparse.ArgumentParser(prog="catabot plot", description=__doc__.split("\n")[0])
+    p.add_argument("run", help="the run folder (runs/<world>-<time>)")
+    p.add_argument("--output", "-o", help="folder for the PNGs and report.html")
+    return p
+
+
+def plot(run_folder: str, out: Path | None) -> Path:
+    data = series.read(RecordedRun(run_folder))
+    out = out or data.run.folder / "plots"
+    out.mkdir(parents=True, exist_ok=True)
+    written: dict[str, str | None] = {}
+    for name, draw in FIGURES.items():
+        fig = draw(data)
+        written[name] = None if fig is None else f"{name}.png"
+        if fig is not None:
+            fig.savefig(out / f"{name}.png", metadata=PNG)
+    report.write(out / "report.html", data, written)
+    return out
+
+
+def main(argv: list[str] | None = None) -> int:
+    args = parser().parse_args(argv)
+    try:
+        out = plot(args.run, Path(args.output) if args.output else None)
+    except CataBotError as exc:
+        print(f"catabot plot: {exc}", file=sys.stderr)
+        return 2
+    except OSError as exc:
+        print(f"catabot plot: {exc.filename or ''}: {exc.strerror}", file=sys.stderr)
+        return 2
+    print(f"plots and report.html in {out}")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

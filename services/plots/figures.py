@@ -1,0 +1,213 @@
+"""The figures of `catabot plot`, one function each, drawn with matplotlib's object API.
+
+`Figure` objects with the Agg canvas, never pyplot: no global state, no display needed, and
+a figure is garbage when its function returns. Each function returns None when the run has
+nothing for it (no IMU, no thrust command), and the report says so.
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+import numpy as np
+from matplotlib.axes import Axes
+from matplotlib.colors import LinearSegmentedColormap, TwoSlopeNorm
+from matplotlib.figure import Figure
+
+from services.plots.series import RunSeries
+
+SEA = ["#0a1e5a", "#2870be", "#96d2e6"]
+LAND = ["#468c46", "#96a050", "#8c6e46", "#c8c8c8"]
+OWN_COLORS = ["#ff8c00", "#d62728", "#9467bd", "#8c564b", "#e377c2", "#17becf"]
+MARGIN_M = 40.0
+
+
+def _figure(rows: int = 1, cols: int = 1, *, size: tuple[float, float] = (10, 4)) -> Figure:
+    fig = Figure(figsize=size, dpi=110, layout="constrained")
+    fig.subplots(rows, cols, squeeze=False)
+    return fig
+
+
+def _axes(fig: Figure) -> list[Axes]:
+    return list(fig.axes)
+
+
+def _color(k: int) -> str:
+    return OWN_COLORS[k % len(OWN_COLORS)]
+
+
+def trajectories(data: RunSeries) -> Figure:
+    """Every vessel's track over the terrain (cropped to the tracks), buoys, starts and ends."""
+    world, pos = data.run.world, data.states.position
+    vessels = len(world.vessels)
+    xy = pos[:, :, :2]
+    lo, hi = np.nanmin(xy.reshape(-1, 2), axis=0) - MARGIN_M, np.nanmax(xy.reshape(-1, 2), axis=0)
+    hi = hi + MARGIN_M
+    fig = _figure(size=(8.5, 8))
+    ax = _axes(fig)[0]
+    _terrain(ax, data, lo, hi)
+    own = {world.body(v).row for v in data.own}
+    for row in range(len(world.scenario.vessels), vessels):
+        ax.plot(xy[:, row, 0], xy[:, row, 1], color="white", lw=0.8, alpha=0.8)
+    if vessels > len(own):
+        ax.plot([], [], color="white", lw=0.8, label=f"traffic ({vessels - len(own)} boats)")
+    for k, vid in enumerate(data.own):
+        row = world.body(vid).row
+        ax.plot(xy[:, row, 0], xy[:, row, 1], color=_color(k), lw=2.2, label=vid)
+        ax.plot(*xy[0, row], "o", color=_color(k), ms=7, mec="black")
+        ax.plot(*xy[-1, row], "s", color=_color(k), ms=7, mec="black")
+    if world.buoys:
+        b = xy[-1, vessels:]
+        ax.scatter(b[:, 0], b[:, 1], s=14, c="#fac81e", edgecolors="black", lw=0.4,
+                   label=f"buoys ({len(b)})", zorder=3)  # fmt: skip
+    ax.set(xlim=(lo[0], hi[0]), ylim=(lo[1], hi[1]), xlabel="east x [m]", ylabel="north y [m]",
+           title=f"Trajectories, {data.t[-1]:.1f} s (o start, ■ end)", aspect="equal")  # fmt: skip
+    ax.legend(loc="upper right", fontsize=8, framealpha=0.9, facecolor="#9fb0c0")  # white shows
+    return fig
+
+
+def _terrain(ax: Axes, data: RunSeries, lo: Any, hi: Any) -> None:
+    terrain = data.run.world.terrain
+    if terrain is None:
+        ax.set_facecolor(SEA[1])
+        return
+    z = terrain.elevation_m
+    w, h = terrain.size_m
+    norm = TwoSlopeNorm(vcenter=0.0, vmin=min(float(z.min()), -1.0), vmax=max(float(z.max()), 1.0))
+    cmap = LinearSegmentedColormap.from_list(
+        "sea_land", [(0.0, SEA[0]), (0.25, SEA[1]), (0.4999, SEA[2]), (0.5, LAND[0]),
+                     (0.7, LAND[1]), (0.85, LAND[2]), (1.0, LAND[3])])  # fmt: skip
+    image = ax.imshow(z, origin="lower", extent=(0, w, 0, h), cmap=cmap, norm=norm)
+    ax.contour(np.linspace(0, w, z.shape[1]), np.linspace(0, h, z.shape[0]), z, levels=[0.0],
+               colors="black", linewidths=0.6)  # fmt: skip
+    ax.figure.colorbar(image, ax=ax, shrink=0.7, label="elevation [m]")
+
+
+def speed_heading(data: RunSeries) -> Figure | None:
+    if not data.own:
+        return None
+    fig = _figure(2, 1, size=(10, 6))
+    speed, heading = _axes(fig)
+    for k, vid in enumerate(data.own):
+        speed.plot(data.t, data.speed[vid], color=_color(k), label=vid)
+        heading.plot(data.t, data.heading[vid], ".", ms=2, color=_color(k), label=vid)
+    speed.set(ylabel="speed over ground [m/s]", title="Speed and heading")
+    heading.set(ylabel="heading [deg from north]", xlabel="simulated time [s]", ylim=(0, 360),
+                yticks=range(0, 361, 90))  # fmt: skip
+    for ax in (speed, heading):
+        ax.grid(alpha=0.3)
+        ax.legend(fontsize=8)
+    return fig
+
+
+def thrust(data: RunSeries) -> Figure | None:
+    owners = [v for v in data.own if v in data.thrust or v in data.setpoint]
+    if not owners:
+        return None
+    fig = _figure(len(owners), 1, size=(10, 2.8 * len(owners)))
+    end = float(data.t[-1])
+    for ax, vid in zip(_axes(fig), owners, strict=True):
+        for series, style in ((data.thrust.get(vid), "-"), (data.setpoint.get(vid), "--")):
+            if series is None:
+                continue
+            t = np.append(series.t, end)  # hold the last command to the end of the run
+            for c, name in enumerate(series.names):
+                values = np.append(series.values[:, c], series.values[-1, c])
+                ax.step(t, values, style, where="post", label=name)
+        ax.set(title=f"{vid}: commands (solid: thrust, -1..1; dashed: twist set-points)",
+               xlabel="simulated time [s]", xlim=(0, end))  # fmt: skip
+        ax.grid(alpha=0.3)
+        ax.legend(fontsize=8, loc="best")
+    return fig
+
+
+def imu(data: RunSeries) -> Figure | None:
+    if not data.imu:
+        return None
+    fig = _figure(len(data.imu), 2, size=(11, 3.2 * len(data.imu)))
+    axes = _axes(fig)
+    for k, (owner, s) in enumerate(data.imu.items()):
+        acc, gyro = axes[2 * k], axes[2 * k + 1]
+        for c, axis in enumerate("xyz"):
+            acc.plot(s.t, s.values[:, c], lw=0.7, label=axis)
+            gyro.plot(s.t, s.values[:, 3 + c], lw=0.7, label=axis)
+        acc.set(title=f"{owner}: specific force", ylabel="[m/s²]", xlabel="simulated time [s]")
+        gyro.set(title=f"{owner}: angular rate", ylabel="[rad/s]", xlabel="simulated time [s]")
+        for ax in (acc, gyro):
+            ax.grid(alpha=0.3)
+            ax.legend(fontsize=8, ncol=3)
+    return fig
+
+
+def lidar_rain(data: RunSeries) -> Figure | None:
+    """Returns and rain returns per scan over time beside the rain rate, and the rain share."""
+    if not data.lidar:
+        return None
+    rate = data.run.world.scenario.rain.rate_mm_h
+    fig = _figure(1, 2, size=(11, 4))
+    counts, share = _axes(fig)
+    for k, (owner, s) in enumerate(data.lidar.items()):
+        counts.plot(s.t, s.values[:, 0], color=_color(k), label=f"{owner}: returns")
+        counts.plot(s.t, s.values[:, 1], "--", color=_color(k), label=f"{owner}: rain returns")
+        fraction = s.values[:, 1] / np.maximum(s.values[:, 0], 1)
+        share.plot(np.full(len(s.t), rate), 100 * fraction, "o", alpha=0.5, color=_color(k),
+                   label=f"{owner} ({len(s.t)} scans)")  # fmt: skip
+    counts.set(title="LiDAR returns per scan", xlabel="simulated time [s]", ylabel="points")
+    counts.set_ylim(0, counts.get_ylim()[1] * 1.3)  # room for the legend above the lines
+    rain = counts.twinx()
+    t_end = max(float(s.t[-1]) for s in data.lidar.values())
+    rain.plot([0, t_end], [rate, rate], color="magenta", lw=1.2, label="rain rate [mm/h]")
+    rain.set(ylabel="rain rate [mm/h]", ylim=(0, max(50.0, rate * 1.1)))
+    lines = counts.get_legend_handles_labels()
+    more = rain.get_legend_handles_labels()
+    counts.legend(lines[0] + more[0], lines[1] + more[1], fontsize=8, loc="upper right", ncol=2)
+    share.set(title="Rain returns against rain rate", xlabel="rain rate [mm/h]",
+              ylabel="rain returns [% of returns]", xlim=(-2, 52))  # fmt: skip
+    share.set_ylim(0, max(1.0, share.get_ylim()[1] * 1.2))
+    share.legend(fontsize=8, loc="upper left")
+    for ax in (counts, share):
+        ax.grid(alpha=0.3)
+    return fig
+
+
+def metrics(data: RunSeries) -> Figure | None:
+    """Closest approach between any two vessels over time; distance and top speed by vessel."""
+    fig = _figure(1, 2, size=(11, 4))
+    gap, bars = _axes(fig)
+    finite = np.isfinite(data.closest)
+    if finite.any():
+        gap.plot(data.t, data.closest, color="#1f77b4")
+        k = int(np.nanargmin(np.where(finite, data.closest, np.nan)))
+        gap.plot(data.t[k], data.closest[k], "v", color="red",
+                 label=f"minimum {data.closest[k]:.2f} m at {data.t[k]:.1f} s")  # fmt: skip
+        gap.legend(fontsize=8)
+    gap.set(title="Closest approach between two vessels", xlabel="simulated time [s]",
+            ylabel="distance [m]")  # fmt: skip
+    gap.grid(alpha=0.3)
+    vessels = (data.metrics or {}).get("vessels", {})
+    shown = [v for v in data.own if v in vessels]
+    if not shown:
+        return fig
+    x = np.arange(len(shown))
+    dist = [vessels[v]["distance_m"] for v in shown]
+    top = [vessels[v]["max_speed_mps"] for v in shown]
+    bars.bar(x - 0.2, dist, 0.4, color="#ff8c00", label="distance [m]")
+    speed = bars.twinx()
+    speed.bar(x + 0.2, top, 0.4, color="#2ca02c", label="top speed [m/s]")
+    bars.set(xticks=x, xticklabels=shown, ylabel="distance travelled [m]",
+             title="Navigation metrics (metrics.json)", ylim=(0, max(dist) * 1.3 or 1))  # fmt: skip
+    speed.set(ylabel="top speed [m/s]", ylim=(0, max(top) * 1.3 or 1))
+    handles = [bars.get_legend_handles_labels()[0][0], speed.get_legend_handles_labels()[0][0]]
+    bars.legend(handles, ["distance [m]", "top speed [m/s]"], loc="upper center", ncol=2,
+                fontsize=8)  # fmt: skip
+    return fig
+
+
+FIGURES = {
+    "trajectories": trajectories,
+    "speed_heading": speed_heading,
+    "thrust": thrust,
+    "imu": imu,
+    "lidar_rain": lidar_rain,
+    "metrics": metrics,
+}

@@ -1,0 +1,5 @@
+import sys
+
+from services.viewer.cli import main
+
+sys.exit(main())

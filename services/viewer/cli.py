@@ -1,0 +1,135 @@
+"""`catabot view`: a recorded run or a running simulation in the rerun viewer.
+
+    catabot view RUN_FOLDER                    replay run.mcap into the native viewer
+    catabot view RUN_FOLDER --web              ... into the web viewer (prints its address)
+    catabot view RUN_FOLDER --save out.rrd     ... into a file (what `recording.rerun` does)
+    catabot view --connect ENDPOINT [SOURCE]   attach to a running simulation; SOURCE is its
+                                               run folder or scenario (default: the default)
+
+`catabot run --view [web]` starts the live form beside the run. The web viewer is served
+until Ctrl-C (a browser that opens it late still gets everything logged so far). Exit codes:
+0 done, 2 refused (no such run folder, no run.mcap, a bad scenario), with one line saying why.
+"""
+
+from __future__ import annotations
+
+import argparse
+import logging
+import signal
+import sys
+import time
+from pathlib import Path
+
+import rerun as rr
+
+from catabot.bus.session import SessionError, add_connection_args, connection_from_args
+from catabot.bus.session import open_session as open_zenoh
+from catabot.config.load import load_scenario
+from catabot.errors import CataBotError
+from catabot.run.recorded import RecordedRun
+from catabot.world.world import World
+from services.viewer.blueprint import blueprint
+from services.viewer.live import LiveView
+from services.viewer.replay import replay
+
+log = logging.getLogger("viewer")
+
+
+def parser() -> argparse.ArgumentParser:
+    p = argparse.ArgumentParser(prog="catabot view", description=__doc__.split("\n")[0])
+    p.add_argument("source", nargs="?", help="run folder, or (with --connect) a scenario")
+    add_connection_args(p)
+    p.add_argument("--web", action="store_true", help="serve the web viewer, do not spawn one")
+    p.add_argument("--web-port", type=int, default=0, help="web viewer port (default: free)")
+    p.add_argument("--grpc-port", type=int, default=0, help="data port (default: free)")
+    p.add_argument("--save", metavar="FILE", help="write an .rrd file instead of showing it")
+    p.add_argument("--no-hold", action="store_true", help="web: stop serving when done")
+    p.add_argument("--ready-file", type=Path, help=argparse.SUPPRESS)  # for catabot run
+    return p
+
+
+def recording(world: World, args: argparse.Namespace, *, live: bool) -> rr.RecordingStream:
+    """A recording on `sim_time` only (no wall-clock timelines), sent where `args` say."""
+    rec = rr.RecordingStream("catabot", recording_id=world.scenario.name, send_properties=False)
+    rec.set_log_time_enabled(False)
+    rec.set_log_tick_enabled(False)
+    layout = blueprint(world, live=live)
+    if args.save:
+        rec.save(args.save, default_blueprint=layout)
+    elif args.web:
+        grpc = rec.serve_grpc(grpc_port=args.grpc_port or None, default_blueprint=layout)
+        rr.serve_web_viewer(web_port=args.web_port or None, open_browser=False, connect_to=grpc)
+        print(f"rerun web viewer: http://127.0.0.1:{args.web_port or 9090}/?url={grpc}", flush=True)
+    else:
+        rec.spawn(default_blueprint=layout)
+    return rec
+
+
+def _world(args: argparse.Namespace) -> World:
+    source = args.source
+    if source is not None and Path(source).is_dir():
+        source = str(Path(source) / "scenario.json")
+    return World.resolve(load_scenario(source))
+
+
+def _live(args: argparse.Namespace) -> rr.RecordingStream:
+    world = _world(args)
+    session = open_zenoh(connection_from_args(args))
+    try:
+        view = LiveView(session, world)  # subscribed before anything is logged
+        rec = recording(world, args, live=True)
+        if view.linked(session) and args.ready_file is not None:
+            args.ready_file.touch()  # catabot run starts its services now
+        run_dir = Path(args.source) if args.source and Path(args.source).is_dir() else None
+        end = view.run(rec, run_dir)
+        rec.flush()
+    finally:
+        session.close()
+    print(f"run ended: {end.reason}" if end else "stopped before the run ended", flush=True)
+    shown = ", ".join(f"{n} {what}" for what, n in sorted(view.shown.items()))
+    cpu = time.process_time()  # every thread of the viewer process, start-up included
+    print(f"shown: {shown or 'nothing'}; viewer CPU {cpu:.1f} s", flush=True)
+    return rec
+
+
+def _replay(args: argparse.Namespace) -> rr.RecordingStream:
+    run = RecordedRun(args.source)
+    rec = recording(run.world, args, live=False)
+    replay(run, rec)
+    rec.flush()
+    return rec
+
+
+def _serve(args: argparse.Namespace, rec: rr.RecordingStream) -> None:
+    """The web viewer lives in this process, its data in `rec`'s server (which closes with
+    `rec`): keep both up until Ctrl-C or SIGTERM."""
+    if not args.web or args.save or args.no_hold:
+        return
+    print("serving the web viewer until Ctrl-C", flush=True)
+    try:
+        while True:
+            time.sleep(3600)
+    except KeyboardInterrupt:
+        pass
+
+
+def main(argv: list[str] | None = None) -> int:
+    logging.basicConfig(level=logging.INFO, format="%(name)s %(levelname)s %(message)s")
+    args = parser().parse_args(argv)
+    signal.signal(signal.SIGTERM, lambda *_: sys.exit(0))  # the launcher's stop: flush, exit
+    if not args.connect and args.source is None:
+        parser().error("give a RUN_FOLDER to replay, or --connect ENDPOINT to attach to a run")
+    try:
+        rec = _live(args) if args.connect else _replay(args)
+    except (CataBotError, SessionError) as exc:
+        print(f"catabot view: {exc}", file=sys.stderr)
+        return 2
+    except OSError as exc:
+        print(f"catabot view: {exc.filename or ''} {exc.strerror}", file=sys.stderr)
+        return 2
+    _serve(args, rec)
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,138 @@
+"""What the viewer logs once, from the resolved World: terrain, body shapes, sensor mounts.
+
+Everything here is static (timeless) in rerun: the terrain mesh with its height colours,
+every body's hull box size and colour (their poses come per tick), each sensor's mount
+under its vessel (LiDAR and radar frames, each camera's pinhole in the ROS optical frame),
+the radar screens' range rings, the label classes' names and colours, and the scripted
+commands (known from the scenario before the run starts).
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import rerun as rr
+
+from catabot.config.sensors import CameraParams, LidarParams, RadarParams
+from catabot.world import rotations
+from catabot.world.terrain_grid import auto_resolution
+from catabot.world.world import Body, MountedSensor, World
+from services.viewer import palette, paths
+
+TERRAIN_TRIANGLES = 200_000  # a viewer mesh: enough to read the shore, light to send
+OPTICAL_TO_BODY = np.array([[0.0, 0.0, 1.0], [-1.0, 0.0, 0.0], [0.0, -1.0, 0.0]])
+"""ROS optical frame (z forward, x right, y down) into the camera's FLU frame (DESIGN.md §8)."""
+
+
+def log_static(rec: rr.RecordingStream, world: World) -> None:
+    rec.log(paths.WORLD, rr.ViewCoordinates.RIGHT_HAND_Z_UP, static=True)
+    rec.log(paths.WORLD, rr.AnnotationContext(palette.class_table()), static=True)
+    rec.log("minimap", rr.AnnotationContext(palette.class_table()), static=True)
+    _terrain(rec, world)
+    _bodies(rec, world)
+    for sensor in world.sensors:
+        _mount(rec, sensor)
+    for body in world.vessels[: len(world.scenario.vessels)]:
+        _script(rec, body)
+
+
+def _terrain(rec: rr.RecordingStream, world: World) -> None:
+    terrain = world.terrain
+    if terrain is None:
+        return
+    z = terrain.elevation_m
+    res = auto_resolution(z.shape, terrain.metres_per_pixel, TERRAIN_TRIANGLES)
+    vertices, triangles = terrain.mesh(res)
+    colors = palette.terrain_colors(vertices[:, 2], float(z.min()), float(z.max()))
+    mesh = rr.Mesh3D(vertex_positions=vertices, triangle_indices=triangles, vertex_colors=colors)
+    rec.log(paths.TERRAIN, mesh, static=True)
+
+
+def hull_boxes(bodies: tuple[Body, ...]) -> tuple[np.ndarray, np.ndarray]:
+    """(N, 3) box centres in each body's frame and (N, 3) half sizes."""
+    boxes = [b.model.hull_box() for b in bodies]
+    lo = np.array([b[0] for b in boxes]).reshape(-1, 3)
+    hi = np.array([b[1] for b in boxes]).reshape(-1, 3)
+    return (lo + hi) / 2, (hi - lo) / 2
+
+
+def body_colors(world: World) -> np.ndarray:
+    scenario = {v.id for v in world.scenario.vessels}
+    table = {"vessel": palette.EGO, "boat": palette.BOAT, "buoy": palette.BUOY}
+    return np.array(
+        [palette.EGO if b.id in scenario else table[b.kind] for b in world.bodies], np.uint8
+    ).reshape(-1, 3)
+
+
+def _bodies(rec: rr.RecordingStream, world: World) -> None:
+    _, half = hull_boxes(world.bodies)
+    boxes = rr.Boxes3D(
+        half_sizes=half,
+        colors=body_colors(world),
+        labels=list(world.body_ids),
+        show_labels=False,
+        fill_mode=rr.components.FillMode.Solid,
+    )
+    rec.log(paths.BODIES, boxes, static=True)
+
+
+def _mount(rec: rr.RecordingStream, sensor: MountedSensor) -> None:
+    path = paths.sensor(sensor.vessel, sensor.config.name)
+    params = sensor.params
+    if isinstance(params, LidarParams):
+        rot = rotations.rpy(0.0, params.mount_pitch_deg, params.mount_yaw_deg)
+        rec.log(path, rr.Transform3D(translation=params.mount_xyz, mat3x3=rot), static=True)
+    elif isinstance(params, RadarParams):
+        rec.log(path, rr.Transform3D(translation=(0, 0, params.antenna_height_m)), static=True)
+        rings = [_circle(params.range_m * k / 4) for k in (1, 2, 3, 4)]
+        r = params.range_m
+        cross = [np.array([(-r, 0.0), (r, 0.0)]), np.array([(0.0, -r), (0.0, r)])]
+        screen = rr.LineStrips2D([*rings, *cross], colors=[(30, 110, 40)], radii=0.004 * r)
+        minimap = paths.minimap(sensor.vessel, sensor.config.name)
+        rec.log(minimap + "/rings", screen, static=True)
+        north = rr.Points2D([(0, -1.04 * r)], labels=["N"], colors=[palette.RADAR], radii=0.01 * r)
+        rec.log(minimap + "/north", north, static=True)
+    elif isinstance(params, CameraParams):
+        rot = rotations.rpy(*params.mount_rpy_deg) @ OPTICAL_TO_BODY
+        rec.log(path, rr.Transform3D(translation=params.mount_xyz, mat3x3=rot), static=True)
+        focal = (params.width / 2) / math.tan(math.radians(params.hfov_deg) / 2)
+        pinhole = rr.Pinhole(
+            focal_length=focal,
+            width=params.width,
+            height=params.height,
+            camera_xyz=rr.ViewCoordinates.RDF,
+            image_plane_distance=4.0,
+        )
+        rec.log(path, pinhole, static=True)
+
+
+def _circle(radius: float, n: int = 120) -> np.ndarray:
+    a = np.linspace(0.0, 2 * math.pi, n + 1)
+    return np.stack([radius * np.cos(a), radius * np.sin(a)], axis=1)
+
+
+def _script(rec: rr.RecordingStream, body: Body) -> None:
+    """A scripted vessel's commands as step series: thrust per thruster, twist set-points."""
+    thrust = [(s.t_s, s.thrust) for s in body.script if s.thrust is not None]
+    twist = [(s.t_s, s.twist) for s in body.script if s.twist is not None]
+    step = rr.components.InterpolationMode.StepAfter
+    if thrust:
+        n = max(len(t) for _, t in thrust)
+        names = [f"{body.id} thruster {i}" for i in range(n)]
+        rec.log(paths.series("thrust", body.id), rr.SeriesLines(names=names,
+                interpolation_mode=step), static=True)  # fmt: skip
+        values = np.array([[*t, *[np.nan] * (n - len(t))] for _, t in thrust])
+        _columns(rec, paths.series("thrust", body.id), [t for t, _ in thrust], values)
+    if twist:
+        names = [f"{body.id} surge [m/s]", f"{body.id} yaw rate [rad/s]"]
+        rec.log(paths.series("setpoint", body.id), rr.SeriesLines(names=names,
+                interpolation_mode=step), static=True)  # fmt: skip
+        values = np.array([[t.surge_mps, t.yaw_rate_radps] for _, t in twist])
+        _columns(rec, paths.series("setpoint", body.id), [t for t, _ in twist], values)
+
+
+def _columns(rec: rr.RecordingStream, path: str, t_s: list[float], values: np.ndarray) -> None:
+    times = rr.TimeColumn("sim_time", duration=np.array(t_s, dtype=np.float64))
+    scalars = rr.Scalars.columns(scalars=values.ravel()).partition([values.shape[1]] * len(t_s))
+    rec.send_columns(path, indexes=[times], columns=scalars)

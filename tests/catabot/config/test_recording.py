@@ -1,0 +1,50 @@
+"""recording: run.rrd, the exports and the dataset rate are checked before anything starts."""
+
+from __future__ import annotations
+
+import re
+from typing import Any
+
+import pytest
+
+from catabot.config.load import parse_scenario
+from catabot.config.scenario import ScenarioError
+
+CAMERA = {"name": "cam", "type": "camera", "rate_hz": 10.0}
+LIDAR = {"name": "lidar", "type": "lidar", "rate_hz": 10.0}
+
+
+def _scenario(recording: dict[str, Any], *sensors: dict[str, Any]) -> dict[str, Any]:
+    return {"vessels": [{"id": "ego", "sensors": list(sensors)}], "recording": recording}
+
+
+def test_defaults_make_no_rrd_and_no_export() -> None:
+    rec = parse_scenario(_scenario({})).recording
+    assert (rec.rerun, rec.export, rec.dataset_rate_hz) == (False, [], None)
+
+
+def test_everything_asked_for_with_its_sources() -> None:
+    rec = {"rerun": True, "export": ["yolo", "coco", "kitti"], "dataset_rate_hz": 2.0}
+    parsed = parse_scenario(_scenario(rec, CAMERA, LIDAR)).recording
+    assert parsed.export == ["yolo", "coco", "kitti"] and parsed.dataset_rate_hz == 2.0
+
+
+@pytest.mark.parametrize(
+    ("recording", "sensors", "message"),
+    [
+        ({"rerun": True, "mcap": False}, [], "recording.rerun: needs recording.mcap: true"),
+        ({"export": ["kitti"], "mcap": False}, [LIDAR], "recording.export: needs recording.mcap"),
+        ({"export": ["yolo"]}, [LIDAR], "recording.export: 'yolo' needs a camera"),
+        ({"export": ["kitti"]}, [CAMERA], "recording.export: 'kitti' needs a lidar"),
+        ({"export": ["coco"], "dataset": False}, [CAMERA], "'coco' needs recording.dataset: true"),
+        ({"export": ["voc"]}, [CAMERA], "recording.export.0: must be one of 'yolo', 'coco'"),
+        ({"dataset_rate_hz": 3.0}, [CAMERA], "recording.dataset_rate_hz: period 333333333 ns"),
+        ({"dataset_rate_hz": 0}, [CAMERA], "recording.dataset_rate_hz: must be > 0"),
+        ({"rerun": "yes"}, [], "recording.rerun: must be true or false"),
+    ],
+)
+def test_refused_with_the_field_named(
+    recording: dict[str, Any], sensors: list[dict[str, Any]], message: str
+) -> None:
+    with pytest.raises(ScenarioError, match=re.escape(message)):
+        parse_scenario(_scenario(recording, *sensors))

@@ -1,0 +1,73 @@
+"""The live viewer is an observer: it shows a running simulation and changes nothing of it."""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Any
+
+import rerun as rr
+from conftest import (
+    basic_scenario,
+    catabot,
+    files_of,
+    only_run_dir,
+    scenario_file,
+    start,
+    wait_for_line,
+)
+
+from catabot.bus.session import free_port
+
+
+def _scenario(seconds: float) -> dict[str, Any]:
+    data = basic_scenario("live", duration_s=seconds)
+    data["vessels"][0]["sensors"] = [
+        {"name": "lidar", "type": "lidar", "rate_hz": 10.0, "params": {"columns": 256}},
+        {"name": "imu", "type": "imu", "rate_hz": 50.0},
+    ]
+    data["traffic"] = {"count": 3, "behaviour_mix": {"circle": 1.0}}
+    return data
+
+
+def test_view_attaches_to_a_running_simulation(tmp_path: Path) -> None:
+    endpoint = f"tcp/127.0.0.1:{free_port()}"
+    scenario = scenario_file(tmp_path, _scenario(5.0))
+    out = tmp_path / "runs"
+    sim = start("run", str(scenario), "--out", str(out), "--quiet", "--listen", endpoint,
+                "--realtime", "1.0")  # fmt: skip
+    try:
+        run_dir = wait_for_line(sim, "run folder:").split(":", 1)[1].strip()
+        saved = tmp_path / "live.rrd"
+        viewer = start("view", "--connect", endpoint, run_dir, "--save", str(saved))
+        assert sim.wait(timeout=60) == 0
+        stdout, stderr = viewer.communicate(timeout=60)
+    finally:
+        sim.kill()
+    assert viewer.returncode == 0, stderr
+    assert "run ended: completed" in stdout
+    rows: dict[str, int] = {}
+    for chunk in rr.chunk.RrdReader(saved).stream():
+        if not chunk.is_static:
+            rows[chunk.entity_path] = rows.get(chunk.entity_path, 0) + chunk.num_rows
+    # Paced at the wall clock for 5 s: the newest state 20 times a second (FPS), the newest
+    # scan of the 10 a second, every IMU sample (small ones are all shown); it attached late.
+    assert 40 < rows["/world/bodies"] <= 5 * 20 + 1
+    assert 20 < rows["/world/vessels/ego/lidar"] <= 50
+    assert 100 < rows["/series/imu_accel/ego.imu"] <= 250
+    assert rows["/metrics"] == 1  # read from the run folder once the recorder wrote it
+
+
+def test_a_run_with_the_view_records_the_same_bytes(tmp_path: Path) -> None:
+    scenario = scenario_file(tmp_path, _scenario(2.0))
+    recorded = []
+    for tag, extra in (("plain", ()), ("viewed", ("--view", "web"))):
+        out = tmp_path / tag
+        out.mkdir()
+        result = catabot("run", str(scenario), "--out", str(out), "--quiet", *extra)
+        assert result.returncode == 0, result.stderr
+        run = only_run_dir(out)
+        recorded.append(files_of(run))
+        if extra:
+            assert "rerun web viewer: http://127.0.0.1:" in result.stdout
+            assert "run ended: completed" in (run / "log" / "viewer.log").read_text()
+    assert recorded[0] == recorded[1] and "run.mcap" in recorded[0]

@@ -1,0 +1,113 @@
+"""The secure profile: TLS, a login per process, and a router whose access control lets each
+name publish only its own keys. Without a login nobody connects; with one, a client that
+may only observe cannot drive the clock or a vessel; a commanding client can command."""
+
+from __future__ import annotations
+
+import json
+import shutil
+import time
+from collections.abc import Iterator
+from pathlib import Path
+
+import pytest
+from conftest import catabot, files_of, only_run_dir, scenario_file, start, wait_for_line
+
+from catabot.bus import codec
+from catabot.bus.keys import Keys
+from catabot.bus.messages import Ack, End, ThrustCmd, Tick
+from catabot.bus.session import Connection, SessionError, free_port, open_session
+
+pytestmark = pytest.mark.skipif(shutil.which("openssl") is None, reason="needs openssl")
+KEYS = Keys("secure")
+
+
+@pytest.fixture(scope="module")
+def profile(tmp_path_factory: pytest.TempPathFactory) -> Iterator[tuple[Path, str]]:
+    """A secure profile and its router, running."""
+    folder, port = tmp_path_factory.mktemp("secure"), free_port()
+    made = catabot("secure", "init", str(folder), "--client", "autopilot", "--observer", "viewer",
+                   "--port", str(port))  # fmt: skip
+    assert made.returncode == 0, made.stderr
+    router = start("router", "--zenoh-config", str(folder / "router.json5"))
+    wait_for_line(router, "zenoh router listening")
+    try:
+        yield folder, f"tls/localhost:{port}"
+    finally:
+        router.terminate()
+        router.wait(timeout=10)
+
+
+def _scenario(tmp: Path) -> Path:
+    imu = {"name": "imu", "type": "imu", "rate_hz": 50.0}
+    data = {"name": "secure", "seed": 2, "duration_s": 4.0, "clock": {"realtime_factor": 2.0},
+            "vessels": [{"id": "ego", "script": [{"t_s": 0.5, "thrust": [0.5, 0.7]}],
+                         "sensors": [imu]}]}  # fmt: skip
+    return scenario_file(tmp, data)
+
+
+def _run(tmp: Path, folder: Path, tag: str, client: str = "") -> dict[str, bytes]:
+    """A run through the router; `client` logs in and sends what it should not."""
+    out = tmp / tag
+    proc = start("run", str(_scenario(tmp)), "--secure", str(folder), "--out", str(out), "--quiet")
+    if client:
+        conn = Connection(mode="client", file=str(folder / f"{client}.json5"))
+        with open_session(conn) as session:
+            time.sleep(2.0)  # the run is going by now
+            for k in range(20):
+                run = "0" * 12
+                session.put(KEYS.tick(), codec.encode(Tick(run, k, k * 10**7, 10**7, (), 20)))
+                session.put(KEYS.end(), codec.encode(End(run, k, "completed")))
+                session.put(KEYS.ack("physics"), codec.encode(Ack(run, 399)))
+                session.put(KEYS.cmd_thrust("ego"), codec.encode(ThrustCmd((1.0, -1.0))))
+                time.sleep(0.05)
+    _, err = proc.communicate(timeout=120)
+    assert proc.returncode == 0, err
+    return files_of(only_run_dir(out))
+
+
+@pytest.mark.parametrize("login", [None, {"user": "viewer", "password": "guessed"}])
+def test_no_login_no_connection(
+    tmp_path: Path, profile: tuple[Path, str], login: dict[str, str] | None
+) -> None:
+    folder, _ = profile
+    config = json.loads((folder / "viewer.json5").read_text())  # TLS with the profile's CA
+    if login is None:
+        del config["transport"]["auth"]
+    else:
+        config["transport"]["auth"]["usrpwd"] = login
+    (tmp_path / "intruder.json5").write_text(json.dumps(config))
+    with pytest.raises(SessionError):
+        open_session(Connection(file=str(tmp_path / "intruder.json5"))).close()
+
+
+def test_the_profile_holds_its_secrets(profile: tuple[Path, str]) -> None:
+    folder, _ = profile
+    assert sorted(p.name for p in folder.iterdir() if p.suffix != ".json5") == [
+        "ca.key", "ca.pem", "router.key", "router.pem", "users.txt"]  # fmt: skip
+    for secret in ("ca.key", "router.key", "users.txt", "viewer.json5", "router.json5"):
+        assert (folder / secret).stat().st_mode & 0o077 == 0, secret
+
+
+def test_bad_names_are_refused(tmp_path: Path) -> None:
+    made = catabot("secure", "init", str(tmp_path / "p"), "--client", "physics")
+    assert made.returncode == 2 and "names must differ" in made.stderr
+    made = catabot("secure", "init", str(tmp_path / "p"), "--observer", "a/b")
+    assert made.returncode == 2 and "observer" in made.stderr
+
+
+def test_an_observer_cannot_drive_the_clock_or_a_vessel(
+    tmp_path: Path, profile: tuple[Path, str]
+) -> None:
+    folder, _ = profile
+    clean = _run(tmp_path, folder, "clean")
+    attacked = _run(tmp_path, folder, "observer", "viewer")
+    assert [name for name in clean if clean[name] != attacked.get(name)] == []
+    assert "vessel.ego.cmd.thrust.csv" not in attacked
+
+
+def test_a_commanding_client_commands(tmp_path: Path, profile: tuple[Path, str]) -> None:
+    folder, _ = profile
+    files = _run(tmp_path, folder, "autopilot", "autopilot")
+    rows = files["vessel.ego.cmd.thrust.csv"].decode().splitlines()
+    assert len(rows) > 1 and rows[1].endswith(",1,-1")

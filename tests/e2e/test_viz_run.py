@@ -1,0 +1,183 @@
+"""One recorded run, then everything made from it: run.rrd (read back with rerun's reader),
+`catabot view RUN --save`, the YOLO, COCO and KITTI exports, `catabot plot`, and the refusals.
+
+The run asks for `recording.rerun` and `recording.export`, so `catabot run` itself makes
+run.rrd and export/<format>/ after the lockstep; the other tools are run on its folder.
+"""
+
+from __future__ import annotations
+
+import json
+from collections import Counter
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import pytest
+import rerun as rr
+from conftest import basic_scenario, catabot, files_of, only_run_dir, scenario_file
+from PIL import Image
+from pycocotools.coco import COCO
+
+from services.recorder.mcap_read import read_mcap_messages
+from tests.services.datasets.yolo_check import check_yolo
+
+SECONDS = 2.0
+pytestmark = pytest.mark.filterwarnings("ignore:__array__ implementation:DeprecationWarning")
+
+
+def _scenario() -> dict[str, Any]:
+    data = basic_scenario("viz", duration_s=SECONDS)
+    data["vessels"][0]["pose"] = {"x_m": 0.0, "y_m": 0.0}
+    data["vessels"][0]["sensors"] = [
+        {"name": "cam", "type": "camera", "rate_hz": 5.0, "params": {"width": 160, "height": 120}},
+        {"name": "lidar", "type": "lidar", "rate_hz": 10.0,
+         "params": {"channels": 16, "columns": 256}},
+        {"name": "radar", "type": "radar", "rate_hz": 20.0, "params": {"rotation_period_s": 0.5}},
+        {"name": "imu", "type": "imu", "rate_hz": 50.0},
+    ]  # fmt: skip
+    data["vessels"].append({"id": "other", "pose": {"x_m": 30.0, "y_m": 1.0}})
+    data["buoys"] = [{"id": "b1", "x_m": 25.0, "y_m": -6.0}]
+    data["traffic"] = {"count": 2, "behaviour_mix": {"circle": 1.0}}
+    data["rain"] = {"rate_mm_h": 20.0}
+    data["recording"] = {"rerun": True, "export": ["yolo", "coco", "kitti"]}
+    return data
+
+
+@pytest.fixture(scope="module")
+def run(tmp_path_factory: pytest.TempPathFactory) -> Path:
+    tmp = tmp_path_factory.mktemp("viz")
+    out = tmp / "runs"
+    out.mkdir()
+    result = catabot("run", str(scenario_file(tmp, _scenario())), "--out", str(out), "--quiet")
+    assert result.returncode == 0, result.stdout + result.stderr
+    return only_run_dir(out)
+
+
+def _rows(rrd: Path) -> tuple[Counter[str], set[str], set[str]]:
+    """Rows on `sim_time` by entity path, the static entities, every timeline seen."""
+    rows: Counter[str] = Counter()
+    static, timelines = set(), set()
+    for chunk in rr.chunk.RrdReader(rrd).stream():
+        timelines.update(chunk.timeline_names)
+        if chunk.is_static:
+            static.add(chunk.entity_path)
+        else:
+            rows[chunk.entity_path] += chunk.num_rows
+    return rows, static, timelines
+
+
+def _topic_counts(run: Path) -> Counter[str]:
+    return Counter(m.topic for m in read_mcap_messages(run / "run.mcap"))
+
+
+def test_run_rrd_holds_every_stream_on_sim_time(run: Path) -> None:
+    rows, static, timelines = _rows(run / "run.rrd")
+    topics = _topic_counts(run)
+    ticks = topics["/tf"]
+    assert ticks == round(SECONDS * 100) and timelines == {"sim_time"}
+    assert rows["/world/bodies"] == ticks and rows["/world/vessels/ego"] == ticks
+    assert rows["/series/speed/ego"] == ticks and rows["/series/speed/other"] == ticks
+    assert rows["/world/vessels/ego/lidar"] == topics["/sensor/ego/lidar"] == 20
+    assert rows["/world/vessels/ego/cam/color"] == topics["/sensor/ego/cam/color"] == 10
+    assert rows["/world/vessels/ego/cam/segmentation"] == rows["/world/vessels/ego/cam/boxes"] == 10
+    assert rows["/minimap/ego.radar/echoes"] == topics["/sensor/ego/radar"] == 40
+    assert rows["/series/imu_accel/ego.imu"] == topics["/sensor/ego/imu"] == 100
+    assert rows["/world/trails"] == round(SECONDS / 0.2) and rows["/metrics"] == 1
+    assert {"/world/bodies", "/world/water", "/world/vessels/ego/cam"} <= static
+
+
+def test_view_replays_the_run_into_the_same_rows(run: Path, tmp_path: Path) -> None:
+    result = catabot("view", str(run), "--save", str(tmp_path / "again.rrd"))
+    assert result.returncode == 0, result.stderr
+    assert _rows(tmp_path / "again.rrd") == _rows(run / "run.rrd")
+
+
+def test_yolo_export_passes_a_strict_check(run: Path) -> None:
+    found = check_yolo(run / "export" / "yolo" / "data.yaml")
+    labels = [json.loads(x) for x in (run / "dataset/ego.cam/labels.jsonl").read_text().split()]
+    assert sum(n for n, _ in found.values()) == len(labels) == 10
+    assert sum(b for _, b in found.values()) == sum(len(x["objects"]) for x in labels) > 0
+
+
+def test_coco_masks_match_the_boxes_and_the_class_images(run: Path) -> None:
+    seen = 0
+    for subset in ("train", "val"):
+        coco = COCO(str(run / "export" / "coco" / "annotations" / f"instances_{subset}.json"))
+        for image in coco.loadImgs(coco.getImgIds()):
+            assert (run / "export" / "coco" / subset / image["file_name"]).is_file()
+            classes = np.asarray(Image.open(run / f"dataset/ego.cam/{image['tick']:08d}_class.png"))
+            painted = np.zeros_like(classes)
+            for ann in coco.loadAnns(coco.getAnnIds(imgIds=image["id"])):
+                mask = coco.annToMask(ann).astype(bool)
+                x, y, w, h = ann["bbox"]
+                ys, xs = np.nonzero(mask)
+                assert mask.sum() == ann["area"] > 0
+                assert xs.min() >= x and xs.max() < x + w and ys.min() >= y and ys.max() < y + h
+                painted[mask] = ann["category_id"]
+                seen += 1
+            bodies = np.isin(classes, (3, 4))
+            assert (painted[bodies] == classes[bodies]).all() and not painted[~bodies].any()
+    labels = [json.loads(x) for x in (run / "dataset/ego.cam/labels.jsonl").read_text().split()]
+    assert seen == sum(len(x["objects"]) for x in labels)
+
+
+def test_kitti_labels_one_per_point_with_rain_as_its_class(run: Path) -> None:
+    seq = run / "export" / "kitti" / "sequences" / "00"
+    clouds = [
+        m.decoded for m in read_mcap_messages(run / "run.mcap") if m.topic == "/sensor/ego/lidar"
+    ]
+    assert len(sorted((seq / "velodyne").glob("*.bin"))) == len(clouds) == 20
+    assert len((seq / "poses.txt").read_text().splitlines()) == len(clouds)
+    for n, cloud in enumerate(clouds):
+        points = np.fromfile(seq / "velodyne" / f"{n:06d}.bin", dtype="<f4").reshape(-1, 4)
+        labels = np.fromfile(seq / "labels" / f"{n:06d}.label", dtype="<u4")
+        assert len(points) == len(labels) == cloud.width
+        rain = np.frombuffer(bytes(cloud.data), np.uint8).reshape(-1, cloud.point_step)[:, 19]
+        assert ((labels & 0xFFFF) == 5).sum() == rain.sum() > 0
+        assert set(np.unique(labels & 0xFFFF).tolist()) <= {0, 1, 2, 3, 4, 5}
+
+
+def test_plot_writes_figures_and_a_report(run: Path, tmp_path: Path) -> None:
+    result = catabot("plot", str(run), "-o", str(tmp_path / "plots"))
+    assert result.returncode == 0, result.stderr
+    pngs = sorted((tmp_path / "plots").glob("*.png"))
+    names = {p.stem for p in pngs}
+    assert names == {"trajectories", "speed_heading", "thrust", "imu", "lidar_rain", "metrics"}
+    for png in pngs:
+        with Image.open(png) as image:
+            pixels = np.asarray(image.convert("L"))
+        assert pixels.std() > 5, f"{png.name} is blank"
+    report = (tmp_path / "plots" / "report.html").read_text()
+    assert all(f'src="{p.name}"' in report for p in pngs) and "Closest approach" in report
+    again = catabot("plot", str(run), "-o", str(tmp_path / "again"))
+    assert again.returncode == 0
+    assert files_of(tmp_path / "plots", ("*",)) == files_of(tmp_path / "again", ("*",))
+
+
+@pytest.mark.parametrize(
+    ("args", "message"),
+    [
+        (("view", "{tmp}/nowhere", "--save", "{tmp}/x.rrd"), "no such run folder"),
+        (("plot", "{tmp}/nowhere"), "no such run folder"),
+        (("dataset", "export", "{tmp}/nowhere", "-f", "yolo", "-o", "{tmp}/o"), "no such run"),
+        (("dataset", "export", "{run}", "-f", "voc", "-o", "{tmp}/o"), "invalid choice: 'voc'"),
+        (("dataset", "export", "{run}", "-f", "yolo", "-o", "{run}"), "is not an empty folder"),
+        (("dataset", "export", "{nocam}", "-f", "coco", "-o", "{tmp}/o"), "no labelled camera"),
+        (("view", "{tmp}"), "not a run folder"),
+    ],
+)
+def test_refusals_exit_2_with_one_clear_line(
+    run: Path, tmp_path: Path, args: tuple[str, ...], message: str
+) -> None:
+    nocam = tmp_path / "nocam"
+    nocam.mkdir()
+    scenario = json.loads((run / "scenario.json").read_text())
+    scenario["vessels"][0]["sensors"] = [s for s in scenario["vessels"][0]["sensors"]
+                                         if s["type"] != "camera"]  # fmt: skip
+    scenario["recording"]["export"] = []
+    (nocam / "scenario.json").write_text(json.dumps(scenario))
+    filled = [a.format(tmp=tmp_path, run=run, nocam=nocam) for a in args]
+    result = catabot(*filled)
+    assert result.returncode == 2, result.stdout + result.stderr
+    assert message in result.stderr and "Traceback" not in result.stderr

@@ -1,0 +1,36 @@
+"""The train/val split: seeded by the scenario, by blocks of simulated time, never one-sided."""
+
+from __future__ import annotations
+
+from services.datasets.split import block_ns, split
+
+S = 1_000_000_000
+
+
+def test_the_same_seed_splits_the_same_way_and_another_may_not() -> None:
+    stamps = [k * S // 5 for k in range(600)]  # 120 s of frames at 5 Hz
+    first = split(stamps, seed=3, val_fraction=0.2)
+    assert first == split(stamps, seed=3, val_fraction=0.2)
+    assert any(split(stamps, seed=s, val_fraction=0.2) != first for s in (4, 5, 6))
+    assert 0.05 < first.count("val") / len(first) < 0.45
+
+
+def test_frames_of_one_block_share_a_set() -> None:
+    stamps = [k * S // 10 for k in range(300)]  # 30 s: blocks of 10 s
+    subsets = split(stamps, seed=1, val_fraction=0.3, block_s=10.0)
+    for block in range(3):
+        assert len(set(subsets[block * 100 : (block + 1) * 100])) == 1
+
+
+def test_neither_set_is_empty_with_two_blocks_or_more() -> None:
+    stamps = [0, 11 * S]
+    for seed in range(20):
+        assert sorted(split(stamps, seed=seed, val_fraction=0.01, block_s=10.0)) == ["train", "val"]
+        assert sorted(split(stamps, seed=seed, val_fraction=0.99, block_s=10.0)) == ["train", "val"]
+    assert split(stamps, seed=0, val_fraction=0.0, block_s=10.0) == ["train", "train"]
+
+
+def test_short_runs_get_blocks_of_a_tenth_of_their_span() -> None:
+    assert block_ns([0, 2 * S], None) == S // 5
+    assert block_ns([0, 600 * S], None) == 10 * S
+    assert block_ns([0, 600 * S], 2.5) == 5 * S // 2

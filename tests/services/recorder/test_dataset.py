@@ -1,0 +1,63 @@
+"""dataset/: frames at the configured rate, depth also as exact float32 .npy, same bytes twice."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import numpy as np
+
+from catabot.bus.messages import CameraFrame
+from catabot.config.load import parse_scenario
+from catabot.world.world import World
+from services.recorder.dataset import Dataset
+
+
+def _world(rate_hz: float | None) -> World:
+    camera = {"name": "cam", "type": "camera", "rate_hz": 10.0, "params": {"width": 4, "height": 3}}
+    return World.resolve(parse_scenario({
+        "vessels": [{"id": "ego", "sensors": [camera]}],
+        "recording": {"dataset_rate_hz": rate_hz},
+    }))  # fmt: skip
+
+
+def _frame(tick: int) -> CameraFrame:
+    depth = np.full((3, 4), 12.3456, np.float32)
+    depth[0, 0] = np.inf
+    return CameraFrame(
+        tick=tick, stamp_ns=tick * 10_000_000, width=4, height=3, hfov_rad=1.0, objects=1,
+        color=np.zeros((3, 4, 3), np.uint8), depth=depth, normals=np.zeros((3, 4, 3), np.int8),
+        segmentation=np.full((3, 4), 3, np.uint8), instance=np.ones((3, 4), np.uint16),
+        boxes=np.array([[1, 3, 0, 0, 4, 3]], np.float32), box_flags=np.zeros((1, 2), np.uint8),
+    )  # fmt: skip
+
+
+def _record(root: Path, rate_hz: float | None) -> list[dict[str, object]]:
+    dataset = Dataset(root, _world(rate_hz))
+    for tick in range(0, 110, 10):  # the camera's frames, every 10 ticks
+        dataset.write("sensor/ego/cam", _frame(tick))
+    lines = (root / "ego.cam" / "labels.jsonl").read_text().splitlines()
+    return [json.loads(line) for line in lines]
+
+
+def test_every_frame_without_a_rate(tmp_path: Path) -> None:
+    assert [r["tick"] for r in _record(tmp_path, None)] == list(range(0, 110, 10))
+
+
+def test_the_first_frame_of_each_dataset_period(tmp_path: Path) -> None:
+    # 4 Hz: periods start at ticks 0, 25, 50, 75, 100; the camera's frames are 10 ticks apart.
+    assert [r["tick"] for r in _record(tmp_path, 4.0)] == [0, 30, 50, 80, 100]
+
+
+def test_depth_as_exact_float32_beside_the_png(tmp_path: Path) -> None:
+    record = _record(tmp_path, 5.0)[1]
+    files = record["files"]
+    assert isinstance(files, dict) and files["depth_m"] == "00000020_depth.npy"
+    depth = np.load(tmp_path / "ego.cam" / files["depth_m"])
+    assert (
+        depth.dtype == np.float32 and np.isinf(depth[0, 0]) and depth[1, 1] == np.float32(12.3456)
+    )
+    again = tmp_path / "again"
+    _record(again, 5.0)
+    for name in ("00000020_depth.npy", "00000020_depth.png", "labels.jsonl"):
+        assert (tmp_path / "ego.cam" / name).read_bytes() == (again / "ego.cam" / name).read_bytes()
