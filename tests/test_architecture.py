@@ -14,8 +14,9 @@ LAYERS = {  # what each part of the library may import from the project, besides
     "catabot.bus": {"catabot.errors"},
     "catabot.config": {"catabot.errors", "catabot.bus"},
     "catabot.world": {"catabot.errors", "catabot.bus", "catabot.config"},
-    "catabot.run": {"catabot.errors", "catabot.bus", "catabot.config", "catabot.world"},
     "catabot.ros2": {"catabot.errors", "catabot.bus", "catabot.config", "catabot.world"},
+    "catabot.run": {"catabot.errors", "catabot.bus", "catabot.config", "catabot.world",
+                    "catabot.ros2"},  # fmt: skip
 }
 PROJECT = ("catabot", "services")
 

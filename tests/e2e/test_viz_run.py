@@ -67,8 +67,8 @@ def _rows(rrd: Path) -> tuple[Counter[str], set[str], set[str]]:
     return rows, static, timelines
 
 
-def _topic_counts(run: Path) -> Counter[str]:
-    return Counter(m.topic for m in read_mcap_messages(run / "run.mcap"))
+def _topic_counts(run: Path, name: str = "run.mcap") -> Counter[str]:
+    return Counter(m.topic for m in read_mcap_messages(run / name))
 
 
 def test_run_rrd_holds_every_stream_on_sim_time(run: Path) -> None:
@@ -78,11 +78,12 @@ def test_run_rrd_holds_every_stream_on_sim_time(run: Path) -> None:
     assert ticks == round(SECONDS * 100) and timelines == {"sim_time"}
     assert rows["/world/bodies"] == ticks and rows["/world/vessels/ego"] == ticks
     assert rows["/series/speed/ego"] == ticks and rows["/series/speed/other"] == ticks
-    assert rows["/world/vessels/ego/lidar"] == topics["/sensor/ego/lidar"] == 20
-    assert rows["/world/vessels/ego/cam/color"] == topics["/sensor/ego/cam/color"] == 10
+    assert rows["/world/vessels/ego/lidar"] == topics["/ego/lidar/points"] == 20
+    assert rows["/world/vessels/ego/cam/color"] == topics["/ego/cam/image_raw"] == 10
     assert rows["/world/vessels/ego/cam/segmentation"] == rows["/world/vessels/ego/cam/boxes"] == 10
-    assert rows["/minimap/ego.radar/echoes"] == topics["/sensor/ego/radar"] == 40
-    assert rows["/series/imu_accel/ego.imu"] == topics["/sensor/ego/imu"] == 100
+    sweeps = _topic_counts(run, "run.extra.mcap")["/sensor/ego/radar"]
+    assert rows["/minimap/ego.radar/echoes"] == sweeps == topics["/ego/radar/points"] == 40
+    assert rows["/series/imu_accel/ego.imu"] == topics["/ego/imu/imu"] == 100
     assert rows["/world/trails"] == round(SECONDS / 0.2) and rows["/metrics"] == 1
     assert {"/world/bodies", "/world/water", "/world/vessels/ego/cam"} <= static
 
@@ -125,7 +126,7 @@ def test_coco_masks_match_the_boxes_and_the_class_images(run: Path) -> None:
 def test_kitti_labels_one_per_point_with_rain_as_its_class(run: Path) -> None:
     seq = run / "export" / "kitti" / "sequences" / "00"
     clouds = [
-        m.decoded for m in read_mcap_messages(run / "run.mcap") if m.topic == "/sensor/ego/lidar"
+        m.decoded for m in read_mcap_messages(run / "run.mcap") if m.topic == "/ego/lidar/points"
     ]
     assert len(sorted((seq / "velodyne").glob("*.bin"))) == len(clouds) == 20
     assert len((seq / "poses.txt").read_text().splitlines()) == len(clouds)
