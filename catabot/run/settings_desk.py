@@ -61,9 +61,9 @@ class SettingsDesk:
 
     def _answer(self, key: str, query: zenoh.Query) -> dict[str, Any]:
         """What a query on `key` gets: the settings, or a change's effect tick."""
-        if key == self.keys.config("settings"):
-            return self.in_force()
-        if key == self.keys.config("set"):
+        if zenoh.KeyExpr(key).intersects(zenoh.KeyExpr(self.keys.config("settings"))):
+            return self.in_force()  # `catabot/*/config/settings` too: how worlds are found
+        if key == self.keys.config("set"):  # a change goes to one world, named
             return self._set(_payload(query))
         raise QueryRefused(
             f"no such settings query {key!r}; ask {self.keys.config('settings')} (get) or "
