@@ -60,7 +60,7 @@ def test_set_rain_mid_run_is_recorded_and_replays_to_the_same_bytes(tmp_path: Pa
     try:
         effect = _set_midway(endpoint)
         _refusals(endpoint)
-        stdout, stderr = run.communicate(timeout=120)
+        _, stderr = run.communicate(timeout=120)
     finally:
         run.kill()
     assert run.returncode == 0, stderr
