@@ -11,14 +11,18 @@ import time
 from pathlib import Path
 
 from conftest import basic_scenario, catabot, csv_rows, files_of, only_run_dir, scenario_file, start
+from PIL import Image
 
 from catabot.bus.session import free_port
 from services.recorder.mcap_read import read_mcap_messages
 
 
 def _scenario(tmp: Path) -> Path:
-    data = basic_scenario("settings", duration_s=6.0, clock={"realtime_factor": 1.0})
-    data["vessels"][0]["sensors"] = [{"name": "lidar", "type": "lidar", "rate_hz": 10.0}]
+    data = basic_scenario("settings", duration_s=10.0, clock={"realtime_factor": 1.0})
+    data["vessels"][0]["sensors"] = [
+        {"name": "lidar", "type": "lidar", "rate_hz": 10.0},
+        {"name": "cam", "type": "camera", "rate_hz": 5.0, "params": {"width": 64, "height": 48}},
+    ]
     return scenario_file(tmp, data)
 
 
@@ -28,12 +32,15 @@ def _granted(endpoint: str) -> int:
     return int(json.loads(got.stdout)["granted"]) if got.returncode == 0 else -2
 
 
-def _set_midway(endpoint: str) -> int:
-    """`catabot set rain 25` once the run is ticking; the tick it takes effect at."""
+def _wait_ticking(endpoint: str) -> None:
     limit = time.monotonic() + 60
     while _granted(endpoint) < 60:
         assert time.monotonic() < limit, "the run never got going"
         time.sleep(0.2)
+
+
+def _set(endpoint: str) -> int:
+    """`catabot set rain 25`; the tick it takes effect at."""
     done = catabot("set", "rain", "25", "-e", endpoint, "--mode", "client")
     assert done.returncode == 0, done.stderr
     match = re.search(r"rain = 25\.0 from tick (\d+)", done.stdout)
@@ -52,14 +59,38 @@ def _refusals(endpoint: str) -> None:
     assert "from 0 to 50" in bad_value.stderr, bad_value.stderr
 
 
+def _snapshot(endpoint: str, png: Path) -> None:
+    """The Space key: the camera's next colour image as a PNG; `get` shows the new rain."""
+    flags = ("-e", endpoint, "--mode", "client")
+    shot = catabot("snapshot", "-o", str(png), *flags)
+    assert shot.returncode == 0, shot.stderr
+    assert "ego/cam" in shot.stdout
+    with Image.open(png) as image:
+        assert image.size == (64, 48) and image.mode == "RGB"
+    got = catabot("get", "rain", *flags)
+    assert got.returncode == 0 and got.stdout.strip() == "25.0", got.stderr
+
+
+def test_no_simulation_is_a_clear_error(tmp_path: Path) -> None:
+    gone = f"tcp/127.0.0.1:{free_port()}"
+    refused = catabot("set", "rain", "1", "-e", gone, "--mode", "client", "--timeout", "1")
+    assert refused.returncode == 2 and "Traceback" not in refused.stderr
+    assert "cannot open zenoh" in refused.stderr
+    alone = catabot("get", "--world", "nobody", "--timeout", "1")
+    assert alone.returncode == 2 and "Traceback" not in alone.stderr
+    assert "no running simulation of world 'nobody' answered within 1 s" in alone.stderr
+
+
 def test_set_rain_mid_run_is_recorded_and_replays_to_the_same_bytes(tmp_path: Path) -> None:
     endpoint = f"tcp/127.0.0.1:{free_port()}"
     out = tmp_path / "live"
     run = start("run", str(_scenario(tmp_path)), "--out", str(out), "--quiet",
                 "--listen", endpoint)  # fmt: skip
     try:
-        effect = _set_midway(endpoint)
-        _refusals(endpoint)
+        _wait_ticking(endpoint)
+        _refusals(endpoint)  # while it runs, and it runs on
+        effect = _set(endpoint)
+        _snapshot(endpoint, tmp_path / "snap.png")
         _, stderr = run.communicate(timeout=120)
     finally:
         run.kill()
@@ -67,7 +98,7 @@ def test_set_rain_mid_run_is_recorded_and_replays_to_the_same_bytes(tmp_path: Pa
     assert "setting refused 2" in stderr  # counted like any refused input
     folder = only_run_dir(out)
     scans = [(int(r[1]), int(r[3])) for r in csv_rows(folder / "sensor.ego.lidar.csv")[1:]]
-    assert len(scans) == 60 and 0 < effect < 600
+    assert len(scans) == 100 and 60 < effect < 900
     assert all(rain == 0 for tick, rain in scans if tick < effect)
     assert all(rain > 100 for tick, rain in scans if tick >= effect)
     assert any(tick >= effect for tick, _ in scans)
@@ -81,6 +112,7 @@ def test_set_rain_mid_run_is_recorded_and_replays_to_the_same_bytes(tmp_path: Pa
     recorded = json.loads((folder / "scenario.json").read_text())["settings"]
     assert recorded == [{"t_s": effect / 100, "key": "rain", "value": 25.0}]
     replay_out = tmp_path / "replay"
-    again = catabot("run", str(folder / "scenario.json"), "--out", str(replay_out), "--quiet")
+    again = catabot("run", str(folder / "scenario.json"), "--out", str(replay_out), "--quiet",
+                    "--realtime", "1000")  # the pace is not in the bytes  # fmt: skip
     assert again.returncode == 0, again.stderr
     assert files_of(only_run_dir(replay_out)) == files_of(folder)
