@@ -54,6 +54,8 @@ def _run(tmp: Path, folder: Path, tag: str, client: str = "") -> dict[str, bytes
         conn = Connection(mode="client", file=str(folder / f"{client}.json5"))
         with open_session(conn) as session:
             time.sleep(2.0)  # the run is going by now
+            change = json.dumps({"key": "rain", "value": 50})
+            replies = list(session.get(KEYS.config("set"), payload=change, timeout=3.0))
             for k in range(20):
                 run = "0" * 12
                 session.put(KEYS.tick(), codec.encode(Tick(run, k, k * 10**7, 10**7, (), 20)))
@@ -63,6 +65,8 @@ def _run(tmp: Path, folder: Path, tag: str, client: str = "") -> dict[str, bytes
                 time.sleep(0.05)
     _, err = proc.communicate(timeout=120)
     assert proc.returncode == 0, err
+    if client:  # only a commanding client may change a setting (`catabot set`)
+        assert [r.ok is not None for r in replies] == ([True] if client == "autopilot" else [])
     return files_of(only_run_dir(out))
 
 
@@ -111,3 +115,4 @@ def test_a_commanding_client_commands(tmp_path: Path, profile: tuple[Path, str])
     files = _run(tmp_path, folder, "autopilot", "autopilot")
     rows = files["vessel.ego.cmd.thrust.csv"].decode().splitlines()
     assert len(rows) > 1 and rows[1].endswith(",1,-1")
+    assert files["config.changes.csv"].decode().splitlines()[1].endswith(",rain,50.0")
