@@ -9,6 +9,7 @@ import shutil
 import time
 from collections.abc import Iterator
 from pathlib import Path
+from typing import Any
 
 import pytest
 from conftest import catabot, files_of, only_run_dir, scenario_file, start, wait_for_line
@@ -53,9 +54,9 @@ def _run(tmp: Path, folder: Path, tag: str, client: str = "") -> dict[str, bytes
     if client:
         conn = Connection(mode="client", file=str(folder / f"{client}.json5"))
         with open_session(conn) as session:
-            time.sleep(2.0)  # the run is going by now
-            change = json.dumps({"key": "rain", "value": 50})
-            replies = list(session.get(KEYS.config("set"), payload=change, timeout=3.0))
+            started = time.monotonic()
+            replies = _set_rain(session, patient=client == "autopilot")
+            time.sleep(max(2.0 - (time.monotonic() - started), 0.0))  # the run is going by now
             for k in range(20):
                 run = "0" * 12
                 session.put(KEYS.tick(), codec.encode(Tick(run, k, k * 10**7, 10**7, (), 20)))
@@ -68,6 +69,20 @@ def _run(tmp: Path, folder: Path, tag: str, client: str = "") -> dict[str, bytes
     if client:  # only a commanding client may change a setting (`catabot set`)
         assert [r.ok is not None for r in replies] == ([True] if client == "autopilot" else [])
     return files_of(only_run_dir(out))
+
+
+def _set_rain(session: Any, *, patient: bool) -> list[Any]:
+    """`catabot set rain 50` as a client does it; `patient`: until the conductor's desk
+    answers (a query nobody can answer yet returns at once, with nothing)."""
+    change = json.dumps({"key": "rain", "value": 50})
+    limit = time.monotonic() + (15.0 if patient else 0.0)
+    if not patient:
+        time.sleep(1.5)  # the desk is up: a refusal is the access control's, not the timing's
+    while True:
+        replies = list(session.get(KEYS.config("set"), payload=change, timeout=2.0))
+        if replies or time.monotonic() > limit:
+            return replies
+        time.sleep(0.1)
 
 
 @pytest.mark.parametrize("login", [None, {"user": "viewer", "password": "guessed"}])

@@ -41,34 +41,36 @@ def _wait_ticking(endpoint: str) -> None:
 
 def _set(endpoint: str) -> int:
     """`catabot set rain 25`; the tick it takes effect at."""
-    done = catabot("set", "rain", "25", "-e", endpoint, "--mode", "client")
+    done = catabot("set", "rain", "25", "-e", endpoint, "--mode", "client", "--timeout", "20")
     assert done.returncode == 0, done.stderr
     match = re.search(r"rain = 25\.0 from tick (\d+)", done.stdout)
     assert match, done.stdout
     return int(match.group(1))
 
 
-def _refusals(endpoint: str) -> None:
-    flags = ("-e", endpoint, "--mode", "client")
-    bad_key = catabot("set", "snow", "3", *flags)
-    assert bad_key.returncode == 2 and "Traceback" not in bad_key.stderr
-    assert "unknown setting 'snow'" in bad_key.stderr and "rain" in bad_key.stderr
-    assert "sensor.ego.lidar.enabled" in bad_key.stderr  # the keys this run offers
-    bad_value = catabot("set", "rain", "80", *flags)
-    assert bad_value.returncode == 2 and "Traceback" not in bad_value.stderr
-    assert "from 0 to 50" in bad_value.stderr, bad_value.stderr
-
-
-def _snapshot(endpoint: str, png: Path) -> None:
-    """The Space key: the camera's next colour image as a PNG; `get` shows the new rain."""
-    flags = ("-e", endpoint, "--mode", "client")
-    shot = catabot("snapshot", "-o", str(png), *flags)
-    assert shot.returncode == 0, shot.stderr
-    assert "ego/cam" in shot.stdout
+def _while_it_runs(endpoint: str, png: Path) -> None:
+    """At once, while the run goes on: a bad key and a bad value (exit 2 naming what is
+    allowed), the Space key (the camera's next colour image as a PNG), and `get rain`."""
+    flags = ("-e", endpoint, "--mode", "client", "--timeout", "20")
+    calls = {
+        "key": start("set", "snow", "3", *flags),
+        "value": start("set", "rain", "80", *flags),
+        "shot": start("snapshot", "-o", str(png), *flags),
+        "get": start("get", "rain", *flags),
+    }
+    done = {name: (proc.communicate(timeout=60), proc.returncode) for name, proc in calls.items()}
+    (_, err), code = done["key"]
+    assert code == 2 and "Traceback" not in err
+    assert "unknown setting 'snow'" in err and "rain" in err
+    assert "sensor.ego.lidar.enabled" in err  # the keys this run offers
+    (_, err), code = done["value"]
+    assert code == 2 and "Traceback" not in err and "from 0 to 50" in err, err
+    (out, err), code = done["shot"]
+    assert code == 0 and "ego/cam" in out, err
     with Image.open(png) as image:
         assert image.size == (64, 48) and image.mode == "RGB"
-    got = catabot("get", "rain", *flags)
-    assert got.returncode == 0 and got.stdout.strip() == "25.0", got.stderr
+    (out, err), code = done["get"]
+    assert code == 0 and out.strip() == "25.0", err
 
 
 def test_no_simulation_is_a_clear_error(tmp_path: Path) -> None:
@@ -88,9 +90,8 @@ def test_set_rain_mid_run_is_recorded_and_replays_to_the_same_bytes(tmp_path: Pa
                 "--listen", endpoint)  # fmt: skip
     try:
         _wait_ticking(endpoint)
-        _refusals(endpoint)  # while it runs, and it runs on
         effect = _set(endpoint)
-        _snapshot(endpoint, tmp_path / "snap.png")
+        _while_it_runs(endpoint, tmp_path / "snap.png")
         _, stderr = run.communicate(timeout=120)
     finally:
         run.kill()
