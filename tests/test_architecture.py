@@ -15,8 +15,13 @@ LAYERS = {  # what each part of the library may import from the project, besides
     "catabot.config": {"catabot.errors", "catabot.bus"},
     "catabot.world": {"catabot.errors", "catabot.bus", "catabot.config"},
     "catabot.ros2": {"catabot.errors", "catabot.bus", "catabot.config", "catabot.world"},
-    "catabot.run": {"catabot.errors", "catabot.bus", "catabot.config", "catabot.world",
-                    "catabot.ros2"},  # fmt: skip
+    "catabot.run": {
+        "catabot.errors",
+        "catabot.bus",
+        "catabot.config",
+        "catabot.world",
+        "catabot.ros2",
+    },
 }
 PROJECT = ("catabot", "services")
 

@@ -67,7 +67,21 @@ def prepare(opts: RunOptions) -> World:
     for name in world.services:
         if name not in SERVICE_MODULES:
             raise LaunchError(f"scenario needs service {name!r}, which this version does not have")
+    _check_logins(opts, world)
     return world
+
+
+def _check_logins(opts: RunOptions, world: World) -> None:
+    """In the secure profile every process needs its own login file."""
+    if opts.zenoh_configs is None:
+        return
+    names = [CONDUCTOR, *world.services, *(["viewer"] if opts.view else [])]
+    missing = [n for n in names if not (opts.zenoh_configs / f"{n}.json5").is_file()]
+    if missing:
+        raise LaunchError(
+            f"secure profile {opts.zenoh_configs} has no login for {', '.join(missing)} (the ROS "
+            "gateway is not in the secure profile; otherwise make it with catabot secure init)"
+        )
 
 
 def make_run_dir(out: Path, scenario: Scenario) -> Path:

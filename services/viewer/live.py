@@ -109,9 +109,12 @@ class LiveView:
                 f: Any = msg
                 logger.camera(sensor, f.stamp_ns, f.color, f.segmentation, f.boxes)
             return
-        for sample in _all(sub, lambda p, _k: codec.decode(p, cls)):
-            (logger.radar if kind == "radar" else logger.imu)(sensor, sample)
-            self.shown[name] += 1
+        samples = _all(sub, lambda p, _k: codec.decode(p, cls))
+        self.shown[name] += len(samples)
+        if kind == "imu":
+            logger.imu(sensor, samples)
+        for sweep in samples if kind == "radar" else []:
+            logger.radar(sensor, sweep)
 
     def _real_time_factor(self, logger: RunLogger, stamp_ns: int) -> None:
         now = time.monotonic()

@@ -41,8 +41,7 @@ def _sensor(run: RecordedRun, logger: RunLogger, sensor: MountedSensor) -> None:
         for sweep in run.messages(stream, RadarSweep):
             logger.radar(sensor, sweep)
     elif kind == "imu":
-        for sample in run.imu(sensor):
-            logger.imu(sensor, sample)
+        logger.imu(sensor, list(run.imu(sensor)))
     elif kind == "camera":
         _camera(run, logger, sensor)
 

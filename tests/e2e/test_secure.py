@@ -131,3 +131,16 @@ def test_a_commanding_client_commands(tmp_path: Path, profile: tuple[Path, str])
     rows = files["vessel.ego.cmd.thrust.csv"].decode().splitlines()
     assert len(rows) > 1 and rows[1].endswith(",1,-1")
     assert files["config.changes.csv"].decode().splitlines()[1].endswith(",rain,50.0")
+
+
+def test_a_process_without_a_login_is_refused_before_anything_starts(
+    tmp_path: Path, profile: tuple[Path, str]
+) -> None:
+    folder, _ = profile
+    partial = tmp_path / "partial"
+    shutil.copytree(folder, partial)
+    (partial / "physics.json5").unlink()
+    done = catabot("run", str(_scenario(tmp_path)), "--secure", str(partial), "--out",
+                   str(tmp_path / "out"))  # fmt: skip
+    assert done.returncode == 2 and "no login for physics" in done.stderr
+    assert not (tmp_path / "out").exists()

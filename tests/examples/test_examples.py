@@ -86,7 +86,8 @@ def test_send_thrust_is_recorded_and_applied(run: type[Run]) -> None:
 
 def test_send_thrust_says_when_no_simulation_listens() -> None:
     lonely = f"tcp/127.0.0.1:{free_port()}"
-    sent = example("send_thrust.py", "--listen", lonely, "--thrust", "0.1", "0.1", timeout=30)
+    sent = example("send_thrust.py", "--listen", lonely, "--thrust", "0.1", "0.1", "--wait", "2",
+                   timeout=30)  # fmt: skip
     assert sent.returncode != 0 and "no simulation subscribes" in sent.stderr
 
 
