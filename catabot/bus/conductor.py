@@ -25,6 +25,7 @@ from catabot.bus.members import Members
 from catabot.bus.messages import Ack, End, Tick
 from catabot.bus.outputs import Outputs
 from catabot.bus.rejections import Rejected, Rejections
+from catabot.bus.settings import Schedule
 
 log = logging.getLogger("catabot.bus.conductor")
 
@@ -67,9 +68,16 @@ class RunResult:
 
 class Conductor:
     def __init__(
-        self, session: zenoh.Session, keys: Keys, spec: ClockSpec, *, roster: Roster | None = None
+        self,
+        session: zenoh.Session,
+        keys: Keys,
+        spec: ClockSpec,
+        *,
+        roster: Roster | None = None,
+        settings: Schedule | None = None,
     ) -> None:
         self.session, self.keys, self.spec = session, keys, spec
+        self.settings = settings if settings is not None else Schedule(ticks=spec.ticks)
         self.run_id = uuid.uuid4().hex[:12]
         self._created = time.monotonic()
         self.events: queue.SimpleQueue[tuple[str, str, bytes]] = queue.SimpleQueue()
@@ -197,7 +205,7 @@ class Conductor:
 
     def _grant(self, last: int, *, again: bool = False) -> None:
         """Publish a Tick granting every tick up to `last` (again: repeat it with a new
-        dropped list)."""
+        dropped list), with the setting changes of the ticks it adds."""
         if last <= self._granted and not again:
             return
         was_idle = self._done > self._granted
@@ -205,7 +213,8 @@ class Conductor:
         if was_idle:  # work is outstanding from now on
             self._restart_deadline()
         k, dt = self._granted, self.spec.dt_ns
-        tick = Tick(self.run_id, k, k * dt, dt, tuple(self.dropped), self.spec.ack_every)
+        changes = self.settings.grant(k)
+        tick = Tick(self.run_id, k, k * dt, dt, tuple(self.dropped), self.spec.ack_every, changes)
         self._out.publish(self.keys.tick(), tick)
 
     def _await_progress(self) -> None:

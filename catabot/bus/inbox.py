@@ -27,6 +27,7 @@ from catabot.errors import CataBotError
 
 Inputs = Mapping[str, list[Message]]
 MAX_PENDING = 10_000  # samples held while their producer's session is not yet known
+OPEN = 2**62  # an off interval not closed yet
 
 
 class Inbox:
@@ -47,6 +48,7 @@ class Inbox:
         self._clocked = [s for s in self.streams.values() if s.period is not None]
         self._holding: set[str] = set()
         self._order = {key: i for i, key in enumerate(self.streams)}  # release in stream order
+        self._off: dict[str, list[tuple[int, int]]] = {}  # [start, end) tags not produced
 
     @property
     def keys(self) -> list[str]:
@@ -111,12 +113,31 @@ class Inbox:
         """Stop waiting for streams of participants the conductor dropped."""
         self.dropped.update(names)
 
+    def switch(self, key: str, tick: int, *, on: bool) -> None:
+        """A stream's producer stops (or starts again) producing from tag `tick` on: a sensor
+        switched at run time. Every participant learns it with the Tick of `tick`, before any
+        step can need a sample tagged `tick`, so none waits for a sample never sent."""
+        spans = self._off.setdefault(key, [])
+        is_off = bool(spans) and spans[-1][1] == OPEN
+        if not on and not is_off:
+            spans.append((tick, OPEN))
+        elif on and is_off:
+            spans[-1] = (spans[-1][0], tick)
+
+    def _due(self, s: Stream, tick: int) -> int:
+        """The last tag due before `tick`, skipping tags its producer was switched off at."""
+        due = s.due_before(tick)
+        for start, end in reversed(self._off.get(s.key, ())):
+            if start <= due < end:
+                due = s.due_before(start + s.lag)
+        return due
+
     def missing(self, tick: int) -> list[str]:
         """Keys whose last sample due before `tick` has not arrived yet."""
         return [
             s.key
             for s in self._clocked
-            if s.producer not in self.dropped and self.latest[s.key] < s.due_before(tick)
+            if s.producer not in self.dropped and self.latest[s.key] < self._due(s, tick)
         ]
 
     def release(self, tick: int) -> dict[str, list[Message]]:

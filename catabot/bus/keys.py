@@ -101,6 +101,14 @@ class Keys:
     def config(self, name: str) -> str:
         return f"{self.prefix}/config/{check_name('config', name)}"
 
+    def configs(self) -> str:
+        """What the conductor's settings desk answers (catabot/run/settings_desk.py)."""
+        return f"{self.prefix}/config/**"
+
+    def config_changes(self) -> str:
+        """The recorded stream of run-time setting changes (`SettingsChange`)."""
+        return self.config("changes")
+
     def relative(self, key: str) -> str:
         """The part of a key after `catabot/<world>/`, used to name files and topics."""
         head = self.prefix + "/"

@@ -50,7 +50,8 @@ class Message:
 class Tick(Message):
     """On `clock/tick`: every tick up to `tick` may be stepped (a grant; DESIGN.md §4), and
     participants ack every `ack_every` ticks and at the grant's last tick. A service's step
-    receives one Tick per tick it steps."""
+    receives one Tick per tick it steps. `settings`: setting changes in the ticks the grant
+    adds; a step's Tick carries those of its tick, applied first (catabot/bus/settings.py)."""
 
     TYPE: ClassVar[str] = "tick"
     run: str
@@ -59,6 +60,7 @@ class Tick(Message):
     dt_ns: int
     dropped: tuple[str, ...] = ()
     ack_every: int = 1
+    settings: tuple[str, ...] = ()
 
 
 @dataclass(frozen=True)
@@ -77,6 +79,17 @@ class End(Message):
     tick: int
     reason: str
     error: str = ""
+
+
+@dataclass(frozen=True)
+class SettingsChange(Message):
+    """Recorded on `config/changes`: a setting (JSON text) in effect from the start of `tick`."""
+
+    TYPE: ClassVar[str] = "settings_change"
+    tick: int
+    stamp_ns: int
+    key: str = field(metadata={"unit": ""})
+    value: str = field(metadata={"unit": ""})
 
 
 @dataclass(frozen=True)
@@ -321,6 +334,7 @@ MESSAGE_TYPES: dict[str, type[Message]] = {
         Tick,
         Ack,
         End,
+        SettingsChange,
         VesselState,
         BodyStates,
         ThrustCmd,

@@ -30,6 +30,7 @@ from catabot.bus.members import Members
 from catabot.bus.messages import Ack, End, Tick
 from catabot.bus.outputs import Outputs
 from catabot.bus.rejections import Rejected, Rejections
+from catabot.bus.settings import from_wire
 
 log = logging.getLogger("catabot.bus.participant")
 ORPHAN_GRACE_S = 0.5
@@ -64,6 +65,7 @@ class Participant(Outputs):
         self.drain_s = drain_s
         self.next_tick = 0
         self._grant: Tick | None = None
+        self._settings: dict[int, list[str]] = {}  # changes granted, by the tick they apply
         self._held_clock: list[Event] = []  # until the conductor's session is known
         self._waiting_since = time.monotonic()  # for the warning about a long wait
         self.events: queue.SimpleQueue[Event] = queue.SimpleQueue()
@@ -130,10 +132,10 @@ class Participant(Outputs):
                 self.put(self._ack, codec.encode(Ack(grant.run, k)))
             self._waiting_since = time.monotonic()
 
-    @staticmethod
-    def _tick_of(grant: Tick, k: int) -> Tick:
+    def _tick_of(self, grant: Tick, k: int) -> Tick:
         stamp = grant.stamp_ns - (grant.tick - k) * grant.dt_ns
-        return Tick(grant.run, k, stamp, grant.dt_ns, grant.dropped, grant.ack_every)
+        changes = tuple(self._settings.pop(k, ()))
+        return Tick(grant.run, k, stamp, grant.dt_ns, grant.dropped, grant.ack_every, changes)
 
     def _next(self) -> Event:
         """The next event; an End may trail the conductor's token, so allow it a grace."""
@@ -205,6 +207,8 @@ class Participant(Outputs):
         if problem:
             raise Rejected("tick the clock cannot send", problem)
         self.run_id = tick.run
+        for text in tick.settings:
+            self._settings.setdefault(from_wire(text).tick, []).append(text)
         self.inbox.drop_producers(tick.dropped)
         self.peers -= set(tick.dropped)  # a dropped peer that crashed will never be present
         if self._grant is None or self.next_tick > self._grant.tick:
@@ -220,7 +224,21 @@ class Participant(Outputs):
         if tick.ack_every < 1:
             return f"ack_every {tick.ack_every}"
         unknown = set(tick.dropped) - self._everyone
-        return f"drops unknown participants {sorted(unknown)}" if unknown else ""
+        if unknown:
+            return f"drops unknown participants {sorted(unknown)}"
+        return self._settings_problem(tick, grant)
+
+    def _settings_problem(self, tick: Tick, grant: int) -> str:
+        """A grant's changes must fall in the ticks it adds: one for a tick already granted
+        could reach a participant that has stepped it, and the run would fork."""
+        for text in tick.settings:
+            try:
+                at = from_wire(text).tick
+            except ValueError as exc:
+                return str(exc)
+            if not max(grant, self.next_tick - 1) < at <= tick.tick:
+                return f"a setting change at tick {at} outside the grant's {grant + 1}..{tick.tick}"
+        return ""
 
     def _checked_end(self, end: End) -> End:
         if self.run_id and end.run != self.run_id:

@@ -31,6 +31,7 @@ from catabot.config.base import (
     unique,
 )
 from catabot.config.environment import CurrentConfig, RainConfig, WindConfig
+from catabot.config.live import SettingChange, check_timeline
 from catabot.config.ros import GATEWAY, RosConfig, check_ros
 from catabot.config.sensors import SENSOR_TYPES
 from catabot.config.terrain import TerrainConfig
@@ -206,6 +207,9 @@ class Scenario(Strict):
     traffic: TrafficConfig = TrafficConfig()
     recording: RecordingConfig = RecordingConfig()
     ros: RosConfig | None = Field(None, description="the ROS 2 gateway (services/ros)")
+    settings: list[SettingChange] = Field(
+        [], description="run-time setting changes by time (catabot/config/live.py; catabot set)"
+    )
 
     @field_validator("vessels")
     @classmethod
@@ -228,6 +232,11 @@ class Scenario(Strict):
                 raise FieldProblem("recording.export", f"{fmt!r} needs a {need} on a vessel")
             if need == "camera" and not rec.dataset:
                 raise FieldProblem("recording.export", f"{fmt!r} needs recording.dataset: true")
+        return self
+
+    @model_validator(mode="after")
+    def _settings_timeline(self) -> Scenario:
+        check_timeline(self)
         return self
 
     @property

@@ -14,7 +14,7 @@ from pathlib import Path
 from catabot.bus.session import Connection, SessionError, add_connection_args, open_session
 from catabot.config.load import json_schema, load_scenario
 from catabot.errors import CataBotError
-from catabot.run import conduct, launcher, secure
+from catabot.run import conduct, launcher, secure, settings_cli
 from catabot.run.companions import VIEW_MODES
 from catabot.run.generate import add_arguments as add_generate_arguments
 from catabot.run.generate import generate
@@ -75,6 +75,11 @@ TOOLS = {  # `catabot <tool> ...`: programs over a run folder, each in its own s
     "view": ("services.viewer.cli", "replay a run or attach to one in the rerun viewer"),
     "dataset": ("services.datasets.cli", "export a run as a YOLO, COCO or KITTI dataset"),
     "plot": ("services.plots.cli", "plot a run: PNG figures and report.html"),
+}
+LIVE = {  # `catabot <command> ...` against a running simulation (its own flags and --help)
+    "get": (settings_cli.get_main, "the settings of a running simulation"),
+    "set": (settings_cli.set_main, "change a setting of a running simulation (rain, wind, ...)"),
+    "snapshot": (settings_cli.snapshot_main, "save a camera's next colour image as PNG"),
 }
 
 
@@ -179,7 +184,7 @@ def parser() -> argparse.ArgumentParser:
     scen.add_argument("file", nargs="?", help="scenario to validate")
     scen.add_argument("--output", "-o", help="write the schema (or generated scenario) here")
     add_generate_arguments(scen)
-    for name, (_, text) in TOOLS.items():
+    for name, (_, text) in [*TOOLS.items(), *LIVE.items()]:
         sub.add_parser(name, help=text, add_help=False)
     return p
 
@@ -190,6 +195,8 @@ def main(argv: list[str] | None = None) -> int:
         return _service(args, rest)
     if args.command in TOOLS:
         return _tool(args, rest)
+    if args.command in LIVE:
+        return LIVE[args.command][0](rest)
     if rest:
         parser().error(f"unrecognized arguments: {' '.join(rest)}")
     handlers = {"run": _run, "router": _router, "scenario": _scenario, "secure": _secure}

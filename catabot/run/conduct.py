@@ -24,10 +24,13 @@ from catabot.bus.session import (
     connection_from_args,
     open_session,
 )
+from catabot.bus.settings import Schedule
+from catabot.config import live
 from catabot.config.load import load_scenario
 from catabot.config.scenario import Scenario, participants
 from catabot.errors import CataBotError
 from catabot.run.service import quiet_gc
+from catabot.run.settings_desk import SettingsDesk
 
 log = logging.getLogger("catabot.bus.conductor")
 
@@ -83,7 +86,11 @@ def main(argv: list[str] | None = None) -> int:
     except CataBotError as exc:
         emit("result", ticks=0, wall_s=0.0, error=str(exc), dropped=[])
         return 2
-    conductor = Conductor(session, Keys(scenario.name), clock_spec(scenario), roster=args.roster)
+    keys, schedule = Keys(scenario.name), Schedule(live.timeline(scenario), ticks=scenario.ticks)
+    conductor = Conductor(
+        session, keys, clock_spec(scenario), roster=args.roster, settings=schedule
+    )
+    desk = SettingsDesk(session, keys, scenario, schedule)
     quiet_gc()
     for sig in (signal.SIGINT, signal.SIGTERM):
         signal.signal(sig, lambda *_: conductor.stop("interrupted"))
@@ -96,8 +103,11 @@ def main(argv: list[str] | None = None) -> int:
             conductor.stop("interrupted")
 
     result = conductor.run(progress)
+    desk.close()
     stop.set()
-    emit("result", **asdict(result), rejected=dict(conductor.rejections.totals))
+    rejected = conductor.rejections.totals + desk.rejections.totals
+    settings = [live.entry(c, scenario.dt_ns) for c in schedule.applied()]
+    emit("result", **asdict(result), rejected=dict(rejected), settings=settings)
     if result.error:
         log.error("run ended by a fault: %s", result.error)
     conductor.close()

@@ -202,6 +202,7 @@ def _watch(scenario: Scenario, run_dir: Path, supervisor: Supervisor, *, quiet: 
     result, cause = dict(supervisor.result), supervisor.cause()
     if cause:
         result["error"] = cause
+    record_settings(scenario, run_dir, result.get("settings"))
     codes = {n: c.proc.returncode for n, c in supervisor.services.items()}
     if int(result.get("ticks_done", 0)) > 0:  # type: ignore[call-overload]
         codes |= after_run(scenario, run_dir)  # run.rrd and dataset exports, from the files
@@ -213,3 +214,17 @@ def _watch(scenario: Scenario, run_dir: Path, supervisor: Supervisor, *, quiet: 
         codes,
         stopped=supervisor.stopped,
     )
+
+
+def record_settings(scenario: Scenario, run_dir: Path, applied: object) -> None:
+    """The run folder's scenario.json gets the settings timeline the run applied (the
+    scenario's own and every `catabot set`, at the ticks they took effect), so running it
+    again replays the same changes and records the same bytes. Untouched without changes."""
+    if not isinstance(applied, list) or applied == scenario.model_dump(mode="json")["settings"]:
+        return
+    data = scenario.model_dump(mode="json") | {"settings": applied}
+    try:
+        resolved = parse_scenario(data, source="the run's settings")
+        (run_dir / "scenario.json").write_text(resolved.model_dump_json(indent=2) + "\n")
+    except (CataBotError, OSError) as exc:
+        print(f"catabot run: the settings timeline was not recorded: {exc}", file=sys.stderr)

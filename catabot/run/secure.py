@@ -39,7 +39,9 @@ OWN = {  # keys each process may put besides its ack and its liveliness token
     "recorder": [],
 }
 COMMANDS = ["vessel/*/cmd/**"]
-READ = ["declare_subscriber", "declare_liveliness_subscriber", "liveliness_query", "query"]
+READ = ["declare_subscriber", "declare_liveliness_subscriber", "liveliness_query"]
+ASK = ["catabot/*/config/settings"]  # everyone may read the settings (`catabot get`)
+SET = ["catabot/*/config/set"]  # commanding clients may change them (`catabot set`)
 
 
 class SecureError(CataBotError, RuntimeError):
@@ -126,10 +128,21 @@ def _acl(writers: list[str], clients: list[str], observers: list[str]) -> dict[s
     everyone = [*writers, *observers]
     rules: list[dict[str, Any]] = [
         _rule("read", READ, ["ingress", "egress"], ["catabot/**"]),
-        _rule("receive", ["put", "delete", "liveliness_token"], ["egress"], ["catabot/**"]),
+        _rule("receive", ["put", "delete", "liveliness_token", "reply"], ["egress"],
+              ["catabot/**"]),
+        _rule("ask", ["query"], ["ingress"], ASK),
+        _rule("set", ["query"], ["ingress"], SET),
+        _rule("desk", ["declare_queryable", "query", "reply"], ["ingress", "egress"],
+              ["catabot/*/config/**"]),
+    ]  # fmt: skip
+    policies = [
+        {"rules": ["read", "receive", "ask"], "subjects": ["everyone"]},
+        {"rules": ["desk"], "subjects": [CONDUCTOR]},
     ]
-    policies = [{"rules": ["read", "receive"], "subjects": ["everyone"]}]
     subjects = [{"id": "everyone", "usernames": everyone}]
+    if clients:
+        subjects.append({"id": "clients", "usernames": clients})
+        policies.append({"rules": ["set"], "subjects": ["clients"]})
     for name in writers:
         keys = [*OWN.get(name, COMMANDS if name in clients else []), f"clock/ack/{name}"]
         rules.append(_rule(f"{name}-puts", ["put"], ["ingress"], [f"catabot/*/{k}" for k in keys]))

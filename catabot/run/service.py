@@ -25,8 +25,9 @@ import zenoh
 from catabot.bus.blas import single_thread_blas
 from catabot.bus.clock import ClockError, Stream
 from catabot.bus.identity import Roster, add_roster_args
+from catabot.bus.inbox import Inbox, Inputs
 from catabot.bus.keys import Keys
-from catabot.bus.messages import End
+from catabot.bus.messages import End, Tick
 from catabot.bus.participant import EndFn, Participant, StepFn
 from catabot.bus.rejections import Rejections
 from catabot.bus.scheduling import batch_scheduling
@@ -35,6 +36,8 @@ from catabot.bus.session import (
     connection_from_args,
     open_session,
 )
+from catabot.bus.settings import changes_of
+from catabot.config import live
 from catabot.config.load import load_scenario
 from catabot.config.scenario import Scenario
 from catabot.errors import CataBotError
@@ -165,9 +168,30 @@ def run_service(
         session.close()
 
 
+def with_switches(ctx: ServiceContext, runner: Runner, step: StepFn) -> StepFn:
+    """`step`, first telling the inbox of sensors switched off or on at this tick (`catabot
+    set sensor.<vessel>.<sensor>.enabled`), so a consumer of a sensor that is off does not
+    wait for its samples; every service gets this, whatever it reads."""
+    inbox = getattr(runner, "inbox", None)
+    specs = live.keys_of(ctx.scenario).items()
+    streams = {k: ctx.keys.sensor(s.owner, s.name) for k, s in specs if s.kind == "enabled"}
+    if not isinstance(inbox, Inbox) or not set(streams.values()) & set(inbox.streams):
+        return step
+
+    def switched(tick: Tick, inputs: Inputs) -> None:
+        for change in changes_of(tick.settings):
+            key = streams.get(change.key)
+            if key is not None and key in inbox.streams:
+                inbox.switch(key, tick.tick, on=bool(change.decoded))
+        step(tick, inputs)
+
+    return switched
+
+
 def _serve(ctx: ServiceContext, build: BuildFn) -> int:
     try:
         participant, step, on_end = build(ctx)
+        step = with_switches(ctx, participant, step)
         quiet_gc()
         cpu_start = time.process_time()
         end = _profiled(ctx.name, ctx.run_dir, lambda: participant.run(step, on_end))

@@ -48,6 +48,13 @@ class EnvironmentLoads:
         self.mooring_n_per_m = float(mooring_n_per_m)
         self._zero_current = np.zeros((n, 3))
 
+    def set_uniform_current(self, velocity_mps: tuple[float, float]) -> None:
+        """A run-time change of the uniform current (`catabot set current`); a map stays."""
+        if self.current is None:
+            self.current = CurrentField(velocity_mps)
+        else:
+            self.current.uniform = np.array(velocity_mps, dtype=np.float64)
+
     def current_world(self, pos: Array) -> Array:
         """The steady current at each body origin, world frame (N, 3); zeros without one."""
         if self.current is None:

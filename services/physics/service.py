@@ -14,7 +14,10 @@ import numpy as np
 
 from catabot.bus.inbox import Inputs
 from catabot.bus.messages import BodyStates, Message, Tick, TwistBatch, VesselState
+from catabot.bus.settings import changes_of
+from catabot.config import live
 from catabot.run.service import Built, ServiceContext, run_service
+from services.physics import settings
 from services.physics.commands import CommandBook
 from services.physics.control import TwistControllerBank
 from services.physics.setup import build_world
@@ -49,9 +52,12 @@ class PhysicsService:
         self.streams += streams.twist_batches(lag=delay)
         self.body_ids = world.body_ids
         self.state_keys = [s.key for s in streams.vessel_states]
+        self.scenario, self.specs = world.scenario, live.keys_of(world.scenario)
         self.participant = ctx.participant(self.streams)
 
     def step(self, tick: Tick, inputs: Inputs) -> None:
+        for change in changes_of(tick.settings):
+            settings.apply(self.world, self.scenario, self.specs, change)
         for key, msgs in inputs.items():
             if key == self.twists_key:
                 self._take_twists(msgs[-1])

@@ -137,6 +137,15 @@ class PhysicsWorld:
         return self._steps * self._dt
 
     @property
+    def loads(self) -> EnvironmentLoads:
+        """The wind and current loads (run-time settings change them)."""
+        return self._loads
+
+    def set_waves(self, waves: WaveField) -> None:
+        """A run-time change of the sea (`catabot set waves`), from the next step on."""
+        self._surface, self._waves = waves.height, waves
+
+    @property
     def vessel_ids(self) -> list[str]:
         return self._ids[: self._n_vessels]
 

@@ -7,6 +7,7 @@ gives the same page every time it is plotted.
 from __future__ import annotations
 
 import html
+import json
 from pathlib import Path
 from typing import Any
 
@@ -38,6 +39,8 @@ def summary(data: RunSeries) -> list[tuple[str, Any]]:
         ("buoys", len(world.buoys)), ("sensors", sensors),
         ("rain", f"{s.rain.rate_mm_h:g} mm/h"), ("waves", waves),
         ("terrain", "none" if world.terrain is None else Path(world.terrain.name).name),
+        ("settings changed", "; ".join(f"{c.key} = {json.dumps(c.value)} at {c.t_s:g} s"
+                                       for c in s.settings) or "none"),
     ]  # fmt: skip
 
 

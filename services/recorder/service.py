@@ -16,7 +16,8 @@ from collections.abc import Callable
 from typing import Any
 
 from catabot.bus.inbox import Inputs
-from catabot.bus.messages import BodyStates, End, Message, Tick, TwistBatch
+from catabot.bus.messages import BodyStates, End, Message, SettingsChange, Tick, TwistBatch
+from catabot.bus.settings import changes_of
 from catabot.ros2.convert import Converter
 from catabot.run.service import Built, ServiceContext, run_service
 from services.recorder.batches import BatchFormatter, Block
@@ -44,6 +45,7 @@ class Recorder:
         self.metrics = Metrics([v.id for v in world.vessels])
         self.run_dir = ctx.run_dir
         self._flushed_at = 0.0
+        self.changes_stream = self.keys.relative(self.keys.config_changes())
         self.participant = ctx.participant(streams)
 
     def step(self, tick: Tick, inputs: Inputs) -> None:
@@ -57,6 +59,9 @@ class Recorder:
                     self._write_block(stream, msg, self.batches.twists)
                 else:
                     self._write(stream, _stamped(msg, tick))
+        for change in changes_of(tick.settings):  # what took effect at this tick: an input
+            record = SettingsChange(tick.tick, tick.stamp_ns, change.key, change.value)
+            self._write(self.changes_stream, record)
         self._flush()
 
     def _write_block(self, stream: str, msg: Any, formatter: Callable[[Any], Block]) -> bool:

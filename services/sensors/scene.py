@@ -132,6 +132,11 @@ class Scene:
         self.time_s = 0.0
         self._posed: tuple[F64, F64] | None = None  # (centres, corners) of the poses now
 
+    def set_waves(self, waves: WaveField) -> None:
+        """A run-time change of the sea (`catabot set waves`): the surface rays hit."""
+        self._waves = waves
+        self._amplitude = float(np.sum(waves.amplitudes_m))
+
     def update(
         self, poses: Mapping[str, tuple[Sequence[float], Sequence[float]]], time_s: float
     ) -> None:

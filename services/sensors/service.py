@@ -14,12 +14,14 @@ from dataclasses import dataclass
 
 from catabot.bus.inbox import Inputs
 from catabot.bus.messages import BodyStates, Message, Tick, VesselState
+from catabot.bus.settings import changes_of
 from catabot.config.sensors import SENSOR_TYPES
 from catabot.run.service import Built, ServiceContext, run_service
 from catabot.world.waves import WaveField
 from catabot.world.world import World
 from services.sensors.registry import Sensor, build_sensor
 from services.sensors.scene import Body, Scene
+from services.sensors.settings import SensorSettings
 
 
 @dataclass
@@ -50,13 +52,18 @@ class SensorsService:
         self.batch = world.start_states()
         self.states = self._carriers(self.batch)
         self.states_key = ctx.keys.world_states()
+        self.settings = SensorSettings(ctx.scenario, self.scene, ctx.keys.sensor)
+        self.models = {m.key: m.sensor for m in self.mounted}
         self.participant = ctx.participant([world.streams.states])
 
     def step(self, tick: Tick, inputs: Inputs) -> None:
+        for change in changes_of(tick.settings):
+            self.settings.apply(change, self.models)
         batches = inputs.get(self.states_key)
         if batches:
             self._take(batches[-1])
-        due = [m for m in self.mounted if tick.tick % m.period == 0]
+        off = self.settings.off
+        due = [m for m in self.mounted if tick.tick % m.period == 0 and m.key not in off]
         if any(m.casts for m in due):
             self._pose_scene(tick)
         for m in due:

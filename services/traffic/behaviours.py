@@ -9,11 +9,13 @@ One NumPy pass per tick for 100-500 boats; the per-boat work is only index bookk
 
 from __future__ import annotations
 
+import math
 from collections.abc import Sequence
 
 import numpy as np
 from numpy.typing import NDArray
 
+from catabot.config.traffic import TrafficConfig
 from catabot.world.traffic_plan import Boat
 
 Array = NDArray[np.float64]
@@ -26,6 +28,7 @@ CIRCLE_LOOKAHEAD_M = 8.0  # radial error at which the correction reaches 45 degr
 # fed forward: 1.0 left a limit cycle with set-points held 0.1 s (a 10 Hz guidance rate).
 CIRCLE_GAIN = 0.5
 HOLD_RADIUS_M = 3.0  # closer than this, hold the heading instead of turning to the point
+PATROL_M = 100.0  # a boat set to waypoints with no path patrols this far ahead and back
 
 
 def wrap(angle: Array) -> Array:
@@ -129,6 +132,28 @@ class Behaviours:
         self.kind[i], self.speed[i] = KINDS[b.behaviour], b.speed_mps
         self.tol[i], self.loop[i] = b.tolerance_m, b.loop
         self._store_path(i, np.array(b.path, dtype=np.float64).reshape(-1, 2))
+
+    def set_behaviour(
+        self, i: int, behaviour: str, here: Array, yaw: float, cfg: TrafficConfig
+    ) -> None:
+        """Boat i changes behaviour at run time (`catabot set traffic.<boat>.behaviour`), from
+        where it is (`here`, `yaw`): hold there; circle from here at the scenario's speed, on its
+        own circle's radius (else the smallest drawn) and sense; follow its path, else the
+        scenario's points, else back and forth between here and `PATROL_M` ahead."""
+        boat, x, y = self.boats[i], float(here[0]), float(here[1])
+        if behaviour == "hold":
+            self.kind[i], self.speed[i], self.hold_yaw[i] = HOLD, cfg.hold.max_speed_mps, yaw
+            self.centre[i] = (x, y)
+        elif behaviour == "circle":
+            r = boat.radius_m if boat.radius_m >= 1.0 else cfg.circle.radius_m[0]
+            d = self.direction[i]
+            self.kind[i], self.speed[i], self.radius[i] = CIRCLE, cfg.circle.speed_mps, r
+            self.centre[i] = (x - d * r * math.sin(yaw), y + d * r * math.cos(yaw))
+        else:
+            ahead = (x + PATROL_M * math.cos(yaw), y + PATROL_M * math.sin(yaw))
+            path = boat.path or cfg.waypoints.points or [(x, y), ahead]
+            w = cfg.waypoints
+            self.set_path(i, np.array(path), w.speed_mps, loop=w.mode == "loop", tol=w.tolerance_m)
 
     def command(self, pos: Array, yaw: Array, velocity_b: Array) -> tuple[Array, Array]:
         """Set-points for every boat: pos (N, 2) m, yaw (N,), body velocity (N, >=2)."""

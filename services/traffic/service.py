@@ -19,6 +19,8 @@ import numpy as np
 
 from catabot.bus.inbox import Inputs
 from catabot.bus.messages import BodyStates, Message, Tick, TwistBatch, WaypointsCmd
+from catabot.bus.settings import changes_of
+from catabot.config import live
 from catabot.config.scenario import guidance_period_ticks
 from catabot.run.service import Built, ServiceContext, run_service
 from catabot.world import rotations
@@ -42,6 +44,7 @@ class TrafficService:
         waypoints = [s for s in world.streams.waypoints if ctx.keys.vessel_of(s.key) in self.row]
         self.twists_key = ctx.keys.world_twists()
         self.period = guidance_period_ticks(ctx.scenario)
+        self.traffic, self.specs = ctx.scenario.traffic, live.keys_of(ctx.scenario)
         self.participant = ctx.participant([world.streams.states, *waypoints])
 
     def step(self, tick: Tick, inputs: Inputs) -> None:
@@ -55,6 +58,8 @@ class TrafficService:
             for msg in msgs:
                 if isinstance(msg, WaypointsCmd):
                     self._take_waypoints(i, msg)
+        for change in changes_of(tick.settings):
+            self._take_setting(change.key, change.decoded)
         if guide:
             self._guide(tick)
 
@@ -70,6 +75,15 @@ class TrafficService:
         self.pos = batch.position[rows, :2].copy()
         self.yaw = rotations.yaw_of_quaternions(batch.orientation[rows])
         self.vel = batch.linear_velocity[rows, :2].copy()
+
+    def _take_setting(self, key: str, value: object) -> None:
+        """A boat's behaviour changed at run time, from its pose at the last guidance tick."""
+        spec = self.specs.get(key)
+        if spec is not None and spec.kind == "behaviour":
+            i = self.row[spec.owner]
+            self.behaviours.set_behaviour(
+                i, str(value), self.pos[i], float(self.yaw[i]), self.traffic
+            )
 
     def _take_waypoints(self, i: int, msg: WaypointsCmd) -> None:
         """Adopt a path from outside, or release the boat (paths are checked on arrival:

@@ -9,6 +9,7 @@ import shutil
 import time
 from collections.abc import Iterator
 from pathlib import Path
+from typing import Any
 
 import pytest
 from conftest import catabot, files_of, only_run_dir, scenario_file, start, wait_for_line
@@ -53,7 +54,9 @@ def _run(tmp: Path, folder: Path, tag: str, client: str = "") -> dict[str, bytes
     if client:
         conn = Connection(mode="client", file=str(folder / f"{client}.json5"))
         with open_session(conn) as session:
-            time.sleep(2.0)  # the run is going by now
+            started = time.monotonic()
+            replies = _set_rain(session, patient=client == "autopilot")
+            time.sleep(max(2.0 - (time.monotonic() - started), 0.0))  # the run is going by now
             for k in range(20):
                 run = "0" * 12
                 session.put(KEYS.tick(), codec.encode(Tick(run, k, k * 10**7, 10**7, (), 20)))
@@ -63,7 +66,23 @@ def _run(tmp: Path, folder: Path, tag: str, client: str = "") -> dict[str, bytes
                 time.sleep(0.05)
     _, err = proc.communicate(timeout=120)
     assert proc.returncode == 0, err
+    if client:  # only a commanding client may change a setting (`catabot set`)
+        assert [r.ok is not None for r in replies] == ([True] if client == "autopilot" else [])
     return files_of(only_run_dir(out))
+
+
+def _set_rain(session: Any, *, patient: bool) -> list[Any]:
+    """`catabot set rain 50` as a client does it; `patient`: until the conductor's desk
+    answers (a query nobody can answer yet returns at once, with nothing)."""
+    change = json.dumps({"key": "rain", "value": 50})
+    limit = time.monotonic() + (15.0 if patient else 0.0)
+    if not patient:
+        time.sleep(1.5)  # the desk is up: a refusal is the access control's, not the timing's
+    while True:
+        replies = list(session.get(KEYS.config("set"), payload=change, timeout=2.0))
+        if replies or time.monotonic() > limit:
+            return replies
+        time.sleep(0.1)
 
 
 @pytest.mark.parametrize("login", [None, {"user": "viewer", "password": "guessed"}])
@@ -111,6 +130,7 @@ def test_a_commanding_client_commands(tmp_path: Path, profile: tuple[Path, str])
     files = _run(tmp_path, folder, "autopilot", "autopilot")
     rows = files["vessel.ego.cmd.thrust.csv"].decode().splitlines()
     assert len(rows) > 1 and rows[1].endswith(",1,-1")
+    assert files["config.changes.csv"].decode().splitlines()[1].endswith(",rain,50.0")
 
 
 def test_a_process_without_a_login_is_refused_before_anything_starts(

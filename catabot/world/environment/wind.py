@@ -51,6 +51,16 @@ class WindField:
         self.gust = self.gust_std * self._rng.standard_normal(len(sources))
         self._phi_dt = (math.nan, 0.0, 0.0)  # (dt, phi, sqrt(1 - phi^2)) cache
 
+    def set_global(
+        self, *, speed_mps: float | None = None, toward_rad: float | None = None
+    ) -> None:
+        """A run-time change of the global mean wind (`catabot set wind.*`); its gust process
+        goes on as it was, so the random stream is the same with or without the change."""
+        if speed_mps is not None:
+            self.mean_speed[0] = speed_mps
+        if toward_rad is not None:
+            self.direction[0] = (math.cos(toward_rad), math.sin(toward_rad))
+
     @property
     def is_calm(self) -> bool:
         """True when no source can ever blow (lets the physics skip the wind entirely)."""

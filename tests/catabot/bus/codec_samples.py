@@ -18,6 +18,7 @@ from catabot.bus.messages import (
     LidarScan,
     Message,
     RadarSweep,
+    SettingsChange,
     ThrustCmd,
     Tick,
     TwistBatch,
@@ -29,6 +30,7 @@ from catabot.bus.messages import (
 SAMPLES: dict[str, Message] = {
     "tick": Tick(run="3f2a9c1d0b7e", tick=41, stamp_ns=410_000_000, dt_ns=10_000_000),
     "ack": Ack(run="3f2a9c1d0b7e", tick=41),
+    "settings_change": SettingsChange(tick=500, stamp_ns=5_000_000_000, key="rain", value="25.0"),
     "end": End(
         run="3f2a9c1d0b7e",
         tick=5999,

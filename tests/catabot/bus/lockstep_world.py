@@ -24,6 +24,7 @@ from catabot.bus.keys import Keys
 from catabot.bus.messages import End, GpsFix, Tick, VesselState
 from catabot.bus.participant import Participant
 from catabot.bus.session import Connection, free_port, open_session
+from catabot.bus.settings import Schedule
 
 DT_NS = 10_000_000
 JOIN_S = 10.0  # generous bound on thread joins; a healthy test takes far less
@@ -123,10 +124,17 @@ class World:
         m = self.members[name] = Member(self, name, step, inputs, peers)
         return m
 
-    def run(self, participants: Sequence[str], ticks: int, **spec: Any) -> RunResult:
+    def run(
+        self,
+        participants: Sequence[str],
+        ticks: int,
+        *,
+        settings: Schedule | None = None,
+        **spec: Any,
+    ) -> RunResult:
         """Start every member and the conductor; wait for the conductor's result."""
         clock = ClockSpec(dt_ns=DT_NS, ticks=ticks, participants=tuple(participants), **spec)
-        self.conductor = Conductor(self.conductor_session, self.keys, clock)
+        self.conductor = Conductor(self.conductor_session, self.keys, clock, settings=settings)
         for m in self.members.values():
             m.thread.start()
 

@@ -1,0 +1,31 @@
+"""Run-time settings that physics owns: the global wind, the uniform current, the sea.
+
+Each change arrives with the Tick of the step it takes effect in (catabot/bus/settings.py)
+and is applied before that step, in the order given, by physics and sensors alike (the sea:
+both must agree on the surface from the same tick on).
+"""
+
+from __future__ import annotations
+
+from catabot.bus.settings import Change
+from catabot.config import live
+from catabot.config.scenario import Scenario
+from catabot.world.waves import WaveField
+from services.physics.world import PhysicsWorld
+
+
+def apply(
+    world: PhysicsWorld, scenario: Scenario, specs: dict[str, live.Spec], change: Change
+) -> None:
+    """Apply one change if it is physics' (other keys are other services')."""
+    spec = specs.get(change.key)
+    kind, value = (spec.kind if spec else ""), change.decoded
+    wind = world.loads.wind
+    if kind == "wind.speed_mps" and wind is not None:
+        wind.set_global(speed_mps=float(value))
+    elif kind == "wind.toward_rad" and wind is not None:
+        wind.set_global(toward_rad=float(value))
+    elif kind == "current":
+        world.loads.set_uniform_current((float(value[0]), float(value[1])))
+    elif kind == "waves":
+        world.set_waves(WaveField(live.wave_config(scenario, value), scenario.seed))

@@ -1,0 +1,40 @@
+"""Run-time settings that the sensors own: the rain, the sea, sensors on and off, and each
+camera's outputs; applied before the step of the tick they take effect in."""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Mapping
+
+from catabot.bus.settings import Change
+from catabot.config import live
+from catabot.config.scenario import Scenario
+from catabot.world.waves import WaveField
+from services.sensors.scene import Scene
+
+
+class SensorSettings:
+    """What is switched: `off` holds the stream keys of sensors turned off."""
+
+    def __init__(self, scenario: Scenario, scene: Scene | None, key_of: Callable[[str, str], str]):
+        self.scenario, self.scene, self.key_of = scenario, scene, key_of
+        self.specs = live.keys_of(scenario)
+        self.off: set[str] = set()
+
+    def apply(self, change: Change, models: Mapping[str, object]) -> None:
+        """Apply one change if it is the sensors' (`models`: each sensor by stream key)."""
+        spec = self.specs.get(change.key)
+        kind, value = (spec.kind if spec else ""), change.decoded
+        if kind == "rain" and self.scene is not None:
+            self.scene.rain_rate_mm_h = float(value)  # LiDAR returns and camera streaks
+        elif kind == "waves" and self.scene is not None:
+            self.scene.set_waves(
+                WaveField(live.wave_config(self.scenario, value), self.scenario.seed)
+            )
+        elif kind == "enabled" and spec is not None:
+            key = self.key_of(spec.owner, spec.name)
+            (self.off.discard if value else self.off.add)(key)
+        elif kind == "output" and spec is not None:
+            camera = models[self.key_of(spec.owner, spec.name)]
+            params = camera.params  # type: ignore[attr-defined]
+            outputs = params.outputs.model_copy(update={spec.output: bool(value)})
+            camera.params = params.model_copy(update={"outputs": outputs})  # type: ignore[attr-defined]
