@@ -47,6 +47,7 @@ class EnvironmentLoads:
         self.anchor_xy = anchor_xy[self.moored]
         self.mooring_n_per_m = float(mooring_n_per_m)
         self._zero_current = np.zeros((n, 3))
+        self._still_air = np.zeros((n, 2))
 
     def set_uniform_current(self, velocity_mps: tuple[float, float]) -> None:
         """A run-time change of the uniform current (`catabot set current`); a map stays."""
@@ -70,8 +71,11 @@ class EnvironmentLoads:
         not a uniform current and stays out of the added-mass terms).
         """
         total = base
-        if self.wind is not None and self.wind_gains is not None and not self.wind.is_calm:
-            wind_xy = self.wind.velocity_at(pos[:, 0], pos[:, 1])
+        if self.wind is not None and self.wind_gains is not None:
+            # In still air a moving hull still meets the air: the apparent wind is -velocity,
+            # so the drag is continuous as the wind goes to zero (it used to switch off).
+            calm = self.wind.is_calm
+            wind_xy = self._still_air if calm else self.wind.velocity_at(pos[:, 0], pos[:, 1])
             total = total + wind_wrench(self.wind_gains, rot, wind_xy, nu)
         if self.moored.size:
             total = total + self._mooring(rot, pos)

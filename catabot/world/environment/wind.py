@@ -63,7 +63,7 @@ class WindField:
 
     @property
     def is_calm(self) -> bool:
-        """True when no source can ever blow (lets the physics skip the wind entirely)."""
+        """True when no source can ever blow (the physics then skips the field: still air)."""
         return not (np.any(self.mean_speed) or np.any(self.gust_std))
 
     def advance(self, dt_s: float) -> None:

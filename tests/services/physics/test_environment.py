@@ -139,6 +139,22 @@ def test_terminal_drift_under_steady_wind_head_and_beam(catabot: VesselModel) ->
     assert velocity[1, 1] == pytest.approx(terminal(k_y, lin[1], quad[1]), rel=0.02)
 
 
+@pytest.mark.parametrize("speed", [0.0, 1e-6])
+def test_still_air_drags_a_moving_boat(catabot: VesselModel, speed: float) -> None:
+    """Top speed solves X_u u + (X_uu + k_x) u^2 = thrust in still air, and a wind of 1e-6 m/s
+    changes nothing: air drag does not switch on with the wind (it used to)."""
+    wind = WindField(WindConfig(speed_mps=speed), seed=0)
+    world = PhysicsWorld([("a", catabot, (0.0, 0.0, 0.0, 0.0))], dt_s=DT, wind=wind)
+    world.set_thrust("a", [1.0, 1.0])
+    run(world, 30.0)
+    k_x = wind_gains([catabot], 1.225)[0, 0]
+    thrust = sum(t.max_forward_n for t in catabot.thrusters)
+    linear, quadratic = catabot.damping.linear[0], catabot.damping.quadratic[0]
+    expected = damping_root(linear, quadratic + k_x, thrust)
+    assert expected < damping_root(linear, quadratic, thrust)
+    assert world.state_arrays().linear_velocity[0, 0] == pytest.approx(expected, rel=5e-4)
+
+
 def test_wind_law_is_vrx_for_the_wamv() -> None:
     """X = 0.5 u|u|, Y = 0.5 v|v|, N = -2 * 0.33 u v on the apparent wind (VRX's plugin)."""
     gains = wind_gains([load_vessel_model("wamv")], 1.225)
