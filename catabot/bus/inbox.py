@@ -154,6 +154,14 @@ class Inbox:
         return out
 
 
+def checked(payload: bytes, stream: Stream) -> Message:
+    """A sample decoded and through its stream's content check, or `Rejected` (for an
+    observer, which has no tags to check)."""
+    msg = _decoded(payload, stream)
+    _check_content(stream, msg)
+    return msg
+
+
 def _decoded(payload: bytes, stream: Stream) -> Message:
     try:
         return codec.decode(payload, stream.message)

@@ -19,6 +19,7 @@ from pathlib import Path
 
 from catabot.bus.session import free_port
 from catabot.config.scenario import Scenario
+from catabot.run.supervisor import ended
 
 VIEW_MODES = ("native", "web")
 VIEWER = "services.viewer"
@@ -52,12 +53,7 @@ class Viewer:
         try:
             self.proc.wait(timeout=wait_s)
         except subprocess.TimeoutExpired:
-            self.proc.terminate()
-            try:
-                self.proc.wait(timeout=5)
-            except subprocess.TimeoutExpired:
-                self.proc.kill()
-                self.proc.wait()
+            ended(self.proc, grace_s=5)
 
     def hold(self) -> None:
         """Serve the web viewer until Ctrl-C (after the run, so it can still be looked at)."""

@@ -156,21 +156,22 @@ class RecordedRun:
 
     def thrust(self, vessel: str) -> Iterator[tuple[int, ThrustCmd]]:
         """(stamp_ns, command) of every thrust command the vessel was given (`thrust`)."""
-        chan = self.topic(self.names.topic(vessel, "thrust"))
-        for i in range(len(chan) if chan is not None else 0):
-            assert chan is not None
-            values = tuple(float(v) for v in self.ros2(chan, i).data)
-            yield chan.stamps[i], ThrustCmd(values)
+        for stamp, m in self.decoded(self.names.topic(vessel, "thrust")):
+            yield stamp, ThrustCmd(tuple(float(v) for v in m.data))
 
     def imu(self, sensor: MountedSensor) -> Iterator[ImuSample]:
         """Every sample of an IMU from its sensor_msgs/Imu (`<sensor>/imu`)."""
-        chan = self.topic(self.names.sensor_topic(sensor, "imu"))
-        for i in range(len(chan) if chan is not None else 0):
-            assert chan is not None
-            m, stamp = self.ros2(chan, i), chan.stamps[i]
+        for stamp, m in self.decoded(self.names.sensor_topic(sensor, "imu")):
             q, w, a = m.orientation, m.angular_velocity, m.linear_acceleration
             yield ImuSample(stamp // self.dt_ns, stamp, (q.x, q.y, q.z, q.w), (w.x, w.y, w.z),
                             (a.x, a.y, a.z))  # fmt: skip
+
+    def decoded(self, topic: str) -> Iterator[tuple[int, Any]]:
+        """(stamp_ns, message) of every message on a topic of run.mcap; none if absent."""
+        chan = self.topic(topic)
+        for i in range(len(chan) if chan is not None else 0):
+            assert chan is not None
+            yield chan.stamps[i], self.ros2(chan, i)
 
     def ros2(self, chan: Channel, i: int) -> Any:
         """Message i of a CDR channel, decoded by mcap_ros2 (PointCloud2, Image)."""
@@ -184,18 +185,15 @@ class RecordedRun:
 
     def lidar_scans(self, sensor: MountedSensor) -> Iterator[LidarScan]:
         """Every scan of a LiDAR, labels included (no range image: the MCAP has returns)."""
-        chan = self.topic(self.names.sensor_topic(sensor, "points"))
-        for i in range(len(chan) if chan is not None else 0):
-            assert chan is not None
-            yield scan_of(self.ros2(chan, i), chan.stamps[i], self.dt_ns)
+        for stamp, cloud in self.decoded(self.names.sensor_topic(sensor, "points")):
+            yield scan_of(cloud, stamp, self.dt_ns)
 
     def images(self, sensor: MountedSensor, output: str) -> Iterator[tuple[int, np.ndarray]]:
         """(stamp_ns, pixels) of one camera output in the MCAP (`color` rgb8 from `image_raw`,
         `depth` 32FC1, ...)."""
-        chan = self.topic(self.names.sensor_topic(sensor, IMAGE_TOPICS.get(output, output)))
-        for i in range(len(chan) if chan is not None else 0):
-            assert chan is not None
-            yield chan.stamps[i], image_of(self.ros2(chan, i))
+        topic = self.names.sensor_topic(sensor, IMAGE_TOPICS.get(output, output))
+        for stamp, msg in self.decoded(topic):
+            yield stamp, image_of(msg)
 
 
 def scan_of(cloud: Any, stamp_ns: int, dt_ns: int) -> LidarScan:

@@ -11,7 +11,6 @@ from __future__ import annotations
 import argparse
 import json
 import queue
-import sys
 import time
 from pathlib import Path
 from typing import Any
@@ -26,6 +25,7 @@ from catabot.bus.messages import CameraFrame
 from catabot.bus.session import add_connection_args, connection_from_args, open_session
 from catabot.config.live import parse_value
 from catabot.errors import CataBotError
+from catabot.run.answer import answered
 
 
 class AskError(CataBotError, RuntimeError):
@@ -182,19 +182,12 @@ def _next_frame(session: zenoh.Session, key: str, timeout: float) -> CameraFrame
 
 
 def _run(prog: str, args: argparse.Namespace, ask: Any) -> int:
-    try:
-        session = _session(args)
-    except CataBotError as exc:
-        print(f"catabot {prog}: {exc}", file=sys.stderr)
-        return 2
+    return answered(prog, lambda: _asked(args, ask))
+
+
+def _asked(args: argparse.Namespace, ask: Any) -> None:
+    session = _session(args)
     try:
         ask(session)
-    except CataBotError as exc:
-        print(f"catabot {prog}: {exc}", file=sys.stderr)
-        return 2
-    except OSError as exc:
-        print(f"catabot {prog}: {exc.strerror or exc}", file=sys.stderr)
-        return 1
     finally:
         session.close()
-    return 0

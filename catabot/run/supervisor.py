@@ -212,12 +212,7 @@ class Supervisor:
             except subprocess.TimeoutExpired:
                 if unjoined:
                     self.stopped.add(name)
-                child.proc.terminate()
-                try:
-                    child.proc.wait(timeout=1.0)
-                except subprocess.TimeoutExpired:
-                    child.proc.kill()
-                    child.proc.wait()
+                ended(child.proc, grace_s=1.0)
 
     def cause(self) -> str:
         """The first fault: a process's own fatal error, a hung process, else the conductor's."""
@@ -228,3 +223,13 @@ class Supervisor:
         if self.hung:
             return self.hung[0]
         return str(self.result.get("error", "") or "")
+
+
+def ended(proc: subprocess.Popen[str], *, grace_s: float) -> None:
+    """SIGTERM, `grace_s` to exit, then SIGKILL: a process that must go, gone."""
+    proc.terminate()
+    try:
+        proc.wait(timeout=grace_s)
+    except subprocess.TimeoutExpired:
+        proc.kill()
+        proc.wait()

@@ -13,7 +13,7 @@ import sys
 from collections.abc import Callable
 from pathlib import Path
 
-from catabot.errors import CataBotError
+from catabot.run.answer import answered
 from catabot.run.recorded import RecordedRun
 from services.datasets import coco, kitti, yolo
 
@@ -57,20 +57,16 @@ def main(argv: list[str] | None = None) -> int:
     p = parser()
     args = p.parse_args(argv)
     out = _check(args, p)
-    try:
+
+    def export() -> str:
         run = RecordedRun(args.run)
         out.mkdir(parents=True, exist_ok=True)
         summary = FORMATS[args.format](
             run, out, val_fraction=args.val_fraction, block_s=args.split_block_s
         )
-    except CataBotError as exc:
-        print(f"catabot dataset export: {exc}", file=sys.stderr)
-        return 2
-    except OSError as exc:
-        print(f"catabot dataset export: {exc.filename or out}: {exc.strerror}", file=sys.stderr)
-        return 2
-    print(f"{args.format} dataset in {out}: {summary}")
-    return 0
+        return f"{args.format} dataset in {out}: {summary}"
+
+    return answered("dataset export", export)
 
 
 if __name__ == "__main__":

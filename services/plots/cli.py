@@ -12,7 +12,7 @@ import argparse
 import sys
 from pathlib import Path
 
-from catabot.errors import CataBotError
+from catabot.run.answer import answered
 from catabot.run.recorded import RecordedRun
 from services.plots import report, series
 from services.plots.figures import FIGURES
@@ -43,16 +43,11 @@ def plot(run_folder: str, out: Path | None) -> Path:
 
 def main(argv: list[str] | None = None) -> int:
     args = parser().parse_args(argv)
-    try:
-        out = plot(args.run, Path(args.output) if args.output else None)
-    except CataBotError as exc:
-        print(f"catabot plot: {exc}", file=sys.stderr)
-        return 2
-    except OSError as exc:
-        print(f"catabot plot: {exc.filename or ''}: {exc.strerror}", file=sys.stderr)
-        return 2
-    print(f"plots and report.html in {out}")
-    return 0
+    return answered("plot", lambda: f"plots and report.html in {plot(args.run, _out(args.output))}")
+
+
+def _out(output: str | None) -> Path | None:
+    return Path(output) if output else None
 
 
 if __name__ == "__main__":

@@ -29,11 +29,11 @@ import zenoh
 from catabot.bus import codec
 from catabot.bus.clock import CONDUCTOR, ClockError, Stream
 from catabot.bus.identity import Roster, sender_of
+from catabot.bus.inbox import checked
 from catabot.bus.keys import Keys
 from catabot.bus.messages import BodyStates, CameraFrame, End, LidarScan, Message, Tick
 from catabot.bus.participant import EndFn, StepFn
 from catabot.bus.rejections import Rejected, Rejections
-from catabot.errors import CataBotError
 
 log = logging.getLogger("ros.observer")
 DEPTH = 100  # samples held per key: a simulated second of states at 10 ms ticks
@@ -149,7 +149,7 @@ class Observer:
             msgs = []
             while held:
                 try:
-                    msgs.append(_checked(held.popleft(), self._streams[key]))
+                    msgs.append(checked(held.popleft(), self._streams[key]))
                 except Rejected as exc:
                     self.rejections.add(key, exc)
             if msgs:
@@ -169,16 +169,3 @@ class Observer:
     def close(self) -> None:
         for sub in [*self._subs, *self._data.values()]:
             sub.undeclare()
-
-
-def _checked(payload: bytes, stream: Stream) -> Message:
-    """The sample decoded and through its stream's content check, or `Rejected`."""
-    try:
-        msg = codec.decode(payload, stream.message)
-        if stream.check is not None:
-            stream.check(msg)
-    except codec.CodecError as exc:
-        raise Rejected("malformed", str(exc)) from None
-    except (ValueError, CataBotError) as exc:
-        raise Rejected("invalid content", str(exc)) from None
-    return msg

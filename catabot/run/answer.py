@@ -1,0 +1,29 @@
+"""How every `catabot` command answers a failure: one line naming what is wrong, exit 2.
+
+The tools over run folders (`dataset`, `plot`) and the settings commands (`get`, `set`,
+`snapshot`) share it, so a bad folder, a refused value or an unwritable file reads the same
+everywhere and never ends in a traceback.
+"""
+
+from __future__ import annotations
+
+import sys
+from collections.abc import Callable
+
+from catabot.errors import CataBotError
+
+
+def answered(prog: str, work: Callable[[], str | None]) -> int:
+    """Run `work`; print what it says and return 0, or one line on stderr and return 2."""
+    try:
+        said = work()
+    except CataBotError as exc:
+        print(f"catabot {prog}: {exc}", file=sys.stderr)
+        return 2
+    except OSError as exc:
+        where = f"{exc.filename}: " if exc.filename else ""
+        print(f"catabot {prog}: {where}{exc.strerror or exc}", file=sys.stderr)
+        return 2
+    if said:
+        print(said)
+    return 0
