@@ -111,15 +111,25 @@ def _validated_fields(cls: type[Message], body: dict[str, Any]) -> dict[str, Any
     specs = _field_specs(cls)
     if not body.keys() <= specs.keys():
         unknown = sorted(set(body) - set(specs), key=repr)  # keys may mix str and bytes
-        raise CodecError(f"{cls.TYPE}: unknown field(s) {unknown}; fields are {sorted(specs)}")
+        said = ", ".join(map(repr, unknown))
+        raise CodecError(f"{cls.TYPE}: unknown field(s) {said} ({expected_fields(cls)})")
     out: dict[str, Any] = {}
     for name, (kind, length, required) in specs.items():
         if name not in body:
             if required:
-                raise CodecError(f"{cls.TYPE}: missing field {name!r}")
+                raise CodecError(f"{cls.TYPE}: missing field {name!r} ({expected_fields(cls)})")
             continue
         out[name] = _check(cls.TYPE, name, kind, length, body[name])
     return out
+
+
+def expected_fields(cls: type[Message]) -> str:
+    """What a malformed payload should have carried, for the one who sent it: `fields:
+    surge, yaw_rate; optional: tick, stamp_ns` (docs/MESSAGES.md has the rest)."""
+    specs = fields_of(cls)
+    needed = ", ".join(f.name for f in specs if f.required) or "none"
+    optional = ", ".join(f.name for f in specs if not f.required)
+    return f"fields: {needed}" + (f"; optional: {optional}" if optional else "")
 
 
 _SPECS: dict[type[Message], dict[str, tuple[str, int | None, bool]]] = {}

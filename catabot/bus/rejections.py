@@ -13,6 +13,8 @@ import time
 from collections import Counter
 from pathlib import Path
 
+REPORT = ": refused a sample on "  # the log line `report_of` reads back
+
 
 class Rejected(Exception):
     """A sample refused where it arrived: `reason` is short (counted), `detail` is logged."""
@@ -37,10 +39,24 @@ class Rejections:
         if now - self._last.get(item, -self.every_s) >= self.every_s:
             count = self._since.pop(item)
             more = f" ({count} since the last report)" if count > 1 else ""
-            self.log.warning("%s: refused a sample on %s: %s%s", self.who, key, rejected, more)
+            self.log.warning("%s%s%s: %s%s", self.who, REPORT, key, rejected, more)
             self._last[item] = now
 
     def write(self, path: Path) -> None:
         """Totals by reason (nothing is written when nothing was refused)."""
         if self.totals:
             path.write_text(json.dumps(dict(sorted(self.totals.items())), indent=2) + "\n")
+
+
+def report_of(line: str) -> tuple[str, str, str] | None:
+    """(key, reason, detail) of a log line `Rejections.add` wrote, else None: `catabot run`
+    echoes the first of each kind to the console (catabot/run/supervisor.py). Reasons never
+    hold ": "; a key from a hostile client might, and then only this echo's grouping suffers."""
+    _, found, rest = line.partition(REPORT)
+    if not found:
+        return None
+    key, _, rest = rest.rstrip("\n").partition(": ")
+    reason, _, detail = rest.partition(": ")
+    if detail.endswith(" since the last report)"):
+        detail = detail.rsplit(" (", 1)[0]
+    return key, reason, detail

@@ -214,7 +214,7 @@ def _close_viewer(viewer: Viewer | None) -> None:
 def _watch(scenario: Scenario, run_dir: Path, supervisor: Supervisor, *, quiet: bool) -> int:
     """Progress while the run goes, then the summary and the exit code."""
     bar = ProgressBar(scenario.duration_ns, enabled=not quiet)
-    supervisor.wait(bar.update)
+    supervisor.wait(bar.update, bar.note)
     bar.close()
     result, cause = dict(supervisor.result), supervisor.cause()
     if cause:

@@ -36,6 +36,14 @@ class ProgressBar:
             sys.stderr.write(self.line(event) + "\n")
             self.last_print = now
 
+    def note(self, text: str) -> None:
+        """A line for the person at the console while the run goes (a refused command),
+        on its own line above the bar; shown with --quiet too."""
+        if self.enabled and self.tty and self.shown:
+            sys.stderr.write("\r\033[K")  # the bar is redrawn by the next update
+        sys.stderr.write(f"{text}\n")
+        sys.stderr.flush()
+
     def close(self) -> None:
         if self.enabled and self.tty and self.shown:
             sys.stderr.write("\n")

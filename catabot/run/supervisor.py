@@ -20,13 +20,17 @@ import subprocess
 import sys
 import threading
 import time
-from collections.abc import Iterator
+from collections.abc import Callable, Iterator
 from pathlib import Path
 from typing import IO
+
+from catabot.bus.rejections import report_of
 
 HANG_S = 3.0  # the conductor's heartbeat is every 0.5 s
 START_S = 60.0  # until its first line (Python's imports on a loaded machine take seconds)
 FAULT_REAP_S = 2.0  # after a fault: End carries the error, services drain for 1 s
+MAX_ECHOED = 10  # kinds of refusal echoed to the console per process
+HINTED = ("malformed", "invalid content")  # refusals of a payload's content
 
 
 class Child:
@@ -60,6 +64,8 @@ class Child:
         self.fatal = ""  # the first CRITICAL line: the process's own fatal fault
         self.fatal_at = 0.0
         self.last_line = ""  # a program's last line, for its fatal fault
+        self.refused: list[str] = []  # console lines: the first refusal of each kind
+        self._refusals: set[tuple[str, str]] = set()
         self._relay = threading.Thread(target=self._copy_stderr, daemon=True)
         self._relay.start()
 
@@ -71,7 +77,25 @@ class Child:
             if " CRITICAL " in line and not self.fatal:
                 self.fatal, self.fatal_at = line.split(" CRITICAL ", 1)[1].strip(), time.monotonic()
             self.last_line = line.strip() or self.last_line
+            self._note_refusal(line)
             log = _write(log, line, self)
+
+    def _note_refusal(self, line: str) -> None:
+        """The first refusal of each (key, reason), for the console (`Supervisor.wait`): a
+        client whose commands are dropped learns why without reading `log/`; at most
+        `MAX_ECHOED` kinds, so a client spraying keys cannot flood the console."""
+        report = report_of(line)
+        if report is None or report[:2] in self._refusals or len(self._refusals) > MAX_ECHOED:
+            return
+        key, reason, detail = (_printable(part) for part in report)
+        self._refusals.add(report[:2])
+        if len(self._refusals) > MAX_ECHOED:
+            self.refused.append(f"{self.name} refused more kinds of samples: see {self.log_path}")
+            return
+        hint = " (messages: docs/MESSAGES.md)" if reason in HINTED else ""
+        said = f"{reason}: {detail}" if detail else reason
+        self.refused.append(f"{self.name} refused {key}: {said}{hint}; first of its kind, all "
+                            f"counted in {self.log_path}")  # fmt: skip
 
     def crashed(self) -> None:
         """A program that ended with an error while the run went: that is its fatal fault."""
@@ -92,6 +116,11 @@ class Child:
 
     def join(self) -> None:
         self._relay.join(timeout=2.0)
+
+
+def _printable(text: str) -> str:
+    """A client's key or field names shown safely: no control characters on a terminal."""
+    return "".join(c if c.isprintable() else repr(c)[1:-1] for c in text)
 
 
 def _exits(proc: subprocess.Popen[str], *, within_s: float) -> bool:
@@ -167,14 +196,17 @@ class Supervisor:
         self.hung: list[str] = []  # processes found hung and killed
         self._started = time.monotonic()
         self._heard: float | None = None  # when the conductor last said anything
+        self._echoed: dict[str, int] = {}  # refusal lines echoed, per process
 
-    def wait(self, on_progress: object = None) -> None:
-        """Until every process has ended (`on_progress(event)` for the progress lines)."""
+    def wait(self, on_progress: object = None, on_note: Callable[[str], None] = print) -> None:
+        """Until every process has ended (`on_progress(event)` for the progress lines,
+        `on_note(line)` for the first refusal of each kind)."""
         reader = threading.Thread(target=self._follow, args=(on_progress,), daemon=True)
         reader.start()
         asked_to_stop = False
         while reader.is_alive():
             reader.join(timeout=0.1)
+            self._echo(on_note)
             died = [c for c in self.services.values() if c.proc.poll() not in (None, 0)]
             if died and not asked_to_stop and self.conductor.proc.poll() is None:
                 for child in died:
@@ -190,6 +222,14 @@ class Supervisor:
         self._reap()
         for child in (self.conductor, *self.services.values()):
             child.join()
+        self._echo(on_note)
+
+    def _echo(self, on_note: Callable[[str], None]) -> None:
+        for child in (self.conductor, *self.services.values()):
+            done = self._echoed.get(child.name, 0)
+            for line in child.refused[done:]:
+                on_note(line)
+            self._echoed[child.name] = done + len(child.refused[done:])
 
     def _silent(self) -> float:
         """How long the conductor has been silent, once that means it hangs (else 0)."""

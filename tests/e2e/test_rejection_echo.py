@@ -1,0 +1,44 @@
+"""A command dropped by physics is said on the console once, with what it should have been."""
+
+from __future__ import annotations
+
+import time
+from pathlib import Path
+
+from conftest import basic_scenario, only_run_dir, scenario_file, start, wait_for_line
+
+from catabot.bus import codec
+from catabot.bus.keys import Keys
+from catabot.bus.session import Connection, free_port, open_session
+
+
+def test_the_first_refusal_of_each_kind_reaches_the_console_once(tmp_path: Path) -> None:
+    endpoint = f"tcp/127.0.0.1:{free_port()}"
+    data = basic_scenario("echo", duration_s=6.0)
+    data["clock"] = {"realtime_factor": 2.0}
+    out = tmp_path / "out"
+    proc = start("run", str(scenario_file(tmp_path, data)), "--out", str(out), "--quiet",
+                 "--listen", endpoint)  # fmt: skip
+    wait_for_line(proc, "zenoh:")
+    key = Keys("echo").cmd_twist("ego")
+    wrong = codec.pack({"v": 1, "type": "twist_cmd", "surge_mps": 1.0, "yaw_rate_radps": 0.1})
+    with open_session(Connection(connect=(endpoint,))) as session:
+        pub = session.declare_publisher(key)
+        for _ in range(100):
+            if pub.matching_status.matching:
+                break
+            time.sleep(0.05)
+        time.sleep(0.5)  # matching means one subscriber (the recorder); let physics match too
+        for _ in range(5):
+            pub.put(wrong)
+            time.sleep(0.3)  # over a second: the log repeats the refusal, the console not
+    stdout, stderr = proc.communicate(timeout=60)
+    assert proc.returncode == 0, stderr
+    said = [line for line in (stdout + stderr).splitlines() if line.startswith("physics refused")]
+    assert len(said) == 1, stdout + stderr
+    assert said[0].startswith(
+        f"physics refused {key}: malformed: twist_cmd: unknown field(s) 'surge_mps', "
+        "'yaw_rate_radps' (fields: surge, yaw_rate; optional: tick, stamp_ns)"
+    ), said[0]
+    log = (only_run_dir(out) / "log" / "physics.log").read_text()
+    assert log.count(f"refused a sample on {key}: malformed") >= 2  # the log says it again
