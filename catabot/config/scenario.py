@@ -33,6 +33,7 @@ from catabot.config.base import (
 from catabot.config.controller import ControllerConfig, check_programs
 from catabot.config.environment import CurrentConfig, RainConfig, WindConfig
 from catabot.config.live import SettingChange, check_timeline
+from catabot.config.pose import Pose, Velocity
 from catabot.config.ros import GATEWAY, RosConfig, check_ros
 from catabot.config.sensors import SENSOR_TYPES
 from catabot.config.terrain import TerrainConfig
@@ -51,14 +52,6 @@ class ClockConfig(Strict):
     external_participants: list[ParticipantName] = Field(
         [], description="names of stepping participants started outside `catabot run`"
     )
-
-
-class Pose(Strict):
-    """Start pose in `map` (ENU); z is ignored for floating vessels (they settle)."""
-
-    x_m: float = 0.0
-    y_m: float = 0.0
-    yaw_rad: float = 0.0
 
 
 class TwistStep(Strict):
@@ -119,6 +112,7 @@ class VesselConfig(Strict):
     id: VesselId
     model: str = "catabot"
     pose: Pose | None = Field(None, description="null: open water near the terrain centre")
+    velocity: Velocity = Field(Velocity(), description="body-frame velocity at t = 0")
     script: list[ScriptStep] = []
     sensors: list[SensorConfig] = []
     controller: ControllerConfig | None = Field(

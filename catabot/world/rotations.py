@@ -112,3 +112,34 @@ def quaternion_of_matrix(rot: Array) -> tuple[float, float, float, float]:
         q = (v[0], v[1], v[2], (m[k, j] - m[j, k]) / s)
     x, y, z, w = (float(c) for c in q)
     return (-x, -y, -z, -w) if w < 0 else (x, y, z, w)
+
+
+def from_rpy(roll: float, pitch: float, yaw: float) -> tuple[float, float, float, float]:
+    """The quaternion of Rz(yaw) Ry(pitch) Rx(roll); a level body (roll = pitch = 0) gets
+    exactly `from_yaw`'s numbers, as every start did before roll and pitch existed."""
+    if roll == 0 and pitch == 0:
+        return from_yaw(yaw)
+    cr, sr, cp, sp = (
+        math.cos(roll / 2),
+        math.sin(roll / 2),
+        math.cos(pitch / 2),
+        math.sin(pitch / 2),
+    )
+    cy, sy = math.cos(yaw / 2), math.sin(yaw / 2)
+    return (
+        sr * cp * cy - cr * sp * sy,
+        cr * sp * cy + sr * cp * sy,
+        cr * cp * sy - sr * sp * cy,
+        cr * cp * cy + sr * sp * sy,
+    )
+
+
+def to_rotvec(q: Array) -> Array:
+    """Rotation vectors (N, 3) of unit quaternions (N, 4), the inverse of `from_rotvec`
+    (angle in [0, pi]; a yaw-only quaternion gives (0, 0, yaw) for |yaw| <= pi)."""
+    q = np.where(q[:, 3:] < 0, -q, q)
+    sin_half = np.linalg.norm(q[:, :3], axis=1)
+    theta = 2 * np.arctan2(sin_half, q[:, 3])
+    small = sin_half < 1e-12
+    scale = np.where(small, 2.0, theta / np.where(small, 1.0, sin_half))
+    return q[:, :3] * scale[:, None]

@@ -13,8 +13,7 @@ the traffic plan's waypoint buoys). A body's label instance is its row + 1 (0: n
 
 from __future__ import annotations
 
-import math
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from functools import cached_property
 from typing import Any, Literal
 
@@ -23,6 +22,7 @@ import numpy as np
 from catabot.bus.clock import ClockLimits, period_in_ticks
 from catabot.bus.keys import Keys
 from catabot.bus.messages import CLASS_BUOY, CLASS_VESSEL, BodyStates
+from catabot.config.pose import Velocity
 from catabot.config.scenario import (
     ControllerConfig,
     Pose,
@@ -35,6 +35,7 @@ from catabot.config.scenario import (
     services,
 )
 from catabot.config.vessel import VesselModel, load_vessel_model
+from catabot.world import rotations
 from catabot.world.environment.current import CurrentField
 from catabot.world.placement import resolve_poses
 from catabot.world.streams import Streams
@@ -57,6 +58,7 @@ class Body:
     row: int  # its row in every `BodyStates`
     script: tuple[ScriptStep, ...] = ()
     controller: ControllerConfig | None = None
+    velocity: Velocity = field(default_factory=Velocity)  # body frame, at t = 0
 
     @property
     def instance(self) -> int:
@@ -163,13 +165,16 @@ class World:
         return {b.id: b for b in self.bodies}
 
     def start_states(self) -> BodyStates:
-        """Every body at rest at its start pose (tick -1, t = 0): what physics starts from."""
+        """Every body at its start pose and velocity (tick -1, t = 0): what physics starts
+        from (services/physics/setup.py), velocities in the body frame."""
         n = len(self.bodies)
-        position = np.array([(b.pose.x_m, b.pose.y_m, 0.0) for b in self.bodies]).reshape(n, 3)
-        halves = [b.pose.yaw_rad / 2 for b in self.bodies]
-        quat = np.array([(0.0, 0.0, math.sin(h), math.cos(h)) for h in halves]).reshape(n, 4)
+        p = np.array([(b.pose.x_m, b.pose.y_m, b.pose.z_m) for b in self.bodies]).reshape(n, 3)
+        turns = [(b.pose.roll_rad, b.pose.pitch_rad, b.pose.yaw_rad) for b in self.bodies]
+        quat = np.array([rotations.from_rpy(*t) for t in turns]).reshape(n, 4)
+        linear = np.array([b.velocity.linear for b in self.bodies]).reshape(n, 3)
+        angular = np.array([b.velocity.angular for b in self.bodies]).reshape(n, 3)
         zero = np.zeros((n, 3))
-        return BodyStates(-1, 0, self.body_ids, position, quat, zero, zero, zero, zero)
+        return BodyStates(-1, 0, self.body_ids, p, quat, linear, angular, zero, zero)
 
 
 def _terrain(scenario: Scenario) -> Terrain | None:
@@ -201,9 +206,11 @@ def _bodies(scenario: Scenario, plan: TrafficPlan) -> tuple[Body, ...]:
 
 def _scenario_part(
     config: VesselConfig | None,
-) -> tuple[tuple[ScriptStep, ...], ControllerConfig | None]:
-    """What only a scenario vessel has: its script and its controller."""
-    return (tuple(config.script), config.controller) if config is not None else ((), None)
+) -> tuple[tuple[ScriptStep, ...], ControllerConfig | None, Velocity]:
+    """What only a scenario vessel has: its script, its controller, its start velocity."""
+    if config is None:
+        return (), None, Velocity()
+    return tuple(config.script), config.controller, config.velocity
 
 
 def _unique(ids: list[str]) -> None:

@@ -24,6 +24,7 @@ from collections.abc import Sequence
 
 import dartpy as dart
 import numpy as np
+from numpy.typing import NDArray
 
 from catabot.config.vessel import VesselModel, load_vessel_model
 from services.physics.hydro import Array
@@ -65,6 +66,14 @@ class Fleet:
     def velocities(self) -> Array:
         """Generalized velocities of every body, (N, 6)."""
         return np.concatenate([s.getVelocities() for s in self.skeletons]).reshape(-1, 6)
+
+    def place(self, rows: NDArray[np.intp], q: Array, v: Array) -> None:
+        """Bodies `rows` to generalized positions `q` and velocities `v` (k, 6 each)."""
+        pos, vel = self.positions(), self.velocities()
+        pos[rows], vel[rows] = q, v
+        for g, skel in enumerate(self.skeletons):
+            skel.setPositions(pos[g * GROUP : (g + 1) * GROUP].ravel())
+            skel.setVelocities(vel[g * GROUP : (g + 1) * GROUP].ravel())
 
     def set_forces(self, generalized: Array) -> None:
         """Generalized forces of every body from an (N, 6) array."""

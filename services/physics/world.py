@@ -189,6 +189,12 @@ class PhysicsWorld:
             raise ValueError("thrust commands: a value is not finite")
         self._thrusters.set_commands(rows, np.clip(commands, -1.0, 1.0))
 
+    def place(self, rows: NDArray[np.intp], pose: Array, velocity_w: Array) -> None:
+        """Start bodies `rows` off rest: `pose` (k, 6) rotation vector and position in `map`,
+        `velocity_w` (k, 6) angular and linear velocity in `map` (services/physics/setup.py)."""
+        self._fleet.place(rows, pose, velocity_w)
+        self._read_state()
+
     def step(self) -> None:
         """Advance every vessel by dt: compute all forces vectorised, apply, step DART.
         `PhysicsDiverged` names the body and the load when a state stops being finite."""
