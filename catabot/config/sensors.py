@@ -8,10 +8,10 @@ from __future__ import annotations
 from dataclasses import dataclass
 from typing import Literal
 
-from pydantic import Field, StrictBool
+from pydantic import Field, StrictBool, model_validator
 
 from catabot.bus.messages import CameraFrame, GpsFix, ImuSample, LidarScan, Message, RadarSweep
-from catabot.config.base import Strict
+from catabot.config.base import FieldProblem, Strict
 
 Vec3 = tuple[float, float, float]
 
@@ -44,6 +44,18 @@ class GpsParams(SensorParams):
     vertical_sigma: float = Field(1.0, ge=0, description="m")
     antenna_offset: Vec3 = (0.0, 0.0, 0.0)
     method: Literal["wgs84", "paper_table"] = "wgs84"
+    altitude: Literal["local", "ellipsoid"] = Field(
+        "local",
+        description="local: height above the origin's level (the world as a local map); "
+        "ellipsoid: WGS84 height of the flat world (grows as d^2 / 2R from the origin)",
+    )
+
+    @model_validator(mode="after")
+    def _curvature_needs_wgs84(self) -> GpsParams:
+        if self.altitude == "ellipsoid" and self.method != "wgs84":
+            raise FieldProblem("altitude", "'ellipsoid' needs method 'wgs84' (the paper's "
+                               "tables ignore the Earth's curvature)")  # fmt: skip
+        return self
 
 
 class RadarParams(SensorParams):

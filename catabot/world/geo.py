@@ -2,7 +2,10 @@
 
 `map` is a flat ENU frame whose origin has a WGS84 position (scenario `origin`). The exact
 mapping, `EnuFrame`, goes ENU -> ECEF (origin + rotation) -> geodetic with Heikkinen's closed
-form (Zhu 1993): well under a millimetre near the surface, no iteration, vectorised.
+form (Zhu 1993): well under a millimetre near the surface, no iteration, vectorised. Its
+altitude is the tangent plane's height above the ellipsoid, which grows away from the origin;
+`EnuFrame.to_map_geodetic` reads the world as a local map instead (altitude above the
+origin's level), what a GPS reports by default (services/sensors/gps.py).
 `paper_table_enu_to_geodetic` keeps the original simulator's table method (paper eq. 8-9)
 for comparison; its error is the Earth's curvature over the offset (see there).
 """
@@ -127,6 +130,14 @@ class EnuFrame:
     def to_geodetic(self, east: ArrayLike, north: ArrayLike, up: ArrayLike) -> Triple:
         """Latitude (deg), longitude (deg), altitude (m) of ENU offsets in metres."""
         return ecef_to_geodetic(self._ecef0 + np.stack(_enu(east, north, up), -1) @ self._rot)
+
+    def to_map_geodetic(self, east: ArrayLike, north: ArrayLike, up: ArrayLike) -> Triple:
+        """The flat world as a local map projection: latitude and longitude as `to_geodetic`
+        gives them, altitude the origin's plus `up` (height above the origin's level), so a
+        boat on the water reads the origin's altitude anywhere, not the tangent plane's rise
+        above the ellipsoid (d^2 / 2R: +1.96 m at 5 km, +49 m at 25 km)."""
+        lat, lon, _ = self.to_geodetic(east, north, up)
+        return lat, lon, self.altitude_m + _enu(east, north, up)[2]
 
     def to_enu(self, lat_deg: ArrayLike, lon_deg: ArrayLike, alt_m: ArrayLike) -> Triple:
         """East, north, up offsets (m) of WGS84 positions from the origin."""

@@ -1,10 +1,14 @@
 """GPS model: the antenna's `map` (ENU) position, plus noise, as a WGS84 fix.
 
-`method="wgs84"` (default) converts exactly (catabot.world.geo.EnuFrame, < 1 mm); a fix taken
-far from the origin then shows the Earth's curvature, e.g. +31 m of altitude at 20 km,
-because `map` is the tangent plane at the origin. `method="paper_table"` reproduces the
-original simulator's eq. (8)-(9) tables, which ignore curvature (errors in the docstring
-of catabot.world.geo.paper_table_enu_to_geodetic).
+`method="wgs84"` (default) converts exactly (catabot.world.geo.EnuFrame, < 1 mm). Its altitude
+is `altitude="local"` by default: the flat world is a local map, and a fix's altitude is the
+origin's plus the antenna's height in `map`, so a boat on the water reads the same altitude
+anywhere. `altitude="ellipsoid"` keeps the exact WGS84 height of the flat world, which shows
+the Earth's curvature far from the origin (+1.96 m at 5 km, +49 m at 25 km: `map` is the
+tangent plane at the origin, d^2 / 2R above the ellipsoid). Latitude and longitude are the
+exact conversion's either way. `method="paper_table"` reproduces the original simulator's
+eq. (8)-(9) tables, which ignore curvature (errors in the docstring of
+catabot.world.geo.paper_table_enu_to_geodetic); its altitude is always local.
 
 Noise is white Gaussian, drawn in metres before the conversion: `horizontal_sigma` on each
 of east and north, `vertical_sigma` on up. Defaults 0.5 m and 1.0 m: a good single-band
@@ -47,6 +51,7 @@ class GpsModel:
         except GeoError as exc:
             raise SensorError(f"GPS {mount.name!r} origin: {exc}") from None
         self.method: Method = params.method
+        self.local = params.altitude == "local"
         self.horizontal_sigma, self.vertical_sigma = params.horizontal_sigma, params.vertical_sigma
         self.antenna_offset = np.array(params.antenna_offset, dtype=np.float64)
         self.noise, self.name = mount.noise, mount.name
@@ -84,7 +89,8 @@ class GpsModel:
         f = self.frame
         try:
             if self.method == "wgs84":
-                lat, lon, alt = f.to_geodetic(enu[0], enu[1], enu[2])
+                convert = f.to_map_geodetic if self.local else f.to_geodetic
+                lat, lon, alt = convert(enu[0], enu[1], enu[2])
             else:
                 origin = (f.latitude_deg, f.longitude_deg, f.altitude_m)
                 lat, lon, alt = paper_table_enu_to_geodetic(enu[0], enu[1], enu[2], origin=origin)

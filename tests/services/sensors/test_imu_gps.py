@@ -171,7 +171,7 @@ def fix_position(fix: GpsFix) -> tuple[float, float, float]:
 
 
 def test_gps_without_noise_at_origin_and_1000m_east() -> None:
-    gps = gps_at(noise=False)
+    gps = gps_at(noise=False, altitude="ellipsoid")  # the exact conversion, altitude too
     fix = gps.sample(state(), tick=3, stamp_ns=30)
     assert isinstance(fix, GpsFix) and (fix.tick, fix.stamp_ns) == (3, 30)
     assert fix_position(fix) == pytest.approx(ORIGIN, abs=1e-9)
@@ -189,7 +189,7 @@ def test_gps_without_noise_at_origin_and_1000m_east() -> None:
 
 
 def test_gps_antenna_offset_follows_heading() -> None:
-    gps = gps_at((0.0, 0.0, 0.0), noise=False, antenna_offset=(1.0, 0.0, 2.0))
+    gps = gps_at((0.0, 0.0, 0.0), noise=False, antenna_offset=(1.0, 0.0, 2.0), altitude="ellipsoid")
     fix = gps.sample(state(orientation=about("z", math.pi / 2)), tick=0, stamp_ns=0)
     expected = enu_to_geodetic(0.0, 1.0, 2.0, origin=(0.0, 0.0, 0.0))
     assert fix_position(fix) == pytest.approx(tuple(map(float, expected)), abs=1e-12)
@@ -207,6 +207,25 @@ def test_gps_noise_statistics_and_determinism() -> None:
     assert not np.allclose(enu[:20], offsets(gps_at(seed=4, name="gps2"), 20))
     fix = model.sample(state(), tick=0, stamp_ns=0)
     assert (fix.horizontal_sigma, fix.vertical_sigma) == (0.5, 1.0)
+
+
+@pytest.mark.parametrize(("where", "rise"), [((5000.0, 0.0), 1.96), ((0.0, -25000.0), 49.0)])
+def test_gps_altitude_of_a_boat_on_the_water_is_the_origins_far_away(
+    where: tuple[float, float], rise: float
+) -> None:
+    """The flat world as a local map: on the water the altitude is the origin's at 5 and
+    25 km; the exact option shows the tangent plane's rise d^2 / 2R above the ellipsoid.
+    Latitude and longitude are the same either way."""
+    on_water = state(position=(*where, 0.0))
+    local = gps_at(noise=False).sample(on_water, tick=0, stamp_ns=0)
+    exact = gps_at(noise=False, altitude="ellipsoid").sample(on_water, tick=0, stamp_ns=0)
+    assert local.altitude == pytest.approx(ORIGIN[2], abs=1e-9)
+    assert exact.altitude - ORIGIN[2] == pytest.approx(rise, rel=0.01)  # R varies with heading
+    assert (local.latitude, local.longitude) == (exact.latitude, exact.longitude)
+    mast = gps_at(noise=False, antenna_offset=(0.0, 0.0, 3.0)).sample(on_water, tick=0, stamp_ns=0)
+    assert mast.altitude == pytest.approx(ORIGIN[2] + 3.0, abs=1e-9)  # up is up on the map
+    with pytest.raises(ValidationError, match="'ellipsoid' needs method 'wgs84'"):
+        gps_at(method="paper_table", altitude="ellipsoid")
 
 
 def test_gps_paper_table_method_and_errors() -> None:
