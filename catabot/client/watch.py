@@ -137,14 +137,16 @@ class Latest:
         self._callbacks.append(callback)
 
     def wait(self, timeout_s: float) -> Message:
-        """The newest message; waits up to `timeout_s` for the first one. RunEnded if the
-        run is over and nothing came; NoData on the timeout."""
+        """The newest message; waits up to `timeout_s` for the first one. RunEnded once the
+        run is over (nothing newer will come); NoData on the timeout."""
         limit = time.monotonic() + timeout_s
         with self.watch.changed:
-            while self.message is None:
+            while True:
                 ended = self.watch.ended()
                 if ended is not None:
-                    raise ended
+                    raise ended  # what was newest is stale now: nothing more will come
+                if self.message is not None:
+                    return self.message
                 left = limit - time.monotonic()
                 if left <= 0:
                     raise NoData(
@@ -152,4 +154,3 @@ class Latest:
                         "lockstep run waits for its external participants before tick 0)"
                     )
                 self.watch.changed.wait(min(left, 0.25))
-            return self.message
