@@ -5,13 +5,14 @@ stack reading sensors whose run records the same bytes twice."""
 from __future__ import annotations
 
 import json
-import subprocess
+import os
+import signal
 import time
 from pathlib import Path
 from typing import Any
 
 import pytest
-from conftest import files_of, only_run_dir, scenario_file, start
+from conftest import files_of, only_run_dir, scenario_file, service_pid, start
 
 from catabot.bus.messages import GpsFix, ImuSample, VesselState
 from catabot.bus.session import free_port
@@ -72,7 +73,9 @@ def test_a_free_running_stack_observes_and_commands(tmp_path: Path) -> None:
                 seen.append(obs)
                 return Thrust([0.25, -0.5])
 
-            assert sim.run_free(step, rate_hz=10, vessel="ego", sensors=["gps"], max_steps=5) is None
+            assert (
+                sim.run_free(step, rate_hz=10, vessel="ego", sensors=["gps"], max_steps=5) is None
+            )
             assert len(seen) == 5 and all(o.state is not None for o in seen)
             assert seen[-1].tick > seen[0].tick and isinstance(seen[-1].sensors["gps"], GpsFix)
             assert len(imu) > 10 and all(isinstance(s, ImuSample) for s in imu)
@@ -110,6 +113,28 @@ def test_the_run_ending_while_a_stack_waits_is_run_ended(tmp_path: Path) -> None
             with pytest.raises(RunEnded, match="has ended"):
                 stack.observe()
         run.finish(code=1)
+    finally:
+        run.kill()
+
+
+def test_a_conductor_that_dies_while_a_stack_waits_is_run_ended(tmp_path: Path) -> None:
+    ego = {"id": "ego", "controller": {"participant": "stack", "rate_hz": 10.0}}
+    run = _run(tmp_path, {"name": "dies", "duration_s": 60.0, "vessels": [ego],
+                          "clock": {"realtime_factor": 1.0}})  # fmt: skip
+    try:
+        with Client.connect([run.endpoint], timeout_s=30) as sim:
+            stack = sim.join("stack")
+            for _ in range(3):
+                stack.observe()
+                stack.act(Thrust([0.2, 0.2]))
+            os.kill(service_pid(run.proc.pid, "catabot.run.conduct"), signal.SIGKILL)
+            started = time.monotonic()
+            with pytest.raises(RunEnded, match="conductor disappeared without ending the run"):
+                while True:
+                    stack.observe()  # act(None) implied: keep the last command
+            assert time.monotonic() - started < 15
+        run.proc.wait(timeout=60)
+        assert run.proc.returncode != 0
     finally:
         run.kill()
 
