@@ -94,8 +94,8 @@ def test_a_free_running_stack_observes_and_commands(tmp_path: Path) -> None:
 
 
 def test_the_run_ending_while_a_stack_waits_is_run_ended(tmp_path: Path) -> None:
-    data = {"name": "ending", "duration_s": 2.0, "vessels": [{"id": "ego"}],
-            "clock": {"external_participants": ["stack", "absent"], "start_timeout_s": 5.0}}  # fmt: skip
+    clock = {"external_participants": ["stack", "absent"], "start_timeout_s": 5.0}
+    data = {"name": "ending", "duration_s": 2.0, "vessels": [{"id": "ego"}], "clock": clock}
     run = _run(tmp_path, data)
     try:
         with Client.connect([run.endpoint], timeout_s=30) as sim:
@@ -140,8 +140,8 @@ def test_a_conductor_that_dies_while_a_stack_waits_is_run_ended(tmp_path: Path) 
 
 
 def _lockstep(tmp: Path) -> tuple[dict[str, bytes], list[Observation]]:
-    ego = {"id": "ego", "sensors": SENSORS,
-           "controller": {"participant": "stack", "rate_hz": 10.0, "command": "thrust"}}  # fmt: skip
+    controller = {"participant": "stack", "rate_hz": 10.0, "command": "thrust"}
+    ego = {"id": "ego", "sensors": SENSORS, "controller": controller}
     run = _run(tmp, {"name": "steps", "seed": 4, "duration_s": 3.0, "vessels": [ego]})
     seen: list[Observation] = []
 

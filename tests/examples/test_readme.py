@@ -6,12 +6,31 @@ from __future__ import annotations
 import re
 import subprocess
 import sys
+from collections.abc import Callable, Iterator
 from pathlib import Path
 
-from tests.examples.test_examples import Run, pytest, run  # noqa: F401 (the fixture)
+import pytest
+
+from tests.examples.test_examples import Run
 from tests.paths import REPO
 
 pytestmark = pytest.mark.timeout(180)
+
+
+@pytest.fixture
+def live(tmp_path: Path) -> Iterator[Callable[..., Run]]:
+    """`catabot run` in the background (test_examples.Run), killed if a test fails."""
+    runs: list[Run] = []
+
+    def start(scenario: str, *flags: str) -> Run:
+        runs.append(Run(tmp_path / f"runs{len(runs)}", scenario, *flags))
+        return runs[-1]
+
+    yield start
+    for r in runs:
+        if r.proc.poll() is None:
+            r.proc.kill()
+            r.proc.wait()
 
 
 def readme_stack(folder: Path) -> Path:
@@ -31,9 +50,11 @@ def _stack(path: Path, *args: str) -> subprocess.CompletedProcess[str]:
     return subprocess.run(cmd, capture_output=True, text=True, timeout=120, cwd=REPO)
 
 
-def test_the_readme_stack_runs_free_and_in_lockstep(tmp_path: Path, run: type[Run]) -> None:
+def test_the_readme_stack_runs_free_and_in_lockstep(
+    tmp_path: Path, live: Callable[..., Run]
+) -> None:
     stack = readme_stack(tmp_path)
-    sim = run("default", "--duration", "10", "--realtime", "2")
+    sim = live("default", "--duration", "10", "--realtime", "2")
     free = _stack(stack, "--connect", sim.endpoint)
     assert free.returncode == 0, free.stderr
     assert "default catabot ['imu', 'gps'] traffic: 0" in free.stdout
@@ -42,7 +63,7 @@ def test_the_readme_stack_runs_free_and_in_lockstep(tmp_path: Path, run: type[Ru
     pairs = [[float(v) for v in r.split(",")[2:]] for r in thrust[1:]]
     assert pairs and all(a + b <= 1.6 + 1e-9 for a, b in pairs)  # ahead -+ turn, ahead <= 0.8
 
-    sim = run("examples/stack.json")
+    sim = live("examples/stack.json")
     locked = _stack(stack, "--connect", sim.endpoint, "--lockstep")
     assert locked.returncode == 0, locked.stderr
     assert "run ended at tick 2999: completed" in locked.stdout
