@@ -139,6 +139,25 @@ def test_a_conductor_that_dies_while_a_stack_waits_is_run_ended(tmp_path: Path) 
         run.kill()
 
 
+def test_a_stack_leaving_mid_run_is_named_and_the_run_ends(tmp_path: Path) -> None:
+    ego = {"id": "ego", "controller": {"participant": "stack", "rate_hz": 10.0}}
+    run = _run(tmp_path, {"name": "leaves", "duration_s": 60.0, "vessels": [ego]})
+    try:
+        with Client.connect([run.endpoint], timeout_s=30) as sim:
+            stack = sim.join("stack")
+            for _ in range(3):
+                stack.observe()
+                stack.act(Thrust([0.2, 0.2]))
+            stack.observe()
+            started = time.monotonic()
+            stack.close()  # while the participant waits for this period's command
+            assert time.monotonic() - started < 6
+        out, err = run.proc.communicate(timeout=60)
+        assert run.proc.returncode == 1 and "participant 'stack' left the run" in err, out + err
+    finally:
+        run.kill()
+
+
 def _lockstep(tmp: Path) -> tuple[dict[str, bytes], list[Observation]]:
     controller = {"participant": "stack", "rate_hz": 10.0, "command": "thrust"}
     ego = {"id": "ego", "sensors": SENSORS, "controller": controller}
