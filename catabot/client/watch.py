@@ -111,6 +111,12 @@ class Watch:
         self._subs.append(sub)
         return sub
 
+    def unsubscribe(self, sub: zenoh.Subscriber) -> None:
+        if sub in self._subs:
+            self._subs.remove(sub)
+            with contextlib.suppress(zenoh.ZError):
+                sub.undeclare()
+
     def close(self) -> None:
         for sub in self._subs:
             with contextlib.suppress(zenoh.ZError):  # the session is already closed
@@ -126,7 +132,7 @@ class Latest:
         self.message: Message | None = None
         self.count = 0
         self._callbacks: list[Callback] = []
-        watch.subscribe(stream, self._on)
+        self.sub = watch.subscribe(stream, self._on)
 
     def _on(self, msg: Message) -> None:
         with self.watch.changed:
