@@ -22,8 +22,11 @@ from catabot.client import (
     NotAParticipant,
     Observation,
     RunEnded,
+    SimulatorNotFound,
     Thrust,
     TooLate,
+    UnknownSensor,
+    UnknownVessel,
 )
 
 pytestmark = pytest.mark.timeout(180)
@@ -54,13 +57,24 @@ def _run(tmp: Path, data: dict[str, Any], *flags: str) -> Run:
     return Run(tmp, data, *flags)
 
 
+def test_no_simulation_running_is_simulator_not_found_after_the_timeout() -> None:
+    started = time.monotonic()
+    with pytest.raises(SimulatorNotFound, match="no simulation of any world answered"):
+        Client.connect([f"tcp/127.0.0.1:{free_port()}"], timeout_s=1.0)
+    assert 1.0 <= time.monotonic() - started < 5.0
+
+
 def test_a_free_running_stack_observes_and_commands(tmp_path: Path) -> None:
     data = {"name": "free", "seed": 1, "duration_s": 16.0, "clock": {"realtime_factor": 2.0},
             "vessels": [{"id": "ego", "sensors": SENSORS}]}  # fmt: skip
     run = _run(tmp_path, data)
     try:
         with Client.connect([run.endpoint], timeout_s=30) as sim:
+            with pytest.raises(UnknownVessel, match="no vessel 'ego2'; its vessels: ego"):
+                sim.vessel("ego2")
             ego = sim.vessel("ego")
+            with pytest.raises(UnknownSensor, match="no sensor 'lidar'; its sensors: gps, imu"):
+                ego.sensor("lidar")
             assert isinstance(ego.state(timeout_s=10), VesselState)
             assert isinstance(ego.sensor("gps").latest(timeout_s=5), GpsFix)
             imu: list[ImuSample] = []
