@@ -22,18 +22,26 @@ py=${PYTHON:-$(command -v python3)}
 tag=$$; sw=cbsw$tag; bridge=cbbr$tag
 # The services this scenario runs, as `catabot run` would start them (the world's participants
 # that are CataBot services; an external stack joins through the router like any client).
-mapfile -t services < <("$py" - "$scenario" <<'EOF'
+mapfile -t lines < <("$py" - "$scenario" <<'EOF'
 import sys
 from catabot.config.load import load_scenario
 from catabot.config.scenario import services
-print("\n".join(s for s in services(load_scenario(sys.argv[1])) if s != "conductor"))
+names = [s for s in services(load_scenario(sys.argv[1])) if s != "conductor"]
+for name in names:  # a shard (`sensors.1` of 4) runs as `catabot service sensors --shard 1/4`
+    base, _, i = name.partition(".")
+    n = sum(other.partition(".")[0] == base for other in names)
+    print(name, base, *(["--shard", f"{i}/{n}"] if i else []))
 EOF
 )
+services=(); declare -A command
+for line in "${lines[@]}"; do
+  read -r name rest <<<"$line"; services+=("$name"); command[$name]=$rest
+done
 hosts=(router conductor "${services[@]}")
 [[ -z $victim || " ${services[*]} " == *" $victim "* ]] || {
   echo "no service $victim in this scenario (it runs: ${services[*]})" >&2; exit 2; }
 
-ns() { echo "cb$1$tag" | cut -c1-15; }   # namespace names: <= 15 characters
+ns() { echo "cb${1//./}$tag" | cut -c1-15; }   # namespace names: <= 15 characters
 cleanup() {
   for h in "${hosts[@]}"; do
     ip netns pids "$(ns "$h")" 2>/dev/null | xargs -r kill -9 2>/dev/null || true
@@ -64,7 +72,8 @@ for _ in $(seq 100); do   # the router's port open, seen from the conductor's ho
   sleep 0.1
 done
 for svc in "${services[@]}"; do
-  (ip netns exec "$(ns "$svc")" "$py" -m catabot service "$svc" "${flags[@]}" --run-dir "$out" \
+  # shellcheck disable=SC2086  # the service and its --shard: words on purpose
+  (ip netns exec "$(ns "$svc")" "$py" -m catabot service ${command[$svc]} "${flags[@]}" --run-dir "$out" \
     >"$out/$svc.log" 2>&1 &)   # not this shell's jobs: no "Killed" lines at the clean-up
 done
 ip netns exec "$(ns conductor)" "$py" -m catabot service conductor "${flags[@]}" \

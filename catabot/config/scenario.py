@@ -33,7 +33,7 @@ from catabot.config.base import (
 from catabot.config.environment import CurrentConfig, RainConfig, WindConfig
 from catabot.config.live import SettingChange, check_timeline
 from catabot.config.ros import GATEWAY, RosConfig, check_ros
-from catabot.config.sensors import SENSOR_TYPES
+from catabot.config.sensors import SENSOR_TYPES, SensorFarmConfig, shard_names
 from catabot.config.terrain import TerrainConfig
 from catabot.config.traffic import TrafficConfig
 from catabot.config.waves import WaveConfig
@@ -206,6 +206,7 @@ class Scenario(Strict):
     vessels: list[VesselConfig] = Field(min_length=1)
     traffic: TrafficConfig = TrafficConfig()
     recording: RecordingConfig = RecordingConfig()
+    sensors: SensorFarmConfig = SensorFarmConfig()
     ros: RosConfig | None = Field(None, description="the ROS 2 gateway (services/ros)")
     settings: list[SettingChange] = Field(
         [], description="run-time setting changes by time (catabot/config/live.py; catabot set)"
@@ -232,6 +233,17 @@ class Scenario(Strict):
                 raise FieldProblem("recording.export", f"{fmt!r} needs a {need} on a vessel")
             if need == "camera" and not rec.dataset:
                 raise FieldProblem("recording.export", f"{fmt!r} needs recording.dataset: true")
+        return self
+
+    @model_validator(mode="after")
+    def _shards_have_vessels(self) -> Scenario:
+        carriers = sum(1 for v in self.vessels if v.sensors)
+        if self.sensors.shards > max(carriers, 1):
+            raise FieldProblem(
+                "sensors.shards",
+                f"{self.sensors.shards} shards for {carriers} vessel(s) carrying sensors: "
+                "a shard owns whole vessels",
+            )
         return self
 
     @model_validator(mode="after")
@@ -297,7 +309,7 @@ def services(scenario: Scenario) -> list[str]:
     """The CataBot services a scenario needs, in start order."""
     names = ["physics"]
     if any(v.sensors for v in scenario.vessels):
-        names.append("sensors")
+        names += shard_names("sensors", scenario.sensors.shards)
     if scenario.traffic.count > 0:
         names.append("traffic")
     if scenario.recording.csv or scenario.recording.mcap:

@@ -42,6 +42,7 @@ class Streams:
     def of(cls, world: World) -> Streams:
         keys, vessels = world.keys, world.vessels
         commands = [s for v in vessels for s in _commands(world, v)]
+        owner = world.sensor_owners
         return cls(
             states=Stream(
                 keys.world_states(),
@@ -54,7 +55,7 @@ class Streams:
                 Stream(keys.vessel_state(v.id), VesselState, "physics") for v in vessels
             ),
             sensors=tuple(
-                Stream(s.key, SENSOR_TYPES[s.config.type].message, "sensors", s.period)
+                Stream(s.key, SENSOR_TYPES[s.config.type].message, owner[s.key], s.period)
                 for s in world.sensors
             ),
             commands=tuple(s for s in commands if s.period is None),

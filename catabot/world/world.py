@@ -37,6 +37,7 @@ from catabot.config.scenario import (
 from catabot.config.vessel import VesselModel, load_vessel_model
 from catabot.world.environment.current import CurrentField
 from catabot.world.placement import resolve_poses
+from catabot.world.shards import sensor_owners
 from catabot.world.streams import Streams
 from catabot.world.terrain import Terrain, load_terrain
 from catabot.world.traffic_plan import Progress, TrafficPlan, plan_traffic
@@ -136,6 +137,12 @@ class World:
     def boat_ids(self) -> tuple[str, ...]:
         """The traffic boats, in `TwistBatch` order."""
         return tuple(b.id for b in self.bodies if b.kind == "boat")
+
+    @cached_property
+    def sensor_owners(self) -> dict[str, str]:
+        """Sensor stream key -> the sensors process (shard) that produces it."""
+        s = self.scenario
+        return sensor_owners(self.sensors, s.sensors.shards, s.dt_ns)
 
     @cached_property
     def streams(self) -> Streams:
