@@ -236,13 +236,12 @@ class Scenario(Strict):
         return self
 
     @model_validator(mode="after")
-    def _shards_have_vessels(self) -> Scenario:
-        carriers = sum(1 for v in self.vessels if v.sensors)
-        if self.sensors.shards > max(carriers, 1):
+    def _shards_have_sensors(self) -> Scenario:
+        count = sum(len(v.sensors) for v in self.vessels)
+        if self.sensors.shards > max(count, 1):
             raise FieldProblem(
                 "sensors.shards",
-                f"{self.sensors.shards} shards for {carriers} vessel(s) carrying sensors: "
-                "a shard owns whole vessels",
+                f"{self.sensors.shards} shards for {count} sensor(s): each shard owns at least one",
             )
         return self
 

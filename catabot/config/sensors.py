@@ -147,10 +147,10 @@ class LidarParams(SensorParams):
 
 class SensorFarmConfig(Strict):
     """The sensors service as several processes (`catabot service sensors --shard i/N`), each
-    owning every sensor of some vessels (catabot/world/shards.py), on one machine or spread
-    over several; the recording is the same for any number."""
+    owning some of the sensors (catabot/world/shards.py), on one machine or spread over
+    several; the recording is the same for any number."""
 
-    shards: int = Field(1, ge=1, le=64, description="sensor processes; each owns whole vessels")
+    shards: int = Field(1, ge=1, le=64, description="sensor processes, sharing the sensors out")
 
 
 def shard_names(service: str, shards: int) -> list[str]:

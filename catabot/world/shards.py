@@ -1,11 +1,11 @@
-"""Which sensors process owns which vessel's sensors (`sensors.shards`).
+"""Which sensors process owns which sensor (`sensors.shards`).
 
-A shard owns whole vessels, so the vessel's sensors share one scene pose and one state row.
-Vessels go to shards by what their sensors cost, most expensive first, each to the shard
-with the least work so far (longest-processing-time first: within 4/3 of the best split);
-ties go to the lower index, so every process derives the same split from the same world.
-The recording does not depend on it: the recorder writes every stream in world order,
-whoever produced it.
+Sensors go to shards by what they cost (rays a second), most expensive first, each to the
+shard with the least work so far (longest-processing-time first: within 4/3 of the best
+split), so one vessel's camera and LiDAR may run side by side; ties go to the lower index,
+so every process derives the same split from the same world. The recording does not depend
+on it: the recorder writes every stream in world order, whoever produced it, and each
+sensor's noise has its own seed.
 """
 
 from __future__ import annotations
@@ -23,24 +23,22 @@ SERVICE = "sensors"
 PER_SENSOR = 1e4  # rays a second a sensor is worth beside its rays (IMU, GPS: messages)
 
 
-def vessel_costs(sensors: Sequence[MountedSensor], dt_ns: int) -> dict[str, float]:
-    """Rays a second each sensor-carrying vessel's sensors cast, in world order."""
-    costs: dict[str, float] = {}
-    for s in sensors:
-        rate_hz = NS_PER_S / (s.period * dt_ns)
-        cost = s.config.typed_params().rays_per_s(rate_hz) + PER_SENSOR
-        costs[s.vessel] = costs.get(s.vessel, 0.0) + cost
-    return costs
+def sensor_costs(sensors: Sequence[MountedSensor], dt_ns: int) -> dict[str, float]:
+    """Rays a second each sensor casts (by stream key, in world order)."""
+    return {
+        s.key: s.config.typed_params().rays_per_s(NS_PER_S / (s.period * dt_ns)) + PER_SENSOR
+        for s in sensors
+    }
 
 
 def split(costs: dict[str, float], shards: int) -> dict[str, int]:
-    """Vessel -> shard index: greedy, most expensive vessel first, to the least loaded."""
+    """Sensor -> shard index: greedy, most expensive first, to the least loaded."""
     load = [0.0] * shards
     owner: dict[str, int] = {}
     order = sorted(enumerate(costs.items()), key=lambda item: (-item[1][1], item[0]))
-    for _, (vessel, cost) in order:
+    for _, (key, cost) in order:
         i = min(range(shards), key=lambda k: (load[k], k))
-        owner[vessel] = i
+        owner[key] = i
         load[i] += cost
     return owner
 
@@ -48,5 +46,5 @@ def split(costs: dict[str, float], shards: int) -> dict[str, int]:
 def sensor_owners(sensors: Sequence[MountedSensor], shards: int, dt_ns: int) -> dict[str, str]:
     """Sensor stream key -> the participant that produces it."""
     names = shard_names(SERVICE, shards)
-    owner = split(vessel_costs(sensors, dt_ns), shards)
-    return {s.key: names[owner[s.vessel]] for s in sensors}
+    owner = split(sensor_costs(sensors, dt_ns), shards)
+    return {key: names[i] for key, i in owner.items()}

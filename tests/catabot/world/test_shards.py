@@ -1,5 +1,5 @@
-"""Sensors shared out between processes: whole vessels, balanced by rays, the same split in
-every process; the scenario refuses more shards than carriers."""
+"""Sensors shared out between processes: balanced by rays a second, the same split in every
+process; the scenario refuses more shards than sensors."""
 
 from __future__ import annotations
 
@@ -9,7 +9,7 @@ import pytest
 
 from catabot.config.load import parse_scenario
 from catabot.config.scenario import ScenarioError
-from catabot.world.shards import split, vessel_costs
+from catabot.world.shards import sensor_costs, split
 from catabot.world.world import World
 
 GPS = {"name": "gps", "type": "gps", "rate_hz": 10.0}
@@ -31,42 +31,42 @@ def test_one_shard_is_the_sensors_service_itself() -> None:
     assert world.services == ["physics", "sensors", "recorder"]
 
 
-def test_shards_are_participants_and_produce_their_vessels_streams() -> None:
+def test_shards_are_participants_and_produce_their_streams() -> None:
     world = _world(2, [GPS], [LIDAR, GPS])
     assert world.services == ["physics", "sensors.0", "sensors.1", "recorder"]
     producers = {s.key: s.producer for s in world.streams.sensors}
     assert producers == world.sensor_owners
-    owners = {key.split("/")[-2]: name for key, name in producers.items()}
-    assert owners == {"v0": "sensors.1", "v1": "sensors.0"}  # the LiDAR carrier first
+    assert producers == {
+        "catabot/w/sensor/v1/lidar": "sensors.0",  # the most expensive first
+        "catabot/w/sensor/v0/gps": "sensors.1",
+        "catabot/w/sensor/v1/gps": "sensors.1",
+    }
 
 
-def test_a_vessels_sensors_stay_together() -> None:
-    world = _world(3, [GPS, LIDAR], [CAMERA, GPS], [GPS], [LIDAR])
-    by_vessel: dict[str, set[str]] = {}
-    for key, name in world.sensor_owners.items():
-        by_vessel.setdefault(key.split("/")[-2], set()).add(name)
-    assert all(len(names) == 1 for names in by_vessel.values())
-    assert len({next(iter(n)) for n in by_vessel.values()}) == 3  # every shard has work
+def test_one_vessels_camera_and_lidar_run_side_by_side() -> None:
+    world = _world(2, [CAMERA, LIDAR, GPS])
+    owners = {key.rsplit("/", 1)[1]: name for key, name in world.sensor_owners.items()}
+    assert owners["cam"] != owners["lidar"]
 
 
 def test_costs_count_rays_a_second() -> None:
     world = _world(1, [GPS], [LIDAR], [CAMERA])
-    costs = vessel_costs(world.sensors, world.scenario.dt_ns)
-    assert costs["v1"] == pytest.approx(32 * 512 * 10 + 1e4)
-    assert costs["v2"] == pytest.approx(640 * 480 * 10 + 1e4)
-    assert costs["v0"] < costs["v1"] < costs["v2"]
+    costs = sensor_costs(world.sensors, world.scenario.dt_ns)
+    assert costs["catabot/w/sensor/v1/lidar"] == pytest.approx(32 * 512 * 10 + 1e4)
+    assert costs["catabot/w/sensor/v2/cam"] == pytest.approx(640 * 480 * 10 + 1e4)
+    assert costs["catabot/w/sensor/v0/gps"] == pytest.approx(1e4)
 
 
 def test_split_is_longest_first_to_the_least_loaded() -> None:
-    owner = split({"a": 5.0, "b": 4.0, "c": 3.0, "d": 3.0, "e": 3.0}, 2)
-    loads = [sum(c for v, c in zip("abcde", (5, 4, 3, 3, 3), strict=True) if owner[v] == i)
-             for i in range(2)]  # fmt: skip
-    assert sorted(loads) == [8, 10]  # the best is 9 / 9: LPT stays within 4/3 of it
+    costs = {"a": 5.0, "b": 4.0, "c": 3.0, "d": 3.0, "e": 3.0}
+    owner = split(costs, 2)
+    loads = sorted(sum(c for k, c in costs.items() if owner[k] == i) for i in range(2))
+    assert loads == [8, 10]  # the best is 9 / 9: LPT stays within 4/3 of it
     assert split({"a": 1.0, "b": 1.0}, 2) == {"a": 0, "b": 1}  # ties: lower index, world order
 
 
-def test_more_shards_than_carriers_is_refused_by_name() -> None:
-    with pytest.raises(ScenarioError, match=r"sensors\.shards.*3 shards for 2 vessel"):
+def test_more_shards_than_sensors_is_refused_by_name() -> None:
+    with pytest.raises(ScenarioError, match=r"sensors\.shards.*3 shards for 2 sensor"):
         _world(3, [GPS], [GPS])
     with pytest.raises(ScenarioError, match=r"sensors\.shards"):
         _world(0, [GPS])
