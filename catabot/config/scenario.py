@@ -310,12 +310,17 @@ def services(scenario: Scenario) -> list[str]:
     if any(v.sensors for v in scenario.vessels):
         names += shard_names("sensors", scenario.sensors.shards)
     if scenario.traffic.count > 0:
-        names.append("traffic")
+        names += shard_names("traffic", scenario.traffic.shards)
     if scenario.recording.csv or scenario.recording.mcap:
         names.append("recorder")
     if scenario.ros is not None:
         names.append(GATEWAY)
     return names
+
+
+def shard_count(scenario: Scenario, service: str) -> int:
+    """How many processes a service runs as (`sensors.shards`, `traffic.shards`)."""
+    return {"sensors": scenario.sensors.shards, "traffic": scenario.traffic.shards}.get(service, 1)
 
 
 def participants(scenario: Scenario) -> list[str]:

@@ -81,7 +81,7 @@ def _check_logins(opts: RunOptions, world: World) -> None:
         raise LaunchError(
             f"secure profile {opts.zenoh_configs} has no login for {', '.join(missing)} (the ROS "
             "gateway is not in the secure profile; otherwise make it with catabot secure init, "
-            "with --sensor-shards N for sensors.shards)"
+            "with --sensor-shards/--traffic-shards N for sensors.shards/traffic.shards)"
         )
 
 

@@ -49,22 +49,24 @@ class SecureError(CataBotError, RuntimeError):
     """The secure profile's files could not be made."""
 
 
-def own_keys(sensor_shards: int) -> dict[str, list[str]]:
-    """Each CataBot process's keys; a shard of the sensors may put any sensor's (consumers
-    believe a sample only from the shard that owns its vessel: catabot/bus/inbox.py)."""
-    if not 1 <= sensor_shards <= 64:
-        raise SecureError(f"sensor shards {sensor_shards}: use 1 to 64 (sensors.shards)")
-    shards = {n: OWN["sensors"] for n in shard_names("sensors", sensor_shards)}
-    return {**OWN, **shards}
+def own_keys(sensor_shards: int = 1, traffic_shards: int = 1) -> dict[str, list[str]]:
+    """Each CataBot process's keys; a shard may put any of its service's (consumers believe
+    a sample only from the shard that owns its stream: catabot/bus/inbox.py)."""
+    for what, n in (("sensors", sensor_shards), ("traffic", traffic_shards)):
+        if not 1 <= n <= 64:
+            raise SecureError(f"{what} shards {n}: use 1 to 64 ({what}.shards)")
+    sensors = {n: OWN["sensors"] for n in shard_names("sensors", sensor_shards)}
+    traffic = {n: ["world/cmd/twist/*"] for n in shard_names("traffic", traffic_shards)}
+    return {**OWN, **sensors, **(traffic if traffic_shards > 1 else {})}
 
 
 def init(
     folder: Path, *, clients: list[str], observers: list[str], host: str = "localhost",
-    port: int = 7447, sensor_shards: int = 1,
+    port: int = 7447, sensor_shards: int = 1, traffic_shards: int = 1,
 ) -> list[Path]:  # fmt: skip
     """Every file of the profile in `folder`; the paths written."""
     observers = [*observers, *(["viewer"] if "viewer" not in observers else [])]  # --view
-    own = own_keys(sensor_shards)
+    own = own_keys(sensor_shards, traffic_shards)
     names = [*own, *(check_name("client", c) for c in clients),
              *(check_name("observer", o) for o in observers)]  # fmt: skip
     if len(set(names)) != len(names):

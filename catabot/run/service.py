@@ -39,7 +39,7 @@ from catabot.bus.session import (
 from catabot.bus.settings import changes_of
 from catabot.config import live
 from catabot.config.load import load_scenario
-from catabot.config.scenario import Scenario
+from catabot.config.scenario import Scenario, shard_count
 from catabot.config.sensors import shard_names
 from catabot.errors import CataBotError
 from catabot.world.world import World
@@ -156,10 +156,10 @@ def parse_shard(text: str) -> tuple[int, int]:
 
 def own_name(service: str, world: World, shard: tuple[int, int] | None) -> str:
     """This process's participant name: the service's own, or its shard's (`sensors.1`)."""
-    n = world.scenario.sensors.shards
+    n = shard_count(world.scenario, service)
     if shard is None and n == 1:
         return service
-    split = f"the scenario splits {service} over {n} processes (sensors.shards)"
+    split = f"the scenario splits {service} over {n} processes ({service}.shards)"
     if shard is None:
         raise ShardError(f"{split}: start each with --shard I/{n}")
     if shard[1] != n:

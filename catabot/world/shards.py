@@ -43,6 +43,13 @@ def split(costs: dict[str, float], shards: int) -> dict[str, int]:
     return owner
 
 
+def blocks(ids: Sequence[str], shards: int) -> list[tuple[str, ...]]:
+    """Contiguous blocks of nearly equal size, in order: a traffic shard's boats. Contiguous,
+    so the recorder meets every boat in the same order whatever the number of shards."""
+    n = len(ids)
+    return [tuple(ids[i * n // shards : (i + 1) * n // shards]) for i in range(shards)]
+
+
 def sensor_owners(sensors: Sequence[MountedSensor], shards: int, dt_ns: int) -> dict[str, str]:
     """Sensor stream key -> the participant that produces it."""
     names = shard_names(SERVICE, shards)

@@ -12,7 +12,7 @@ from conftest import catabot, files_of, only_run_dir, scenario_file
 pytestmark = pytest.mark.timeout(240)
 
 
-def fleet(shards: int) -> dict[str, Any]:
+def fleet(shards: int, guides: int = 1) -> dict[str, Any]:
     vessels = []
     for i in range(4):
         sensors: list[dict[str, Any]] = [
@@ -24,21 +24,23 @@ def fleet(shards: int) -> dict[str, Any]:
                             "params": {"channels": 8, "columns": 128}})  # fmt: skip
         vessels.append({"id": f"v{i}", "pose": {"x_m": 20.0 * i}, "sensors": sensors,
                         "script": [{"t_s": 0.2, "thrust": [0.5, 0.7]}]})  # fmt: skip
-    return {"name": "shards", "seed": 5, "duration_s": 1.5, "traffic": {"count": 2},
+    traffic = {"count": 5, "shards": guides, "behaviour_mix": {"circle": 0.6, "waypoints": 0.4}}
+    return {"name": "shards", "seed": 5, "duration_s": 1.5, "traffic": traffic,
             "sensors": {"shards": shards}, "vessels": vessels}  # fmt: skip
 
 
-def test_any_number_of_sensor_shards_records_the_same_bytes(tmp_path: Path) -> None:
+def test_any_number_of_sensor_and_traffic_shards_records_the_same_bytes(tmp_path: Path) -> None:
     recorded = {}
-    for shards in (1, 2, 4):
+    for shards, guides in ((1, 1), (2, 2), (4, 3)):
         out = tmp_path / f"out{shards}"
-        scenario = scenario_file(tmp_path, fleet(shards), name=f"s{shards}.json")
+        scenario = scenario_file(tmp_path, fleet(shards, guides), name=f"s{shards}.json")
         done = catabot("run", str(scenario), "--out", str(out), "--quiet")
         assert done.returncode == 0, done.stdout + done.stderr
         run = only_run_dir(out)
         recorded[shards] = files_of(run)
-        logs = {p.stem for p in (run / "log").glob("sensors*.log")}
-        assert logs == ({"sensors"} if shards == 1 else {f"sensors.{i}" for i in range(shards)})
+        logs = {p.stem for p in (run / "log").glob("*.log")}
+        assert logs >= ({"sensors"} if shards == 1 else {f"sensors.{i}" for i in range(shards)})
+        assert logs >= ({"traffic"} if guides == 1 else {f"traffic.{i}" for i in range(guides)})
     assert len(recorded[1]) > 10
     assert recorded[2] == recorded[1]
     assert recorded[4] == recorded[1]

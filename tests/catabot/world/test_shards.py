@@ -70,3 +70,21 @@ def test_more_shards_than_sensors_is_refused_by_name() -> None:
         _world(3, [GPS], [GPS])
     with pytest.raises(ScenarioError, match=r"sensors\.shards"):
         _world(0, [GPS])
+
+
+def test_traffic_shards_guide_contiguous_blocks_on_keys_of_their_own() -> None:
+    data = {"name": "w", "vessels": [{"id": "ego"}], "traffic": {"count": 7, "shards": 3}}
+    world = World.resolve(parse_scenario(data))
+    assert list(world.traffic_blocks.values()) == [
+        ("boat_000", "boat_001"), ("boat_002", "boat_003", "boat_004"), ("boat_005", "boat_006"),
+    ]  # fmt: skip
+    assert world.services == ["physics", "traffic.0", "traffic.1", "traffic.2", "recorder"]
+    streams = world.streams.twists
+    assert [s.key for s in streams] == [f"catabot/w/world/cmd/twist/{i:02d}" for i in range(3)]
+    assert [s.producer for s in streams] == ["traffic.0", "traffic.1", "traffic.2"]
+
+
+def test_more_traffic_shards_than_boats_is_refused_by_name() -> None:
+    data = {"name": "w", "vessels": [{"id": "ego"}], "traffic": {"count": 2, "shards": 3}}
+    with pytest.raises(ScenarioError, match=r"traffic\.shards: 3 shards for 2 boat"):
+        parse_scenario(data)
