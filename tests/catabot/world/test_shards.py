@@ -76,7 +76,7 @@ def test_traffic_shards_guide_contiguous_blocks_on_keys_of_their_own() -> None:
     data = {"name": "w", "vessels": [{"id": "ego"}], "traffic": {"count": 7, "shards": 3}}
     world = World.resolve(parse_scenario(data))
     assert list(world.traffic_blocks.values()) == [
-        ("boat_000", "boat_001"), ("boat_002", "boat_003", "boat_004"), ("boat_005", "boat_006"),
+        ("boat_000", "boat_001"), ("boat_002", "boat_003"), ("boat_004", "boat_005", "boat_006"),
     ]  # fmt: skip
     assert world.services == ["physics", "traffic.0", "traffic.1", "traffic.2", "recorder"]
     streams = world.streams.twists
