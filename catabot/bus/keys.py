@@ -81,9 +81,11 @@ class Keys:
         """Every body's state in one `BodyStates` per tick (what lockstep services read)."""
         return f"{self.prefix}/world/states"
 
-    def world_twists(self) -> str:
-        """Every traffic boat's twist set-point in one `TwistBatch` per tick (lockstep)."""
-        return f"{self.prefix}/world/cmd/twist"
+    def world_twists(self, shard: int | None = None) -> str:
+        """Every traffic boat's twist set-point in one `TwistBatch` per tick (lockstep); with
+        `traffic.shards`, each shard's block of boats on a key of its own."""
+        base = f"{self.prefix}/world/cmd/twist"
+        return base if shard is None else f"{base}/{shard:02d}"  # sorted = shard order
 
     def cmd_thrust(self, vessel: str) -> str:
         return f"{self.prefix}/vessel/{check_name('vessel', vessel)}/cmd/thrust"

@@ -22,7 +22,7 @@ from catabot.bus.identity import check_zid
 from catabot.errors import CataBotError
 
 MODES = ("peer", "client", "router")
-LEASE_MS = 2000
+LEASE_MS = 1500
 LOOPBACK = "tcp/127.0.0.1:0"
 BLOCK = zenoh.CongestionControl.BLOCK  # lockstep data and clock messages are never dropped
 
@@ -38,7 +38,7 @@ class Connection:
     `file` (or the ZENOH_CONFIG environment variable) is a Zenoh config file (JSON5): TLS,
     credentials, a router's access control (the secure profile: deploy/secure/). With one,
     CataBot changes only what its flags set (mode, connect, listen, zid); without one, the
-    embedded defaults: peer mode on loopback, no multicast scouting, a 2 s link lease."""
+    embedded defaults: peer mode on loopback, no multicast scouting, a 1.5 s link lease."""
 
     connect: tuple[str, ...] = ()
     listen: tuple[str, ...] = ()  # none given: tcp/127.0.0.1:0 in peer mode, without a file
@@ -74,8 +74,9 @@ def _embedded(mode: str) -> zenoh.Config:
     cfg.insert_json5("scouting/multicast/enabled", "false")
     cfg.insert_json5("connect/endpoints", "[]")
     cfg.insert_json5("listen/endpoints", json.dumps([] if mode == "client" else [LOOPBACK]))
-    # A peer that stops answering (a stopped process, a cut link) is gone after 2 s, not
-    # Zenoh's default 10 s: keep-alives every 0.5 s.
+    # A peer that stops answering (a stopped process, a cut link) is gone within 2 s, not
+    # Zenoh's default 10 s: keep-alives every 0.375 s, a lease of 1.5 s (a cut cable is named
+    # 1.6-1.9 s after the cut across six hosts, tests/e2e/test_distributed.py).
     cfg.insert_json5("transport/link/tx/lease", str(LEASE_MS))
     cfg.insert_json5("transport/link/tx/keep_alive", "4")
     return cfg

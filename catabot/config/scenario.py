@@ -35,7 +35,7 @@ from catabot.config.environment import CurrentConfig, RainConfig, WindConfig
 from catabot.config.live import SettingChange, check_timeline
 from catabot.config.pose import Pose, Velocity
 from catabot.config.ros import GATEWAY, RosConfig, check_ros
-from catabot.config.sensors import SENSOR_TYPES
+from catabot.config.sensors import SENSOR_TYPES, SensorFarmConfig, shard_names
 from catabot.config.terrain import TerrainConfig
 from catabot.config.traffic import TrafficConfig
 from catabot.config.waves import WaveConfig
@@ -191,6 +191,7 @@ class Scenario(Strict):
     vessels: list[VesselConfig] = Field(min_length=1)
     traffic: TrafficConfig = TrafficConfig()
     recording: RecordingConfig = RecordingConfig()
+    sensors: SensorFarmConfig = SensorFarmConfig()
     ros: RosConfig | None = Field(None, description="the ROS 2 gateway (services/ros)")
     settings: list[SettingChange] = Field(
         [], description="run-time setting changes by time (catabot/config/live.py; catabot set)"
@@ -222,6 +223,16 @@ class Scenario(Strict):
                 raise FieldProblem("recording.export", f"{fmt!r} needs a {need} on a vessel")
             if need == "camera" and not rec.dataset:
                 raise FieldProblem("recording.export", f"{fmt!r} needs recording.dataset: true")
+        return self
+
+    @model_validator(mode="after")
+    def _shards_have_sensors(self) -> Scenario:
+        count = sum(len(v.sensors) for v in self.vessels)
+        if self.sensors.shards > max(count, 1):
+            raise FieldProblem(
+                "sensors.shards",
+                f"{self.sensors.shards} shards for {count} sensor(s): each shard owns at least one",
+            )
         return self
 
     @model_validator(mode="after")
@@ -290,14 +301,19 @@ def services(scenario: Scenario) -> list[str]:
     """The CataBot services a scenario needs, in start order."""
     names = ["physics"]
     if any(v.sensors for v in scenario.vessels):
-        names.append("sensors")
+        names += shard_names("sensors", scenario.sensors.shards)
     if scenario.traffic.count > 0:
-        names.append("traffic")
+        names += shard_names("traffic", scenario.traffic.shards)
     if scenario.recording.csv or scenario.recording.mcap:
         names.append("recorder")
     if scenario.ros is not None:
         names.append(GATEWAY)
     return names
+
+
+def shard_count(scenario: Scenario, service: str) -> int:
+    """How many processes a service runs as (`sensors.shards`, `traffic.shards`)."""
+    return {"sensors": scenario.sensors.shards, "traffic": scenario.traffic.shards}.get(service, 1)
 
 
 def participants(scenario: Scenario) -> list[str]:

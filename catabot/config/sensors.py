@@ -27,6 +27,11 @@ class SensorParams(Strict):
         """Why one sample would not fit in `SENSOR_MEMORY_BUDGET` ("" when it fits)."""
         return ""
 
+    def rays_per_s(self, rate_hz: float) -> float:
+        """Rays cast a second: what a sensor costs, for sharing sensors out between
+        processes (catabot/world/shards.py); 0 for a sensor that casts none."""
+        return 0.0
+
 
 class ImuParams(SensorParams):
     gyro_sigma: float = Field(0.009, ge=0, description="rad/s, white noise per sample")
@@ -79,6 +84,10 @@ class RadarParams(SensorParams):
     ppi_size_px: int = Field(256, ge=16, le=2048)
     fade_s: float = Field(1.0, gt=0, description="PPI returns fade to nothing in this time")
 
+    def rays_per_s(self, rate_hz: float) -> float:
+        beams = 360.0 / (self.beam_width_deg / 2)  # a turn, whatever the sampling rate
+        return beams * self.sub_rays * len(self.elevations_deg) / self.rotation_period_s
+
 
 class CameraOutputs(SensorParams):
     color: StrictBool = True
@@ -106,6 +115,9 @@ class CameraParams(SensorParams):
     occluded_fraction: float = Field(
         0.3, ge=0, le=1, description="occluded when visible px < fraction x projected box"
     )
+
+    def rays_per_s(self, rate_hz: float) -> float:
+        return float(self.width * self.height) * rate_hz
 
     def memory_problem(self) -> str:
         need = self.width * self.height * BYTES_PER_PIXEL
@@ -140,6 +152,22 @@ class LidarParams(SensorParams):
     reflectivity: float = Field(0.9, gt=0, le=1, description="s in rho = s / pi")
     q_ext: float = Field(2.0, ge=0)
     q_back: float = Field(2.0, ge=0)
+
+    def rays_per_s(self, rate_hz: float) -> float:
+        return float(self.channels * self.columns) * rate_hz
+
+
+class SensorFarmConfig(Strict):
+    """The sensors service as several processes (`catabot service sensors --shard i/N`), each
+    owning some of the sensors (catabot/world/shards.py), on one machine or spread over
+    several; the recording is the same for any number."""
+
+    shards: int = Field(1, ge=1, le=64, description="sensor processes, sharing the sensors out")
+
+
+def shard_names(service: str, shards: int) -> list[str]:
+    """The participant names of a service split `shards` ways (one: the service's own)."""
+    return [service] if shards == 1 else [f"{service}.{i}" for i in range(shards)]
 
 
 @dataclass(frozen=True)

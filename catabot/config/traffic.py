@@ -11,7 +11,7 @@ from typing import Literal
 
 from pydantic import Field, StrictBool, field_validator, model_validator
 
-from catabot.config.base import Seed, Strict
+from catabot.config.base import FieldProblem, Seed, Strict
 
 BEHAVIOURS = ("circle", "waypoints", "hold")
 Behaviour = Literal["circle", "waypoints", "hold"]
@@ -110,6 +110,13 @@ class TrafficConfig(Strict):
         "set-points; physics holds each one and runs the velocity controller every tick. "
         "A whole number of ticks",
     )
+    shards: int = Field(
+        1,
+        ge=1,
+        le=64,
+        description="traffic processes, each guiding a contiguous block of the boats "
+        "(catabot service traffic --shard I/N); the recording is the same for any number",
+    )
     setpoint_delay_ticks: int = Field(
         0,
         ge=0,
@@ -122,6 +129,13 @@ class TrafficConfig(Strict):
     def boat_ids(self) -> list[str]:
         """The boats' ids, in `TwistBatch` order: they name keys, files and ROS topics."""
         return [boat_id(i) for i in range(self.count)]
+
+    @model_validator(mode="after")
+    def _shards_have_boats(self) -> TrafficConfig:
+        if self.shards > max(self.count, 1):
+            raise FieldProblem("shards", f"{self.shards} shards for {self.count} boat(s): "
+                               "each shard guides at least one")  # fmt: skip
+        return self
 
     @field_validator("models")
     @classmethod

@@ -94,10 +94,11 @@ class Converter:
             return Out(self.names.topic(vessel, "thrust"), types.FLOAT64_ARRAY, thrust(msg.thrust))
         raise ValueError(f"{vessel}: no ROS 2 form for a {type(msg).__name__} command")
 
-    def boat_twists(self, batch: TwistBatch) -> np.ndarray:
-        """Every traffic boat's set-point as a Twist, an (N, 52) byte matrix in
-        `boat_twist_topics` order. Raises ValueError for other boats or shapes."""
-        batch.check(self.world.boat_ids)
+    def boat_twists(self, batch: TwistBatch, boats: tuple[str, ...] | None = None) -> np.ndarray:
+        """The set-points of `boats` (every traffic boat, or a traffic shard's block) as
+        Twists, an (N, 52) byte matrix in their order. Raises ValueError for other boats or
+        shapes."""
+        batch.check(self.world.boat_ids if boats is None else boats)
         return twist_rows(batch.surge, batch.yaw_rate)
 
     def buoys(self) -> Out | None:

@@ -49,7 +49,7 @@ def _secure(args: argparse.Namespace) -> int:
     try:
         files = secure.init(
             Path(args.folder), clients=args.client, observers=args.observer, host=args.host,
-            port=args.port,
+            port=args.port, sensor_shards=args.sensor_shards, traffic_shards=args.traffic_shards,
         )  # fmt: skip
     except CataBotError as exc:
         print(f"catabot secure: {exc}", file=sys.stderr)
@@ -175,6 +175,10 @@ def parser() -> argparse.ArgumentParser:
         "--host", default="localhost", help="the router's host name (default localhost)"
     )
     sec.add_argument("--port", type=int, default=7447, help="the router's TLS port (default 7447)")
+    shards = "logins for N sensor processes (a scenario's sensors.shards)"
+    sec.add_argument("--sensor-shards", type=int, default=1, metavar="N", help=shards)
+    guides = "logins for N traffic processes (a scenario's traffic.shards)"
+    sec.add_argument("--traffic-shards", type=int, default=1, metavar="N", help=guides)
     svc = sub.add_parser("service", help="run one service (conductor, physics, ...) alone")
     svc.add_argument("name")
     rtr = sub.add_parser("router", help="run a zenoh router for distributed runs")

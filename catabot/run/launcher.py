@@ -66,7 +66,7 @@ def prepare(opts: RunOptions) -> World:
         data["clock"]["realtime_factor"] = opts.realtime
     world = World.resolve(parse_scenario(data, source="command line"), progress=PlanningProgress())
     for name in world.services:
-        if name not in SERVICE_MODULES:
+        if name.partition(".")[0] not in SERVICE_MODULES:
             raise LaunchError(f"scenario needs service {name!r}, which this version does not have")
     programs.programs(world.scenario, opts.scenario)  # each controller's program is a file
     _check_logins(opts, world)
@@ -84,7 +84,8 @@ def _check_logins(opts: RunOptions, world: World) -> None:
         raise LaunchError(
             f"secure profile {opts.zenoh_configs} has no login for {', '.join(missing)} (the ROS "
             "gateway is not in the secure profile; a controller's program needs a client login: "
-            "catabot secure init --client NAME; otherwise make it with catabot secure init)"
+            "catabot secure init --client NAME; shards need --sensor-shards/--traffic-shards N; "
+            "otherwise make it with catabot secure init)"
         )
 
 
@@ -170,7 +171,11 @@ def _start(
     stops.conductor = conductor.proc
     viewer = _viewer(opts, run_dir, [*flags[1], *_login("viewer", opts.zenoh_configs)])
     services = {
-        name: child(name, SERVICE_MODULES[name], ["--run-dir", str(run_dir), *flags[1]])
+        name: child(
+            name,
+            _module(name),
+            ["--run-dir", str(run_dir), *flags[1], *_shard(name, world.services)],
+        )
         for name in world.services
     }
     for stack in stacks:
@@ -185,6 +190,17 @@ def _start(
             env=programs.environment(run_dir),
         )
     return Supervisor(conductor, services, stops), viewer
+
+
+def _module(name: str) -> str:
+    return SERVICE_MODULES[name.partition(".")[0]]  # a shard runs its service's program
+
+
+def _shard(name: str, names: list[str]) -> list[str]:
+    """`sensors.1` of `sensors.shards: 4` runs as `--shard 1/4`."""
+    base, _, index = name.partition(".")
+    n = sum(1 for other in names if other.partition(".")[0] == base)
+    return ["--shard", f"{index}/{n}"] if index else []
 
 
 def _viewer(opts: RunOptions, run_dir: Path, svc_flags: list[str]) -> Viewer | None:

@@ -29,6 +29,7 @@ from typing import Any
 from catabot.bus.clock import CONDUCTOR
 from catabot.bus.keys import check_name
 from catabot.bus.session import LEASE_MS
+from catabot.config.sensors import shard_names
 from catabot.errors import CataBotError
 
 OWN = {  # keys each process may put besides its ack and its liveliness token
@@ -49,16 +50,28 @@ class SecureError(CataBotError, RuntimeError):
     """The secure profile's files could not be made."""
 
 
+def own_keys(sensor_shards: int = 1, traffic_shards: int = 1) -> dict[str, list[str]]:
+    """Each CataBot process's keys; a shard may put any of its service's (consumers believe
+    a sample only from the shard that owns its stream: catabot/bus/inbox.py)."""
+    for what, n in (("sensors", sensor_shards), ("traffic", traffic_shards)):
+        if not 1 <= n <= 64:
+            raise SecureError(f"{what} shards {n}: use 1 to 64 ({what}.shards)")
+    sensors = {n: OWN["sensors"] for n in shard_names("sensors", sensor_shards)}
+    traffic = {n: ["world/cmd/twist/*"] for n in shard_names("traffic", traffic_shards)}
+    return {**OWN, **sensors, **(traffic if traffic_shards > 1 else {})}
+
+
 def init(
     folder: Path, *, clients: list[str], observers: list[str], host: str = "localhost",
-    port: int = 7447,
+    port: int = 7447, sensor_shards: int = 1, traffic_shards: int = 1,
 ) -> list[Path]:  # fmt: skip
     """Every file of the profile in `folder`; the paths written."""
     observers = [*observers, *(["viewer"] if "viewer" not in observers else [])]  # --view
-    names = [*OWN, *(check_name("client", c) for c in clients),
+    own = own_keys(sensor_shards, traffic_shards)
+    names = [*own, *(check_name("client", c) for c in clients),
              *(check_name("observer", o) for o in observers)]  # fmt: skip
     if len(set(names)) != len(names):
-        raise SecureError(f"names must differ from each other and from {', '.join(OWN)}")
+        raise SecureError(f"names must differ from each other and from {', '.join(own)}")
     folder = folder.resolve()  # the config files name the certificates from anywhere
     folder.mkdir(parents=True, exist_ok=True)
     _certificates(folder, host)
@@ -66,8 +79,8 @@ def init(
     (folder / "users.txt").write_text("".join(f"{u}:{p}\n" for u, p in users.items()))
     (folder / "users.txt").chmod(0o600)
     endpoint = f"tls/{host}:{port}"
-    written = [folder / "users.txt", _write(folder / "router.json5", _router(folder, endpoint,
-               users, clients, observers))]  # fmt: skip
+    router = _router(folder, endpoint, users, clients, observers, own)
+    written = [folder / "users.txt", _write(folder / "router.json5", router)]
     for name in names:
         written.append(_write(folder / f"{name}.json5", _session(folder, endpoint, name, users)))
     return written
@@ -98,8 +111,9 @@ def _certificates(folder: Path, host: str) -> None:
 
 
 def _router(
-    folder: Path, endpoint: str, users: dict[str, str], clients: list[str], observers: list[str]
-) -> dict[str, Any]:
+    folder: Path, endpoint: str, users: dict[str, str], clients: list[str], observers: list[str],
+    own: dict[str, list[str]],
+) -> dict[str, Any]:  # fmt: skip
     return {
         "mode": "router",
         "listen": {"endpoints": [endpoint]},
@@ -120,12 +134,13 @@ def _router(
                 }
             },
         },
-        "access_control": _acl([*OWN, *clients], clients, observers),
+        "access_control": _acl(own, clients, observers),
     }
 
 
-def _acl(writers: list[str], clients: list[str], observers: list[str]) -> dict[str, Any]:
+def _acl(own: dict[str, list[str]], clients: list[str], observers: list[str]) -> dict[str, Any]:
     """Default deny; everyone may subscribe and receive; each writer its own keys."""
+    writers = [*own, *clients]
     everyone = [*writers, *observers]
     rules: list[dict[str, Any]] = [
         _rule("read", READ, ["ingress", "egress"], ["catabot/**"]),
@@ -145,7 +160,7 @@ def _acl(writers: list[str], clients: list[str], observers: list[str]) -> dict[s
         subjects.append({"id": "clients", "usernames": clients})
         policies.append({"rules": ["set"], "subjects": ["clients"]})
     for name in writers:
-        keys = [*OWN.get(name, COMMANDS if name in clients else []), f"clock/ack/{name}"]
+        keys = [*own.get(name, COMMANDS if name in clients else []), f"clock/ack/{name}"]
         rules.append(_rule(f"{name}-puts", ["put"], ["ingress"], [f"catabot/*/{k}" for k in keys]))
         rules.append(_rule(f"{name}-token", ["liveliness_token"], ["ingress", "egress"],
                            [f"catabot/*/live/{name}/*"]))  # fmt: skip

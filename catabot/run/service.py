@@ -39,7 +39,8 @@ from catabot.bus.session import (
 from catabot.bus.settings import changes_of
 from catabot.config import live
 from catabot.config.load import load_scenario
-from catabot.config.scenario import Scenario
+from catabot.config.scenario import Scenario, shard_count
+from catabot.config.sensors import shard_names
 from catabot.errors import CataBotError
 from catabot.world.world import World
 
@@ -142,22 +143,57 @@ def _write_usage(name: str, run_dir: Path, cpu_s: float) -> None:
     (run_dir / "log" / f"{name}.usage.json").write_text(json.dumps({"cpu_s": round(cpu_s, 3)}))
 
 
+class ShardError(CataBotError, ValueError):
+    """A `--shard` that does not match the scenario's split."""
+
+
+def parse_shard(text: str) -> tuple[int, int]:
+    i, sep, n = text.partition("/")
+    if not (sep and i.isdigit() and n.isdigit() and 0 <= int(i) < int(n)):
+        raise argparse.ArgumentTypeError(f"{text!r}: use I/N with 0 <= I < N, e.g. 0/2")
+    return int(i), int(n)
+
+
+def own_name(service: str, world: World, shard: tuple[int, int] | None) -> str:
+    """This process's participant name: the service's own, or its shard's (`sensors.1`)."""
+    n = shard_count(world.scenario, service)
+    if shard is None and n == 1:
+        return service
+    split = f"the scenario splits {service} over {n} processes ({service}.shards)"
+    if shard is None:
+        raise ShardError(f"{split}: start each with --shard I/{n}")
+    if shard[1] != n:
+        raise ShardError(f"--shard {shard[0]}/{shard[1]}: {split}")
+    return shard_names(service, n)[shard[0]]
+
+
 def run_service(
-    name: str, build: BuildFn, argv: list[str] | None = None, *, timestamping: bool = False
+    name: str,
+    build: BuildFn,
+    argv: list[str] | None = None,
+    *,
+    timestamping: bool = False,
+    shardable: bool = False,
 ) -> int:
     """Run one stepping service to the end of the run; returns the process exit code.
 
     A fault of the service's own is logged as CRITICAL (what `catabot run` reports as the
     run's cause); a fault of the clock (the conductor gone, the run ended by a fault
     elsewhere) as ERROR: it is a consequence, not a cause. `timestamping`: the session stamps
-    samples (Zenoh's advanced publishers need it)."""
-    args = service_parser(name).parse_args(argv)
+    samples (Zenoh's advanced publishers need it). `shardable`: it takes `--shard I/N` and
+    runs as that shard (`sensors.shards`)."""
+    parser = service_parser(name)
+    if shardable:
+        what = "run shard I of the N the scenario splits this service into"
+        parser.add_argument("--shard", type=parse_shard, metavar="I/N", help=what)
+    args = parser.parse_args(argv)
     setup_logging()
     single_thread_blas()  # idle BLAS threads spin on the cores other services need
     signal.signal(signal.SIGTERM, lambda *_: sys.exit(143))
     try:
         batch_scheduling()  # before Zenoh starts its threads, so that they inherit it
         world = World.resolve(load_scenario(args.scenario))  # the same in every process
+        name = own_name(name, world, args.shard) if shardable else name
         session = open_session(replace(connection_from_args(args), timestamping=timestamping))
     except CataBotError as exc:
         log.critical("%s", exc)

@@ -36,12 +36,13 @@ class Streams:
     commands: tuple[Stream, ...]  # thrust and twist of every vessel from outside (tick -1)
     controls: tuple[Stream, ...]  # the commands of vessels' controllers (lockstep stacks)
     waypoints: tuple[Stream, ...]  # high-level commands from outside
-    twist_batch: Stream | None  # the traffic service's set-points (none without traffic)
+    twists: tuple[Stream, ...]  # the traffic service's set-points, one per shard (or none)
 
     @classmethod
     def of(cls, world: World) -> Streams:
         keys, vessels = world.keys, world.vessels
         commands = [s for v in vessels for s in _commands(world, v)]
+        owner = world.sensor_owners
         return cls(
             states=Stream(
                 keys.world_states(),
@@ -54,13 +55,13 @@ class Streams:
                 Stream(keys.vessel_state(v.id), VesselState, "physics") for v in vessels
             ),
             sensors=tuple(
-                Stream(s.key, SENSOR_TYPES[s.config.type].message, "sensors", s.period)
+                Stream(s.key, SENSOR_TYPES[s.config.type].message, owner[s.key], s.period)
                 for s in world.sensors
             ),
             commands=tuple(s for s in commands if s.period is None),
             controls=tuple(s for s in commands if s.period is not None),
             waypoints=tuple(_waypoints(world, v) for v in vessels),
-            twist_batch=_twist_batch(world),
+            twists=_twist_batches(world),
         )
 
     def lockstep(self) -> list[Stream]:
@@ -68,10 +69,8 @@ class Streams:
         return [self.states, *self.sensors, *self.twist_batches(), *self.controls]
 
     def twist_batches(self, *, lag: int = 0) -> list[Stream]:
-        """The traffic set-points as a list (empty without traffic), read `lag` ticks late."""
-        if self.twist_batch is None:
-            return []
-        return [replace(self.twist_batch, lag=lag)]
+        """The traffic set-points (empty without traffic), read `lag` ticks late."""
+        return [replace(s, lag=lag) for s in self.twists]
 
 
 def _commands(world: World, vessel: Body) -> list[Stream]:
@@ -101,10 +100,16 @@ def _waypoints(world: World, vessel: Body) -> Stream:
     return Stream(key, WaypointsCmd, EXTERNAL, None, check=checks.waypoints)
 
 
-def _twist_batch(world: World) -> Stream | None:
-    """The traffic service's set-points for every boat, one batch a guidance period."""
-    if not world.boat_ids:
-        return None
-    period = guidance_period_ticks(world.scenario)
-    check = checks.twist_batch(world.boat_ids)
-    return Stream(world.keys.world_twists(), TwistBatch, "traffic", period, check=check)
+def _twist_batches(world: World) -> tuple[Stream, ...]:
+    """The traffic service's set-points, one batch a guidance period from each shard for its
+    block of boats (one shard: every boat, on `world/cmd/twist`)."""
+    blocks = world.traffic_blocks
+    period = guidance_period_ticks(world.scenario) if blocks else 0
+    return tuple(
+        Stream(twist_key(world, i), TwistBatch, name, period, check=checks.twist_batch(ids))
+        for i, (name, ids) in enumerate(blocks.items())
+    )
+
+
+def twist_key(world: World, shard: int) -> str:
+    return world.keys.world_twists(shard if world.scenario.traffic.shards > 1 else None)

@@ -34,10 +34,12 @@ from catabot.config.scenario import (
     participants,
     services,
 )
+from catabot.config.sensors import shard_names
 from catabot.config.vessel import VesselModel, load_vessel_model
 from catabot.world import rotations
 from catabot.world.environment.current import CurrentField
 from catabot.world.placement import resolve_poses
+from catabot.world.shards import blocks, sensor_owners
 from catabot.world.streams import Streams
 from catabot.world.terrain import Terrain, load_terrain
 from catabot.world.traffic_plan import Progress, TrafficPlan, plan_traffic
@@ -138,6 +140,21 @@ class World:
     def boat_ids(self) -> tuple[str, ...]:
         """The traffic boats, in `TwistBatch` order."""
         return tuple(b.id for b in self.bodies if b.kind == "boat")
+
+    @cached_property
+    def sensor_owners(self) -> dict[str, str]:
+        """Sensor stream key -> the sensors process (shard) that produces it."""
+        s = self.scenario
+        return sensor_owners(self.sensors, s.sensors.shards, s.dt_ns)
+
+    @cached_property
+    def traffic_blocks(self) -> dict[str, tuple[str, ...]]:
+        """Traffic participant -> the boats it guides, in `TwistBatch` order (one block per
+        shard of `traffic.shards`; none without traffic)."""
+        if not self.boat_ids:
+            return {}
+        names = shard_names("traffic", self.scenario.traffic.shards)
+        return dict(zip(names, blocks(self.boat_ids, len(names)), strict=True))
 
     @cached_property
     def streams(self) -> Streams:

@@ -56,7 +56,7 @@ class CommandBook:
         self.external: dict[str, Order] = {}
         self.set_point = np.zeros((len(self.ids), 2))  # (surge m/s, yaw rate rad/s)
         self.has_set_point = np.zeros(len(self.ids), dtype=bool)
-        self._batch_rows: tuple[tuple[str, ...], NDArray[np.intp]] = ((), np.zeros(0, np.intp))
+        self._batch_rows: dict[tuple[str, ...], NDArray[np.intp]] = {}  # a traffic shard's
 
     def order(self, vessel: str, stamp_ns: int) -> Order:
         """One vessel's order now: external > lockstep set-point > script."""
@@ -95,9 +95,10 @@ class CommandBook:
             log.error("refused twist set-points at tick %d: non-finite for %s", batch.tick, bad)
 
     def _rows_of(self, boats: tuple[str, ...]) -> NDArray[np.intp]:
-        if self._batch_rows[0] != boats:
-            self._batch_rows = (boats, np.array([self.row[b] for b in boats], dtype=np.intp))
-        return self._batch_rows[1]
+        rows = self._batch_rows.get(boats)
+        if rows is None:
+            rows = self._batch_rows[boats] = np.array([self.row[b] for b in boats], np.intp)
+        return rows
 
     def take(self, vessel: str, msgs: list[Message]) -> None:
         """Adopt the newest command from the bus (checked on arrival: one finite value per

@@ -46,8 +46,8 @@ class PhysicsService:
         streams = world.streams
         self.streams = [*streams.commands, *streams.controls, *streams.waypoints]
         self.vessel_of = {s.key: ctx.keys.vessel_of(s.key) for s in self.streams}
-        self.twists_key = ctx.keys.world_twists()
-        self.boats = world.boat_ids
+        self.blocks = {s.key: ids for s, ids in zip(streams.twists, world.traffic_blocks.values(),
+                                                      strict=True)}  # fmt: skip
         delay = world.scenario.traffic.setpoint_delay_ticks  # physics steps ahead of traffic
         self.streams += streams.twist_batches(lag=delay)
         self.body_ids = world.body_ids
@@ -59,17 +59,17 @@ class PhysicsService:
         for change in changes_of(tick.settings):
             settings.apply(self.world, self.scenario, self.specs, change)
         for key, msgs in inputs.items():
-            if key == self.twists_key:
-                self._take_twists(msgs[-1])
+            if key in self.blocks:
+                self._take_twists(msgs[-1], self.blocks[key])
             else:
                 self.book.take(self.vessel_of[key], msgs)
         self._apply_orders(tick.stamp_ns)
         self.world.step()
         self._publish(tick)
 
-    def _take_twists(self, batch: Message) -> None:
+    def _take_twists(self, batch: Message, boats: tuple[str, ...]) -> None:
         assert isinstance(batch, TwistBatch)  # the inbox decodes each stream as its type
-        self.book.take_batch(batch, self.boats)
+        self.book.take_batch(batch, boats)
 
     def _apply_orders(self, stamp_ns: int) -> None:
         """Thrust orders as given; twist orders through one controller pass for all vessels."""

@@ -36,6 +36,7 @@ class Block:
     typename: str
     groups: list[tuple[np.ndarray, np.ndarray]]
     tf: bytes | None = None
+    family: tuple[str, ...] = ()  # topics whose channels are declared together, in order
 
 
 class BatchFormatter:
@@ -46,6 +47,7 @@ class BatchFormatter:
         self.convert = convert
         self.state_streams = tuple(f"vessel/{b}/state" for b in world.body_ids)
         self.twist_streams = tuple(f"vessel/{b}/cmd/twist" for b in world.boat_ids)
+        self.twist_blocks = _slices(list(world.traffic_blocks.values()))
 
     def states(self, batch: BodyStates) -> Block:
         """Raises ValueError for a batch of other bodies (rows would land in wrong files)."""
@@ -59,11 +61,25 @@ class BatchFormatter:
 
     def twists(self, batch: TwistBatch) -> Block:
         """Raises ValueError for a batch of other boats or of the wrong shape."""
-        rows = self.convert.boat_twists(batch)  # checks ids and shapes first
+        block = self.twist_blocks.get(tuple(batch.ids))  # a traffic shard's boats
+        if block is None:
+            raise ValueError(f"twist batch at tick {batch.tick} lists {list(batch.ids)[:8]}, "
+                             "expected one traffic shard's boats")  # fmt: skip
+        rows = self.convert.boat_twists(batch, tuple(batch.ids))  # checks shapes first
         table = np.stack((batch.surge, batch.yaw_rate), axis=1).astype(np.float64)
         lines = tabular.block_lines(batch.stamp_ns, batch.tick, table)
         groups = [(np.arange(len(rows)), rows)]
-        topics = self.convert.boat_twist_topics
+        topics = self.convert.boat_twist_topics[block]
         return Block(
-            TwistCmd, batch.stamp_ns, self.twist_streams, lines, topics, types.TWIST, groups
-        )
+            TwistCmd, batch.stamp_ns, self.twist_streams[block], lines, topics, types.TWIST, groups,
+            family=self.convert.boat_twist_topics,  # one order of channels for any traffic shards
+        )  # fmt: skip
+
+
+def _slices(blocks: list[tuple[str, ...]]) -> dict[tuple[str, ...], slice]:
+    """Each traffic shard's boats -> its rows among every boat's (blocks are contiguous)."""
+    out, start = {}, 0
+    for ids in blocks:
+        out[ids] = slice(start, start + len(ids))
+        start += len(ids)
+    return out

@@ -61,6 +61,8 @@ class McapRecording:
 
     def block(self, block: Block) -> None:
         self.start()
+        if block.family:
+            self.mcap.declare(block.family, block.typename)
         if block.tf is not None:
             self.mcap.write(TF, types.TF, block.tf, stamp_ns=block.stamp_ns)
         for rows, matrix in block.groups:

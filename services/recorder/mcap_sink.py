@@ -110,6 +110,12 @@ class McapSink:
             ids = self._group(topics, typename)
             self._writer.add_block(ids, self._sequences(ids), stamp_ns, payloads)
 
+    def declare(self, topics: Sequence[str], typename: str) -> None:
+        """Channels for `topics`, in their order, before any of them is written: a batch
+        split in blocks (traffic shards) then registers them as the whole batch would."""
+        if topics:
+            self._group(topics, typename)
+
     def write_json(
         self, topic: str, schema_name: str, schema: dict[str, Any], data: bytes, *, stamp_ns: int
     ) -> None:

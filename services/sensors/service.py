@@ -36,7 +36,8 @@ class Mounted:
 class SensorsService:
     def __init__(self, ctx: ServiceContext) -> None:
         world = ctx.world
-        casts = any(SENSOR_TYPES[s.config.type].casts for s in world.sensors)
+        mine = [s for s in world.sensors if world.sensor_owners[s.key] == ctx.name]
+        casts = any(SENSOR_TYPES[s.config.type].casts for s in mine)
         self.scene = build_scene(world) if casts else None
         self.mounted = [
             Mounted(
@@ -46,7 +47,7 @@ class SensorsService:
                 build_sensor(s, world, scene=self.scene),
                 SENSOR_TYPES[s.config.type].casts,
             )
-            for s in world.sensors
+            for s in mine  # a shard's: every sensor of its vessels (catabot/world/shards.py)
         ]
         self.carrier_rows = sorted({m.row for m in self.mounted})
         self.batch = world.start_states()
@@ -116,7 +117,7 @@ def build(ctx: ServiceContext) -> Built:
 
 
 def main(argv: list[str] | None = None) -> int:
-    return run_service("sensors", build, argv)
+    return run_service("sensors", build, argv, shardable=True)
 
 
 if __name__ == "__main__":

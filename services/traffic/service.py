@@ -30,8 +30,8 @@ from services.traffic.behaviours import Behaviours
 class TrafficService:
     def __init__(self, ctx: ServiceContext) -> None:
         world = ctx.world
-        boats = world.traffic.boats
-        self.ids = world.boat_ids
+        self.ids = world.traffic_blocks[ctx.name]  # every boat, or this shard's block
+        boats = [b for b in world.traffic.boats if b.id in set(self.ids)]
         self.row = {vid: i for i, vid in enumerate(self.ids)}
         self.keys = ctx.keys
         self.behaviours = Behaviours(boats, hold_gain=ctx.scenario.traffic.hold.gain)
@@ -42,7 +42,7 @@ class TrafficService:
         self.states_key = ctx.keys.world_states()
         self.boat_rows = np.array([world.body(vid).row for vid in self.ids], dtype=np.intp)
         waypoints = [s for s in world.streams.waypoints if ctx.keys.vessel_of(s.key) in self.row]
-        self.twists_key = ctx.keys.world_twists()
+        (self.twists_key,) = [s.key for s in world.streams.twists if s.producer == ctx.name]
         self.period = guidance_period_ticks(ctx.scenario)
         self.traffic, self.specs = ctx.scenario.traffic, live.keys_of(ctx.scenario)
         self.participant = ctx.participant([world.streams.states, *waypoints])
@@ -79,7 +79,7 @@ class TrafficService:
     def _take_setting(self, key: str, value: object) -> None:
         """A boat's behaviour changed at run time, from its pose at the last guidance tick."""
         spec = self.specs.get(key)
-        if spec is not None and spec.kind == "behaviour":
+        if spec is not None and spec.kind == "behaviour" and spec.owner in self.row:
             i = self.row[spec.owner]
             self.behaviours.set_behaviour(
                 i, str(value), self.pos[i], float(self.yaw[i]), self.traffic
@@ -101,7 +101,7 @@ def build(ctx: ServiceContext) -> Built:
 
 
 def main(argv: list[str] | None = None) -> int:
-    return run_service("traffic", build, argv)
+    return run_service("traffic", build, argv, shardable=True)
 
 
 if __name__ == "__main__":

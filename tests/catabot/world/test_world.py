@@ -90,7 +90,7 @@ def test_rows_are_vessels_then_boats_then_buoys() -> None:
     assert [b.row for b in world.bodies] == list(range(len(world.bodies)))
     assert world.boat_ids == ("boat_000", "boat_001", "boat_002")
     assert [b.instance for b in world.bodies] == [b.row + 1 for b in world.bodies]
-    assert world.streams.twist_batch is not None
+    assert [s.producer for s in world.streams.twists] == ["traffic"]
 
 
 def test_start_states_are_the_start_poses_at_rest() -> None:
