@@ -27,7 +27,7 @@ from catabot.world.world import World
 from services.recorder.episodes import Episodes
 from services.recorder.metrics_json import write_metrics
 from services.recorder.seabed import Seabed
-from services.recorder.tasks import Goals, Routes, Thrust
+from services.recorder.tasks import Goals, Routes, Thrust, rowdot
 
 CONTACT_M = 0.05  # hull boxes this close touch (physics keeps contacts a few mm apart)
 EPISODE_GAP_S = 1.0  # a contact that stops for less than this is the same contact
@@ -42,7 +42,7 @@ class Metrics:
         self.subjects = len(subjects)
         n, s = len(self.ids), self.subjects
         self.distance = np.zeros(n)
-        self.max_speed = np.zeros(n)
+        self.max_speed2 = np.zeros(n)  # squared: one sqrt at the end
         self.last: np.ndarray | None = None
         self.stamp_ns = 0
         self.offset, self.half = footprints([b.model for b in world.bodies])
@@ -56,6 +56,8 @@ class Metrics:
         self.radius = world.scenario.recording.encounter_radius_m
         self.pair_ok = np.ones((s, total), dtype=bool)  # each pair once, never a body itself
         self.pair_ok[:, :s] = np.triu(np.ones((s, s), dtype=bool), k=1)
+        self.pair_vessels = self.pair_ok[:, :n]
+        self.itself = (np.arange(s), np.arange(s))
         self.no_pairs = np.zeros((s, total), dtype=bool)
         self.reach_sum = self.reach[:s, None] + self.reach[None, :] + CONTACT_M
         tasks = [v.task for v in world.scenario.vessels]
@@ -78,21 +80,22 @@ class Metrics:
         pos = everything[:n]
         if self.last is not None:
             step = pos - self.last
-            self.distance += np.sqrt(np.einsum("ij,ij->i", step, step))
+            self.distance += np.sqrt(rowdot(step, step))
         self.last = pos.copy()
         vel = np.asarray(batch.linear_velocity[:n])
-        np.maximum(self.max_speed, np.sqrt(np.einsum("ij,ij->i", vel, vel)), out=self.max_speed)
+        np.maximum(self.max_speed2, rowdot(vel, vel), out=self.max_speed2)
         self.stamp_ns = stamp
         gap = np.hypot(
             everything[None, :, 0] - pos[:s, None, 0], everything[None, :, 1] - pos[:s, None, 1]
         )
-        gap[np.arange(s), np.arange(s)] = np.inf
-        self.nearest["vessel"].add(gap[:, :n], stamp)
+        gap[self.itself] = np.inf
+        vessels = gap[:, :n]
+        self.nearest["vessel"].add(vessels, stamp)
         self.nearest["buoy"].add(gap[:, n:], stamp)
-        self.encounters.update(self.pair_ok[:, :n] & (gap[:, :n] <= self.radius), stamp, gap[:, :n])
+        self.encounters.update(self.pair_vessels & (vessels <= self.radius), stamp, vessels)
         self._collisions(batch, gap, stamp)
         if self.seabed is not None:
-            shore, shallow = self.seabed.lookup(pos[:s])
+            shore, shallow = self.seabed.check(pos[:s])
             if shore is not None:
                 self.nearest["shore"].add(shore[:, None], stamp)
             quat = np.asarray(batch.orientation[:s])
@@ -134,9 +137,9 @@ class _Nearest:
     def add(self, gap: np.ndarray, stamp_ns: int) -> None:
         if gap.shape[1] == 0:
             return
-        k = np.argmin(gap, axis=1)
-        least = gap[np.arange(len(k)), k]
+        least = np.minimum.reduce(gap, axis=1)
         better = least < self.distance
-        if better.any():
-            self.distance[better], self.what[better] = least[better], k[better]
+        if better.any():  # which body, only when the record improves
+            self.distance[better] = least[better]
+            self.what[better] = np.argmin(gap[better], axis=1)
             self.at_ns[better] = stamp_ns

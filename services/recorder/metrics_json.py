@@ -10,6 +10,8 @@ import json
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
+import numpy as np
+
 from catabot.bus.clock import NS_PER_S
 
 if TYPE_CHECKING:
@@ -25,7 +27,7 @@ def record(m: Metrics) -> dict[str, Any]:
     vessels = {
         vid: {
             "distance_m": float(m.distance[k]),
-            "max_speed_mps": float(m.max_speed[k]),
+            "max_speed_mps": float(np.sqrt(m.max_speed2[k])),
             "final_position_m": [float(v) for v in m.last[k]] if m.last is not None else None,
         }
         for k, vid in enumerate(m.ids)
@@ -56,13 +58,13 @@ def record(m: Metrics) -> dict[str, Any]:
 
 def _subject(m: Metrics, k: int) -> dict[str, Any]:
     """What only a scenario vessel has: nearest bodies, its task, thrust, contact counts."""
-    n = len(m.ids)
+    n, (impulse, unknown) = len(m.ids), m.thrust.totals()
     out: dict[str, Any] = {
         "nearest_vessel": _nearest(m, "vessel", k, m.body_ids),
         "nearest_buoy": _nearest(m, "buoy", k, m.body_ids[n:]),
         "nearest_shore": _nearest(m, "shore", k, None),
-        "thrust_impulse_Ns": float(m.thrust.impulse[k]),
-        "thrust_unknown_s": float(m.thrust.unknown_s[k]),
+        "thrust_impulse_Ns": float(impulse[k]),
+        "thrust_unknown_s": float(unknown[k]),
         "collisions": sum(k in e.slot for e in m.collisions.all()),
         "groundings": sum(e.slot[0] == k for e in m.groundings.all()),
     }

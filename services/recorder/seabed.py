@@ -13,6 +13,8 @@ plus `SHALLOW_MARGIN_M` (a second distance transform), so open water costs one l
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 from numpy.typing import NDArray
 
@@ -20,6 +22,7 @@ from catabot.world.hulls import model_probes
 from catabot.world.rotations import matrices
 from catabot.world.terrain import Terrain
 from catabot.world.world import Body
+from services.recorder.tasks import rowdot
 
 Array = NDArray[np.float64]
 SHALLOW_MARGIN_M = 3.0  # heave in waves and roll or pitch lower a keel by less than this
@@ -100,10 +103,29 @@ class Seabed:
         self.last_cell = np.array([self.nx - 2, ny - 2])
         # a probe reaches this far from the origin; bilinear heights reach one pixel further
         self.reach = np.hypot(*self.probes[..., :2].transpose(2, 0, 1)).max(axis=1) + 1.5 * self.mpp
+        n = len(bodies)
+        self.best = np.full(n, np.inf)  # the nearest each vessel came to the shore so far
+        self.anchor, self.slack2 = np.zeros((n, 2)), np.full(n, -1.0)  # -1: look at once
+        self.nowhere = np.zeros(n, dtype=bool)
 
-    def lookup(self, pos: Array) -> tuple[Array | None, NDArray[np.bool_]]:
-        """(distance to the shore (m) per vessel, None on a map without land; which vessels
-        are near enough shallow water to test their probes), from positions (S, 3).
+    def check(self, pos: Array) -> tuple[Array | None, NDArray[np.bool_]]:
+        """`lookup`, skipped while no vessel can have come nearer the shore than before or
+        within reach of shallow water: the fields change by at most sqrt(2) m per metre
+        moved (distances are 1-Lipschitz; bilinear keeps each partial derivative <= 1), so
+        after a lookup at `anchor` nothing can change until a vessel has moved `slack`."""
+        off = pos[:, :2] - self.anchor
+        if (rowdot(off, off) <= self.slack2).all():
+            return None, self.nowhere
+        shore, shallow = self.lookup(pos)
+        np.minimum(self.best, shore, out=self.best)
+        slack = np.minimum(shore - self.best, shallow - self.reach) / math.sqrt(2.0)
+        self.anchor = pos[:, :2].copy()
+        self.slack2 = np.where(slack >= 0.0, slack * slack, -1.0)
+        return (shore if self.has_land else None), shallow <= self.reach
+
+    def lookup(self, pos: Array) -> tuple[Array, Array]:
+        """(distance to the shore, to water a keel could touch) (m) per vessel; FAR_M where
+        the map has none, from positions (S, 3).
         Bilinear between pixel centres, clamped to the edge (`Terrain.height`'s rule): the
         four corners in one gather from the flattened fields."""
         uv = np.minimum(np.maximum(pos[:, :2] * self.per_m - 0.5, 0.0), self.last_centre)
@@ -113,7 +135,7 @@ class Seabed:
         west, fu = g[:, :, 0], f[:, :1, None]  # [vessel, south/north, west/east, field]
         along = west + fu * (g[:, :, 1] - west)
         d = along[:, 0] + f[:, 1:] * (along[:, 1] - along[:, 0])
-        return (d[:, 0] if self.has_land else None), d[:, 1] <= self.reach
+        return d[:, 0], d[:, 1]
 
     def aground(self, pos: Array, quat: Array, near: NDArray[np.bool_]) -> NDArray[np.bool_]:
         """Which vessels have a hull probe below the terrain (pos (S, 3), quat (S, 4)); only

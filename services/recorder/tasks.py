@@ -40,13 +40,15 @@ class Goals:
         self.path_m = np.zeros(len(self.rows))
         self.radius2 = self.radius * self.radius
         self.all_reached = not len(self.rows)
+        self.pending = np.ones(len(self.rows), dtype=bool)
 
     def add(self, pos: Array, travelled: Array, stamp_ns: int) -> None:
         if self.all_reached:
             return
         off = pos[self.rows, :2] - self.centre
-        new = (np.einsum("ij,ij->i", off, off) <= self.radius2) & (self.reached_ns < 0)
+        new = (rowdot(off, off) <= self.radius2) & self.pending
         if new.any():
+            self.pending &= ~new
             self.reached_ns[new] = stamp_ns
             self.path_m[new] = travelled[self.rows[new]]
             self.all_reached = bool((self.reached_ns >= 0).all())
@@ -83,10 +85,10 @@ class Routes:
         if not len(self.rows):
             return
         rel = pos[self.seg_rows, :2] - self.a
-        t = np.einsum("ij,ij->i", rel, self.ab) / self.len2
-        np.clip(t, 0.0, 1.0, out=t)
+        t = rowdot(rel, self.ab) / self.len2
+        np.minimum(np.maximum(t, 0.0, out=t), 1.0, out=t)
         rel -= t[:, None] * self.ab
-        xte2 = np.minimum.reduceat(np.einsum("ij,ij->i", rel, rel), self.first)
+        xte2 = np.minimum.reduceat(rowdot(rel, rel), self.first)
         np.maximum(self.max2, xte2, out=self.max2)
         self.sum2 += xte2
         self.ticks += 1
@@ -116,6 +118,7 @@ class Thrust:
         self.known = np.ones(len(bodies), dtype=bool)
         self.impulse = np.zeros(len(bodies))
         self.unknown_s = np.zeros(len(bodies))
+        self.pending = 0  # ticks driven by the current forces, not yet added up
         for i in range(len(bodies)):
             self._resolve(i, -1)
 
@@ -123,6 +126,7 @@ class Thrust:
         """A `ThrustCmd` or `TwistCmd` the recorder received for a scenario vessel."""
         i = self.row.get(vessel)
         if i is not None and isinstance(msg, ThrustCmd | TwistCmd):
+            self._settle()
             self.bus[i] = msg
             self._resolve(i, -1)
 
@@ -132,10 +136,22 @@ class Thrust:
         began = stamp_ns - self.dt_ns
         while self.next_event < len(self.events) and self.events[self.next_event] <= began:
             self.next_event += 1
+            self._settle()
             for i in range(len(self.bodies)):
                 self._resolve(i, began)
-        self.impulse += self.force * self.dt_s
-        self.unknown_s += ~self.known * self.dt_s
+        self.pending += 1  # added up when a force changes: nothing per tick
+
+    def totals(self) -> tuple[Array, Array]:
+        """(thrust impulse N s, seconds under velocity control) per vessel, so far."""
+        self._settle()
+        return self.impulse, self.unknown_s
+
+    def _settle(self) -> None:
+        if self.pending:
+            span = self.pending * self.dt_s
+            self.impulse += self.force * span
+            self.unknown_s += ~self.known * span
+            self.pending = 0
 
     def _resolve(self, i: int, began: int) -> None:
         msg = self.bus.get(i)
@@ -163,3 +179,10 @@ class Thrust:
 
 def _steps(body: Body) -> list[ScriptStep]:
     return sorted(body.script, key=lambda s: s.t_s)
+
+
+def rowdot(a: Array, b: Array) -> Array:
+    """Row-wise dot products: a ufunc reduce, cheaper than einsum's dispatch on small arrays
+    (the metrics' per-tick cost is dominated by calls on a few rows)."""
+    out: Array = np.add.reduce(a * b, axis=1)
+    return out

@@ -63,8 +63,33 @@ def test_shore_lookup_is_the_terrains_bilinear_rule() -> None:
 def test_no_land_no_shore_distance() -> None:
     terrain = Terrain(np.full((10, 10), -20.0), 2.0)
     seabed = Seabed(terrain, _world(terrain, [5.0]).bodies)
-    shore, near = seabed.lookup(np.array([[5.0, 5.0, 0.0]]))
+    shore, near = seabed.check(np.array([[5.0, 5.0, 0.0]]))
     assert shore is None and not near.any()
+
+
+def test_skipped_lookups_change_nothing() -> None:
+    """`check` looks up only when the slope bound allows a change: along a random walk near
+    the bank its running minimum and its grounding candidates are those of every lookup."""
+    gy, gx = np.mgrid[0:40, 0:60] + 0.5
+    island = 30.0 * np.exp(-((gx - 30) ** 2 + (gy - 20) ** 2) / 40.0) - 20.0
+    terrain = Terrain(island + np.random.default_rng(3).normal(0.0, 0.5, (40, 60)), 1.0)
+    world = _world(terrain, [10.0, 20.0])
+    seabed = Seabed(terrain, world.bodies)
+    rng = np.random.default_rng(4)
+    pos = np.array([[20.0, 20.0, 0.0], [40.0, 10.0, 0.0]])
+    best, looked = np.full(2, np.inf), 0
+    for _ in range(400):
+        pos[:, :2] += rng.normal(0.0, 0.3, (2, 2))
+        shore, near = seabed.check(pos)
+        every, shallow = seabed.lookup(pos)
+        best = np.minimum(best, every)
+        looked += shore is not None
+        if shore is None:
+            assert not near.any() and (shallow > seabed.reach).all()
+        else:
+            np.testing.assert_array_equal(near, shallow <= seabed.reach)
+        np.testing.assert_array_equal(seabed.best, best)
+    assert 0 < looked < 400
 
 
 def _at(world: World, x: float, pitch: float = 0.0) -> BodyStates:
@@ -83,7 +108,7 @@ def test_a_bow_probe_below_the_bank_is_aground() -> None:
     contact = 39.5 + 9.94 / 15 - 0.95
     for x, aground in ((10.0, False), (contact - 0.01, False), (contact + 0.01, True)):
         s = _at(world, x)
-        _, near = seabed.lookup(s.position)
+        _, near = seabed.check(s.position)
         assert bool(seabed.aground(s.position, s.orientation, near)[0]) is aground, x
 
 
@@ -95,7 +120,7 @@ def test_pitching_puts_the_bow_on_a_shoal() -> None:
     seabed = Seabed(shoal, world.bodies)
     for pitch, aground in ((0.0, False), (0.2, True), (-0.2, True), (0.1, False)):
         s = _at(world, 10.0, pitch)
-        _, near = seabed.lookup(s.position)
+        _, near = seabed.check(s.position)
         assert bool(seabed.aground(s.position, s.orientation, near)[0]) is aground, pitch
 
 
