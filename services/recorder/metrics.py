@@ -45,6 +45,7 @@ class Metrics:
         self.max_speed2 = np.zeros(n)  # squared: one sqrt at the end
         self.last: np.ndarray | None = None
         self.stamp_ns = 0
+        self.skipped = 0  # state batches with a non-finite position, left out
         self.offset, self.half = footprints([b.model for b in world.bodies])
         self.reach = np.hypot(*self.offset.T) + np.hypot(*self.half.T)  # the box within it
         self.nearest = {kind: _Nearest(s) for kind in ("vessel", "buoy", "shore")}
@@ -77,6 +78,9 @@ class Metrics:
     def add(self, batch: BodyStates) -> None:
         n, s, stamp = len(self.ids), self.subjects, batch.stamp_ns
         everything = np.asarray(batch.position)
+        if not np.isfinite(everything).all():  # a diverged body: no figure can use it
+            self.skipped += 1
+            return
         pos = everything[:n]
         if self.last is not None:
             step = pos - self.last

@@ -37,6 +37,7 @@ def record(m: Metrics) -> dict[str, Any]:
     ids = m.body_ids
     return {
         "sim_time_s": m.stamp_ns / NS_PER_S,
+        "states_skipped": m.skipped,
         "vessels": vessels,
         "closest_approach": _closest(m),
         "encounter_radius_m": m.radius,

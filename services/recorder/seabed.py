@@ -128,7 +128,7 @@ class Seabed:
         the map has none, from positions (S, 3).
         Bilinear between pixel centres, clamped to the edge (`Terrain.height`'s rule): the
         four corners in one gather from the flattened fields."""
-        uv = np.minimum(np.maximum(pos[:, :2] * self.per_m - 0.5, 0.0), self.last_centre)
+        uv = np.minimum(np.fmax(pos[:, :2] * self.per_m - 0.5, 0.0), self.last_centre)
         ij = np.minimum(uv.astype(np.intp), self.last_cell)
         f = uv - ij
         g = self.flat[(ij[:, 1] * self.nx + ij[:, 0])[:, None, None] + self.corner]  # (S, 2, 2, 2)

@@ -166,3 +166,17 @@ def test_same_states_same_bytes(tmp_path: Path) -> None:
         metrics.write(tmp_path / name)
         outputs.append((tmp_path / name).read_bytes())
     assert outputs[0] == outputs[1]
+
+
+def test_a_non_finite_batch_is_left_out(tmp_path: Path) -> None:
+    world = _world()
+    metrics = Metrics(world)
+    metrics.add(_states(world, 0, [(0.0, 0.0), (0.0, 10.0)], speed=1.0))
+    metrics.add(_states(world, 1, [(math.nan, 0.0), (0.0, 10.0)], speed=9.0))
+    metrics.add(_states(world, 2, [(1.0, 0.0), (0.0, 10.0)], speed=1.0))
+    metrics.write(tmp_path / "metrics.json")
+    text = (tmp_path / "metrics.json").read_text()
+    record = json.loads(text)
+    assert "NaN" not in text and record["states_skipped"] == 1
+    assert record["vessels"]["v0"]["distance_m"] == 1.0
+    assert record["vessels"]["v0"]["max_speed_mps"] == 1.0
