@@ -34,6 +34,16 @@ def test_distance_transform_is_exact(seed: int) -> None:
     assert np.array_equal(distance_transform(mask), _brute(mask))
 
 
+def test_stacked_masks_share_the_row_pass() -> None:
+    rng = np.random.default_rng(7)
+    for shape in ((2, 9, 17), (3, 17, 9)):  # wide grids are transposed first
+        masks = rng.random(shape) < 0.05
+        masks[-1] = False  # one without any pixel: inf everywhere
+        got = distance_transform(masks)
+        for k in range(shape[0]):
+            assert np.array_equal(got[k], _brute(masks[k]))
+
+
 def _shore() -> Terrain:
     """1 m pixels, 10 m deep west of x = 40 m, +5 m (land) from there on."""
     z = np.full((30, 50), -10.0)
