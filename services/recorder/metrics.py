@@ -57,6 +57,7 @@ class Metrics:
         self.radius = world.scenario.recording.encounter_radius_m
         self.pair_ok = np.ones((s, total), dtype=bool)  # each pair once, never a body itself
         self.pair_ok[:, :s] = np.triu(np.ones((s, s), dtype=bool), k=1)
+        self.least_gap = np.full((s, total), np.inf)  # to every body, over the run
         self.pair_vessels = self.pair_ok[:, :n]
         self.itself = (np.arange(s), np.arange(s))
         self.no_pairs = np.zeros((s, total), dtype=bool)
@@ -93,6 +94,7 @@ class Metrics:
             everything[None, :, 0] - pos[:s, None, 0], everything[None, :, 1] - pos[:s, None, 1]
         )
         gap[self.itself] = np.inf
+        np.minimum(self.least_gap, gap, out=self.least_gap)
         vessels = gap[:, :n]
         self.nearest["vessel"].add(vessels, stamp)
         self.nearest["buoy"].add(gap[:, n:], stamp)

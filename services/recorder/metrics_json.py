@@ -64,6 +64,11 @@ def _subject(m: Metrics, k: int) -> dict[str, Any]:
         "nearest_vessel": _nearest(m, "vessel", k, m.body_ids),
         "nearest_buoy": _nearest(m, "buoy", k, m.body_ids[n:]),
         "nearest_shore": _nearest(m, "shore", k, None),
+        "min_distance_m": {
+            body: float(d)
+            for body, d in zip(m.body_ids, m.least_gap[k], strict=True)
+            if body != m.ids[k]
+        },
         "thrust_impulse_Ns": float(impulse[k]),
         "thrust_unknown_s": float(unknown[k]),
         "collisions": sum(k in e.slot for e in m.collisions.all()),

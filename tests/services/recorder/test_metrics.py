@@ -55,6 +55,7 @@ def test_distance_speed_and_closest_approach(tmp_path: Path) -> None:
     assert record["closest_approach"] == {"distance_m": 10.0, "vessels": ["v0", "v1"],
                                           "stamp_ns": DT}  # fmt: skip
     assert v0["nearest_vessel"] == {"distance_m": 10.0, "id": "v1", "t_s": 0.01}
+    assert v0["min_distance_m"] == {"v1": 10.0}
     assert v0["nearest_buoy"] is None and v0["nearest_shore"] is None
     assert record["sim_time_s"] == 0.11
 
@@ -133,6 +134,7 @@ def test_buoys_are_nearest_and_can_be_hit(tmp_path: Path) -> None:
         metrics.add(_states(world, tick, [(float(tick), 0.0), (50.0, 0.0), (5.0, 0.0)]))
     record = _record(metrics, tmp_path)
     assert record["vessels"]["v0"]["nearest_buoy"] == {"distance_m": 1.0, "id": "near", "t_s": 0.05}
+    assert record["vessels"]["v0"]["min_distance_m"] == {"far": 46.0, "near": 1.0}
     assert [c["bodies"] for c in record["collisions"]] == [["v0", "near"]]
     assert record["collisions"][0]["start_s"] == 0.05  # 1.0 m <= 0.95 + 0.22 + 0.05
 
