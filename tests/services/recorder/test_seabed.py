@@ -151,3 +151,18 @@ def test_metrics_report_grounding_episodes_and_shore(tmp_path: Path) -> None:
     assert record["vessels"]["v0"]["groundings"] == 2
     assert record["vessels"]["v0"]["nearest_shore"] == {"distance_m": pytest.approx(1.0),
                                                         "t_s": 0.04}  # fmt: skip
+
+
+def test_vessels_of_different_models_each_by_their_own_probes() -> None:
+    """A shoal 0.07 m deep: the WAM-V's keel (-0.089 m) touches, the catamaran's (-0.06 m, its
+    probes padded to the WAM-V's count) does not."""
+    shoal = Terrain(np.full((30, 50), -0.07), 1.0)
+    cat = {"id": "cat", "pose": {"x_m": 10.0, "y_m": 10.0}}
+    wamv = {"id": "wamv", "model": "wamv", "pose": {"x_m": 30.0, "y_m": 10.0}}
+    data = {"name": "s", "vessels": [cat, wamv]}
+    world = dataclasses.replace(World.resolve(parse_scenario(data)), terrain=shoal)
+    seabed = Seabed(shoal, world.bodies)
+    pos = np.array([[10.0, 10.0, 0.0], [30.0, 10.0, 0.0]])
+    quat = np.tile([0.0, 0.0, 0.0, 1.0], (2, 1))
+    _, near = seabed.check(pos)
+    assert seabed.aground(pos, quat, near).tolist() == [False, True]
