@@ -29,13 +29,12 @@ from services.recorder.metrics_json import write_metrics
 from services.recorder.seabed import Seabed
 from services.recorder.tasks import Goals, Routes, Thrust, rowdot
 
-CONTACT_M = 0.05  # hull boxes this close touch (physics keeps contacts a few mm apart)
+CONTACT_M = 0.05  # hull boxes this close touch (physics resolves a contact within mm)
 EPISODE_GAP_S = 1.0  # a contact that stops for less than this is the same contact
 
 
 class Metrics:
     def __init__(self, world: World) -> None:
-        self.world = world
         self.ids = [v.id for v in world.vessels]  # the first rows of every batch
         self.body_ids = list(world.body_ids)
         subjects = world.bodies[: len(world.scenario.vessels)]
