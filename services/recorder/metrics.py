@@ -29,7 +29,7 @@ from services.recorder.metrics_json import write_metrics
 from services.recorder.seabed import Seabed
 from services.recorder.tasks import Goals, Routes, Thrust, rowdot
 
-CONTACT_M = 0.05  # hull boxes this close touch (physics resolves a contact within mm)
+CONTACT_M = 0.01  # hull boxes this close touch (physics resolves a contact within mm)
 EPISODE_GAP_S = 1.0  # a contact that stops for less than this is the same contact
 
 

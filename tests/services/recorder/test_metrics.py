@@ -126,6 +126,15 @@ def test_rotated_hulls_collide_by_their_boxes(tmp_path: Path) -> None:
         assert bool(_record(metrics, tmp_path)["collisions"]) is touching
 
 
+def test_boxes_within_a_centimetre_touch(tmp_path: Path) -> None:
+    """Side by side the beams (2 x 0.52 m) leave 5 mm (touching) or 20 mm (apart)."""
+    world = _world()
+    for y, touching in ((1.045, True), (1.06, False)):
+        metrics = Metrics(world)
+        metrics.add(_states(world, 0, [(0.0, 0.0), (0.0, y)]))
+        assert bool(_record(metrics, tmp_path)["collisions"]) is touching
+
+
 def test_buoys_are_nearest_and_can_be_hit(tmp_path: Path) -> None:
     buoys = [{"id": "far", "x_m": 50.0, "y_m": 0.0}, {"id": "near", "x_m": 5.0, "y_m": 0.0}]
     world = _world(vessels=[{"id": "v0", "pose": {"x_m": 0.0, "y_m": 0.0}}], buoys=buoys)
@@ -136,7 +145,7 @@ def test_buoys_are_nearest_and_can_be_hit(tmp_path: Path) -> None:
     assert record["vessels"]["v0"]["nearest_buoy"] == {"distance_m": 1.0, "id": "near", "t_s": 0.05}
     assert record["vessels"]["v0"]["min_distance_m"] == {"far": 46.0, "near": 1.0}
     assert [c["bodies"] for c in record["collisions"]] == [["v0", "near"]]
-    assert record["collisions"][0]["start_s"] == 0.05  # 1.0 m <= 0.95 + 0.22 + 0.05
+    assert record["collisions"][0]["start_s"] == 0.05  # 1.0 m < 0.95 + 0.22: overlapping
 
 
 def test_thrust_impulse_of_script_and_bus_commands(tmp_path: Path) -> None:
