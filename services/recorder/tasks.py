@@ -103,7 +103,9 @@ class Routes:
 class Thrust:
     """The commanded thrust force of each scenario vessel (N, summed over its thrusters), and
     its integral. Commands change rarely: the force is re-derived only when one arrives or a
-    script step begins, so a tick costs two array operations."""
+    script step begins, and the integral is added up then, so a tick costs a counter.
+    A command from the bus counts from the tick the recorder receives it (physics applies
+    it from the next: the impulse is exact to within a tick per command)."""
 
     def __init__(self, bodies: Sequence[Body], dt_ns: int) -> None:
         self.dt_s = dt_ns / NS_PER_S
