@@ -11,6 +11,8 @@ import json
 from pathlib import Path
 from typing import Any
 
+MAX_LINES = 8
+
 
 def metrics_lines(run_dir: Path) -> list[str]:
     """`  <vessel>: goal ..., nearest ..., collisions ..., thrust impulse ...` per scenario
@@ -20,10 +22,14 @@ def metrics_lines(run_dir: Path) -> list[str]:
         record = json.loads((run_dir / "metrics.json").read_text())
     if not isinstance(record, dict) or not isinstance(record.get("vessels"), dict):
         return []
-    lines = []
-    for vid, m in record["vessels"].items():
-        if isinstance(m, dict) and "nearest_vessel" in m:
-            lines.append(f"  {vid}: " + "; ".join(filter(None, _parts(m))))
+    lines = [
+        f"  {vid}: " + "; ".join(filter(None, _parts(m)))
+        for vid, m in record["vessels"].items()
+        if isinstance(m, dict) and "nearest_vessel" in m
+    ]
+    if len(lines) > MAX_LINES:  # a fleet of scenario vessels: the file has them all
+        more = len(lines) - MAX_LINES + 1
+        lines[MAX_LINES - 1 :] = [f"  ... {more} more in {run_dir / 'metrics.json'}"]
     return lines
 
 

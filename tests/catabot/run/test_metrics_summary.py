@@ -42,3 +42,11 @@ def test_no_or_broken_metrics_print_nothing(tmp_path: Path) -> None:
     assert metrics_lines(tmp_path) == []
     (tmp_path / "metrics.json").write_text("[1, 2]")
     assert metrics_lines(tmp_path) == []
+
+
+def test_a_fleet_is_cut_short(tmp_path: Path) -> None:
+    record = {"vessels": {f"v{k:02d}": EGO for k in range(20)}}
+    (tmp_path / "metrics.json").write_text(json.dumps(record))
+    lines = metrics_lines(tmp_path)
+    assert len(lines) == 8 and lines[6].startswith("  v06: goal reached")
+    assert lines[7] == f"  ... 13 more in {tmp_path / 'metrics.json'}"
