@@ -36,6 +36,7 @@ from catabot.config.live import SettingChange, check_timeline
 from catabot.config.pose import Pose, Velocity
 from catabot.config.ros import GATEWAY, RosConfig, check_ros
 from catabot.config.sensors import SENSOR_TYPES, SensorFarmConfig, shard_names
+from catabot.config.task import TaskConfig
 from catabot.config.terrain import TerrainConfig
 from catabot.config.traffic import TrafficConfig
 from catabot.config.waves import WaveConfig
@@ -118,6 +119,9 @@ class VesselConfig(Strict):
     controller: ControllerConfig | None = Field(
         None, description="a lockstep stack outside `catabot run` that commands this vessel"
     )
+    task: TaskConfig | None = Field(
+        None, description="a goal region and/or a route, measured in metrics.json"
+    )
 
     @field_validator("sensors")
     @classmethod
@@ -157,6 +161,9 @@ class RecordingConfig(Strict):
     )
     ppi: StrictBool = Field(True, description="the radar's PPI (the paper's minimap) in dataset/")
     rerun: StrictBool = Field(False, description="run.rrd for the rerun viewer, from run.mcap")
+    encounter_radius_m: float = Field(
+        50.0, gt=0, description="metrics.json: two vessels this close are an encounter (CPA)"
+    )
     export: list[Literal["yolo", "coco", "kitti"]] = Field(
         [], description="datasets converted into export/<format>/ when the run ends"
     )
