@@ -6,9 +6,11 @@
 # 2. the image from deploy/Dockerfile (pip downloads the wheels from PyPI);
 # 3. `catabot deploy compose SCENARIO` and every service of that compose file as a container,
 #    in dependency order, each started when what it depends on is healthy by its own
-#    healthcheck (scripts/compose_podman.py reads the YAML; host network, a free port);
-# 4. the same scenario with `catabot run` on the host, and the recorded CSV and MCAP files
-#    compared byte for byte (same scenario, same seed: the same bytes).
+#    healthcheck (scripts/compose_podman.py reads the YAML; host network, a free port):
+#    plain, then the secure variant (a `catabot secure init` profile: TLS, a login each);
+# 4. the same with an external participant that never joins: named, exit 1;
+# 5. the scenario with `catabot run` on the host, and the recorded CSV and MCAP files of both
+#    container runs compared with its byte for byte (same scenario, same seed: same bytes).
 # Needs root, podman, runc and debootstrap (apt-get install podman runc debootstrap) and a
 # Python with CataBot and pyyaml (PYTHON, default .venv/bin/python). Takes minutes; CI runs
 # the structural test of the compose file instead (tests/catabot/run/test_compose.py).
@@ -66,6 +68,7 @@ start=$(date +%s)
 echo "built in $(( $(date +%s) - start )) s; $("${podman[@]}" image inspect "$image" --format '{{.Size}}' | numfmt --to=iec) "
 "${podman[@]}" run --rm "${run_flags[@]}" --entrypoint python "$image" -c \
   "import dartpy, open3d, zenoh, rerun; print('the image loads dartpy', dartpy.__version__, 'and open3d', open3d.__version__)"
+"${podman[@]}" run --rm "${run_flags[@]}" "$image" scenario validate harbour  # its terrain PNG
 
 say "scenario $scenario, $duration s"
 rm -rf "$work/scenario" "$work/runs" "$work/host" "$work/logs" "$work/secure"

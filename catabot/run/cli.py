@@ -7,6 +7,7 @@ import argparse
 import importlib
 import json
 import os
+import signal
 import sys
 import time
 from pathlib import Path
@@ -105,6 +106,7 @@ def _router(args: argparse.Namespace) -> int:
         return 2
     where = ", ".join(listen) or f"the endpoints of {config}"
     print(f"zenoh router listening on {where} (Ctrl-C to stop)", flush=True)
+    signal.signal(signal.SIGTERM, signal.default_int_handler)  # `docker stop`: PID 1 has none
     try:
         while True:
             time.sleep(3600)

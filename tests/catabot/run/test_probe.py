@@ -5,6 +5,7 @@ conductor's container ends only once every participant has left)."""
 from __future__ import annotations
 
 import json
+import signal
 import socket
 import subprocess
 import sys
@@ -87,3 +88,19 @@ def test_the_conductor_refuses_bad_seconds() -> None:
     command = [sys.executable, "-m", "catabot.run.conduct", "--start-timeout", "-1"]
     done = subprocess.run(command, cwd=REPO, capture_output=True, text=True, timeout=60)
     assert done.returncode == 2 and "more than 0" in done.stderr
+
+
+def test_the_router_ends_at_once_on_sigterm() -> None:
+    """`docker stop` / `compose down` send SIGTERM; as a container's PID 1 a process without
+    a handler would ignore it and be killed 10 s later."""
+    endpoint = f"tcp/127.0.0.1:{free_port()}"
+    command = [sys.executable, "-m", "catabot", "router", "--listen", endpoint]
+    proc = subprocess.Popen(command, cwd=REPO, stdout=subprocess.PIPE, text=True)
+    try:
+        assert proc.stdout is not None and "listening" in proc.stdout.readline()
+        assert probe.port_open(endpoint) == ""
+        proc.send_signal(signal.SIGTERM)
+        assert proc.wait(timeout=5) == 0
+    finally:
+        proc.kill()
+        proc.wait()
