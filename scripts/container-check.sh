@@ -9,8 +9,11 @@
 #    healthcheck (scripts/compose_podman.py reads the YAML; host network, a free port):
 #    plain, then the secure variant (a `catabot secure init` profile: TLS, a login each);
 # 4. the same with an external participant that never joins: named, exit 1;
-# 5. the scenario with `catabot run` on the host, and the recorded CSV and MCAP files of both
-#    container runs compared with its byte for byte (same scenario, same seed: same bytes).
+# 5. both files under podman-compose (from PyPI, in a venv here): a podman network, the
+#    router reached by its name (the secure one by its certificate's, an alias), `run --rm
+#    conductor` as a user would (podman 4.3 has no health conditions: it ignores them);
+# 6. the scenario with `catabot run` on the host, and the recorded CSV and MCAP files of the
+#    four container runs compared with its byte for byte (same scenario and seed: same bytes).
 # Needs root, podman, runc and debootstrap (apt-get install podman runc debootstrap) and a
 # Python with CataBot and pyyaml (PYTHON, default .venv/bin/python). Takes minutes; CI runs
 # the structural test of the compose file instead (tests/catabot/run/test_compose.py).
@@ -102,7 +105,7 @@ export CATABOT_LISTEN=tcp/127.0.0.1:$port CATABOT_ROUTER=tcp/127.0.0.1:$port
 containers plain "$work/scenario/scenario.json" || { tail -n 5 "$work"/logs/plain/*.log; exit 1; }
 
 say "secure: a catabot secure init profile, TLS and a login per container"
-"$py" -m catabot secure init "$work/secure" --host router --port "$port" | head -n 1
+"$py" -m catabot secure init "$work/secure" --host catabot-router --port "$port" | head -n 1
 export CATABOT_LISTEN=tls/127.0.0.1:$port CATABOT_ROUTER=tls/localhost:$port  # in its certificate
 containers secure "$work/scenario/scenario.json" --secure "$work/secure" \
   || { tail -n 5 "$work"/logs/secure/*.log; exit 1; }
@@ -115,13 +118,33 @@ fi
 grep -q 'never joined within 3 s: stack' "$work/logs/missing/conductor.log" \
   || { echo "container-check: FAIL (the missing participant is not named)"; exit 1; }
 
+say "compose: both files under podman-compose (PyPI), a podman network, the router by name"
+[ -x "$work/pc/bin/podman-compose" ] || { python3 -m venv "$work/pc" \
+  && "$work/pc/bin/pip" install -q podman-compose >"$work/pc.log" 2>&1; }
+"$work/pc/bin/podman-compose" --version | head -n 1
+unset CATABOT_LISTEN CATABOT_ROUTER  # the files' defaults: the router's name in the network
+compose() {  # VARIANT ARGS...: podman-compose on $work/VARIANT.yml
+  local variant=$1; shift
+  CATABOT_RUN=compose-$variant CATABOT_PORT=$port "$work/pc/bin/podman-compose" \
+    --podman-args="--runtime runc" -p "cbcheck$$$variant" -f "$work/$variant.yml" \
+    --podman-run-args="--ulimit nofile=1024:1024 --ulimit nproc=1024:1024" "$@"
+}
+for variant in plain secure; do
+  status=0
+  compose "$variant" run --rm conductor >"$work/logs/compose-$variant.log" 2>&1 || status=$?
+  compose "$variant" down >/dev/null 2>&1 || true
+  grep -h '"kind": "result"' "$work/logs/compose-$variant.log" | cut -c1-120
+  echo "$variant: podman-compose run --rm conductor: exit $status"
+  [ "$status" = 0 ] || { tail -n 20 "$work/logs/compose-$variant.log"; exit 1; }
+done
+
 say "the same scenario on the host (catabot run)"
 "$py" -m catabot run "$work/scenario/scenario.json" --out "$work/host" --quiet | tail -n 2
 host_run=$(ls -d "$work/host"/*/)
 
 say "recorded bytes, containers against host"
 fail=0
-for variant in plain secure; do
+for variant in plain secure compose-plain compose-secure; do
   cd "$work/runs/$variant"
   files=$(ls ./*.csv ./*.mcap)
   for f in $files; do
@@ -133,5 +156,5 @@ for variant in plain secure; do
   # shellcheck disable=SC2086
   echo "$variant: $(echo "$files" | wc -w) files, $(cat $files | wc -c) bytes, compared with the host's"
 done
-[ "$fail" = 0 ] && echo "container-check: PASS (plain and secure byte-identical to the host)" \
+[ "$fail" = 0 ] && echo "container-check: PASS (4 container runs byte-identical to the host's)" \
   || { echo "container-check: FAIL"; exit 1; }

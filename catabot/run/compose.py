@@ -16,6 +16,7 @@ deploy/docker-compose.yml is this command's output for deploy/scenario.json.
 from __future__ import annotations
 
 import argparse
+import math
 import os
 import sys
 from dataclasses import dataclass
@@ -34,6 +35,7 @@ from catabot.run.launcher import SERVICE_MODULES
 
 REPO = Path(__file__).resolve().parents[2]  # in a checkout, deploy/Dockerfile is beside catabot/
 PORT = 7447
+START_S = 120  # a service's start period: at least the scenario's start timeout
 LINGER_S = 30  # the conductor's container ends once every participant has left (or after this)
 BRIDGE_IMAGE = "eclipse/zenoh-bridge-ros2dds:1.1.0"  # Zenoh 1.x, as our eclipse-zenoh
 VIEWER_PORTS = (9090, 9876)  # the rerun web viewer and its data (gRPC) port
@@ -107,7 +109,8 @@ def _image(p: Plan) -> Service:
     return {"image": "${CATABOT_IMAGE:-catabot:latest}", **({"build": p.build} if p.build else {})}
 
 
-def _health(probe: list[str], start_s: int = 120) -> Service:
+def _health(probe: list[str], start_s: int) -> Service:
+    """Probe every 5 s; failures count only after `start_s` (loading the world)."""
     return {"test": ["CMD", "python", "-m", "catabot.run.probe", *probe], "interval": "5s",
             "timeout": "10s", "retries": 3, "start_period": f"{start_s}s"}  # fmt: skip
 
@@ -119,7 +122,7 @@ def _process(p: Plan, name: str, command: list[str], probe: list[str], runs: boo
         "command": [*command, "--connect", p.router, "--mode", "client", *p.login(name)],
         "depends_on": {"router": {"condition": "service_healthy"}},
         "restart": "no",
-        "healthcheck": _health(probe),
+        "healthcheck": _health(probe, max(START_S, math.ceil(p.scenario.clock.start_timeout_s))),
     }
     if p.secure:
         extra = p.secure.mounts(name)
@@ -134,7 +137,7 @@ def _router(p: Plan) -> Service:
         "command": ["router", "--listen", p.listen, *config],
         "ports": [f"${{CATABOT_PORT:-{p.port}}}:{p.port}"],
         "restart": "no",
-        "healthcheck": _health([p.listen], start_s=30),
+        "healthcheck": _health([p.listen], 30),
     }
     return svc | (p.secure.router_mounts() if p.secure else {})
 

@@ -108,7 +108,7 @@ def test_a_ros_scenario_gets_the_gateway_and_the_bridge_profile(tmp_path: Path) 
 
 
 def test_a_lockstep_gateway_and_an_external_stack(tmp_path: Path) -> None:
-    clock = {"external_participants": ["stack"], "start_timeout_s": 12}
+    clock = {"external_participants": ["stack"], "start_timeout_s": 200}
     path = scenario_file(tmp_path, ros={"lockstep": True}, clock=clock)
     text = compose.text(str(path), tmp_path / "c.yml")
     doc = yaml.safe_load(text)
@@ -118,7 +118,8 @@ def test_a_lockstep_gateway_and_an_external_stack(tmp_path: Path) -> None:
     assert doc["x-catabot"]["external"] == ["stack"] and "stack" not in svcs
     assert "External participants: stack: start them yourself" in text
     command = svcs["conductor"]["command"]
-    assert command[command.index("--start-timeout") + 1] == "${CATABOT_START_TIMEOUT:-12}"
+    assert command[command.index("--start-timeout") + 1] == "${CATABOT_START_TIMEOUT:-200}"
+    assert svcs["physics"]["healthcheck"]["start_period"] == "200s"  # loading may take as long
 
 
 @pytest.mark.skipif(shutil.which("openssl") is None, reason="needs openssl")
