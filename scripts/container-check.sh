@@ -47,7 +47,8 @@ local_base() {  # a python:3.11-slim stand-in: Debian bookworm minbase + python3
   # This host's certificate authorities (a proxy may intercept TLS on the way to PyPI).
   cp /etc/ssl/certs/ca-certificates.crt "$root/etc/ssl/certs/ca-certificates.crt"
   rm -rf "$root"/var/lib/apt/lists/* "$root"/var/cache/apt/archives/*.deb
-  tar -C "$root" -c . | "${podman[@]}" import --change 'CMD ["python3"]' - "$tag" >/dev/null
+  tar -C "$root" -c . | "${podman[@]}" import --change 'CMD ["python3"]' - "$tag" \
+    >/dev/null 2>>"$work/debootstrap.log"
   rm -rf "$root"
   echo "$tag"
 }

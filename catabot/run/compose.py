@@ -28,7 +28,7 @@ from catabot.config.load import BUNDLED, load_scenario
 from catabot.config.scenario import Scenario, participants, services
 from catabot.errors import CataBotError
 from catabot.run import probe
-from catabot.run.compose_secure import Profile, SecureComposeError, profile
+from catabot.run.compose_secure import Profile, profile
 from catabot.run.compose_text import HEADER, NOTES, inside_folder
 from catabot.run.compose_yaml import dump
 from catabot.run.launcher import SERVICE_MODULES
@@ -42,7 +42,7 @@ VIEWER_PORTS = (9090, 9876)  # the rerun web viewer and its data (gRPC) port
 Service = dict[str, Any]
 
 
-class ComposeError(SecureComposeError):
+class ComposeError(CataBotError, ValueError):
     """No compose file can be made for this scenario."""
 
 
