@@ -32,7 +32,7 @@ def scalar(value: Data) -> str:
 def flow(value: Data) -> str:
     """A list or a map on one line: `[a, "b c"]`, `{source: x, target: y}`."""
     if isinstance(value, Mapping):
-        return "{" + ", ".join(f"{k}: {flow(v)}" for k, v in value.items()) + "}"
+        return "{" + ", ".join(f"{scalar(k)}: {flow(v)}" for k, v in value.items()) + "}"
     if isinstance(value, list):
         return "[" + ", ".join(flow(v) for v in value) + "]"
     return scalar(value)
@@ -62,7 +62,7 @@ def block(
         here = f"{path}.{key}" if path else key
         lines += [f"{pad}# {line}".rstrip() for line in notes.get(here, "").splitlines()]
         if isinstance(value, Mapping) and value:
-            lines.append(f"{pad}{key}:")
+            lines.append(f"{pad}{scalar(key)}:")
             lines += block(value, notes, here, indent + 2)
         elif _flat(value) or value == {}:
             lines += _keyed(pad, key, value)
@@ -73,11 +73,11 @@ def block(
 
 def _keyed(pad: str, key: str, value: Data) -> list[str]:
     """`key: value`, a long flow list wrapped one item a line."""
-    line = f"{pad}{key}: {flow(value)}"
+    line = f"{pad}{scalar(key)}: {flow(value)}"
     if len(line) <= WIDTH or not isinstance(value, list):
         return [line]
     items = [f"{pad}  - {flow(v)}" for v in value]
-    return [f"{pad}{key}:", *items]
+    return [f"{pad}{scalar(key)}:", *items]
 
 
 def dump(data: Mapping[str, Data], notes: Mapping[str, str], header: str) -> str:
