@@ -1,5 +1,5 @@
-"""The `catabot` command: run, service, router, scenario, and the tools over run folders
-(view, dataset, plot)."""
+"""The `catabot` command: run, service, router, scenario, secure, deploy, and the tools over
+run folders (view, dataset, plot)."""
 
 from __future__ import annotations
 
@@ -7,6 +7,7 @@ import argparse
 import importlib
 import json
 import os
+import signal
 import sys
 import time
 from pathlib import Path
@@ -14,7 +15,7 @@ from pathlib import Path
 from catabot.bus.session import Connection, SessionError, add_connection_args, open_session
 from catabot.config.load import json_schema, load_scenario
 from catabot.errors import CataBotError
-from catabot.run import conduct, launcher, secure, settings_cli
+from catabot.run import compose, conduct, launcher, secure, settings_cli
 from catabot.run.companions import VIEW_MODES
 from catabot.run.generate import add_arguments as add_generate_arguments
 from catabot.run.generate import generate
@@ -82,6 +83,10 @@ LIVE = {  # `catabot <command> ...` against a running simulation (its own flags 
     "snapshot": (settings_cli.snapshot_main, "save a camera's next colour image as PNG"),
 }
 
+DEPLOY = {  # `catabot deploy compose|probe ...`: containers (catabot/run/compose.py)
+    "deploy": (compose.main, "containers: the compose file a scenario needs, health probes"),
+}
+
 
 def _tool(args: argparse.Namespace, rest: list[str]) -> int:
     """Hand the rest of the command line to the tool's own parser (its --help too)."""
@@ -101,6 +106,7 @@ def _router(args: argparse.Namespace) -> int:
         return 2
     where = ", ".join(listen) or f"the endpoints of {config}"
     print(f"zenoh router listening on {where} (Ctrl-C to stop)", flush=True)
+    signal.signal(signal.SIGTERM, signal.default_int_handler)  # `docker stop`: PID 1 has none
     try:
         while True:
             time.sleep(3600)
@@ -188,7 +194,7 @@ def parser() -> argparse.ArgumentParser:
     scen.add_argument("file", nargs="?", help="scenario to validate")
     scen.add_argument("--output", "-o", help="write the schema (or generated scenario) here")
     add_generate_arguments(scen)
-    for name, (_, text) in [*TOOLS.items(), *LIVE.items()]:
+    for name, (_, text) in [*TOOLS.items(), *LIVE.items(), *DEPLOY.items()]:
         sub.add_parser(name, help=text, add_help=False)
     return p
 
@@ -201,6 +207,8 @@ def main(argv: list[str] | None = None) -> int:
         return _tool(args, rest)
     if args.command in LIVE:
         return LIVE[args.command][0](rest)
+    if args.command in DEPLOY:
+        return DEPLOY[args.command][0](rest)
     if rest:
         parser().error(f"unrecognized arguments: {' '.join(rest)}")
     handlers = {"run": _run, "router": _router, "scenario": _scenario, "secure": _secure}

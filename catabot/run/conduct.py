@@ -12,7 +12,10 @@ import logging
 import signal
 import sys
 import threading
+import time
 from dataclasses import asdict
+
+import zenoh
 
 from catabot.bus.blas import single_thread_blas
 from catabot.bus.clock import Policy
@@ -36,14 +39,15 @@ from catabot.run.world_info import WorldInfoDesk
 log = logging.getLogger("catabot.bus.conductor")
 
 
-def clock_spec(scenario: Scenario) -> ClockSpec:
+def clock_spec(scenario: Scenario, start_timeout_s: float | None = None) -> ClockSpec:
+    """The clock of a run; `start_timeout_s` (`--start-timeout`) replaces the scenario's."""
     c = scenario.clock
     return ClockSpec(
         dt_ns=scenario.dt_ns,
         ticks=scenario.ticks,
         participants=tuple(participants(scenario)),
         deadline_s=c.deadline_s,
-        start_timeout_s=c.start_timeout_s,
+        start_timeout_s=start_timeout_s or c.start_timeout_s,
         policy=Policy(c.policy),
         realtime_factor=c.realtime_factor,
         window_ticks=c.window_ticks,
@@ -76,6 +80,19 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--scenario", help="scenario file (default: the bundled default)")
     add_connection_args(parser)
     add_roster_args(parser)
+    parser.add_argument(
+        "--start-timeout",
+        type=_seconds,
+        metavar="S",
+        help="how long to wait for every participant (default: clock.start_timeout_s)",
+    )
+    parser.add_argument(
+        "--linger",
+        type=_seconds,
+        default=0.0,
+        metavar="S",
+        help="after the end, wait up to S s for every participant to leave (in containers)",
+    )
     args = parser.parse_args(argv)
     stop = threading.Event()  # the heartbeat, from before the session (a login takes a while)
     threading.Thread(target=heartbeat, args=(stop,), name="heartbeat", daemon=True).start()
@@ -89,7 +106,11 @@ def main(argv: list[str] | None = None) -> int:
         return 2
     keys, schedule = Keys(scenario.name), Schedule(live.timeline(scenario), ticks=scenario.ticks)
     conductor = Conductor(
-        session, keys, clock_spec(scenario), roster=args.roster, settings=schedule
+        session,
+        keys,
+        clock_spec(scenario, args.start_timeout),
+        roster=args.roster,
+        settings=schedule,
     )
     desk = SettingsDesk(session, keys, scenario, schedule)
     info = WorldInfoDesk(session, scenario, args.roster, schedule)  # for stacks: catabot.client
@@ -114,8 +135,34 @@ def main(argv: list[str] | None = None) -> int:
     if result.error:
         log.error("run ended by a fault: %s", result.error)
     conductor.close()
+    _linger(session, keys, args.linger)
     session.close()
     return 1 if result.error else (130 if result.reason == "interrupted" else 0)
+
+
+def _seconds(text: str) -> float:
+    try:
+        value = float(text)
+    except ValueError:
+        value = -1.0
+    if not 0 < value < 1e6:
+        raise argparse.ArgumentTypeError(f"{text!r}: seconds, more than 0 and less than 1e6")
+    return value
+
+
+def _linger(session: zenoh.Session, keys: Keys, linger_s: float) -> None:
+    """Wait until no participant's liveliness token is left (a service drops it once its
+    files are closed), at most `linger_s`. In containers the conductor's exit is the run's
+    end (`docker compose run conductor` returns, then `down` stops the rest): without this,
+    the recorder could be stopped while it still writes the last ticks."""
+    limit = time.monotonic() + linger_s
+    while time.monotonic() < limit:
+        left = [r for r in session.liveliness().get(keys.lives(), timeout=1.0) if r.ok]
+        if not left:
+            return
+        time.sleep(0.2)
+    if linger_s:
+        log.warning("participants still on the bus %g s after the end", linger_s)
 
 
 if __name__ == "__main__":

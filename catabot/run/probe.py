@@ -1,0 +1,79 @@
+"""`catabot deploy probe`: the health check of a container (compose's `healthcheck`).
+
+Cheap and real, so an engine can run it every few seconds beside a busy simulation:
+
+- `probe ENDPOINT`: the router is up when its port takes a TCP connection (nothing is
+  sent; a TLS endpoint is probed the same way).
+- `probe ENDPOINT --name physics`: a CataBot process is healthy once it is on the bus,
+  i.e. its liveliness token `catabot/<world>/live/physics/<zid>` is there (declared when it
+  joined: catabot/bus/participant.py; gone when it ends or crashes). One short Zenoh client
+  session asks the router; with `--zenoh-config` it logs in as the secure profile says.
+
+Exit 0 healthy, 1 not (one line says why). This module imports only the bus's session
+code: a probe costs a Python start-up and one session, not the simulation's imports.
+"""
+
+from __future__ import annotations
+
+import argparse
+import socket
+import sys
+
+from catabot.bus.keys import check_name
+from catabot.bus.session import Connection, check_endpoint, open_session
+from catabot.errors import CataBotError
+
+TIMEOUT_S = 3.0
+
+
+def parser() -> argparse.ArgumentParser:
+    p = argparse.ArgumentParser(prog="catabot deploy probe", description=__doc__.split("\n")[0])
+    p.add_argument("endpoint", help="the router's endpoint, e.g. tcp/router:7447")
+    p.add_argument("--name", help="a process that must be on the bus (its liveliness token)")
+    p.add_argument("--zenoh-config", metavar="FILE", help="a login of the secure profile")
+    return p
+
+
+def port_open(endpoint: str, timeout_s: float = TIMEOUT_S) -> str:
+    """'' when the endpoint's TCP port takes a connection, else why not. A listening
+    address (0.0.0.0, [::]) is probed on this host's loopback."""
+    host, _, port = check_endpoint(endpoint).partition("/")[2].rpartition(":")
+    host = host.strip("[]")
+    host = {"0.0.0.0": "127.0.0.1", "::": "::1"}.get(host, host)
+    try:
+        with socket.create_connection((host, int(port)), timeout=timeout_s):
+            return ""
+    except OSError as exc:
+        return f"{endpoint}: {exc.strerror or exc}"
+
+
+def on_bus(endpoint: str, name: str, config: str | None, timeout_s: float = TIMEOUT_S) -> str:
+    """'' when a liveliness token of `name` (in any world on this router) answers."""
+    key = f"catabot/*/live/{check_name('participant', name)}/*"
+    session = open_session(Connection(connect=(endpoint,), mode="client", file=config))
+    try:
+        replies = session.liveliness().get(key, timeout=timeout_s)
+        if any(reply.ok is not None for reply in replies):
+            return ""
+        return f"{name} has no liveliness token on {endpoint} (not joined, or gone)"
+    finally:
+        session.close()
+
+
+def main(argv: list[str] | None = None) -> int:
+    args = parser().parse_args(argv)
+    try:
+        why = port_open(args.endpoint)
+        if not why and args.name:
+            why = on_bus(args.endpoint, args.name, args.zenoh_config)
+    except CataBotError as exc:  # a bad endpoint, name or login file
+        why = str(exc)
+    if why:
+        print(f"unhealthy: {why}", file=sys.stderr)
+        return 1
+    print(f"healthy: {args.name or args.endpoint}")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
