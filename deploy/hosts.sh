@@ -26,11 +26,11 @@ mapfile -t lines < <("$py" - "$scenario" <<'EOF'
 import sys
 from catabot.config.load import load_scenario
 from catabot.config.scenario import services
+from catabot.config.sensors import service_of
 names = [s for s in services(load_scenario(sys.argv[1])) if s != "conductor"]
 for name in names:  # a shard (`sensors.1` of 4) runs as `catabot service sensors --shard 1/4`
-    base, _, i = name.partition(".")
-    n = sum(other.partition(".")[0] == base for other in names)
-    print(name, base, *(["--shard", f"{i}/{n}"] if i else []))
+    program, shard = service_of(name, names)
+    print(name, program, *shard)
 EOF
 )
 services=(); declare -A command

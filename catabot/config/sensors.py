@@ -170,6 +170,14 @@ def shard_names(service: str, shards: int) -> list[str]:
     return [service] if shards == 1 else [f"{service}.{i}" for i in range(shards)]
 
 
+def service_of(name: str, names: list[str]) -> tuple[str, list[str]]:
+    """The program a participant of `names` runs and its shard flag: `sensors.1` of four
+    sensor shards runs `catabot service sensors --shard 1/4`."""
+    base, _, index = name.partition(".")
+    n = sum(1 for other in names if other.partition(".")[0] == base)
+    return base, ["--shard", f"{index}/{n}"] if index else []
+
+
 @dataclass(frozen=True)
 class SensorSpec:
     """One sensor type (Gymnasium's `EnvSpec` shape): its parameters, validated before anything

@@ -26,6 +26,7 @@ from typing import Any
 from catabot.bus.clock import CONDUCTOR
 from catabot.config.load import BUNDLED, load_scenario
 from catabot.config.scenario import Scenario, participants, services
+from catabot.config.sensors import service_of
 from catabot.errors import CataBotError
 from catabot.run import probe
 from catabot.run.compose_secure import Profile, profile
@@ -77,7 +78,8 @@ class Plan:
 def plan(scenario_arg: str, output: Path, secure_dir: Path | None = None) -> Plan:
     """Read the scenario (a bad one is refused, its field named) and place its files."""
     scenario = load_scenario(scenario_arg)
-    unknown = [n for n in services(scenario) if n not in SERVICE_MODULES]
+    names = services(scenario)
+    unknown = [n for n in names if service_of(n, names)[0] not in SERVICE_MODULES]
     if unknown:
         raise ComposeError(f"scenario needs service(s) {', '.join(unknown)}, which this lacks")
     out_dir = output.resolve().parent
@@ -177,7 +179,8 @@ def document(p: Plan) -> dict[str, Any]:
     run_dir = f"/runs/${{CATABOT_RUN:-{s.name}}}"
     for name in names:
         token = ["--name", name, *p.login(name)] if name in stepping else []  # observers: none
-        command = ["service", name, "--scenario", p.source, "--run-dir", run_dir]
+        program, shard = service_of(name, names)  # a shard: its service with --shard I/N
+        command = ["service", program, *shard, "--scenario", p.source, "--run-dir", run_dir]
         svcs[name] = _process(p, name, command, [p.router, *token], runs=True)
     svcs["viewer"] = _viewer(p)
     if s.ros is not None:

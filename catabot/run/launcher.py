@@ -18,6 +18,7 @@ from catabot.bus.scheduling import requested_policy
 from catabot.bus.session import check_endpoint, free_port
 from catabot.config.load import load_scenario, parse_scenario
 from catabot.config.scenario import Scenario
+from catabot.config.sensors import service_of
 from catabot.errors import CataBotError
 from catabot.run import programs
 from catabot.run.companions import Viewer, after_run, start_viewer
@@ -173,8 +174,8 @@ def _start(
     services = {
         name: child(
             name,
-            _module(name),
-            ["--run-dir", str(run_dir), *flags[1], *_shard(name, world.services)],
+            SERVICE_MODULES[service_of(name, world.services)[0]],
+            ["--run-dir", str(run_dir), *flags[1], *service_of(name, world.services)[1]],
         )
         for name in world.services
     }
@@ -190,17 +191,6 @@ def _start(
             env=programs.environment(run_dir),
         )
     return Supervisor(conductor, services, stops), viewer
-
-
-def _module(name: str) -> str:
-    return SERVICE_MODULES[name.partition(".")[0]]  # a shard runs its service's program
-
-
-def _shard(name: str, names: list[str]) -> list[str]:
-    """`sensors.1` of `sensors.shards: 4` runs as `--shard 1/4`."""
-    base, _, index = name.partition(".")
-    n = sum(1 for other in names if other.partition(".")[0] == base)
-    return ["--shard", f"{index}/{n}"] if index else []
 
 
 def _viewer(opts: RunOptions, run_dir: Path, svc_flags: list[str]) -> Viewer | None:

@@ -210,3 +210,17 @@ def test_deploy_compose_is_the_output_for_deploy_scenario(monkeypatch: pytest.Mo
         "deploy/docker-compose.yml is stale: catabot deploy compose deploy/scenario.json "
         "-o deploy/docker-compose.yml"
     )
+
+
+def test_shards_are_services_of_their_own_with_their_place(tmp_path: Path) -> None:
+    gps = {"name": "gps", "type": "gps", "rate_hz": 10.0}
+    path = scenario_file(tmp_path, sensors={"shards": 2}, traffic={"count": 3, "shards": 3})
+    data = json.loads(path.read_text())
+    data["vessels"][0]["sensors"].append(gps | {"name": "gps2"})
+    path.write_text(json.dumps(data))
+    doc = generate(path, tmp_path / "compose.yml")
+    names = ["physics", "sensors.0", "sensors.1", "traffic.0", "traffic.1", "traffic.2", "recorder"]
+    assert doc["x-catabot"]["services"] == names
+    assert doc["services"]["sensors.1"]["command"][:4] == ["service", "sensors", "--shard", "1/2"]
+    assert doc["services"]["traffic.2"]["command"][:4] == ["service", "traffic", "--shard", "2/3"]
+    assert set(names) <= set(doc["services"]["conductor"]["depends_on"])
