@@ -11,7 +11,8 @@ clock's fixed cost per tick. From those it projects how many LiDAR+camera vessel
 of C cores keep in real time, and predicts the 2- and 4-shard cells' RTF on this machine to
 check itself against the measurements.
 
-Usage: python -m benchmarks.shards [seconds]  (simulated seconds per cell, default 20)
+Usage: python -m benchmarks.shards [seconds [ego_seconds]]  (simulated seconds per Table II
+cell, default 60, and per ten-ego cell, default 10: those run at a tenth of real time)
 """
 
 from __future__ import annotations
@@ -19,14 +20,18 @@ from __future__ import annotations
 import os
 import sys
 import tempfile
+import threading
+import time
 from pathlib import Path
 from typing import Any
 
 from benchmarks.table2 import run_once
 from benchmarks.table2 import scenario as table2_scenario
+from catabot.bus.session import Connection, free_port, open_session
 
 SHARDS = (1, 2, 4)
 EGOS = 10
+TICKS_PER_S = 100  # dt 10 ms
 UTILISATION = 0.9  # of each core, what a CPU-bound stack reached in Table II (91 %)
 LIDAR = {"name": "lidar", "type": "lidar", "rate_hz": 10.0}
 CAMERA = {"name": "camera", "type": "camera", "rate_hz": 10.0}
@@ -72,14 +77,15 @@ def row(label: str, shards: int, result: dict[str, Any]) -> str:
             f"| {per[2]:.2f} |")  # fmt: skip
 
 
-def measure(seconds: float, tmp: Path) -> dict[tuple[str, int], dict[str, Any]]:
+def measure(seconds: float, ego_seconds: float, tmp: Path) -> dict[tuple[str, int], dict[str, Any]]:
     print("| set-up | shards | RTF | physics ms/tick | sensors ms/tick (each shard) "
           "| recorder ms/tick |\n|---|---:|---:|---:|---:|---:|")  # fmt: skip
     results: dict[tuple[str, int], dict[str, Any]] = {}
-    for label, make in (("Table II 100 boats, 4-output camera", table2_100),
-                        (f"{EGOS} egos, LiDAR + camera each", egos)):  # fmt: skip
+    cells = (("Table II 100 boats, 4-output camera", table2_100, seconds),
+             (f"{EGOS} egos, LiDAR + camera each", egos, ego_seconds))  # fmt: skip
+    for label, make, cell_s in cells:
         for shards in SHARDS:
-            results[(label, shards)] = run_once(make(shards, seconds), tmp)
+            results[(label, shards)] = run_once(make(shards, cell_s), tmp)
             print(row(label, shards, results[(label, shards)]), flush=True)
     results[("empty", 1)] = run_once(table2(0, 1, seconds), tmp)
     return results
@@ -89,43 +95,73 @@ def table2_100(shards: int, seconds: float) -> dict[str, Any]:
     return table2(100, shards, seconds)
 
 
+def hop_ms(size: int, repeats: int = 40) -> float:
+    """Wall ms for one message of `size` bytes from one Zenoh session to another over
+    loopback TCP (two peers, as two processes of a run talk), received and copied out."""
+    port = free_port()
+    got = threading.Semaphore(0)
+    a = open_session(Connection(listen=(f"tcp/127.0.0.1:{port}",)))
+    b = open_session(Connection(connect=(f"tcp/127.0.0.1:{port}",)))
+    sub = b.declare_subscriber("bench/hop", lambda s: (s.payload.to_bytes(), got.release()))
+    time.sleep(0.5)  # the subscription reaches the publisher
+    payload = bytes(size)
+    start = time.perf_counter()
+    for _ in range(repeats):
+        a.put("bench/hop", payload)
+        got.acquire(timeout=5)
+    ms = 1e3 * (time.perf_counter() - start) / repeats
+    sub.undeclare()
+    b.close()
+    a.close()
+    return ms
+
+
 def cost_model(results: dict[tuple[str, int], dict[str, Any]]) -> None:
-    """CPU per scan, per frame, per body tick; projections; the 2- and 4-shard check."""
+    """CPU per scan + frame, per body tick, per hop; projections; the check against 2 and 4
+    shards."""
     t2 = results[("Table II 100 boats, 4-output camera", 1)]
     farm = {n: results[(f"{EGOS} egos, LiDAR + camera each", n)] for n in SHARDS}
     empty = results[("empty", 1)]
     if not all(r.get("wall_s") for r in (t2, empty, *farm.values())):
         print("cost model: a cell failed; nothing projected")
         return
-    # Ten egos: every tenth tick each ego scans once and takes a frame.
-    per_vessel_ms = cpu_ms(farm[1], "sensors") * 10 / EGOS  # one scan + one frame, CPU ms
-    fixed_ms = sum(cpu_ms(empty, p) for p in ("physics", "recorder", "sensors"))
-    body_ms = (sum(cpu_ms(t2, p) for p in ("physics", "traffic", "recorder"))
-               - sum(cpu_ms(empty, p) for p in ("physics", "recorder"))) / 100  # fmt: skip
     cores = os.cpu_count() or 1
-    print(f"\ncost model (CPU, this machine, {cores} cores): a LiDAR scan + a camera frame "
-          f"{per_vessel_ms:.1f} ms; a body {1e3 * body_ms:.1f} us a tick; the 0-boat stack "
-          f"(camera ego) {fixed_ms:.2f} ms a tick")  # fmt: skip
-    need_s = per_vessel_ms * 10 / 1e3  # CPU seconds a simulated second per LiDAR+camera vessel
-    print("| machines x cores | LiDAR + camera vessels in real time (10 Hz each) |\n|---|---:|")
+    # CPU seconds a simulated second for one LiDAR + camera vessel (a scan and a frame at
+    # 10 Hz): to sense it (sensors) and to record it (the one recorder of a run).
+    sense_s = cpu_ms(farm[1], "sensors") * TICKS_PER_S / 1e3 / EGOS
+    record_s = cpu_ms(farm[1], "recorder") * TICKS_PER_S / 1e3 / EGOS
+    body_us = 1e3 * (sum(cpu_ms(t2, p) for p in ("physics", "traffic", "recorder"))
+                     - sum(cpu_ms(empty, p) for p in ("physics", "recorder"))) / 100  # fmt: skip
+    frame = 640 * 480 * (3 + 4 + 12 + 2 + 4)  # colour, depth, normals, segmentation, instance
+    hop = hop_ms(frame)
+    print(f"\ncost model (this machine, {cores} cores, CPU s per simulated s): sensing a LiDAR + "
+          f"camera vessel {sense_s:.3f}, recording it {record_s:.3f}; a body {body_us:.1f} us "
+          f"a tick; one hop of a {frame / 1e6:.1f} MB camera frame {hop:.1f} ms wall")  # fmt: skip
+    print("| machines x cores (sensor shards) | vessels in real time: sensing "
+          "| recording (one recorder) | both |\n|---|---:|---:|---:|")  # fmt: skip
     for machines, c in ((1, cores), (2, cores), (4, cores), (4, 16)):
-        print(f"| {machines} x {c} | {int(UTILISATION * machines * c / need_s)} |")
+        hops_s = 10 * hop / 1e3 * (machines > 1)  # frames leave the machine: a hop each
+        sensing = int(UTILISATION * machines * c / (sense_s + hops_s))
+        recording = int(1.0 / record_s)  # one process, one core
+        print(f"| {machines} x {c} | {sensing} | {recording} | {min(sensing, recording)} |")
     total_s = sum(cpu_ms(farm[1], p) for p in ("physics", "sensors", "recorder")) * 100 / 1e3
-    ceiling = cores * UTILISATION / total_s  # CPU-bound: every core busy, work balanced
+    ceiling = min(cores * UTILISATION / total_s, 1.0 / (record_s * EGOS))
     for n in SHARDS:
         print(
-            f"{n} shard(s), {EGOS} egos: measured RTF {rtf(farm[n]):.2f}, CPU-bound ceiling "
-            f"{ceiling:.2f} ({total_s:.2f} CPU s a simulated second on {cores} cores)"
+            f"{n} shard(s), {EGOS} egos: measured RTF {rtf(farm[n]):.3f}; predicted "
+            f"{ceiling:.3f} (all cores busy, or the recorder's one core: the lower)"
         )
 
 
 def main(argv: list[str] | None = None) -> None:
     args = sys.argv[1:] if argv is None else argv
-    numbers = [a for a in args if a.replace(".", "", 1).isdigit()]
-    seconds = float(numbers[0]) if numbers else 20.0
-    print(f"Sensor farm: {seconds:g} s simulated per cell, recorder on")
+    numbers = [float(a) for a in args if a.replace(".", "", 1).isdigit()]
+    seconds = numbers[0] if numbers else 60.0
+    ego_seconds = numbers[1] if len(numbers) > 1 else 10.0
+    print(f"Sensor farm: {seconds:g} s simulated per Table II cell, {ego_seconds:g} s per "
+          f"{EGOS}-ego cell, recorder on")  # fmt: skip
     with tempfile.TemporaryDirectory(prefix="shards-") as tmp:
-        cost_model(measure(seconds, Path(tmp)))
+        cost_model(measure(seconds, ego_seconds, Path(tmp)))
 
 
 if __name__ == "__main__":
