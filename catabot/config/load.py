@@ -58,6 +58,7 @@ def absolute_paths(data: Any, base: Path) -> Any:
     for vessel in vessels if isinstance(vessels, list) else []:
         if isinstance(vessel, dict) and str(vessel.get("model", "")).endswith(".json"):
             _absolute(vessel, "model", base)
+        _program(_node(vessel, "controller") if isinstance(vessel, dict) else {}, base)
     return data
 
 
@@ -73,6 +74,20 @@ def _node(data: dict[str, Any], *path: str) -> dict[str, Any]:
 def _absolute(node: dict[str, Any], key: str, base: Path) -> None:
     if isinstance(node.get(key), str):
         node[key] = str(base / Path(node[key]).expanduser())
+
+
+def _program(controller: dict[str, Any], base: Path) -> None:
+    """A controller's program: next to the scenario file if it is there, else from the
+    current directory (`examples/navigate.py` from the repository root); left as written
+    when neither has it, for `catabot run` to refuse by name (catabot/run/programs.py)."""
+    program = controller.get("program")
+    if not isinstance(program, str) or not program:
+        return
+    for folder in (base, Path.cwd()):
+        path = folder / Path(program).expanduser()
+        if path.is_file():
+            controller["program"] = str(path.resolve())
+            return
 
 
 def json_schema() -> dict[str, Any]:

@@ -30,6 +30,7 @@ from catabot.config.base import (
     WorldName,
     unique,
 )
+from catabot.config.controller import ControllerConfig, check_programs
 from catabot.config.environment import CurrentConfig, RainConfig, WindConfig
 from catabot.config.live import SettingChange, check_timeline
 from catabot.config.ros import GATEWAY, RosConfig, check_ros
@@ -112,16 +113,6 @@ class SensorConfig(Strict):
     @property
     def period_ns(self) -> int:
         return round(NS_PER_S / self.rate_hz)
-
-
-class ControllerConfig(Strict):
-    """The vessel is driven by a lockstep participant started outside `catabot run` (an
-    autonomy stack): its commands are a clocked stream on `vessel/<id>/cmd/<command>`, so
-    physics waits for each and applies it at the same tick on every run (DESIGN.md §4)."""
-
-    participant: ParticipantName = Field(description="the stack's participant name")
-    rate_hz: float = Field(10.0, gt=0, description="commands per second, a whole number of ticks")
-    command: Literal["thrust", "twist"] = "thrust"
 
 
 class VesselConfig(Strict):
@@ -222,6 +213,11 @@ class Scenario(Strict):
         return self
 
     @model_validator(mode="after")
+    def _controller_programs(self) -> Scenario:
+        check_programs([v.controller for v in self.vessels], SERVICE_NAMES)
+        return self
+
+    @model_validator(mode="after")
     def _exports_have_sources(self) -> Scenario:
         """Camera datasets need a camera and dataset/; KITTI scans need a LiDAR."""
         types = {s.type for v in self.vessels for s in v.sensors}
@@ -291,6 +287,9 @@ def rate_in_ticks(rate_hz: float, dt_ns: int, *, where: str) -> int:
 def guidance_period_ticks(scenario: Scenario) -> int:
     """Ticks between two rounds of traffic set-points (`traffic.guidance_hz`)."""
     return rate_in_ticks(scenario.traffic.guidance_hz, scenario.dt_ns, where="traffic.guidance_hz")
+
+
+SERVICE_NAMES = ("conductor", "physics", "sensors", "traffic", "recorder", GATEWAY, "viewer")
 
 
 def services(scenario: Scenario) -> list[str]:

@@ -19,6 +19,7 @@ from catabot.bus.session import check_endpoint, free_port
 from catabot.config.load import load_scenario, parse_scenario
 from catabot.config.scenario import Scenario
 from catabot.errors import CataBotError
+from catabot.run import programs
 from catabot.run.companions import Viewer, after_run, start_viewer
 from catabot.run.progress import PlanningProgress, ProgressBar
 from catabot.run.summary import summarise
@@ -67,6 +68,7 @@ def prepare(opts: RunOptions) -> World:
     for name in world.services:
         if name not in SERVICE_MODULES:
             raise LaunchError(f"scenario needs service {name!r}, which this version does not have")
+    programs.programs(world.scenario, opts.scenario)  # each controller's program is a file
     _check_logins(opts, world)
     return world
 
@@ -76,11 +78,13 @@ def _check_logins(opts: RunOptions, world: World) -> None:
     if opts.zenoh_configs is None:
         return
     names = [CONDUCTOR, *world.services, *(["viewer"] if opts.view else [])]
+    names += [p.participant for p in programs.programs(world.scenario, opts.scenario)]
     missing = [n for n in names if not (opts.zenoh_configs / f"{n}.json5").is_file()]
     if missing:
         raise LaunchError(
             f"secure profile {opts.zenoh_configs} has no login for {', '.join(missing)} (the ROS "
-            "gateway is not in the secure profile; otherwise make it with catabot secure init)"
+            "gateway is not in the secure profile; a controller's program needs a client login: "
+            "catabot secure init --client NAME; otherwise make it with catabot secure init)"
         )
 
 
@@ -150,10 +154,12 @@ def _start(
     stops: Stops,
     flags: tuple[list[str], list[str]],
 ) -> tuple[Supervisor, Viewer | None]:
-    """The conductor, the viewer (it sees the run from tick 0), then every service, each a
-    process with its own session id."""
+    """The conductor, the viewer (it sees the run from tick 0), every service, then every
+    controller's program, each a process with its own session id."""
     scen = str(run_dir / "scenario.json")
-    roster = Roster({name: new_zid() for name in (CONDUCTOR, *world.services)})
+    stacks = programs.programs(world.scenario, opts.scenario)
+    names = (CONDUCTOR, *world.services, *(p.participant for p in stacks))
+    roster = Roster({name: new_zid() for name in names})
 
     def child(name: str, module: str, extra: list[str], *, stdout: bool = False) -> Child:
         identity = _identity(roster, name, opts.zenoh_configs)
@@ -167,6 +173,17 @@ def _start(
         name: child(name, SERVICE_MODULES[name], ["--run-dir", str(run_dir), *flags[1]])
         for name in world.services
     }
+    for stack in stacks:
+        name = stack.participant
+        own = [*flags[1], "--zid", str(roster.zid(name)), *_login(name, opts.zenoh_configs)]
+        services[name] = Child(
+            name,
+            programs.command(stack, world.scenario.name, own),
+            run_dir / "log" / f"{name}.log",
+            stdout=False,
+            program=True,
+            env=programs.environment(run_dir),
+        )
     return Supervisor(conductor, services, stops), viewer
 
 

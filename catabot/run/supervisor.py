@@ -30,29 +30,59 @@ FAULT_REAP_S = 2.0  # after a fault: End carries the error, services drain for 1
 
 
 class Child:
-    """One process of the run, its stderr relayed into its log by a thread."""
+    """One process of the run, its stderr relayed into its log by a thread.
 
-    def __init__(self, name: str, args: list[str], log_path: Path, *, stdout: bool) -> None:
-        self.name, self.log_path = name, log_path
+    A service (`python -m MODULE ...`) states its own fatal fault in a CRITICAL line; a
+    `program` (a controller's stack, catabot/run/programs.py: `command` is its whole command
+    line) need not: its stdout goes into the log too, and an exit with an error while the
+    run goes is its fatal fault, named with its last line (a traceback's exception)."""
+
+    def __init__(
+        self,
+        name: str,
+        command: list[str],
+        log_path: Path,
+        *,
+        stdout: bool,
+        program: bool = False,
+        env: dict[str, str] | None = None,
+    ) -> None:
+        self.name, self.log_path, self.program = name, log_path, program
+        self.what = command[1] if program else ""  # the program's file
         self.proc = subprocess.Popen(
-            [sys.executable, "-m", *args],
-            stdout=subprocess.PIPE if stdout else subprocess.DEVNULL,
-            stderr=subprocess.PIPE,
+            command if program else [sys.executable, "-m", *command],
+            stdout=subprocess.PIPE if stdout or program else subprocess.DEVNULL,
+            stderr=subprocess.STDOUT if program else subprocess.PIPE,  # a program's: one stream
             text=True,
+            env=env,
             start_new_session=True,  # Ctrl-C reaches the launcher only; it ends the run cleanly
         )
         self.fatal = ""  # the first CRITICAL line: the process's own fatal fault
         self.fatal_at = 0.0
+        self.last_line = ""  # a program's last line, for its fatal fault
         self._relay = threading.Thread(target=self._copy_stderr, daemon=True)
         self._relay.start()
 
     def _copy_stderr(self) -> None:
-        assert self.proc.stderr is not None
+        lines = self.proc.stdout if self.program else self.proc.stderr
+        assert lines is not None
         log = _open(self.log_path)
-        for line in self.proc.stderr:
+        for line in lines:
             if " CRITICAL " in line and not self.fatal:
                 self.fatal, self.fatal_at = line.split(" CRITICAL ", 1)[1].strip(), time.monotonic()
+            self.last_line = line.strip() or self.last_line
             log = _write(log, line, self)
+
+    def crashed(self) -> None:
+        """A program that ended with an error while the run went: that is its fatal fault."""
+        code = self.proc.returncode
+        if not self.program or self.fatal or code is None or code == 0:
+            return
+        self._relay.join(timeout=1.0)  # its last lines
+        how = f"exit code {code}" if code > 0 else f"killed by signal {-code}"
+        said = f": {self.last_line}" if self.last_line else ""
+        self.fatal = f"the program {self.what} ended ({how}){said}"
+        self.fatal_at = time.monotonic()
 
     def state(self) -> str:
         """The Linux scheduler's state letter of the process ('T': stopped), or ''."""
@@ -145,14 +175,17 @@ class Supervisor:
         asked_to_stop = False
         while reader.is_alive():
             reader.join(timeout=0.1)
-            died = [n for n, c in self.services.items() if c.proc.poll() not in (None, 0)]
+            died = [c for c in self.services.values() if c.proc.poll() not in (None, 0)]
             if died and not asked_to_stop and self.conductor.proc.poll() is None:
+                for child in died:
+                    child.crashed()
                 self.conductor.proc.send_signal(signal.SIGTERM)
                 asked_to_stop = True
             silent = self._silent()
             if silent and self.conductor.proc.poll() is None:
                 self._kill(self.conductor, f"the conductor hung (nothing from it for {silent:g} s)")
         self.conductor.proc.wait()
+        self._programs_that_left()
         self._kill_hung_participants()
         self._reap()
         for child in (self.conductor, *self.services.values()):
@@ -185,6 +218,15 @@ class Supervisor:
     def _kill(self, child: Child, why: str) -> None:
         child.proc.kill()  # SIGKILL: a stopped process does not take SIGTERM
         self.hung.append(why)
+
+    def _programs_that_left(self) -> None:
+        """A program the conductor saw leave (often before this loop saw it end) and that
+        ended with an error: its own crash is the cause, not merely its leaving."""
+        error = str(self.result.get("error", ""))
+        for name, child in self.services.items():
+            left = child.program and f"participant {name!r}" in error
+            if left and _exits(child.proc, within_s=1.0):
+                child.crashed()
 
     def _kill_hung_participants(self) -> None:
         """Participants the conductor reports as gone or late, whose process still exists a

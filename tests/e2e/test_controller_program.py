@@ -1,0 +1,60 @@
+"""`vessels[].controller.program`: `catabot run` starts the stack as one more participant."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+from typing import Any
+
+from conftest import basic_scenario, catabot, csv_rows, files_of, only_run_dir, scenario_file
+
+PROGRAM = "tests/e2e/stack_program.py"  # from the repository root: the current directory
+
+
+def _scenario(tmp: Path, *args: str, program: str = PROGRAM) -> Path:
+    data: dict[str, Any] = basic_scenario("program", duration_s=3.0)
+    data["vessels"][0] = {
+        "id": "ego",
+        "pose": {"x_m": 0.0, "y_m": 0.0, "yaw_rad": 0.0},
+        "controller": {"participant": "stack", "rate_hz": 10.0, "program": program,
+                       "args": list(args)},
+    }  # fmt: skip
+    return scenario_file(tmp, data)
+
+
+def _run(tmp: Path, scenario: Path, tag: str) -> tuple[int, str, Path | None]:
+    out = tmp / tag
+    out.mkdir()
+    result = catabot("run", str(scenario), "--out", str(out), "--quiet")
+    runs = list(out.iterdir())
+    return result.returncode, result.stdout + result.stderr, only_run_dir(out) if runs else None
+
+
+def test_a_program_driven_vessel_records_the_same_bytes_twice(tmp_path: Path) -> None:
+    scenario = _scenario(tmp_path, "--goal", "30", "10")
+    code_a, said_a, run_a = _run(tmp_path, scenario, "a")
+    code_b, said_b, run_b = _run(tmp_path, scenario, "b")
+    assert code_a == 0 and code_b == 0, said_a + said_b
+    assert run_a is not None and run_b is not None
+    assert files_of(run_a) == files_of(run_b)
+    rows = csv_rows(run_a / "vessel.ego.state.csv")
+    x = [float(r[rows[0].index("position_x[m]")]) for r in rows[1:]]
+    assert x[-1] > 1.0  # the program's thrust moved the boat
+    assert "stack ended at tick" in (run_a / "log" / "stack.log").read_text()  # its stdout
+    record = json.loads((run_a / "log" / "run.json").read_text())
+    assert record["services"]["stack"] == 0  # counted with the services
+
+
+def test_a_program_crashing_mid_run_is_named_as_the_cause(tmp_path: Path) -> None:
+    code, said, run = _run(tmp_path, _scenario(tmp_path, "--crash-at", "120"), "crash")
+    assert code == 1, said
+    cause = next(line for line in said.splitlines() if line.startswith("run failed:"))
+    assert "stack" in cause and "stack_program.py" in cause, cause
+    assert "ZeroDivisionError: the stack fell over at tick 120" in cause
+    assert run is not None and "Traceback" in (run / "log" / "stack.log").read_text()
+
+
+def test_a_missing_program_is_refused_before_anything_starts(tmp_path: Path) -> None:
+    code, said, run = _run(tmp_path, _scenario(tmp_path, program="no/such/stack.py"), "missing")
+    assert code == 2 and run is None
+    assert "vessels.0.controller.program: 'no/such/stack.py' is not a file" in said
