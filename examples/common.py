@@ -6,6 +6,7 @@ import argparse
 
 import zenoh
 
+from catabot.bus.keys import Keys
 from catabot.bus.session import add_connection_args, connection_from_args, open_session
 
 
@@ -14,10 +15,20 @@ def parser(description: str | None) -> argparse.ArgumentParser:
         description=description, formatter_class=argparse.RawDescriptionHelpFormatter
     )
     add_connection_args(p)
-    p.add_argument("--world", default="default", help="scenario name (key prefix catabot/<world>)")
+    p.add_argument(
+        "--world", help="scenario name (key prefix catabot/<world>; default: the one running)"
+    )
     p.add_argument("--vessel", default="ego", help="vessel id")
+    p.add_argument(
+        "--participant", help="lockstep name (default: the vessel's controller.participant)"
+    )
     return p
 
 
 def session(args: argparse.Namespace) -> zenoh.Session:
     return open_session(connection_from_args(args))
+
+
+def keys(args: argparse.Namespace) -> Keys:
+    """The keys of `--world` (the bundled `default` scenario when not given)."""
+    return Keys(args.world or "default")

@@ -13,6 +13,7 @@ under the GPS noise.
 from __future__ import annotations
 
 import math
+from collections.abc import Sequence
 from dataclasses import dataclass
 from typing import Any
 
@@ -61,6 +62,13 @@ class LocalFrame:
             self.latitude_deg + math.degrees(north_m / north),
             self.longitude_deg + math.degrees(east_m / east),
         )
+
+
+def yaw_of(q: Sequence[float]) -> float:
+    """ENU heading (rad, 0 = east, counter-clockwise) of an orientation quaternion (x, y, z, w),
+    the IMU's."""
+    x, y, z, w = (float(v) for v in q)
+    return math.atan2(2 * (w * z + x * y), 1 - 2 * (y * y + z * z))
 
 
 def wrap(angle: float) -> float:
@@ -125,3 +133,41 @@ class Catamaran:
         total = force / self.max_forward_n
         turn = moment / (self.lever_m * self.max_forward_n)  # starboard minus port
         return [max(-1.0, min(1.0, (total - turn) / 2)), max(-1.0, min(1.0, (total + turn) / 2))]
+
+
+def task_of(scenario: dict[str, Any], vessel: str) -> dict[str, Any]:
+    """The vessel's `task` in the resolved scenario ({} when it has none)."""
+    for v in scenario.get("vessels", []):
+        if v.get("id") == vessel:
+            return v.get("task") or {}
+    return {}
+
+
+def goal_of(
+    given: list[float] | None, scenario: dict[str, Any], vessel: str
+) -> tuple[float, float]:
+    """`--goal X Y`, else the scenario's `vessels[].task.goal`; a clear exit with neither."""
+    if given is not None:
+        return float(given[0]), float(given[1])
+    goal = task_of(scenario, vessel).get("goal")
+    if not goal:
+        raise SystemExit(f"no goal: give --goal X Y or a task.goal for vessel {vessel!r}")
+    return float(goal["x_m"]), float(goal["y_m"])
+
+
+def route_of(
+    given: list[float] | None, scenario: dict[str, Any], vessel: str
+) -> list[tuple[float, float]]:
+    """`--waypoints X Y X Y ...`, else the scenario's `vessels[].task.route`."""
+    if given is not None:
+        if len(given) < 4 or len(given) % 2:
+            raise SystemExit(f"--waypoints takes pairs X Y, at least two (got {len(given)} values)")
+        points = list(zip(given[::2], given[1::2], strict=True))
+    else:
+        points = [(p[0], p[1]) for p in task_of(scenario, vessel).get("route") or []]
+        if not points:
+            raise SystemExit(f"no path: give --waypoints or a task.route for vessel {vessel!r}")
+    for a, b in zip(points, points[1:], strict=False):
+        if a == b:
+            raise SystemExit(f"the path repeats the point {a}: every leg needs two points")
+    return [(float(x), float(y)) for x, y in points]

@@ -3,10 +3,10 @@ dynamic-window planner over it. Pure NumPy functions, tested on synthetic scans 
 tests/examples/test_planning.py.
 
 The grid is ENU-aligned and centred on the vessel (offsets in metres, not map positions), so a
-noisy GPS fix moves the goal a little but never the obstacles. Traffic moves and the scan
-carries no velocities, so an obstacle is taken as able to close in at up to
-`Planner.obstacle_speed_mps`: a candidate arc must keep `hull + margin + speed * t` away from
-every occupied cell at every time t of its horizon (the cone of where the obstacle could be).
+noisy GPS fix moves the goal a little but never the obstacles. Traffic moves: each occupied
+cell carries its object's velocity (tracking.py) and is predicted along it, and since an
+estimate is only an estimate, a candidate arc must keep `hull + margin + uncertainty * t`
+away from every predicted cell at every time t of its horizon.
 """
 
 from __future__ import annotations
@@ -48,7 +48,7 @@ class Planner:
     step_s: float = 0.5
     hull_m: float = 1.1  # the vessel's circumscribed radius
     margin_m: float = 1.5
-    obstacle_speed_mps: float = 0.6  # how fast an unseen-velocity obstacle is assumed to close
+    uncertainty_mps: float = 0.3  # how fast an obstacle may stray from its predicted track
     clearance_cap_m: float = 10.0  # farther than this, more room earns nothing
     surges: int = 5
     yaw_rates: int = 15
@@ -67,12 +67,6 @@ def quaternion_matrix(q: F64) -> F64:
             [2 * (x * z - y * w), 2 * (y * z + x * w), 1 - 2 * (x * x + y * y)],
         ]
     )
-
-
-def yaw_of(q: F64) -> float:
-    """ENU heading (rad, 0 = east, counter-clockwise) of an orientation quaternion."""
-    x, y, z, w = (float(v) for v in q)
-    return float(np.arctan2(2 * (w * z + x * y), 1 - 2 * (y * y + z * z)))
 
 
 def rpy_matrix(roll: float, pitch: float, yaw: float) -> F64:
@@ -127,6 +121,13 @@ def occupancy(offsets: F64, reflectivities: F64, spec: GridSpec) -> NDArray[np.b
     return hits >= spec.min_hits
 
 
+def cell_grid(spec: GridSpec) -> F64:
+    """(size, size, 2) east, north offsets of every cell's centre."""
+    centre = np.arange(spec.size) * spec.cell_m - spec.half_m + spec.cell_m / 2
+    east, north = np.meshgrid(centre, centre)
+    return np.stack([east, north], axis=-1)
+
+
 def cell_centres(grid: NDArray[np.bool_], spec: GridSpec) -> F64:
     """(M, 2) east, north offsets of the occupied cells' centres."""
     rows, cols = np.nonzero(grid)
@@ -160,21 +161,23 @@ def rollout(candidates: F64, heading: float, p: Planner) -> F64:
     return np.stack([x, y], axis=-1)
 
 
-def clearance(paths: F64, obstacles: F64, p: Planner) -> F64:
-    """(K,) the least room each path keeps, in metres beyond `hull + margin + speed * t`
-    (negative: the path may meet an obstacle); `clearance_cap_m` with no obstacle at all."""
+def clearance(paths: F64, obstacles: F64, velocities: F64, p: Planner) -> F64:
+    """(K,) the least room each path keeps from the obstacle cells (M, 2) moving at
+    `velocities` (M, 2), in metres beyond `hull + margin + uncertainty * t` (negative: the
+    path may meet one); `clearance_cap_m` with no obstacle at all."""
     if len(obstacles) == 0:
         return np.full(len(paths), p.clearance_cap_m)
     t = np.arange(1, paths.shape[1] + 1) * p.step_s
-    gap = paths[:, :, None, :].astype(np.float32) - obstacles[None, None, :, :].astype(np.float32)
+    ahead = obstacles[None, :, :] + velocities[None, :, :] * t[:, None, None]  # (T, M, 2)
+    gap = paths[:, :, None, :].astype(np.float32) - ahead[None].astype(np.float32)
     nearest = np.sqrt(np.einsum("ktmi,ktmi->ktm", gap, gap).min(axis=2))  # (K, T)
-    room = nearest - (p.hull_m + p.margin_m + p.obstacle_speed_mps * t)
+    room = nearest - (p.hull_m + p.margin_m + p.uncertainty_mps * t)
     return np.minimum(room.min(axis=1), p.clearance_cap_m)
 
 
 def choose(
-    surge: float, yaw_rate: float, heading: float, goal: F64, obstacles: F64, period_s: float,
-    p: Planner,
+    surge: float, yaw_rate: float, heading: float, goal: F64, obstacles: F64,
+    velocities: F64, period_s: float, p: Planner,
 ) -> tuple[float, float]:  # fmt: skip
     """The (surge, yaw rate) to command: the admissible arc that best trades progress to the
     goal (an ENU offset), clearance and speed; with none admissible, the one with most room
@@ -183,10 +186,9 @@ def choose(
     cands = window(surge, yaw_rate, period_s, max(0.2, distance / 4.0), p)  # slow near the goal
     paths = rollout(cands, heading, p)
     reach = p.max_surge_mps * p.horizon_s + p.hull_m + p.margin_m + p.clearance_cap_m
-    near = obstacles[
-        np.hypot(obstacles[:, 0], obstacles[:, 1]) < reach + p.obstacle_speed_mps * p.horizon_s
-    ]
-    room = clearance(paths, near, p)
+    speed = np.hypot(velocities[:, 0], velocities[:, 1]) + p.uncertainty_mps
+    near = np.hypot(obstacles[:, 0], obstacles[:, 1]) < reach + speed * p.horizon_s
+    room = clearance(paths, obstacles[near], velocities[near], p)
     end = np.hypot(goal[0] - paths[:, -1, 0], goal[1] - paths[:, -1, 1])
     progress = (distance - end) / (p.max_surge_mps * p.horizon_s)
     score = (

@@ -34,7 +34,9 @@ def test_local_frame_round_trips_and_crosses_the_antimeridian() -> None:
 
 
 def test_local_frame_of_a_scenario_without_origin_says_so() -> None:
-    assert LocalFrame.of_scenario({"origin": {"latitude_deg": 1, "longitude_deg": 2}}).altitude_m == 0
+    assert (
+        LocalFrame.of_scenario({"origin": {"latitude_deg": 1, "longitude_deg": 2}}).altitude_m == 0
+    )
     with pytest.raises(SystemExit, match="no usable `origin`"):
         LocalFrame.of_scenario({"name": "x"})
 
@@ -62,7 +64,9 @@ def test_next_leg_switches_when_close_or_past_the_end() -> None:
 
 def test_steer_and_wrap() -> None:
     assert wrap(3 * math.pi) == pytest.approx(-math.pi)
-    assert steer(math.radians(170), math.radians(-170), 1.0, 1.0) == pytest.approx(math.radians(-20))
+    assert steer(math.radians(170), math.radians(-170), 1.0, 1.0) == pytest.approx(
+        math.radians(-20)
+    )
     assert steer(2.0, 0.0, 1.0, 0.3) == 0.3
 
 
