@@ -3,11 +3,14 @@
 from __future__ import annotations
 
 import argparse
+from collections.abc import Iterator
+from contextlib import contextmanager
 
 import zenoh
 
 from catabot.bus.keys import Keys
 from catabot.bus.session import add_connection_args, connection_from_args, open_session
+from catabot.client import ClientError
 
 
 def parser(description: str | None) -> argparse.ArgumentParser:
@@ -32,3 +35,13 @@ def session(args: argparse.Namespace) -> zenoh.Session:
 def keys(args: argparse.Namespace) -> Keys:
     """The keys of `--world` (the bundled `default` scenario when not given)."""
     return Keys(args.world or "default")
+
+
+@contextmanager
+def clear_errors(program: str) -> Iterator[None]:
+    """A client's error (no simulation, no such vessel or sensor, the run ended...) ends the
+    program with its message, not a traceback."""
+    try:
+        yield
+    except ClientError as e:
+        raise SystemExit(f"{program}: {e}") from None

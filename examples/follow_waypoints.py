@@ -11,9 +11,10 @@ from __future__ import annotations
 
 import math
 
-from common import parser
+from common import clear_errors, parser
 from guidance import Catamaran, LocalFrame, line_of_sight, next_leg, route_of, steer, wrap, yaw_of
 
+from catabot.bus.messages import End
 from catabot.client import Client, Thrust, Twist
 from catabot.client.lockstep import Observation
 
@@ -78,14 +79,16 @@ def main() -> None:
         help="what to send when free-running (in lockstep: the controller's kind)",
     )
     p.add_argument("--rate", type=float, default=10.0, help="Hz when free-running")  # fmt: skip
+    p.add_argument("--timeout", type=float, default=30.0, help="seconds to wait for the run")
     args = p.parse_args()
-    with Client.from_args(args, timeout_s=10.0) as sim:
+    with clear_errors("follow_waypoints.py"), Client.from_args(args) as sim:
         vessel = sim.vessel(args.vessel).info
         control = vessel.controller
         frame, scenario = LocalFrame.of_scenario(sim.info.scenario), sim.info.scenario
         path = route_of(args.waypoints, scenario, vessel.id)
         kind = control.command if control is not None else args.command
         follower = Follower(frame, path, kind, args.speed, args.lookahead, args.accept)
+        end: End | None
         if control is not None:
             name = args.participant or control.participant
             end = sim.run_lockstep(name, follower.step, vessel=vessel.id, sensors=["gps", "imu"])

@@ -12,10 +12,14 @@ under the GPS noise.
 
 from __future__ import annotations
 
+import itertools
 import math
 from collections.abc import Sequence
 from dataclasses import dataclass
 from typing import Any
+
+import numpy as np
+from numpy.typing import NDArray
 
 WGS84_A = 6378137.0
 WGS84_E2 = (1.0 / 298.257223563) * (2.0 - 1.0 / 298.257223563)
@@ -64,7 +68,7 @@ class LocalFrame:
         )
 
 
-def yaw_of(q: Sequence[float]) -> float:
+def yaw_of(q: Sequence[float] | NDArray[np.float64]) -> float:
     """ENU heading (rad, 0 = east, counter-clockwise) of an orientation quaternion (x, y, z, w),
     the IMU's."""
     x, y, z, w = (float(v) for v in q)
@@ -167,7 +171,7 @@ def route_of(
         points = [(p[0], p[1]) for p in task_of(scenario, vessel).get("route") or []]
         if not points:
             raise SystemExit(f"no path: give --waypoints or a task.route for vessel {vessel!r}")
-    for a, b in zip(points, points[1:], strict=False):
+    for a, b in itertools.pairwise(points):
         if a == b:
             raise SystemExit(f"the path repeats the point {a}: every leg needs two points")
     return [(float(x), float(y)) for x, y in points]

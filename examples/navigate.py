@@ -16,7 +16,7 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from common import parser
+from common import clear_errors, parser
 from guidance import Catamaran, LocalFrame, goal_of, yaw_of
 from planning import GridSpec, Planner, choose, reflectivity, world_offsets
 from tracking import Obstacles, Tracker
@@ -84,8 +84,9 @@ def main() -> None:
     p.add_argument("--goal", type=float, nargs=2, metavar=("X", "Y"),
                    help="in map (m); default: the vessel's task.goal in the scenario")  # fmt: skip
     p.add_argument("--tolerance", type=float, default=3.0, help="m from the goal to stop")
+    p.add_argument("--timeout", type=float, default=30.0, help="seconds to wait for the run")
     args = p.parse_args()
-    with Client.from_args(args, timeout_s=10.0) as sim:
+    with clear_errors("navigate.py"), Client.from_args(args) as sim:
         vessel = sim.vessel(args.vessel).info
         if vessel.controller is None:
             raise SystemExit(f"vessel {vessel.id!r} has no controller: nothing to join as")

@@ -131,7 +131,9 @@ def cell_grid(spec: GridSpec) -> F64:
 def cell_centres(grid: NDArray[np.bool_], spec: GridSpec) -> F64:
     """(M, 2) east, north offsets of the occupied cells' centres."""
     rows, cols = np.nonzero(grid)
-    return np.stack([cols, rows], axis=1) * spec.cell_m - spec.half_m + spec.cell_m / 2
+    return np.stack([cols, rows], axis=1).astype(np.float64) * spec.cell_m + (
+        spec.cell_m / 2 - spec.half_m
+    )
 
 
 def window(surge: float, yaw_rate: float, period_s: float, top: float, p: Planner) -> F64:

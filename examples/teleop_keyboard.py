@@ -11,11 +11,12 @@ python examples/teleop_keyboard.py --connect tcp/127.0.0.1:7447
 
 from __future__ import annotations
 
+import contextlib
 import curses
 import math
 from pathlib import Path
 
-from common import parser
+from common import clear_errors, parser
 from guidance import yaw_of
 from PIL import Image
 
@@ -79,18 +80,18 @@ def screenshot(ego: Vessel, camera: str, folder: Path) -> str:
         path = save_png(frame, folder, f"{ego.id}_{camera}")
     except (ClientError, ValueError, OSError) as e:
         return f"no screenshot: {e}"
-    return f"saved {path} ({frame.width} x {frame.height}, t={frame.stamp_ns / 1e9:.1f} s)"
+    size, t = f"{frame.width} x {frame.height}", frame.stamp_ns / 1e9
+    return f"saved {path.name} ({size}, t={t:.1f} s) in {folder}"
 
 
-def drive(win: curses.window, sim: Client, ego: Vessel, camera: str, folder: Path,
-          rate_hz: float) -> str:  # fmt: skip
-    """The key loop: a key, the command, the screen, `rate_hz` times a second; returns why
-    it ended."""
+def drive(win: curses.window, ego: Vessel, camera: str, folder: Path, rate_hz: float) -> str:
+    """The key loop: a key, the command, the screen, `rate_hz` times a second, until Q (or
+    RunEnded from the state once the run is over)."""
     curses.curs_set(0)
     win.timeout(round(1000 / rate_hz))
     thrust, note = (0.0,) * ego.info.thrusters, ""
     state: VesselState | None = None
-    while (ended := sim.watch.ended()) is None:
+    while True:
         key = win.getch()
         if key in (ord("q"), ord("Q")):
             ego.send(Thrust([0.0] * len(thrust)))
@@ -100,16 +101,13 @@ def drive(win: curses.window, sim: Client, ego: Vessel, camera: str, folder: Pat
         elif 0 <= key < 256:
             thrust = press(thrust, chr(key))
         ego.send(Thrust(list(thrust)))
-        try:
+        with contextlib.suppress(NoData):  # the first state may take a moment
             state = ego.state(timeout_s=0.0 if state is not None else 1.0)
-        except NoData:
-            pass
         win.erase()
         height, width = win.getmaxyx()
         for row, line in enumerate(screen(state, thrust, note)[: height - 1]):
             win.addnstr(row, 0, line, width - 1)
         win.refresh()
-    return f"the run ended ({ended})"
 
 
 def main() -> None:
@@ -117,11 +115,12 @@ def main() -> None:
     p.add_argument("--camera", default="camera", help="the camera Space saves")
     p.add_argument("--out", type=Path, default=Path("screenshots"), help="folder for the PNGs")
     p.add_argument("--rate", type=float, default=10.0, help="commands (and redraws) per second")
+    p.add_argument("--timeout", type=float, default=30.0, help="seconds to wait for the run")
     args = p.parse_args()
-    with Client.from_args(args, timeout_s=10.0) as sim:
+    with clear_errors("teleop_keyboard.py"), Client.from_args(args) as sim:
         ego = sim.vessel(args.vessel)
         try:
-            why = curses.wrapper(drive, sim, ego, args.camera, args.out, args.rate)
+            why = curses.wrapper(drive, ego, args.camera, args.out, args.rate)
         except RunEnded as e:
             why = f"the run ended ({e})"
     print(f"teleop: {why}")

@@ -8,6 +8,7 @@ import sys
 from collections.abc import Iterator
 from pathlib import Path
 
+import numpy as np
 import pytest
 
 from catabot.bus.session import free_port
@@ -57,12 +58,20 @@ def run(tmp_path: Path) -> Iterator[type[Run]]:
             r.proc.wait()
 
 
+HELPERS = {"common.py", "guidance.py", "planning.py", "tracking.py"}  # shared, no main()
+
+
 def test_every_example_has_a_main_and_is_checked_here() -> None:
-    source = Path(__file__).read_text()
+    source = "".join(p.read_text() for p in Path(__file__).parent.glob("test_*.py"))
     for path in sorted(EXAMPLES.glob("*.py")):
-        if path.name != "common.py":
+        if path.name not in HELPERS:
             assert 'if __name__ == "__main__":\n    main()' in path.read_text(), path.name
             assert f'"{path.name}"' in source, f"{path.name} has no test here"
+        else:
+            assert (
+                f"test_{path.stem}.py" in {p.name for p in Path(__file__).parent.iterdir()}
+                or path.name == "common.py"
+            ), f"{path.name} has no unit tests"
 
 
 def test_watch_state_prints_the_vessel_moving(run: type[Run]) -> None:
@@ -111,3 +120,86 @@ def test_lockstep_stack_reaches_its_goal_and_records_the_same_bytes_twice(
     commands = recorded[0]["vessel.ego.cmd.thrust.csv"].decode().splitlines()
     assert len(commands) == 1 + 300  # 10 Hz for 30 s, each tagged with its tick
     assert [c.split(",")[1] for c in commands[1:4]] == ["0", "10", "20"]
+
+
+def test_follow_waypoints_in_lockstep_with_thrust(run: type[Run]) -> None:
+    """The scenario starts the follower itself (controller.program), in current and wind."""
+    run_dir = run("examples/follow_waypoints.json").finish()
+    log = (run_dir / "log" / "follower.log").read_text()
+    assert "path done" in log and "run ended at tick 5999 (completed)" in log, log
+    summary = log.splitlines()[-1]
+    worst = float(summary.split("max ")[1].split(" m")[0])
+    assert worst < 4.0, summary  # at the corners; along the legs it stays within ~1.5 m
+    assert len((run_dir / "vessel.ego.cmd.thrust.csv").read_text().splitlines()) == 1 + 600
+
+
+def test_follow_waypoints_free_running_beside_a_run(run: type[Run]) -> None:
+    sim = run("default", "--duration", "20", "--realtime", "2")
+    shown = example("follow_waypoints.py", "--connect", sim.endpoint, "--waypoints", "0", "0",
+                    "12", "0", "--speed", "1.0", "--command", "twist")  # fmt: skip
+    assert shown.returncode == 0, shown.stderr
+    assert "path done" in shown.stdout and "run ended" in shown.stdout, shown.stdout
+    sim.finish()
+    (twists,) = sim.out.glob("*/vessel.ego.cmd.twist.csv")
+    rows = twists.read_text().splitlines()
+    assert rows[0].startswith("stamp_ns,tick,surge")
+    surges = [float(r.split(",")[2]) for r in rows[1:]]
+    assert len(surges) > 50 and max(surges) == pytest.approx(1.0, abs=1e-3) and surges[-1] == 0.0
+
+
+GOAL = (90.0, 0.0)  # examples/navigate.json's --goal
+
+
+@pytest.fixture(scope="module")
+def navigated(tmp_path_factory: pytest.TempPathFactory) -> list[Path]:
+    """examples/navigate.json run twice: `catabot run` starts the navigator (its controller's
+    program) as a lockstep participant; 75 s simulated, 20 boats."""
+    folders = []
+    for i in range(2):
+        out = tmp_path_factory.mktemp(f"navigate{i}")
+        cmd = [sys.executable, "-m", "catabot", "run", "examples/navigate.json", "--quiet",
+               "--out", str(out)]  # fmt: skip
+        done = subprocess.run(cmd, capture_output=True, text=True, timeout=300, cwd=REPO)
+        assert done.returncode == 0, done.stdout + done.stderr
+        (folder,) = out.iterdir()
+        folders.append(folder)
+    return folders
+
+
+def positions(folder: Path, vessel: str) -> np.ndarray:
+    """(ticks, 2) x, y of a vessel from its recorded states."""
+    return np.loadtxt(folder / f"vessel.{vessel}.state.csv", delimiter=",", skiprows=1,
+                      usecols=(2, 3))  # fmt: skip
+
+
+def test_navigate_reaches_its_goal_through_traffic_without_touching_a_boat(
+    navigated: list[Path],
+) -> None:
+    folder = navigated[0]
+    log = (folder / "log" / "navigator.log").read_text()
+    assert "reached the goal" in log and "run ended at tick 7499 (completed)" in log, log
+    ego = positions(folder, "ego")
+    assert np.hypot(*(ego[-1] - GOAL)) < 3.5, ego[-1]
+    boats = [p.name.split(".")[1] for p in folder.glob("vessel.boat_*.state.csv")]
+    assert len(boats) == 20
+    # hull contact needs the centres within 1.07 m (catamaran) + 2.49 m (monohull, bow)
+    gaps = {b: np.hypot(*(positions(folder, b) - ego).T).min() for b in boats}
+    assert min(gaps.values()) > 3.6, sorted(gaps.items(), key=lambda g: g[1])[:3]
+    # and the boats were in the way: a straight run at 1.5 m/s would have hit one
+    t = np.arange(len(ego)) * 0.01
+    straight = np.stack([np.minimum(1.5 * t, GOAL[0]), np.zeros_like(t)], axis=1)
+    assert min(np.hypot(*(positions(folder, b) - straight).T).min() for b in boats) < 3.6
+
+
+def test_navigate_in_lockstep_records_the_same_bytes_twice(navigated: list[Path]) -> None:
+    first, second = ({p.name: p.read_bytes() for p in sorted(f.glob("*.csv"))} for f in navigated)
+    assert first.keys() == second.keys() and len(first) > 40
+    assert first == second
+    assert (navigated[0] / "run.mcap").read_bytes() == (navigated[1] / "run.mcap").read_bytes()
+
+
+def test_navigate_says_when_no_simulation_answers() -> None:
+    lonely = f"tcp/127.0.0.1:{free_port()}"
+    shown = example("navigate.py", "--listen", lonely, "--timeout", "1", timeout=30)
+    assert shown.returncode != 0 and "Traceback" not in shown.stderr
+    assert shown.stderr.startswith("navigate.py: no simulation"), shown.stderr

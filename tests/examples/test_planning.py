@@ -30,7 +30,7 @@ def hull_points(cx: float, cy: float, radius: float, n: int = 200) -> np.ndarray
     """Returns off a round hull: a ring of points at two heights above the water."""
     a = np.linspace(0, math.tau, n, endpoint=False)
     ring = np.stack([cx + radius * np.cos(a), cy + radius * np.sin(a), np.full(n, 0.4)], 1)
-    return np.concatenate([ring, ring + [0, 0, 0.3]])
+    return np.concatenate([ring, ring + np.array([0.0, 0.0, 0.3])])
 
 
 def yaw_quaternion(yaw: float) -> np.ndarray:

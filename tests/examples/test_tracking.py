@@ -8,7 +8,7 @@ import math
 import numpy as np
 import pytest
 from planning import GridSpec, Planner, cell_grid, choose
-from tracking import Obstacles, Tracker, Tracks, centroids, cell_velocities, clusters
+from tracking import Obstacles, Tracker, Tracks, cell_velocities, centroids, clusters
 
 SPEC = GridSpec()
 
@@ -60,7 +60,7 @@ def test_cells_take_their_objects_velocity_once_it_is_known() -> None:
 def hull_ring(cx: float, cy: float, radius: float, n: int = 80) -> np.ndarray:
     a = np.linspace(0, math.tau, n, endpoint=False)
     ring = np.stack([cx + radius * np.cos(a), cy + radius * np.sin(a), np.full(n, 0.4)], 1)
-    return np.concatenate([ring, ring + [0, 0, 0.3]])
+    return np.concatenate([ring, ring + np.array([0.0, 0.0, 0.3])])
 
 
 def sail(moving: list[tuple[float, float, float, float, float]], seconds: float = 60.0
