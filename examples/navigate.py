@@ -14,6 +14,7 @@ python examples/navigate.py --connect tcp/127.0.0.1:7447 --goal 80 0
 from __future__ import annotations
 
 import math
+import time
 
 import numpy as np
 from common import clear_errors, parser
@@ -44,10 +45,19 @@ class Navigator:
         self.scanned_ns = -1
         self.seen: tuple[np.ndarray, np.ndarray] = (np.empty((0, 2)), np.empty((0, 2)))
         self.arrived_s: float | None = None
+        self.busy_s, self.steps = 0.0, 0  # wall-clock cost of the stack (the log only)
         self.closest_m = math.inf  # nearest occupied cell seen
         self.position = (math.nan, math.nan)
 
     def step(self, obs: Observation) -> Thrust | Twist | None:
+        started = time.perf_counter()
+        try:
+            return self._step(obs)
+        finally:
+            self.busy_s += time.perf_counter() - started
+            self.steps += 1
+
+    def _step(self, obs: Observation) -> Thrust | Twist | None:
         fix, imu, scan = (obs.sensors[n] for n in ("gps", "imu", "lidar"))
         if fix is None or imu is None:
             return None  # the first period: nothing measured yet, keep still
@@ -101,7 +111,8 @@ def main() -> None:
         end = sim.run_lockstep(name, nav.step, vessel=vessel.id, sensors=["gps", "imu", "lidar"])
     arrived = f"arrived at t={nav.arrived_s:.1f} s" if nav.arrived_s is not None else "not arrived"
     print(f"run ended at tick {end.tick} ({end.reason}); {vessel.id} at {nav.where()}, {arrived}, "
-          f"nearest obstacle seen {nav.closest_m:.1f} m")  # fmt: skip
+          f"nearest obstacle seen {nav.closest_m:.1f} m; "
+          f"{1e3 * nav.busy_s / max(nav.steps, 1):.1f} ms a period")  # fmt: skip
 
 
 if __name__ == "__main__":
