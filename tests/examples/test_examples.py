@@ -3,6 +3,7 @@ a real `catabot run` listening on loopback, the example as its own process conne
 
 from __future__ import annotations
 
+import json
 import subprocess
 import sys
 from collections.abc import Iterator
@@ -180,6 +181,8 @@ def test_navigate_reaches_its_goal_through_traffic_without_touching_a_boat(
     assert "reached the goal" in log and "run ended at tick 7499 (completed)" in log, log
     ego = positions(folder, "ego")
     assert np.hypot(*(ego[-1] - GOAL)) < 3.5, ego[-1]
+    rain = np.loadtxt(folder / "sensor.ego.lidar.csv", delimiter=",", skiprows=1, usecols=3)
+    assert rain.min() > 50  # every scan had raindrop returns for the grid to drop
     boats = [p.name.split(".")[1] for p in folder.glob("vessel.boat_*.state.csv")]
     assert len(boats) == 20
     # hull contact needs the centres within 1.07 m (catamaran) + 2.49 m (monohull, bow)
@@ -196,6 +199,34 @@ def test_navigate_in_lockstep_records_the_same_bytes_twice(navigated: list[Path]
     assert first.keys() == second.keys() and len(first) > 40
     assert first == second
     assert (navigated[0] / "run.mcap").read_bytes() == (navigated[1] / "run.mcap").read_bytes()
+
+
+def test_navigate_by_hand_with_thrust_around_a_moored_boat(run: type[Run], tmp_path: Path) -> None:
+    """The navigator started by hand beside `catabot run --listen`, on a thrust controller, a
+    boat holding station on the straight line to its goal."""
+    lidar = {"name": "lidar", "type": "lidar", "rate_hz": 10.0, "params": {
+        "channels": 16, "columns": 360, "vertical_fov_deg": 20.0, "max_range_m": 30.0}}  # fmt: skip
+    scenario = {
+        "name": "by_hand", "seed": 2, "duration_s": 30.0,
+        "vessels": [{"id": "ego", "pose": {"x_m": 0.0, "y_m": 0.0, "yaw_rad": 0.0},
+                     "controller": {"participant": "navigator", "command": "thrust"},
+                     "sensors": [lidar,
+                                 {"name": "gps", "type": "gps", "rate_hz": 10.0},
+                                 {"name": "imu", "type": "imu", "rate_hz": 10.0}]}],
+        "traffic": {"count": 1, "behaviour_mix": {"hold": 1.0},
+                    "boats": [{"index": 0, "x_m": 12.0, "y_m": 0.5, "yaw_rad": 1.57}]},
+    }  # fmt: skip
+    path = tmp_path / "by_hand.json"
+    path.write_text(json.dumps(scenario))
+    sim = run(str(path))
+    shown = example("navigate.py", "--connect", sim.endpoint, "--goal", "24", "0", timeout=120)
+    assert shown.returncode == 0, shown.stderr
+    assert "arrived at t=" in shown.stdout and "(completed)" in shown.stdout, shown.stdout
+    run_dir = sim.finish()
+    ego, boat = positions(run_dir, "ego"), positions(run_dir, "boat_000")
+    assert np.hypot(*(ego - boat).T).min() > 3.6
+    rows = (run_dir / "vessel.ego.cmd.thrust.csv").read_text().splitlines()
+    assert len(rows) == 1 + 300 and rows[0] == "stamp_ns,tick,thrust_0,thrust_1"
 
 
 def test_navigate_says_when_no_simulation_answers() -> None:
