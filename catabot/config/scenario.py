@@ -35,6 +35,7 @@ from catabot.config.environment import CurrentConfig, RainConfig, WindConfig
 from catabot.config.live import SettingChange, check_timeline
 from catabot.config.ros import GATEWAY, RosConfig, check_ros
 from catabot.config.sensors import SENSOR_TYPES
+from catabot.config.task import TaskConfig
 from catabot.config.terrain import TerrainConfig
 from catabot.config.traffic import TrafficConfig
 from catabot.config.waves import WaveConfig
@@ -124,6 +125,9 @@ class VesselConfig(Strict):
     controller: ControllerConfig | None = Field(
         None, description="a lockstep stack outside `catabot run` that commands this vessel"
     )
+    task: TaskConfig | None = Field(
+        None, description="a goal region and/or a route, measured in metrics.json"
+    )
 
     @field_validator("sensors")
     @classmethod
@@ -163,6 +167,9 @@ class RecordingConfig(Strict):
     )
     ppi: StrictBool = Field(True, description="the radar's PPI (the paper's minimap) in dataset/")
     rerun: StrictBool = Field(False, description="run.rrd for the rerun viewer, from run.mcap")
+    encounter_radius_m: float = Field(
+        50.0, gt=0, description="metrics.json: two vessels this close are an encounter (CPA)"
+    )
     export: list[Literal["yolo", "coco", "kitti"]] = Field(
         [], description="datasets converted into export/<format>/ when the run ends"
     )

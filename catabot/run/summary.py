@@ -15,6 +15,7 @@ from collections.abc import Mapping
 from pathlib import Path
 
 from catabot.config.scenario import Scenario
+from catabot.run.metrics_summary import metrics_lines
 
 
 def describe_exit(code: int | None) -> str:
@@ -101,6 +102,8 @@ def summarise(
         f"{ticks} ticks, {sim_s:.2f} s simulated in {wall:.2f} s "
         f"({ticks / max(wall, 1e-9):.0f} ticks/s, real-time factor {rtf:.1f})"
     )
+    for line in metrics_lines(run_dir):
+        print(line)
     for name in sorted(unjoined):
         print(f"  {name}: stopped by catabot run before it joined", file=sys.stderr)
     for name, code in failed.items():

@@ -42,7 +42,8 @@ import dartpy as dart
 import numpy as np
 from numpy.typing import NDArray
 
-from catabot.config.vessel import Hull, VesselModel
+from catabot.config.vessel import VesselModel
+from catabot.world.hulls import hull_probes
 from catabot.world.terrain import Terrain
 from services.physics.hydro import Array
 
@@ -58,25 +59,6 @@ class ContactParams:
     support_probes: int = 4  # e.g. a hull on a rock under its four corners
     damping_ratio: float = 1.0  # of that heave mode: a grounding hull does not bounce
     probe_spacing_m: float = 0.5  # along and across each hull bottom
-
-
-def hull_probes(hull: Hull, spacing_m: float) -> Array:
-    """Contact probe points (K, 3), body frame: a grid on the hull's underside, edges included
-    (a bow corner is what touches a bank first). A cylinder gets three lines at -50, 0, 50
-    degrees around its keel."""
-    cx, cy, cz = hull.center_m
-    n_along = min(33, max(2, math.ceil(hull.length_m / spacing_m) + 1))
-    xs = np.linspace(cx - hull.length_m / 2, cx + hull.length_m / 2, n_along)
-    if hull.shape == "cylinder":
-        angle = np.radians([-50.0, 0.0, 50.0])
-        r = hull.beam_m / 2
-        ys, zs = cy + r * np.sin(angle), cz - r * np.cos(angle)
-    else:
-        n_across = min(9, max(2, math.ceil(hull.beam_m / spacing_m) + 1))
-        ys = np.linspace(cy - hull.beam_m / 2, cy + hull.beam_m / 2, n_across)
-        zs = np.full(n_across, cz - hull.vertical_extent_m / 2)
-    gx, gi = np.meshgrid(xs, np.arange(len(ys)), indexing="ij")
-    return np.stack([gx.ravel(), ys[gi].ravel(), zs[gi].ravel()], axis=1)
 
 
 class Grounding:

@@ -1,73 +1,149 @@
-"""`metrics.json`: navigation figures of every vessel, accumulated tick by tick.
+"""`metrics.json`: navigation figures, accumulated tick by tick from the recorded states.
 
-The paper's simulator records navigation metrics beside the data; these are the ones a
-planner's test needs first: how far each vessel went, how fast, where it ended, and how
-close any two vessels came (the collision margin). Computed from the `BodyStates` batch
-with NumPy, so the cost does not grow with a Python loop over vessels; written with
-`repr` floats and sorted keys so two runs of one seed give the same bytes.
+Computed by the recorder from the `BodyStates` every stack produces, so a stack is measured
+the same way whatever it is. Every vessel (scenario vessels and traffic boats): distance
+travelled, top speed, final position. Each scenario vessel (what a stack drives), against
+everything else: the nearest vessel, buoy and shore it came to (centre to centre; shore:
+the nearest land pixel), its goal and route (`tasks.py`), its thrust impulse, and episodes
+(`episodes.py`): encounters (another vessel within `recording.encounter_radius_m`, with the
+closest point of approach), collisions (plan-view hull boxes within `CONTACT_M`, the
+physics collision shapes; other vessels and buoys) and groundings (`seabed.py`).
+
+Cost: arrays of (scenario vessels x bodies) per tick, no loop over bodies (DESIGN.md §8).
+Written with `repr` floats and sorted keys so two runs of one seed give the same bytes.
 """
 
 from __future__ import annotations
 
-import json
 from pathlib import Path
 
 import numpy as np
 
-from catabot.bus.messages import BodyStates
+from catabot.bus.clock import NS_PER_S
+from catabot.bus.messages import BodyStates, Message
+from catabot.world.hulls import box_gaps, footprints
+from catabot.world.rotations import yaw_of_quaternions
+from catabot.world.world import World
+from services.recorder.episodes import Episodes
+from services.recorder.metrics_json import write_metrics
+from services.recorder.seabed import Seabed
+from services.recorder.tasks import Goals, Routes, Thrust, rowdot
+
+CONTACT_M = 0.05  # hull boxes this close touch (physics keeps contacts a few mm apart)
+EPISODE_GAP_S = 1.0  # a contact that stops for less than this is the same contact
 
 
 class Metrics:
-    def __init__(self, vessel_ids: list[str]) -> None:
-        self.ids = vessel_ids  # the first rows of every batch (buoys come after)
-        n = len(vessel_ids)
+    def __init__(self, world: World) -> None:
+        self.world = world
+        self.ids = [v.id for v in world.vessels]  # the first rows of every batch
+        self.body_ids = list(world.body_ids)
+        subjects = world.bodies[: len(world.scenario.vessels)]
+        self.subjects = len(subjects)
+        n, s = len(self.ids), self.subjects
         self.distance = np.zeros(n)
-        self.max_speed = np.zeros(n)
+        self.max_speed2 = np.zeros(n)  # squared: one sqrt at the end
         self.last: np.ndarray | None = None
-        self.closest = (np.inf, "", "", 0)  # metres, vessel a, vessel b, stamp_ns
         self.stamp_ns = 0
+        self.skipped = 0  # state batches with a non-finite position, left out
+        self.offset, self.half = footprints([b.model for b in world.bodies])
+        self.reach = np.hypot(*self.offset.T) + np.hypot(*self.half.T)  # the box within it
+        self.nearest = {kind: _Nearest(s) for kind in ("vessel", "buoy", "shore")}
+        gap = round(EPISODE_GAP_S * NS_PER_S)
+        total = len(self.body_ids)
+        self.encounters = Episodes((s, n), gap_ns=0)
+        self.collisions = Episodes((s, total), gap_ns=gap)
+        self.groundings = Episodes((s,), gap_ns=gap)
+        self.radius = world.scenario.recording.encounter_radius_m
+        self.pair_ok = np.ones((s, total), dtype=bool)  # each pair once, never a body itself
+        self.pair_ok[:, :s] = np.triu(np.ones((s, s), dtype=bool), k=1)
+        self.pair_vessels = self.pair_ok[:, :n]
+        self.itself = (np.arange(s), np.arange(s))
+        self.no_pairs = np.zeros((s, total), dtype=bool)
+        self.reach_sum = self.reach[:s, None] + self.reach[None, :] + CONTACT_M
+        tasks = [v.task for v in world.scenario.vessels]
+        self.goals, self.routes = Goals(tasks), Routes(tasks)
+        self.thrust = Thrust(subjects, world.scenario.dt_ns)
+        self.seabed = Seabed(world.terrain, subjects) if world.terrain is not None else None
+        keys = world.keys
+        self.command_keys = {keys.cmd_thrust(b.id): b.id for b in subjects}
+        self.command_keys |= {keys.cmd_twist(b.id): b.id for b in subjects}
+
+    def command(self, key: str, msg: Message) -> None:
+        """A command the recorder received: the thrust in force from now on (`tasks.Thrust`)."""
+        vessel = self.command_keys.get(key)
+        if vessel is not None:
+            self.thrust.command(vessel, msg)
 
     def add(self, batch: BodyStates) -> None:
-        n = len(self.ids)
-        pos = np.asarray(batch.position[:n])
-        if self.last is not None:
-            self.distance += np.linalg.norm(pos - self.last, axis=1)
-        self.last = pos.copy()
-        speed = np.linalg.norm(np.asarray(batch.linear_velocity[:n]), axis=1)
-        self.max_speed = np.maximum(self.max_speed, speed)
-        self.stamp_ns = batch.stamp_ns
-        self._closest(pos, batch.stamp_ns)
-
-    def _closest(self, pos: np.ndarray, stamp_ns: int) -> None:
-        if len(pos) < 2:
+        n, s, stamp = len(self.ids), self.subjects, batch.stamp_ns
+        everything = np.asarray(batch.position)
+        if not np.isfinite(everything).all():  # a diverged body: no figure can use it
+            self.skipped += 1
             return
-        dx = np.subtract.outer(pos[:, 0], pos[:, 0])
-        dy = np.subtract.outer(pos[:, 1], pos[:, 1])
-        gap2 = np.multiply(dx, dx, out=dx)
-        gap2 += np.multiply(dy, dy, out=dy)  # squared: one sqrt, of the minimum only
-        np.fill_diagonal(gap2, np.inf)
-        i, j = np.unravel_index(int(np.argmin(gap2)), gap2.shape)
-        gap = float(np.hypot(pos[i, 0] - pos[j, 0], pos[i, 1] - pos[j, 1]))
-        if gap < self.closest[0]:
-            a, b = sorted((self.ids[i], self.ids[j]))
-            self.closest = (gap, a, b, stamp_ns)
+        pos = everything[:n]
+        if self.last is not None:
+            step = pos - self.last
+            self.distance += np.sqrt(rowdot(step, step))
+        self.last = pos.copy()
+        vel = np.asarray(batch.linear_velocity[:n])
+        np.maximum(self.max_speed2, rowdot(vel, vel), out=self.max_speed2)
+        self.stamp_ns = stamp
+        gap = np.hypot(
+            everything[None, :, 0] - pos[:s, None, 0], everything[None, :, 1] - pos[:s, None, 1]
+        )
+        gap[self.itself] = np.inf
+        vessels = gap[:, :n]
+        self.nearest["vessel"].add(vessels, stamp)
+        self.nearest["buoy"].add(gap[:, n:], stamp)
+        self.encounters.update(self.pair_vessels & (vessels <= self.radius), stamp, vessels)
+        self._collisions(batch, gap, stamp)
+        if self.seabed is not None:
+            shore, shallow = self.seabed.check(pos[:s])
+            if shore is not None:
+                self.nearest["shore"].add(shore[:, None], stamp)
+            quat = np.asarray(batch.orientation[:s])
+            self.groundings.update(self.seabed.aground(pos[:s], quat, shallow), stamp)
+        self.goals.add(pos, self.distance, stamp)
+        self.routes.add(pos)
+        self.thrust.add(stamp)
+
+    def _collisions(self, batch: BodyStates, gap: np.ndarray, stamp: int) -> None:
+        """Hull boxes of the pairs whose bounding circles are within reach, tested exactly."""
+        near = self.pair_ok & (gap <= self.reach_sum)
+        touching = self.no_pairs
+        if near.any():
+            touching = np.zeros_like(near)
+            a, b = np.nonzero(near)
+            quat = np.asarray(batch.orientation)
+            rows = np.unique(np.concatenate([a, b]))
+            heading = np.zeros(len(self.body_ids))
+            heading[rows] = yaw_of_quaternions(quat[rows])
+            c, h = np.cos(heading[rows]), np.sin(heading[rows])
+            centre = np.asarray(batch.position)[:, :2].copy()
+            ox, oy = self.offset[rows].T  # the box centre, body frame, turned to the world's
+            centre[rows] += np.stack([c * ox - h * oy, h * ox + c * oy], axis=1)
+            touching[a, b] = box_gaps(centre, heading, self.half, a, b) <= CONTACT_M
+        self.collisions.update(touching, stamp)
 
     def write(self, path: Path) -> None:
-        vessels = {
-            vid: {
-                "distance_m": float(self.distance[k]),
-                "max_speed_mps": float(self.max_speed[k]),
-                "final_position_m": [float(v) for v in self.last[k]]
-                if self.last is not None
-                else None,
-            }
-            for k, vid in enumerate(self.ids)
-        }
-        gap, a, b, when = self.closest
-        closest = None if a == "" else {"distance_m": gap, "vessels": [a, b], "stamp_ns": when}
-        record = {
-            "sim_time_s": self.stamp_ns / 1e9,
-            "vessels": vessels,
-            "closest_approach": closest,
-        }
-        path.write_text(json.dumps(record, indent=2, sort_keys=True) + "\n")
+        write_metrics(self, path)
+
+
+class _Nearest:
+    """Per scenario vessel: the least distance to anything of one kind, what and when."""
+
+    def __init__(self, s: int) -> None:
+        self.distance = np.full(s, np.inf)
+        self.what = np.full(s, -1, dtype=np.intp)
+        self.at_ns = np.zeros(s, dtype=np.int64)
+
+    def add(self, gap: np.ndarray, stamp_ns: int) -> None:
+        if gap.shape[1] == 0:
+            return
+        least = np.minimum.reduce(gap, axis=1)
+        better = least < self.distance
+        if better.any():  # which body, only when the record improves
+            self.distance[better] = least[better]
+            self.what[better] = np.argmin(gap[better], axis=1)
+            self.at_ns[better] = stamp_ns

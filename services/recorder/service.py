@@ -42,7 +42,7 @@ class Recorder:
         self.dataset = Dataset(ctx.run_dir / "dataset", world)
         streams = [*world.streams.lockstep(), *world.streams.commands]
         self.batches = BatchFormatter(convert)
-        self.metrics = Metrics([v.id for v in world.vessels])
+        self.metrics = Metrics(world)
         self.run_dir = ctx.run_dir
         self._flushed_at = 0.0
         self.changes_stream = self.keys.relative(self.keys.config_changes())
@@ -58,6 +58,7 @@ class Recorder:
                 elif isinstance(msg, TwistBatch):
                     self._write_block(stream, msg, self.batches.twists)
                 else:
+                    self.metrics.command(key, msg)  # the thrust in force, for its impulse
                     self._write(stream, _stamped(msg, tick))
         for change in changes_of(tick.settings):  # what took effect at this tick: an input
             record = SettingsChange(tick.tick, tick.stamp_ns, change.key, change.value)

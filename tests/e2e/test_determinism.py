@@ -24,6 +24,11 @@ def _scenario(tmp: Path) -> Path:
         {"name": "imu", "type": "imu", "rate_hz": 50.0},
         {"name": "gps", "type": "gps", "rate_hz": 5.0},
     ]
+    data["vessels"][0]["task"] = {  # metrics.json's goal, route and encounter figures too
+        "goal": {"x_m": 3.0, "y_m": 0.0, "radius_m": 1.0},
+        "route": [[0.0, 0.0], [10.0, 2.0]],
+    }
+    data["buoys"] = [{"id": "mark", "x_m": 8.0, "y_m": 3.0}]
     data["vessels"].append(
         {
             "id": "other",
@@ -39,6 +44,7 @@ def test_two_runs_record_identical_bytes(tmp_path: Path) -> None:
     first = _record(tmp_path, scenario, "a")
     second = _record(tmp_path, scenario, "b")
     assert set(first) >= {"vessel.ego.state.csv", "sensor.ego.imu.csv", "run.mcap"}
+    assert b'"encounters": [' in first["metrics.json"] and b"cpa_m" in first["metrics.json"]
     assert first == second
 
 

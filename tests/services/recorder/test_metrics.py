@@ -1,44 +1,182 @@
-"""metrics.json: distance, speed, final position and closest approach from the state batches."""
+"""metrics.json from synthetic state batches: every figure against its analytic value."""
 
 from __future__ import annotations
 
 import json
+import math
 from pathlib import Path
+from typing import Any
 
 import numpy as np
+import pytest
 
-from catabot.bus.messages import BodyStates
+from catabot.bus.messages import BodyStates, ThrustCmd, TwistCmd
+from catabot.config.load import parse_scenario
+from catabot.world.world import World
 from services.recorder.metrics import Metrics
 
+DT = 10_000_000
 
-def _batch(tick: int, xs: list[float], speed: float) -> BodyStates:
-    n = len(xs)
-    pos = np.array([[x, 10.0 * k, 0.0] for k, x in enumerate(xs)])
-    vel = np.tile([speed, 0.0, 0.0], (n, 1))
-    zero, quat = np.zeros((n, 3)), np.tile([0.0, 0.0, 0.0, 1.0], (n, 1))
-    ids = (*(f"v{k}" for k in range(n - 1)), "buoy")
-    return BodyStates(tick, (tick + 1) * 10, ids, pos, quat, vel, zero, zero, zero)
+
+def _world(**top: Any) -> World:
+    data = {"name": "m", "vessels": [{"id": "v0", "pose": {"x_m": 0.0, "y_m": 0.0}},
+                                     {"id": "v1", "pose": {"x_m": 0.0, "y_m": 10.0}}]}  # fmt: skip
+    data |= top
+    return World.resolve(parse_scenario(data))
+
+
+def _states(world: World, tick: int, xy: list[tuple[float, float]], **kw: Any) -> BodyStates:
+    n = len(world.body_ids)
+    pos = np.zeros((n, 3))
+    pos[:, :2] = xy
+    yaw = np.asarray(kw.get("yaw", np.zeros(n)))
+    quat = np.zeros((n, 4))
+    quat[:, 2], quat[:, 3] = np.sin(yaw / 2), np.cos(yaw / 2)
+    vel = np.tile([kw.get("speed", 0.0), 0.0, 0.0], (n, 1))
+    z = np.zeros((n, 3))
+    return BodyStates(tick, (tick + 1) * DT, world.body_ids, pos, quat, vel, z, z, z)
+
+
+def _record(metrics: Metrics, tmp: Path) -> dict[str, Any]:
+    metrics.write(tmp / "metrics.json")
+    out: dict[str, Any] = json.loads((tmp / "metrics.json").read_text())
+    return out
 
 
 def test_distance_speed_and_closest_approach(tmp_path: Path) -> None:
-    metrics = Metrics(["v0", "v1"])  # the buoy row after them is ignored
+    world = _world()
+    metrics = Metrics(world)
     for tick in range(11):
-        metrics.add(_batch(tick, [0.5 * tick, 0.0, 1000.0], speed=0.1 * tick))
-    metrics.write(tmp_path / "metrics.json")
-    record = json.loads((tmp_path / "metrics.json").read_text())
+        metrics.add(_states(world, tick, [(0.5 * tick, 0.0), (0.0, 10.0)], speed=0.1 * tick))
+    record = _record(metrics, tmp_path)
     v0 = record["vessels"]["v0"]
     assert v0["distance_m"] == 5.0 and v0["final_position_m"] == [5.0, 0.0, 0.0]
     assert abs(v0["max_speed_mps"] - 1.0) < 1e-12
-    assert record["closest_approach"] == {
-        "distance_m": 10.0,
-        "vessels": ["v0", "v1"],
-        "stamp_ns": 10,
+    assert record["closest_approach"] == {"distance_m": 10.0, "vessels": ["v0", "v1"],
+                                          "stamp_ns": DT}  # fmt: skip
+    assert v0["nearest_vessel"] == {"distance_m": 10.0, "id": "v1", "t_s": 0.01}
+    assert v0["nearest_buoy"] is None and v0["nearest_shore"] is None
+    assert record["sim_time_s"] == 0.11
+
+
+def test_goal_time_path_length_and_cross_track(tmp_path: Path) -> None:
+    task = {
+        "goal": {"x_m": 10.0, "y_m": 0.0, "radius_m": 2.0},
+        "route": [[0, -1], [20, -1], [20, 20]],
     }
-    assert record["sim_time_s"] == 110e-9
+    world = _world(vessels=[{"id": "v0", "pose": {"x_m": 0.0, "y_m": 0.0}, "task": task}])
+    metrics = Metrics(world)
+    for tick in range(100):  # 0.1 m a tick along y = 0: 1 m off the route's first leg
+        metrics.add(_states(world, tick, [(0.1 * tick, 0.0)]))
+    v0 = _record(metrics, tmp_path)["vessels"]["v0"]
+    # inside the goal from x = 8 m: tick 80, stamped at the end of the tick
+    assert v0["goal"] == {
+        "reached": True,
+        "time_to_goal_s": 0.81,
+        "path_length_m": pytest.approx(8.0),
+        "final_distance_m": pytest.approx(0.1),
+    }
+    assert v0["route"]["max_cross_track_m"] == pytest.approx(1.0)
+    assert v0["route"]["rms_cross_track_m"] == pytest.approx(1.0)
 
 
-def test_single_vessel_has_no_closest_approach(tmp_path: Path) -> None:
-    metrics = Metrics(["v0"])
-    metrics.add(_batch(0, [0.0, 5.0], speed=0.0))
-    metrics.write(tmp_path / "m.json")
-    assert json.loads((tmp_path / "m.json").read_text())["closest_approach"] is None
+def test_cross_track_of_a_corner_and_an_unreached_goal(tmp_path: Path) -> None:
+    task = {
+        "goal": {"x_m": 50.0, "y_m": 50.0, "radius_m": 1.0},
+        "route": [[0, 0], [10, 0], [10, 10]],
+    }
+    world = _world(vessels=[{"id": "v0", "task": task, "pose": {"x_m": 0.0, "y_m": 0.0}}])
+    metrics = Metrics(world)
+    points = [(5.0, 3.0), (13.0, 5.0), (14.0, -3.0)]  # 3 m off each leg, 5 m off the corner
+    for tick, p in enumerate(points):
+        metrics.add(_states(world, tick, [p]))
+    v0 = _record(metrics, tmp_path)["vessels"]["v0"]
+    assert v0["route"]["max_cross_track_m"] == pytest.approx(5.0)
+    assert v0["route"]["rms_cross_track_m"] == pytest.approx(math.sqrt((9 + 9 + 25) / 3))
+    assert v0["goal"]["reached"] is False and v0["goal"]["time_to_goal_s"] is None
+    assert v0["goal"]["final_distance_m"] == pytest.approx(math.hypot(36.0, 53.0))
+
+
+def test_encounter_cpa_and_collision_of_a_head_on_pass(tmp_path: Path) -> None:
+    """v1 comes head on at 1 m/tick, 0.5 m to the side: CPA 0.5 m when x meet; the hull
+    boxes (1.9 m long) touch from a centre gap of 1.95 m on, and part after they pass."""
+    world = _world(recording={"encounter_radius_m": 20.0})
+    metrics = Metrics(world)
+    yaw = np.array([0.0, math.pi])
+    for tick in range(61):
+        metrics.add(_states(world, tick, [(0.0, 0.0), (30.0 - tick, 0.5)], yaw=yaw))
+    record = _record(metrics, tmp_path)
+    (enc,) = record["encounters"]
+    assert enc["vessels"] == ["v0", "v1"] and enc["cpa_m"] == pytest.approx(0.5)
+    assert enc["cpa_s"] == pytest.approx(0.31)  # tick 30
+    # within 20 m from x = 19 (tick 11) to x = -19 (tick 49): 20.006 m at x = +-20
+    assert enc["start_s"] == pytest.approx(0.12) and enc["end_s"] == pytest.approx(0.50)
+    (hit,) = record["collisions"]  # ticks 29..31 touch (gaps 1, 0, 1 m): one episode,
+    assert hit == {"bodies": ["v0", "v1"], "start_s": 0.30, "end_s": None}  # apart < 1 s
+    assert record["vessels"]["v0"]["collisions"] == 1 == record["vessels"]["v1"]["collisions"]
+
+
+def test_rotated_hulls_collide_by_their_boxes(tmp_path: Path) -> None:
+    """Side by side 1.2 m apart the beams (1.04 m) clear; turned across, the length reaches."""
+    world = _world()
+    for yaw, touching in ((0.0, False), (math.pi / 2, True)):
+        metrics = Metrics(world)
+        metrics.add(_states(world, 0, [(0.0, 0.0), (0.0, 1.2)], yaw=np.array([yaw, 0.0])))
+        assert bool(_record(metrics, tmp_path)["collisions"]) is touching
+
+
+def test_buoys_are_nearest_and_can_be_hit(tmp_path: Path) -> None:
+    buoys = [{"id": "far", "x_m": 50.0, "y_m": 0.0}, {"id": "near", "x_m": 5.0, "y_m": 0.0}]
+    world = _world(vessels=[{"id": "v0", "pose": {"x_m": 0.0, "y_m": 0.0}}], buoys=buoys)
+    metrics = Metrics(world)
+    for tick in range(5):
+        metrics.add(_states(world, tick, [(float(tick), 0.0), (50.0, 0.0), (5.0, 0.0)]))
+    record = _record(metrics, tmp_path)
+    assert record["vessels"]["v0"]["nearest_buoy"] == {"distance_m": 1.0, "id": "near", "t_s": 0.05}
+    assert [c["bodies"] for c in record["collisions"]] == [["v0", "near"]]
+    assert record["collisions"][0]["start_s"] == 0.05  # 1.0 m <= 0.95 + 0.22 + 0.05
+
+
+def test_thrust_impulse_of_script_and_bus_commands(tmp_path: Path) -> None:
+    script = [{"t_s": 0.0, "thrust": [0.5, -1.0]}, {"t_s": 0.1, "thrust": [1.0, 1.0]}]
+    world = _world(vessels=[{"id": "v0", "script": script, "pose": {"x_m": 0.0, "y_m": 0.0}}])
+    metrics = Metrics(world)
+    key = world.keys.cmd_thrust("v0")
+    for tick in range(30):
+        if tick == 20:
+            metrics.command(key, ThrustCmd((0.0, 0.0)))
+        if tick == 25:
+            metrics.command(world.keys.cmd_twist("v0"), TwistCmd(1.0, 0.0))
+        metrics.add(_states(world, tick, [(0.0, 0.0)]))
+    v0 = _record(metrics, tmp_path)["vessels"]["v0"]
+    # 10 ticks at 0.5*36 + 1*28 = 46 N, 10 ticks at 72 N, then nothing; then 5 ticks unknown
+    assert v0["thrust_impulse_Ns"] == pytest.approx(0.1 * 46 + 0.1 * 72)
+    assert v0["thrust_unknown_s"] == pytest.approx(0.05)
+
+
+def test_same_states_same_bytes(tmp_path: Path) -> None:
+    world = _world(buoys=[{"id": "b", "x_m": 3.0, "y_m": 3.0}])
+    outputs = []
+    for name in ("a.json", "b.json"):
+        metrics = Metrics(world)
+        for tick in range(50):
+            metrics.add(
+                _states(world, tick, [(0.1 * tick, 0.0), (5.0 - 0.1 * tick, 1.0), (3.0, 3.0)])
+            )
+        metrics.write(tmp_path / name)
+        outputs.append((tmp_path / name).read_bytes())
+    assert outputs[0] == outputs[1]
+
+
+def test_a_non_finite_batch_is_left_out(tmp_path: Path) -> None:
+    world = _world()
+    metrics = Metrics(world)
+    metrics.add(_states(world, 0, [(0.0, 0.0), (0.0, 10.0)], speed=1.0))
+    metrics.add(_states(world, 1, [(math.nan, 0.0), (0.0, 10.0)], speed=9.0))
+    metrics.add(_states(world, 2, [(1.0, 0.0), (0.0, 10.0)], speed=1.0))
+    metrics.write(tmp_path / "metrics.json")
+    text = (tmp_path / "metrics.json").read_text()
+    record = json.loads(text)
+    assert "NaN" not in text and record["states_skipped"] == 1
+    assert record["vessels"]["v0"]["distance_m"] == 1.0
+    assert record["vessels"]["v0"]["max_speed_mps"] == 1.0

@@ -1,0 +1,57 @@
+"""The navigation metrics in `catabot run`'s summary: one line per scenario vessel.
+
+Read from the run folder's `metrics.json` (the recorder writes it as the run ends); a run
+without one (no recorder, or a recorder that failed) prints nothing here.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import json
+from pathlib import Path
+from typing import Any
+
+
+def metrics_lines(run_dir: Path) -> list[str]:
+    """`  <vessel>: goal ..., nearest ..., collisions ..., thrust impulse ...` per scenario
+    vessel (the vessels measured against everything else: they have `nearest_vessel`)."""
+    record: Any = None
+    with contextlib.suppress(OSError, ValueError):
+        record = json.loads((run_dir / "metrics.json").read_text())
+    if not isinstance(record, dict) or not isinstance(record.get("vessels"), dict):
+        return []
+    lines = []
+    for vid, m in record["vessels"].items():
+        if isinstance(m, dict) and "nearest_vessel" in m:
+            lines.append(f"  {vid}: " + "; ".join(filter(None, _parts(m))))
+    return lines
+
+
+def _parts(m: dict[str, Any]) -> list[str]:
+    goal, route = m.get("goal"), m.get("route")
+    near = [
+        f"{kind} {n['distance_m']:.2f} m" + (f" ({n['id']})" if "id" in n else "")
+        for kind in ("vessel", "buoy", "shore")
+        if (n := m.get(f"nearest_{kind}"))
+    ]
+    xte = ""
+    if isinstance(route, dict):
+        top, rms = route["max_cross_track_m"], route["rms_cross_track_m"]
+        xte = f"cross-track max {top:.2f} m, RMS {rms:.2f} m"
+    impulse = f"thrust impulse {m['thrust_impulse_Ns']:.0f} N s"
+    if m.get("thrust_unknown_s"):
+        impulse += f" (+{m['thrust_unknown_s']:.1f} s under velocity control)"
+    return [
+        _goal(goal) if goal else "",
+        xte,
+        "nearest " + ", ".join(near) if near else "",
+        f"collisions {m['collisions']}, groundings {m['groundings']}",
+        impulse,
+    ]  # fmt: skip
+
+
+def _goal(goal: dict[str, Any]) -> str:
+    if goal.get("reached"):
+        return f"goal reached at {goal['time_to_goal_s']:.2f} s ({goal['path_length_m']:.1f} m)"
+    left = goal.get("final_distance_m")
+    return "goal not reached" + (f" ({left:.1f} m short)" if left is not None else "")
