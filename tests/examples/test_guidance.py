@@ -6,7 +6,16 @@ import math
 
 import numpy as np
 import pytest
-from guidance import Catamaran, LocalFrame, line_of_sight, next_leg, steer, wrap
+from guidance import (
+    Catamaran,
+    LocalFrame,
+    goal_of,
+    line_of_sight,
+    next_leg,
+    route_of,
+    steer,
+    wrap,
+)
 
 from catabot.world.geo import EnuFrame
 
@@ -79,3 +88,21 @@ def test_catamaran_thrust_balances_its_damping() -> None:
     port, starboard = boat.thrust(0.5, 0.2, 0.0)  # turning too slowly: more difference
     assert starboard - port > (80 * 0.2 + 15 * 0.04) / (0.4 * 36)
     assert boat.thrust(5.0, 0.0, 0.0) == [1.0, 1.0]
+
+
+def test_goal_and_route_come_from_the_flags_or_the_scenarios_task() -> None:
+    scenario = {"vessels": [{"id": "ego", "task": {"goal": {"x_m": 9, "y_m": -2, "radius_m": 3},
+                                                   "route": [[0, 0], [5, 0], [5, 5]]}},
+                            {"id": "other"}]}  # fmt: skip
+    assert goal_of(None, scenario, "ego") == (9.0, -2.0)
+    assert goal_of([1.0, 2.0], scenario, "ego") == (1.0, 2.0)
+    assert route_of(None, scenario, "ego") == [(0.0, 0.0), (5.0, 0.0), (5.0, 5.0)]
+    assert route_of([0, 0, 3, 4], scenario, "other") == [(0.0, 0.0), (3.0, 4.0)]
+    with pytest.raises(SystemExit, match="no goal: give --goal X Y or a task"):
+        goal_of(None, scenario, "other")
+    with pytest.raises(SystemExit, match="no path: give --waypoints"):
+        route_of(None, scenario, "other")
+    with pytest.raises(SystemExit, match="pairs X Y, at least two"):
+        route_of([0, 0, 3], scenario, "ego")
+    with pytest.raises(SystemExit, match="repeats the point"):
+        route_of([0, 0, 0, 0, 1, 1], scenario, "ego")
