@@ -14,9 +14,7 @@ import math
 from common import clear_errors, parser
 from guidance import Catamaran, LocalFrame, line_of_sight, next_leg, route_of, steer, wrap, yaw_of
 
-from catabot.bus.messages import End
-from catabot.client import Client, Thrust, Twist
-from catabot.client.lockstep import Observation
+from catabot.client import Client, End, Observation, Thrust, Twist
 
 
 class Follower:

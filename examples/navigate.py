@@ -22,9 +22,7 @@ from guidance import Catamaran, LocalFrame, goal_of, yaw_of
 from planning import GridSpec, Planner, choose, reflectivity, world_offsets
 from tracking import Obstacles, Tracker
 
-from catabot.client import Client, Thrust, Twist
-from catabot.client.info import SensorInfo
-from catabot.client.lockstep import Observation
+from catabot.client import Client, Observation, SensorInfo, Thrust, Twist
 
 
 class Navigator:

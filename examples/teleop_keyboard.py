@@ -20,10 +20,16 @@ from common import clear_errors, parser
 from guidance import yaw_of
 from PIL import Image
 
-from catabot.bus.messages import CameraFrame, VesselState
-from catabot.client import Client, Thrust
-from catabot.client.errors import ClientError, NoData, RunEnded
-from catabot.client.vessel import Vessel
+from catabot.client import (
+    CameraFrame,
+    Client,
+    ClientError,
+    NoData,
+    RunEnded,
+    Thrust,
+    Vessel,
+    VesselState,
+)
 
 STEP = 0.1  # thrust per key press, of full (-1..1)
 KEYS = {"r": (0, STEP), "f": (0, -STEP), "u": (1, STEP), "j": (1, -STEP)}
