@@ -85,6 +85,9 @@ def main() -> None:
         frame, scenario = LocalFrame.of_scenario(sim.info.scenario), sim.info.scenario
         path = route_of(args.waypoints, scenario, vessel.id)
         kind = control.command if control is not None else args.command
+        if kind == "thrust" and vessel.model != "catabot":
+            raise SystemExit(f"follow_waypoints.py mixes thrust for the catabot model only "
+                             f"({vessel.id!r} is a {vessel.model!r}): use twist")  # fmt: skip
         follower = Follower(frame, path, kind, args.speed, args.lookahead, args.accept)
         end: End | None
         if control is not None:

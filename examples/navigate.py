@@ -34,11 +34,8 @@ class Navigator:
         self.frame, self.goal, self.kind = frame, np.array(goal), kind
         self.mount = np.array(lidar.mount_xyz), np.array(lidar.mount_rpy)
         self.period_s, self.tolerance_m = period_s, tolerance_m
-        self.obstacles, self.plan, self.boat = (
-            Obstacles(GridSpec(), Tracker()),
-            Planner(),
-            Catamaran(),
-        )
+        self.obstacles = Obstacles(GridSpec(), Tracker())
+        self.plan, self.boat = Planner(), Catamaran()
         self.surge = self.yaw_rate = 0.0
         self.scanned_ns = -1
         self.seen: tuple[np.ndarray, np.ndarray] = (np.empty((0, 2)), np.empty((0, 2)))
@@ -101,6 +98,9 @@ def main() -> None:
         lidar = vessel.sensor("lidar")
         vessel.sensor("gps"), vessel.sensor("imu")  # UnknownSensor now rather than later
         scenario, control = sim.info.scenario, vessel.controller
+        if control.command == "thrust" and vessel.model != "catabot":
+            raise SystemExit(f"navigate.py mixes thrust for the catabot model only "
+                             f"({vessel.id!r} is a {vessel.model!r}): use twist")  # fmt: skip
         nav = Navigator(
             LocalFrame.of_scenario(scenario), goal_of(args.goal, scenario, vessel.id), lidar,
             control.command, control.period_ticks * sim.info.dt_ns / 1e9, args.tolerance,
