@@ -136,8 +136,15 @@ def test_follow_waypoints_in_lockstep_with_thrust(run: type[Run]) -> None:
     assert len((run_dir / "vessel.ego.cmd.thrust.csv").read_text().splitlines()) == 1 + 600
 
 
-def test_follow_waypoints_free_running_beside_a_run(run: type[Run]) -> None:
-    sim = run("default", "--duration", "20", "--realtime", "2")
+def test_follow_waypoints_free_running_beside_a_run(run: type[Run], tmp_path: Path) -> None:
+    """Free-running (no controller): paced at 4x the wall clock, the vessel still until the
+    follower's first twist, however long it takes to connect on a loaded machine."""
+    scenario = {"name": "free", "duration_s": 40.0, "clock": {"realtime_factor": 4.0},
+                "vessels": [{"id": "ego", "sensors": [
+                    {"name": "gps", "type": "gps", "rate_hz": 10.0},
+                    {"name": "imu", "type": "imu", "rate_hz": 10.0}]}]}  # fmt: skip
+    (tmp_path / "free.json").write_text(json.dumps(scenario))
+    sim = run(str(tmp_path / "free.json"))
     shown = example("follow_waypoints.py", "--connect", sim.endpoint, "--waypoints", "0", "0",
                     "12", "0", "--speed", "1.0", "--command", "twist")  # fmt: skip
     assert shown.returncode == 0, shown.stderr
