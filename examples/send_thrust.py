@@ -7,10 +7,9 @@ python examples/send_thrust.py --connect tcp/127.0.0.1:7447 --thrust 0.5 0.9
 import time
 
 import zenoh
-from common import parser, session
+from common import keys, parser, session
 
 from catabot.bus import codec
-from catabot.bus.keys import Keys
 from catabot.bus.messages import ThrustCmd
 
 
@@ -30,10 +29,10 @@ def main() -> None:
     p.add_argument("--repeat", type=int, default=10, help="send this many times, 0.1 s apart")
     p.add_argument("--wait", type=float, default=10.0, help="seconds to wait for the simulation")
     args = p.parse_args()
-    keys = Keys(args.world)
+    at = keys(args)
     with session(args) as s:
-        pub = s.declare_publisher(keys.cmd_thrust(args.vessel))
-        states = s.declare_subscriber(keys.vessel_state(args.vessel), zenoh.handlers.RingChannel(1))
+        pub = s.declare_publisher(at.cmd_thrust(args.vessel))
+        states = s.declare_subscriber(at.vessel_state(args.vessel), zenoh.handlers.RingChannel(1))
         if not ticking(states, timeout_s=args.wait):  # then every service of the run is listening
             raise SystemExit(f"no simulation subscribes to {pub.key_expr}: is it running?")
         states.undeclare()

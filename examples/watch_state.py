@@ -5,10 +5,9 @@ python examples/watch_state.py --connect tcp/127.0.0.1:7447 --vessel ego --count
 """
 
 import zenoh
-from common import parser, session
+from common import keys, parser, session
 
 from catabot.bus import codec
-from catabot.bus.keys import Keys
 from catabot.bus.messages import VesselState
 
 
@@ -25,7 +24,7 @@ def main() -> None:
     args = p.parse_args()
     with session(args) as s:
         sub = s.declare_subscriber(
-            Keys(args.world).vessel_state(args.vessel), zenoh.handlers.RingChannel(256)
+            keys(args).vessel_state(args.vessel), zenoh.handlers.RingChannel(256)
         )
         shown = 0
         for n, sample in enumerate(sub):

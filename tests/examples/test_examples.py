@@ -3,11 +3,13 @@ a real `catabot run` listening on loopback, the example as its own process conne
 
 from __future__ import annotations
 
+import json
 import subprocess
 import sys
 from collections.abc import Iterator
 from pathlib import Path
 
+import numpy as np
 import pytest
 
 from catabot.bus.session import free_port
@@ -57,12 +59,20 @@ def run(tmp_path: Path) -> Iterator[type[Run]]:
             r.proc.wait()
 
 
+HELPERS = {"common.py", "guidance.py", "planning.py", "tracking.py"}  # shared, no main()
+
+
 def test_every_example_has_a_main_and_is_checked_here() -> None:
-    source = Path(__file__).read_text()
+    source = "".join(p.read_text() for p in Path(__file__).parent.glob("test_*.py"))
     for path in sorted(EXAMPLES.glob("*.py")):
-        if path.name != "common.py":
+        if path.name not in HELPERS:
             assert 'if __name__ == "__main__":\n    main()' in path.read_text(), path.name
             assert f'"{path.name}"' in source, f"{path.name} has no test here"
+        else:
+            assert (
+                f"test_{path.stem}.py" in {p.name for p in Path(__file__).parent.iterdir()}
+                or path.name == "common.py"
+            ), f"{path.name} has no unit tests"
 
 
 def test_watch_state_prints_the_vessel_moving(run: type[Run]) -> None:
@@ -111,3 +121,126 @@ def test_lockstep_stack_reaches_its_goal_and_records_the_same_bytes_twice(
     commands = recorded[0]["vessel.ego.cmd.thrust.csv"].decode().splitlines()
     assert len(commands) == 1 + 300  # 10 Hz for 30 s, each tagged with its tick
     assert [c.split(",")[1] for c in commands[1:4]] == ["0", "10", "20"]
+
+
+def test_follow_waypoints_in_lockstep_with_thrust(run: type[Run]) -> None:
+    """The scenario starts the follower itself (controller.program), in current and wind."""
+    run_dir = run("examples/follow_waypoints.json").finish()
+    log = (run_dir / "log" / "follower.log").read_text()
+    assert "path done" in log and "run ended at tick 5999 (completed)" in log, log
+    summary = log.splitlines()[-1]
+    worst = float(summary.split("max ")[1].split(" m")[0])
+    assert worst < 4.0, summary  # from GPS fixes, against the current leg: worst at a corner
+    route = json.loads((run_dir / "metrics.json").read_text())["vessels"]["ego"]["route"]
+    assert route["max_cross_track_m"] < 2.0 and route["rms_cross_track_m"] < 1.0, route
+    assert len((run_dir / "vessel.ego.cmd.thrust.csv").read_text().splitlines()) == 1 + 600
+
+
+def test_follow_waypoints_free_running_beside_a_run(run: type[Run], tmp_path: Path) -> None:
+    """Free-running (no controller): paced at 4x the wall clock, the vessel still until the
+    follower's first twist, however long it takes to connect on a loaded machine."""
+    scenario = {"name": "free", "duration_s": 40.0, "clock": {"realtime_factor": 4.0},
+                "vessels": [{"id": "ego", "sensors": [
+                    {"name": "gps", "type": "gps", "rate_hz": 10.0},
+                    {"name": "imu", "type": "imu", "rate_hz": 10.0}]}]}  # fmt: skip
+    (tmp_path / "free.json").write_text(json.dumps(scenario))
+    sim = run(str(tmp_path / "free.json"))
+    shown = example("follow_waypoints.py", "--connect", sim.endpoint, "--waypoints", "0", "0",
+                    "12", "0", "--speed", "1.0", "--command", "twist")  # fmt: skip
+    assert shown.returncode == 0, shown.stderr
+    assert "path done" in shown.stdout and "run ended" in shown.stdout, shown.stdout
+    sim.finish()
+    (twists,) = sim.out.glob("*/vessel.ego.cmd.twist.csv")
+    rows = twists.read_text().splitlines()
+    assert rows[0].startswith("stamp_ns,tick,surge")
+    surges = [float(r.split(",")[2]) for r in rows[1:]]
+    assert len(surges) > 50 and max(surges) == pytest.approx(1.0, abs=1e-3) and surges[-1] == 0.0
+
+
+GOAL = (90.0, 0.0)  # examples/navigate.json's task.goal
+
+
+@pytest.fixture(scope="module")
+def navigated(tmp_path_factory: pytest.TempPathFactory) -> list[Path]:
+    """examples/navigate.json run twice: `catabot run` starts the navigator (its controller's
+    program) as a lockstep participant; 75 s simulated, 20 boats."""
+    folders = []
+    for i in range(2):
+        out = tmp_path_factory.mktemp(f"navigate{i}")
+        cmd = [sys.executable, "-m", "catabot", "run", "examples/navigate.json", "--quiet",
+               "--out", str(out)]  # fmt: skip
+        done = subprocess.run(cmd, capture_output=True, text=True, timeout=300, cwd=REPO)
+        assert done.returncode == 0, done.stdout + done.stderr
+        (folder,) = out.iterdir()
+        folders.append(folder)
+    return folders
+
+
+def positions(folder: Path, vessel: str) -> np.ndarray:
+    """(ticks, 2) x, y of a vessel from its recorded states."""
+    return np.loadtxt(folder / f"vessel.{vessel}.state.csv", delimiter=",", skiprows=1,
+                      usecols=(2, 3))  # fmt: skip
+
+
+def test_navigate_reaches_its_goal_through_traffic_without_touching_a_boat(
+    navigated: list[Path],
+) -> None:
+    folder = navigated[0]
+    log = (folder / "log" / "navigator.log").read_text()
+    assert "reached the goal" in log and "run ended at tick 7499 (completed)" in log, log
+    rain = np.loadtxt(folder / "sensor.ego.lidar.csv", delimiter=",", skiprows=1, usecols=3)
+    assert rain.min() > 50  # every scan had raindrop returns for the grid to drop
+    ego_metrics = json.loads((folder / "metrics.json").read_text())["vessels"]["ego"]
+    assert ego_metrics["goal"]["reached"] and ego_metrics["goal"]["time_to_goal_s"] < 72.0
+    assert ego_metrics["collisions"] == 0 and ego_metrics["groundings"] == 0, ego_metrics
+    # contact needs the centres within 1.07 m (catamaran) + 2.49 m (monohull, bow)
+    assert ego_metrics["nearest_vessel"]["distance_m"] > 3.6, ego_metrics["nearest_vessel"]
+    ego = positions(folder, "ego")
+    boats = [p.name.split(".")[1] for p in folder.glob("vessel.boat_*.state.csv")]
+    assert len(boats) == 20
+    # and the boats were in the way: a straight run at 1.5 m/s would have hit one
+    t = np.arange(len(ego)) * 0.01
+    straight = np.stack([np.minimum(1.5 * t, GOAL[0]), np.zeros_like(t)], axis=1)
+    assert min(np.hypot(*(positions(folder, b) - straight).T).min() for b in boats) < 3.6
+
+
+def test_navigate_in_lockstep_records_the_same_bytes_twice(navigated: list[Path]) -> None:
+    first, second = ({p.name: p.read_bytes() for p in sorted(f.glob("*.csv"))} for f in navigated)
+    assert first.keys() == second.keys() and len(first) > 40
+    assert first == second
+    assert (navigated[0] / "run.mcap").read_bytes() == (navigated[1] / "run.mcap").read_bytes()
+
+
+def test_navigate_by_hand_with_thrust_around_a_moored_boat(run: type[Run], tmp_path: Path) -> None:
+    """The navigator started by hand beside `catabot run --listen`, on a thrust controller, a
+    boat holding station on the straight line to its goal."""
+    lidar = {"name": "lidar", "type": "lidar", "rate_hz": 10.0, "params": {
+        "channels": 16, "columns": 360, "vertical_fov_deg": 20.0, "max_range_m": 30.0}}  # fmt: skip
+    scenario = {
+        "name": "by_hand", "seed": 2, "duration_s": 30.0,
+        "vessels": [{"id": "ego", "pose": {"x_m": 0.0, "y_m": 0.0, "yaw_rad": 0.0},
+                     "controller": {"participant": "navigator", "command": "thrust"},
+                     "sensors": [lidar,
+                                 {"name": "gps", "type": "gps", "rate_hz": 10.0},
+                                 {"name": "imu", "type": "imu", "rate_hz": 10.0}]}],
+        "traffic": {"count": 1, "behaviour_mix": {"hold": 1.0},
+                    "boats": [{"index": 0, "x_m": 12.0, "y_m": 0.5, "yaw_rad": 1.57}]},
+    }  # fmt: skip
+    path = tmp_path / "by_hand.json"
+    path.write_text(json.dumps(scenario))
+    sim = run(str(path))
+    shown = example("navigate.py", "--connect", sim.endpoint, "--goal", "24", "0", timeout=120)
+    assert shown.returncode == 0, shown.stderr
+    assert "arrived at t=" in shown.stdout and "(completed)" in shown.stdout, shown.stdout
+    run_dir = sim.finish()
+    ego, boat = positions(run_dir, "ego"), positions(run_dir, "boat_000")
+    assert np.hypot(*(ego - boat).T).min() > 3.6
+    rows = (run_dir / "vessel.ego.cmd.thrust.csv").read_text().splitlines()
+    assert len(rows) == 1 + 300 and rows[0] == "stamp_ns,tick,thrust_0,thrust_1"
+
+
+def test_navigate_says_when_no_simulation_answers() -> None:
+    lonely = f"tcp/127.0.0.1:{free_port()}"
+    shown = example("navigate.py", "--listen", lonely, "--timeout", "1", timeout=30)
+    assert shown.returncode != 0 and "Traceback" not in shown.stderr
+    assert shown.stderr.startswith("navigate.py: no simulation"), shown.stderr
