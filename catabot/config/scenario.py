@@ -166,6 +166,9 @@ class Origin(Strict):
 class RecordingConfig(Strict):
     csv: StrictBool = True
     mcap: StrictBool = True
+    mcap_compression: Literal["zstd", "lz4", "none"] = Field(
+        "zstd", description="run.mcap's chunks: zstd (smallest), lz4 (fastest) or none"
+    )
     dataset: StrictBool = Field(True, description="camera frames as PNGs + labels in dataset/")
     dataset_rate_hz: float | None = Field(
         None, gt=0, description="camera frames saved to dataset/ per second; null: every frame"

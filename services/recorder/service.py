@@ -38,7 +38,11 @@ class Recorder:
         world = ctx.world
         convert = Converter(world, ctx.scenario.ros)  # the gateway's topics and frames
         self.csv = CsvSink(ctx.run_dir) if rec.csv else None
-        self.mcap = McapRecording(ctx.run_dir, convert) if rec.mcap else None
+        self.mcap = (
+            McapRecording(ctx.run_dir, convert, compression=rec.mcap_compression)
+            if rec.mcap
+            else None
+        )
         self.dataset = Dataset(ctx.run_dir / "dataset", world)
         streams = [*world.streams.lockstep(), *world.streams.commands]
         self.batches = BatchFormatter(convert)

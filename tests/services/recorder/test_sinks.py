@@ -6,6 +6,7 @@ from __future__ import annotations
 import math
 import shutil
 from pathlib import Path
+from typing import Any
 
 import pytest
 from mcap.reader import make_reader
@@ -62,9 +63,9 @@ ODOM, TWIST_TOPIC, THRUST_TOPIC = "/ego/odom", "/ego/cmd_vel", "/ego/thrust"
 ODOMETRY = cdr.odometry_encoder("map", "ego/base_link")
 
 
-def _record_mcap(path: Path, ticks: int = 5, *, close: bool = True) -> McapSink:
+def _record_mcap(path: Path, ticks: int = 5, *, close: bool = True, **kw: Any) -> McapSink:
     """Per tick an Odometry, a Twist and a thrust array, as the recorder writes them."""
-    sink = McapSink(path)
+    sink = McapSink(path, **kw)
     for k in range(ticks):
         stamp = k * DT
         sink.write(ODOM, types.ODOMETRY, ODOMETRY(_state(k), stamp), stamp_ns=stamp)
@@ -188,8 +189,9 @@ def test_truncated_mcap_reads_up_to_last_flush(tmp_path: Path) -> None:
 
 
 def test_torn_tail_is_ignored(tmp_path: Path) -> None:
+    """A torn chunk is lost whole; what came before it reads (here a chunk a message)."""
     path = tmp_path / "run.mcap"
-    _record_mcap(path, ticks=2, close=False)
+    _record_mcap(path, ticks=2, close=False, chunk_bytes=1)
     data = path.read_bytes()
     full = len(read_mcap_messages(path))
     for cut in range(len(data) - 1, len(data) - 60, -1):  # a record torn mid-write
