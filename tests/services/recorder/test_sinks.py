@@ -94,7 +94,7 @@ def test_csv_files_headers_and_rows(tmp_path: Path) -> None:
     assert thrust[0] == "stamp_ns,tick,thrust_0,thrust_1"
     assert thrust[2] == "100000000,1,0.1,-0.1"
     twist = (tmp_path / "vessel.ego.cmd.twist.csv").read_text().splitlines()
-    assert twist[:2] == ["stamp_ns,tick,surge[m/s],yaw_rate[rad/s]", "0,0,0.333333333333,nan"]
+    assert twist[:2] == ["stamp_ns,tick,surge[m/s],yaw_rate[rad/s]", "0,0,0.3333333333333333,nan"]
 
 
 def test_csv_is_byte_identical_for_identical_writes(tmp_path: Path) -> None:
