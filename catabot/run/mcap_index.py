@@ -7,16 +7,19 @@ object per message (≈17 us each); here the records are walked with one `struct
 and only offsets are kept, so a channel's payloads can be sliced (or gathered with NumPy)
 straight from the file's bytes. Uncompressed chunks (`recording.mcap_compression: none`)
 and unchunked files are walked in place in the memory-mapped file; compressed chunks are
-decompressed into one buffer first (memory the size of the decompressed data). A file
-without a summary (a killed writer) reads to its last complete record.
+decompressed once into a memory-mapped temporary file (disk the size of the decompressed
+data, not memory). A file without a summary (a killed writer) reads to its last complete
+record.
 """
 
 from __future__ import annotations
 
 import mmap
 import struct
+import tempfile
 from dataclasses import dataclass, field
 from pathlib import Path
+from typing import BinaryIO
 
 import numpy as np
 from numpy.typing import NDArray
@@ -192,11 +195,23 @@ def _chunk(data: bytes | mmap.mmap, body: int) -> tuple[str, int, int]:
     return compression, p + 8, size
 
 
-def _flat(data: bytes | mmap.mmap, path: Path) -> bytes:
+def _flat(data: bytes | mmap.mmap, path: Path) -> bytes | mmap.mmap:
     """The file's records with every chunk replaced by its records, decompressed: an
-    unchunked record stream (no magic) that `_Walker` indexes in place. Costs memory the
-    size of the decompressed data."""
-    parts: list[bytes] = []
+    unchunked record stream (no magic) that `_Walker` indexes in place. It goes to an
+    unlinked temporary file beside the recording (its disk has held the data once) that is
+    memory-mapped, so a recording of any length costs disk, not memory, as an uncompressed
+    one does; the space is freed with the index."""
+    try:
+        out = tempfile.TemporaryFile(dir=path.parent)  # noqa: SIM115 - mapped, then closed
+    except OSError:  # a read-only folder
+        out = tempfile.TemporaryFile()  # noqa: SIM115
+    with out:
+        _decompressed(data, path, out)
+        out.flush()
+        return _mapped(out.fileno())  # the map keeps the unlinked file's pages
+
+
+def _decompressed(data: bytes | mmap.mmap, path: Path, out: BinaryIO) -> None:
     pos, size = len(MAGIC), len(data)
     while pos + _HEAD.size <= size:
         opcode, length = _HEAD.unpack_from(data, pos)
@@ -206,10 +221,9 @@ def _flat(data: bytes | mmap.mmap, path: Path) -> bytes:
         if opcode == OP_CHUNK:
             compression, records, uncompressed = _chunk(data, pos + _HEAD.size)
             try:
-                parts.append(decompress(memoryview(data)[records:end], compression, uncompressed))
+                out.write(decompress(memoryview(data)[records:end], compression, uncompressed))
             except Exception as exc:  # each library raises its own error types
                 raise McapIndexError(f"{path}: chunk at byte {pos} unreadable ({exc})") from None
         elif opcode in (OP_SCHEMA, OP_CHANNEL, OP_MESSAGE):
-            parts.append(bytes(data[pos:end]))
+            out.write(data[pos:end])
         pos = end
-    return b"".join(parts)

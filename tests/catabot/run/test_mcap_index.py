@@ -35,7 +35,10 @@ def _write(path: Path, *, chunked: bool, messages: int = 50, compression: str = 
 def test_every_message_found(tmp_path: Path, chunked: bool, compression: str) -> None:
     _write(tmp_path / "f.mcap", chunked=chunked, compression=compression)
     index = McapIndex(tmp_path / "f.mcap")
-    assert isinstance(index.data, mmap.mmap) == (compression == "none")  # read in place
+    assert isinstance(index.data, mmap.mmap)  # the file, or its decompressed records' copy
+    in_place = len(index.data) == (tmp_path / "f.mcap").stat().st_size
+    assert in_place == (compression == "none")
+    assert [p.name for p in tmp_path.iterdir()] == ["f.mcap"]  # the copy is unlinked
     assert index.topics() == ["/a", "/b"]
     a, b = index.channel("/a"), index.channel("/b")
     assert a is not None and b is not None
