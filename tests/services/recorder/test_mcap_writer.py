@@ -4,6 +4,7 @@ summary, chunk and message indexes, every compression."""
 from __future__ import annotations
 
 import io
+import struct
 from pathlib import Path
 
 import numpy as np
@@ -12,6 +13,7 @@ from mcap.reader import make_reader
 from mcap.records import Chunk, MessageIndex
 from mcap.stream_reader import CRCValidationError, StreamReader
 
+from catabot.run.mcap_compression import decompress
 from services.recorder.mcap_read import read_mcap_messages
 from services.recorder.mcap_writer import McapWriter
 
@@ -136,6 +138,13 @@ def test_chunks_are_bounded_indexed_and_read_by_topic_and_time(
         assert chunk.uncompressed_size < 2000 + 2 * 250 or chunk.uncompressed_size == 100_031
     indexes = [r for r in records if isinstance(r, MessageIndex)]
     assert sum(len(i.records) for i in indexes) == 40 * 2 + 4
+    owner = {id(i): c for c in chunks for i in _indexes_after(records, c)}
+    for index in indexes:  # every entry points at a message of its channel and log time
+        chunk = owner[id(index)]
+        data = decompress(chunk.data, chunk.compression, chunk.uncompressed_size)
+        for log_time, offset in index.records:
+            opcode, _, channel, _, at = struct.unpack_from("<BQHIQ", data, offset)
+            assert (opcode, channel, at) == (0x05, index.channel_id, log_time)
     with open(path, "rb") as f:
         reader = make_reader(f, validate_crcs=True)
         summary = reader.get_summary()
@@ -144,6 +153,16 @@ def test_chunks_are_bounded_indexed_and_read_by_topic_and_time(
         assert len(bulk) == 4 and all(list(c.message_index_offsets) == [3] for c in bulk)
         got = [(c.topic, m.log_time) for _, c, m in reader.iter_messages("/a", starting_at=300)]
     assert got == [("/a", t) for t in range(300, 400, 10)]
+
+
+def _indexes_after(records: list[object], chunk: Chunk) -> list[MessageIndex]:
+    """The message index records that follow `chunk` in the file."""
+    out = []
+    for record in records[records.index(chunk) + 1 :]:
+        if not isinstance(record, MessageIndex):
+            break
+        out.append(record)
+    return out
 
 
 def test_same_messages_same_bytes_and_compression_is_checked(tmp_path: Path) -> None:
