@@ -3,6 +3,7 @@ bag (profile ros2, CDR only), JSON only in the extras file."""
 
 from __future__ import annotations
 
+import errno
 import math
 import shutil
 from pathlib import Path
@@ -17,7 +18,8 @@ from rosbags.typesys import Stores, get_typestore
 from catabot.bus.messages import Message, ThrustCmd, TwistCmd, VesselState
 from catabot.ros2 import cdr, cdr_more, types
 from catabot.ros2.convert import thrust
-from services.recorder.csv_sink import CsvSink, RecorderError
+from catabot.run.mcap_index import McapIndex
+from services.recorder.csv_sink import CsvSink, DiskError, RecorderError
 from services.recorder.mcap_read import read_mcap_messages
 from services.recorder.mcap_sink import McapSink
 
@@ -226,3 +228,36 @@ def test_extras_are_json_with_a_schema(tmp_path: Path) -> None:
         {"a": 1},
         5,
     )
+
+
+class _FullDisk:
+    """A file with `room` bytes left: a write past it writes what fits, then fails."""
+
+    def __init__(self, file: Any, room: int) -> None:
+        self._file, self._room = file, room
+
+    def write(self, data: Any) -> int:
+        if self._room <= 0:
+            raise OSError(errno.ENOSPC, "No space left on device")
+        written = int(self._file.write(data[: self._room]))
+        self._room -= written
+        return written
+
+    def __getattr__(self, name: str) -> Any:
+        return getattr(self._file, name)
+
+
+def test_a_full_disk_cuts_the_mcap_back_to_its_last_whole_chunk(tmp_path: Path) -> None:
+    """A failed flush is cut back off: the file ends with the last finished chunk."""
+    path = tmp_path / "run.mcap"
+    sink = _record_mcap(path, ticks=6, close=False, chunk_bytes=1500)  # chunks of ~5 messages
+    finished = [m.log_time for m in read_mcap_messages(path)]
+    sink.write(ODOM, types.ODOMETRY, ODOMETRY(_state(6), 6 * DT), stamp_ns=6 * DT)
+    sink._out._file = _FullDisk(sink._out._file, room=100)  # type: ignore[assignment]
+    with pytest.raises(DiskError, match="No space left on device"):
+        sink.flush()
+    left = read_mcap_messages(path)
+    assert 0 < len(left) < len(finished)  # the finished chunks, not the open one
+    assert path.stat().st_size == sink._out._size  # cut back to the last whole chunk
+    assert [m.log_time for m in left] == finished[: len(left)]
+    assert McapIndex(path).channel(ODOM) is not None
