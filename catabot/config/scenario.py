@@ -167,7 +167,7 @@ class RecordingConfig(Strict):
     csv: StrictBool = True
     mcap: StrictBool = True
     mcap_compression: Literal["zstd", "lz4", "none"] = Field(
-        "zstd", description="run.mcap's chunks: zstd (smallest), lz4 (fastest) or none"
+        "zstd", description="the MCAP files' chunks: zstd (smallest; as cheap as none), lz4 or none"
     )
     dataset: StrictBool = Field(True, description="camera frames as PNGs + labels in dataset/")
     dataset_rate_hz: float | None = Field(
