@@ -8,8 +8,9 @@ and only offsets are kept, so a channel's payloads can be sliced (or gathered wi
 straight from the file's bytes. Uncompressed chunks (`recording.mcap_compression: none`)
 and unchunked files are walked in place in the memory-mapped file; compressed chunks are
 decompressed once into a memory-mapped temporary file (disk the size of the decompressed
-data, not memory). A file without a summary (a killed writer) reads to its last complete
-record.
+data, not memory). A finished chunked file is indexed from its summary and the message
+index records after each chunk (one NumPy array per chunk and channel, no record walked); a
+file without them (unchunked, or a killed writer's) is walked to its last complete record.
 """
 
 from __future__ import annotations
@@ -17,6 +18,7 @@ from __future__ import annotations
 import mmap
 import struct
 import tempfile
+from collections.abc import Iterator
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import BinaryIO
@@ -33,6 +35,10 @@ _MESSAGE = struct.Struct("<HIQQ")  # channel id, sequence, log time, publish tim
 _U16 = struct.Struct("<H")
 _U32 = struct.Struct("<I")
 _U64 = struct.Struct("<Q")
+_FOOTER = struct.Struct("<BQQQI")  # opcode, length, summary start, summary offsets, crc
+_INDEX_PAIR = struct.Struct("<HQ")  # channel id, message index record offset
+_ENTRY = np.dtype([("log_time", "<u8"), ("offset", "<u8")])
+OP_CHUNK_INDEX = 0x08
 OP_FOOTER, OP_SCHEMA, OP_CHANNEL, OP_MESSAGE, OP_CHUNK, OP_DATA_END = (
     0x02,
     0x03,
@@ -79,8 +85,11 @@ class McapIndex:
         if self.data[: len(MAGIC)] != MAGIC:
             raise McapIndexError(f"{self.path}: not an MCAP file (no magic bytes)")
         self.channels: dict[str, Channel] = {}
-        if not _walk(self.data, self.channels):
-            self.data = _flat(self.data, self.path)
+        indexed = _from_summary(self.data, self.path)
+        if indexed is not None:
+            self.data, self.channels = indexed
+        elif not _walk(self.data, self.channels):
+            self.data, _ = _flat(self.data, self.path)
             _Walker(self.channels).walk(self.data, 0, len(self.data))
 
     def topics(self) -> list[str]:
@@ -195,23 +204,25 @@ def _chunk(data: bytes | mmap.mmap, body: int) -> tuple[str, int, int]:
     return compression, p + 8, size
 
 
-def _flat(data: bytes | mmap.mmap, path: Path) -> bytes | mmap.mmap:
+def _flat(data: bytes | mmap.mmap, path: Path) -> tuple[bytes | mmap.mmap, dict[int, int]]:
     """The file's records with every chunk replaced by its records, decompressed: an
     unchunked record stream (no magic) that `_Walker` indexes in place. It goes to an
     unlinked temporary file beside the recording (its disk has held the data once) that is
     memory-mapped, so a recording of any length costs disk, not memory, as an uncompressed
-    one does; the space is freed with the index."""
+    one does; the space is freed with the index. Also: where each chunk's records begin in
+    it, by the chunk's offset in the file."""
     try:
         out = tempfile.TemporaryFile(dir=path.parent)  # noqa: SIM115 - mapped, then closed
     except OSError:  # a read-only folder
         out = tempfile.TemporaryFile()  # noqa: SIM115
     with out:
-        _decompressed(data, path, out)
+        bases = _decompressed(data, path, out)
         out.flush()
-        return _mapped(out.fileno())  # the map keeps the unlinked file's pages
+        return _mapped(out.fileno()), bases  # the map keeps the unlinked file's pages
 
 
-def _decompressed(data: bytes | mmap.mmap, path: Path, out: BinaryIO) -> None:
+def _decompressed(data: bytes | mmap.mmap, path: Path, out: BinaryIO) -> dict[int, int]:
+    bases: dict[int, int] = {}
     pos, size = len(MAGIC), len(data)
     while pos + _HEAD.size <= size:
         opcode, length = _HEAD.unpack_from(data, pos)
@@ -220,6 +231,7 @@ def _decompressed(data: bytes | mmap.mmap, path: Path, out: BinaryIO) -> None:
             break
         if opcode == OP_CHUNK:
             compression, records, uncompressed = _chunk(data, pos + _HEAD.size)
+            bases[pos] = out.tell()
             try:
                 out.write(decompress(memoryview(data)[records:end], compression, uncompressed))
             except Exception as exc:  # each library raises its own error types
@@ -227,3 +239,61 @@ def _decompressed(data: bytes | mmap.mmap, path: Path, out: BinaryIO) -> None:
         elif opcode in (OP_SCHEMA, OP_CHANNEL, OP_MESSAGE):
             out.write(data[pos:end])
         pos = end
+    return bases
+
+
+def _from_summary(
+    data: bytes | mmap.mmap, path: Path
+) -> tuple[bytes | mmap.mmap, dict[str, Channel]] | None:
+    """Every channel from a finished chunked file's summary and the message index records
+    after each chunk, without walking a record: each (chunk, channel) index is one NumPy
+    array of (log time, offset). None for a file without them (unchunked, or a killed
+    writer's: no summary), which `_walk` reads."""
+    footer = len(data) - len(MAGIC) - _FOOTER.size
+    if footer < len(MAGIC) or data[-len(MAGIC) :] != MAGIC or data[footer] != OP_FOOTER:
+        return None
+    _, _, start, _, _ = _FOOTER.unpack_from(data, footer)
+    channels: dict[str, Channel] = {}
+    walker = _Walker(channels)
+    walker.walk(data, start, footer)  # schemas and channels
+    chunks = list(_chunk_indexes(data, start, footer))
+    if start == 0 or not chunks or not all(offsets for _, offsets in chunks):
+        return None
+    if any(_chunk(data, at + _HEAD.size)[0] for at, _ in chunks):
+        buffer, bases = _flat(data, path)
+    else:
+        buffer, bases = data, {at: _chunk(data, at + _HEAD.size)[1] for at, _ in chunks}
+    found: dict[int, list[tuple[NDArray[np.uint64], NDArray[np.uint64]]]] = {}
+    for at, offsets in chunks:
+        for chan_id, where in offsets.items():
+            (length,) = _U32.unpack_from(data, where + _HEAD.size + 2)
+            entries = np.frombuffer(data, _ENTRY, length // _ENTRY.itemsize, where + 15)
+            found.setdefault(chan_id, []).append((entries["log_time"],
+                                                   entries["offset"] + bases[at]))  # fmt: skip
+    view = np.frombuffer(buffer, np.uint8)
+    for chan_id, parts in found.items():
+        times = np.concatenate([t for t, _ in parts]).astype(np.int64)
+        pos = np.concatenate([o for _, o in parts]).astype(np.int64)
+        order = np.lexsort((pos, times))  # time order; file order among equal times
+        times, pos = times[order], pos[order]
+        lengths = view[pos[:, None] + 1 + np.arange(8)].copy().view("<u8").ravel()
+        chan = walker.by_id[chan_id]
+        chan.stamps = times.tolist()
+        chan.starts = (pos + _HEAD.size + _MESSAGE.size).tolist()
+        chan.ends = (pos + _HEAD.size + lengths.astype(np.int64)).tolist()
+    return buffer, channels
+
+
+def _chunk_indexes(
+    data: bytes | mmap.mmap, pos: int, end: int
+) -> Iterator[tuple[int, dict[int, int]]]:
+    """(chunk offset, {channel id: message index record offset}) of each chunk index."""
+    while pos + _HEAD.size <= end:
+        opcode, length = _HEAD.unpack_from(data, pos)
+        if opcode == OP_CHUNK_INDEX:
+            body = pos + _HEAD.size
+            (chunk,) = _U64.unpack_from(data, body + 16)
+            (size,) = _U32.unpack_from(data, body + 32)
+            pairs = [_INDEX_PAIR.unpack_from(data, body + 36 + i) for i in range(0, size, 10)]
+            yield chunk, dict(pairs)
+        pos += _HEAD.size + length

@@ -10,7 +10,7 @@ from pathlib import Path
 import pytest
 from mcap.writer import CompressionType, Writer
 
-from catabot.run.mcap_index import McapIndex, McapIndexError
+from catabot.run.mcap_index import McapIndex, McapIndexError, _from_summary
 from services.recorder.mcap_sink import McapSink
 
 
@@ -94,3 +94,22 @@ def test_other_files_are_refused(tmp_path: Path) -> None:
         McapIndex(tmp_path / "x.mcap")
     with pytest.raises(McapIndexError, match="cannot read"):
         McapIndex(tmp_path / "missing.mcap")
+
+
+@pytest.mark.parametrize("compression", ["none", "zstd", "lz4"])
+def test_the_summary_and_message_indexes_give_what_a_walk_gives(
+    tmp_path: Path, compression: str
+) -> None:
+    """A finished file is indexed from its summary (no record walked); without the footer
+    (the last byte cut) the same file is walked: both find the same messages."""
+    _write(tmp_path / "f.mcap", chunked=True, compression=compression, messages=300)
+    data = (tmp_path / "f.mcap").read_bytes()
+    (tmp_path / "cut.mcap").write_bytes(data[:-1])
+    assert _from_summary(data, tmp_path) is not None and _from_summary(data[:-1], tmp_path) is None
+    indexed, walked = McapIndex(tmp_path / "f.mcap"), McapIndex(tmp_path / "cut.mcap")
+    assert indexed.topics() == walked.topics() == ["/a", "/b"]
+    for topic in ("/a", "/b"):
+        one, two = indexed.channel(topic), walked.channel(topic)
+        assert one is not None and two is not None and len(one) == len(two) > 50
+        assert one.stamps == two.stamps and indexed.payloads(one) == walked.payloads(two)
+        assert one.schema_name == two.schema_name == "s"
