@@ -14,6 +14,7 @@ BENCHMARKS = {
     "ros": "benchmarks.ros",
     "viewer": "benchmarks.viewer",
     "shards": "benchmarks.shards",
+    "recording": "benchmarks.recording",
 }
 
 

@@ -155,6 +155,9 @@ class Origin(Strict):
 class RecordingConfig(Strict):
     csv: StrictBool = True
     mcap: StrictBool = True
+    mcap_compression: Literal["zstd", "lz4", "none"] = Field(
+        "zstd", description="the MCAP files' chunks: zstd (smallest; as cheap as none), lz4 or none"
+    )
     dataset: StrictBool = Field(True, description="camera frames as PNGs + labels in dataset/")
     dataset_rate_hz: float | None = Field(
         None, gt=0, description="camera frames saved to dataset/ per second; null: every frame"

@@ -76,7 +76,8 @@ def closest_approach(xy: F64) -> F64:
 
 
 def _commands(run: RecordedRun, out: RunSeries) -> None:
-    """Thrust: the scripts' steps and any thrust command on the bus; twist set-points."""
+    """Thrust: every recorded thrust command, scripted or sent (a folder recorded before
+    the recorder wrote the script's steps: the script's steps); twist set-points."""
     for vid in out.own:
         body = run.world.body(vid)
         steps: list[tuple[float, Sequence[float]]] = [
@@ -85,7 +86,7 @@ def _commands(run: RecordedRun, out: RunSeries) -> None:
         sent: list[tuple[float, Sequence[float]]] = [
             (stamp_ns / 1e9, c.thrust) for stamp_ns, c in run.thrust(vid)
         ]
-        both = sorted(steps + sent, key=lambda p: p[0])
+        both = sorted(sent or steps, key=lambda p: p[0])
         if both:
             n = max(len(v) for _, v in both)
             values = np.array([[*v, *[np.nan] * (n - len(v))] for _, v in both])

@@ -43,9 +43,10 @@ LABELS_SCHEMA = {
 
 
 class McapRecording:
-    def __init__(self, run_dir: Path, convert: Converter) -> None:
+    def __init__(self, run_dir: Path, convert: Converter, *, compression: str) -> None:
         self.convert = convert
-        self.mcap = McapSink(run_dir / "run.mcap")
+        self.compression = compression
+        self.mcap = McapSink(run_dir / "run.mcap", compression=compression)
         self._extra_path = run_dir / "run.extra.mcap"
         self._extra: McapSink | None = None
         self._started = False
@@ -106,7 +107,7 @@ class McapRecording:
     def extra(self) -> McapSink:
         """run.extra.mcap, opened when the first message without a ROS 2 type comes."""
         if self._extra is None:
-            self._extra = McapSink(self._extra_path, profile="")
+            self._extra = McapSink(self._extra_path, profile="", compression=self.compression)
         return self._extra
 
     def flush(self) -> None:

@@ -6,9 +6,13 @@ Foxglove read it as a ROS 2 bag. What has no ROS 2 type (camera boxes and labels
 future message without a conversion) goes to `run.extra.mcap`: JSON with a JSON Schema.
 
 Why it is written this way:
-- Unchunked records, and bytes reach the file only in `flush()` (once per tick): a recorder
-  killed at any moment leaves a file whose records are all complete up to the last tick,
-  which `mcap_read.read_mcap_messages` reads without the summary that only `close()` writes.
+- Chunked and indexed (mcap_writer.py), compressed as `recording.mcap_compression` says, so
+  Foxglove and `mcap`'s reader open a recording of any length by its summary.
+- Bytes reach the file only in `flush()` (whole ticks): the finished chunks, then the open
+  chunks as provisional uncompressed chunk records that the next flush writes over. A
+  recorder killed at any moment leaves a file of complete records up to its last flush,
+  which `mcap_read.read_mcap_messages` reads without the summary that only `close()` writes;
+  a flush that fails (a full disk) is cut back to the last complete record.
 - log time = publish time = `stamp_ns` and a per-channel sequence number: nothing in the file
   comes from the wall clock or a random source, so two identical runs give identical bytes.
 """
@@ -17,6 +21,7 @@ from __future__ import annotations
 
 import io
 import json
+import os
 import typing
 from collections.abc import Sequence
 from pathlib import Path
@@ -29,20 +34,24 @@ from numpy.typing import NDArray
 
 from catabot.ros2 import types
 from services.recorder.csv_sink import RecorderError, write_whole
+from services.recorder.mcap_chunks import CHUNK_BYTES
 from services.recorder.mcap_writer import McapWriter
 
 ROS2 = "ros2"  # the profile of run.mcap
+DEFAULT_COMPRESSION = "zstd"  # `recording.mcap_compression`'s default (README, Performance)
 
 
 class _TickBuffer(io.BufferedIOBase):
-    """A write-only file whose bytes reach the disk only on flush (tick-atomic records); a
-    flush that fails (a full disk) is cut back off, so the file ends with a whole record."""
+    """A write-only file whose bytes reach the disk only on flush (tick-atomic records), each
+    flush followed by a provisional `tail` that the next one replaces; a flush that fails
+    (a full disk) is cut back off, so the file ends with a whole record."""
 
     def __init__(self, path: Path) -> None:
         super().__init__()
         self._file = open(path, "wb", buffering=0)  # noqa: SIM115
         self._pending = bytearray()
         self._size = 0  # bytes of complete flushes
+        self._tail = b""  # the provisional bytes on disk after them
 
     def writable(self) -> bool:
         return True
@@ -54,17 +63,22 @@ class _TickBuffer(io.BufferedIOBase):
     def tell(self) -> int:
         return self._size + len(self._pending)
 
-    def flush(self) -> None:
-        if self._file.closed or not self._pending:
+    def flush(self, tail: bytes = b"") -> None:
+        if self._file.closed or (not self._pending and tail == self._tail):
             return  # IOBase.close() flushes once more after our file is closed
-        data = bytes(self._pending)
+        data = bytes(self._pending) + tail
         self._pending.clear()
+        before, self._tail = self._tail, b""  # a failed write cuts the file back to _size
+        self._file.seek(self._size)
         write_whole(self._file, data, self._size)
-        self._size += len(data)
+        self._size += len(data) - len(tail)
+        if len(tail) < len(before):
+            os.ftruncate(self._file.fileno(), self._size + len(tail))  # a longer tail before
+        self._tail = tail
 
     def close(self) -> None:
         if not self._file.closed:
-            self.flush()
+            self.flush(self._tail)  # the tail stays unless replaced (garbage collection)
             self._file.close()
         super().close()
 
@@ -73,13 +87,18 @@ class McapSink:
     """Writes one MCAP file: `flush()` once per tick, `close()` at the end. With the `ros2`
     profile every channel is CDR of a ROS 2 type; without a profile (`run.extra.mcap`) JSON."""
 
-    def __init__(self, path: Path, *, profile: str = ROS2) -> None:
+    def __init__(
+        self, path: Path, *, profile: str = ROS2, compression: str = DEFAULT_COMPRESSION,
+        chunk_bytes: int = CHUNK_BYTES,
+    ) -> None:  # fmt: skip
         self.profile = profile
         self._out = _TickBuffer(Path(path))
         self._writer = McapWriter(
             typing.cast(BinaryIO, self._out),
             profile=profile,
             library=f"catabot {LIBRARY_IDENTIFIER}",
+            compression=compression,
+            chunk_bytes=chunk_bytes,
         )
         self._out.flush()  # the file is valid from the first byte on
         self._schemas: dict[str, int] = {}
@@ -181,17 +200,17 @@ class McapSink:
         self._writer.add_messages(ids, sequences.tolist(), stamp_ns, payloads)
 
     def flush(self) -> None:
-        """Put every record written so far into the file (call once per tick)."""
-        # Unchunked, the writer hands each record to our buffer at once, so flushing the
-        # buffer is enough.
+        """Put every record written so far into the file (call between ticks): finished
+        chunks for good, the open ones provisionally."""
         if not self._closed:
-            self._out.flush()
+            self._out.flush(self._writer.tail())
 
     def close(self) -> None:
         """Write the summary and footer, then close the file."""
         if self._closed:
             return
         self._writer.finish()
+        self._out.flush(b"")  # the open chunks are finished: no tail
         self._out.close()
         self._closed = True
 

@@ -1,11 +1,16 @@
-"""An unchunked MCAP writer that packs many messages in one call.
+"""A chunked, indexed MCAP writer that packs many messages in one call.
 
 Why not `mcap.writer.Writer.add_message`: it builds each Message record field by field
 through a `BytesIO` (~20 us a message), which with 100 boats (an Odometry and a twist
 command each, every tick) was most of the recorder's time. Here a tick's messages become
-bytes with one `struct` call each and reach the output in one write; every other record
-(header, schemas, channels, statistics, summary, footer) is serialised by `mcap.records`
-itself, so the file layout is the library's. CRCs are computed as `mcap`'s writer does.
+bytes with one `struct` call each (or one NumPy fill for a block) and go into an open chunk
+(mcap_chunks.py); a full chunk reaches the output compressed, followed by its message
+index records. `finish()` writes the summary: schemas, channels, chunk indexes, statistics
+and their offsets, so readers seek instead of scanning (DESIGN.md §7). Schema and channel
+records go to the output at once, outside chunks, so they precede every chunk using them.
+Other records are serialised by `mcap.records`; CRCs are computed as `mcap`'s writer does.
+
+Chunks close on size alone, so the same messages give the same chunks and the same bytes.
 """
 
 from __future__ import annotations
@@ -18,8 +23,20 @@ from typing import Any, BinaryIO
 import numpy as np
 from mcap.data_stream import RecordBuilder
 from mcap.opcode import Opcode
-from mcap.records import Channel, DataEnd, Footer, Header, Schema, Statistics, SummaryOffset
+from mcap.records import (
+    Channel,
+    ChunkIndex,
+    DataEnd,
+    Footer,
+    Header,
+    Schema,
+    Statistics,
+    SummaryOffset,
+)  # fmt: skip
 from numpy.typing import NDArray
+
+from catabot.run.mcap_compression import COMPRESSIONS
+from services.recorder.mcap_chunks import BULK_BYTES, CHUNK_BYTES, OpenChunk
 
 MAGIC = b"\x89MCAP0\r\n"
 # opcode, record length, channel id, sequence, log time, publish time; then the data
@@ -32,10 +49,20 @@ _HEAD_DTYPE = np.dtype(  # the same head as a packed NumPy record, for whole blo
 
 
 class McapWriter:
-    """Writes to `stream` (bytes reach the disk when the caller flushes it)."""
+    """Writes to `stream` (bytes reach the disk when the caller flushes it); `compression`
+    "none", "zstd" or "lz4" for every chunk, chunks of about `chunk_bytes` uncompressed."""
 
-    def __init__(self, stream: BinaryIO, *, profile: str, library: str) -> None:
+    def __init__(
+        self, stream: BinaryIO, *, profile: str, library: str, compression: str = "zstd",
+        chunk_bytes: int = CHUNK_BYTES,
+    ) -> None:  # fmt: skip
+        if compression not in COMPRESSIONS:
+            raise ValueError(f"compression {compression!r}; allowed: {', '.join(COMPRESSIONS)}")
         self._stream = stream
+        self._compression = COMPRESSIONS[compression]
+        self._chunk_bytes = chunk_bytes
+        self._open = (OpenChunk(), OpenChunk())  # small messages, bulk (>= BULK_BYTES)
+        self._chunk_indexes: list[ChunkIndex] = []
         self._crc = 0
         self._schemas: list[Schema] = []
         self._channels: list[Channel] = []
@@ -79,15 +106,18 @@ class McapWriter:
             )
         if not payloads:
             return
-        self._count(np.asarray(channels))
+        ids = np.asarray(channels)
+        self._count(ids)
         pack = _MESSAGE_HEAD.pack
         parts: list[Any] = []
         for chan, seq, data in zip(channels, sequences, payloads, strict=True):
             parts.append(pack(Opcode.MESSAGE, _MESSAGE_FIXED + len(data), chan, seq,
                               log_time, log_time))  # fmt: skip
             parts.append(data)
+        lengths = np.fromiter(map(len, payloads), np.int64, len(payloads))
         self._note_times(log_time, len(payloads))
-        self._write(b"".join(parts))
+        chunk = self._chunk(int(lengths.max()))
+        chunk.add(parts, ids, lengths + _MESSAGE_HEAD.size, log_time)
 
     def written(self, channels: NDArray[np.integer]) -> NDArray[np.int64]:
         """Messages written so far on each of `channels`: the sequence numbers their next
@@ -127,10 +157,33 @@ class McapWriter:
         records[:, : _MESSAGE_HEAD.size] = head.view(np.uint8).reshape(k, -1)
         records[:, _MESSAGE_HEAD.size :] = payloads
         self._note_times(log_time, k)
-        self._write(records.tobytes())
+        chunk = self._chunk(length)
+        chunk.add(records.tobytes(), channels, np.full(k, records.shape[1], np.int64), log_time)
+
+    def _chunk(self, longest: int) -> OpenChunk:
+        """The open chunk for messages up to `longest` bytes, written out first if full."""
+        chunk = self._open[int(longest >= BULK_BYTES)]
+        if chunk.size >= self._chunk_bytes:
+            self._close(chunk)
+        return chunk
+
+    def _close(self, chunk: OpenChunk) -> None:
+        closed = chunk.close(self._compression)
+        self._chunk_indexes.append(closed.index(self._stream.tell()))
+        self._write(closed.data)
+        chunk.clear()
+
+    def tail(self) -> bytes:
+        """The open chunks as provisional records (`OpenChunk.provisional`): the caller
+        puts them after what was written, and writes over them at its next flush."""
+        return b"".join(c.provisional() for c in self._open if c)
 
     def finish(self) -> None:
-        """DataEnd, the summary (schemas, channels, statistics, offsets) and the footer."""
+        """The open chunks, DataEnd, the summary (schemas, channels, chunk indexes,
+        statistics, offsets) and the footer."""
+        for chunk in self._open:
+            if chunk:
+                self._close(chunk)
         self._record(DataEnd(data_section_crc=self._crc))
         start = self._stream.tell()
         summary = RecordBuilder()
@@ -138,8 +191,11 @@ class McapWriter:
         for opcode, records in (
             (Opcode.SCHEMA, self._schemas),
             (Opcode.CHANNEL, self._channels),
+            (Opcode.CHUNK_INDEX, self._chunk_indexes),
             (Opcode.STATISTICS, [self._statistics()]),
         ):
+            if not records:
+                continue
             group = summary.count
             for record in records:
                 record.write(summary)
@@ -164,7 +220,7 @@ class McapWriter:
             channel_count=len(self._channels),
             attachment_count=0,
             metadata_count=0,
-            chunk_count=0,
+            chunk_count=len(self._chunk_indexes),
             message_start_time=max(self._first, 0),
             message_end_time=max(self._last, 0),
             channel_message_counts={c.id: int(self._counts[c.id]) for c in self._channels},

@@ -25,6 +25,7 @@ from services.recorder.csv_sink import CsvSink, RecorderError
 from services.recorder.dataset import Dataset
 from services.recorder.mcap_recording import McapRecording
 from services.recorder.metrics import Metrics
+from services.recorder.scripts import ScriptedCommands
 
 log = logging.getLogger("recorder")
 FLUSH_EVERY_S = 0.1
@@ -38,17 +39,28 @@ class Recorder:
         world = ctx.world
         convert = Converter(world, ctx.scenario.ros)  # the gateway's topics and frames
         self.csv = CsvSink(ctx.run_dir) if rec.csv else None
-        self.mcap = McapRecording(ctx.run_dir, convert) if rec.mcap else None
+        self.mcap = (
+            McapRecording(ctx.run_dir, convert, compression=rec.mcap_compression)
+            if rec.mcap
+            else None
+        )
         self.dataset = Dataset(ctx.run_dir / "dataset", world)
         streams = [*world.streams.lockstep(), *world.streams.commands]
         self.batches = BatchFormatter(convert)
         self.metrics = Metrics(world)
+        self.scripts = ScriptedCommands(world)
         self.run_dir = ctx.run_dir
         self._flushed_at = 0.0
         self.changes_stream = self.keys.relative(self.keys.config_changes())
         self.participant = ctx.participant(streams)
 
     def step(self, tick: Tick, inputs: Inputs) -> None:
+        self._inputs(tick, inputs)
+        for stream, cmd in self.scripts.due(tick.tick, tick.stamp_ns):  # as if sent
+            self._write(stream, cmd)
+        self._flush()
+
+    def _inputs(self, tick: Tick, inputs: Inputs) -> None:
         for key in sorted(inputs):
             stream = self.keys.relative(key)
             for msg in inputs[key]:
@@ -63,7 +75,6 @@ class Recorder:
         for change in changes_of(tick.settings):  # what took effect at this tick: an input
             record = SettingsChange(tick.tick, tick.stamp_ns, change.key, change.value)
             self._write(self.changes_stream, record)
-        self._flush()
 
     def _write_block(self, stream: str, msg: Any, formatter: Callable[[Any], Block]) -> bool:
         """A batch as the per-vessel rows it stands for (`batches.py`); False if refused."""
@@ -104,7 +115,7 @@ class Recorder:
             self.mcap.flush()
 
     def on_end(self, end: End, inputs: Inputs) -> None:
-        self.step(Tick(end.run, end.tick + 1, 0, 0), inputs)
+        self._inputs(Tick(end.run, end.tick + 1, 0, 0), inputs)  # no tick after the end
         if self.csv is not None:
             self.csv.close()
         if self.mcap is not None:

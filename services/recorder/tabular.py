@@ -3,7 +3,10 @@
 Column names come only from the field metadata of `catabot.bus.messages` (`unit`, `axes`), so
 adding a field to a message adds its columns without a second description that could drift.
 Numbers are written deterministically (decimal ints, shortest round-trip floats) because the
-same scenario and seed must give byte-identical files.
+same scenario and seed must give byte-identical files. A float always reads back as a float:
+Python's repr has a decimal point or an exponent (`1.0`, `0.1`, `1e-05`, `nan`, `inf`), so
+pandas and csv readers type a float column float64 even when every value is whole, and
+parse each value back to the very float64 that was recorded.
 
 Layout: `stamp_ns`, `tick`, then every other field in declaration order. A vector field with
 axes expands to one column per axis (`position_x[m]`); a variable-length vector (axes None)
@@ -99,20 +102,16 @@ def sample_columns(msg: Message) -> list[str]:
     return out
 
 
-FLOAT = "%.12g"
-
-
 def fmt(value: Any) -> str:
-    """One cell, byte-stable across runs: ints in decimal, floats with `FLOAT` (12
-    significant digits: a micrometre at 1000 km; the MCAP keeps every float64 exactly).
-    Not repr: shortest round-trip formatting costs 2.6x as much, and a tick with 100 boats
-    formats ~2500 floats."""
+    """One cell, byte-stable across runs: ints in decimal, floats as Python's repr (the
+    shortest text that parses back to the same float64, with a decimal point or exponent;
+    `%.12g` wrote 1.0 as `1`, which pandas typed int64, and lost the last digits)."""
     if isinstance(value, bool | np.bool_):
         return "true" if value else "false"
     if isinstance(value, int | np.integer):
         return str(int(value))
     if isinstance(value, float | np.floating):
-        return FLOAT % float(value)  # 'nan', 'inf', '-inf' as such
+        return repr(float(value))  # 'nan', 'inf', '-inf' as such
     if isinstance(value, str):
         return value
     raise TypeError(f"cannot write a {type(value).__name__} to a CSV cell")
@@ -134,9 +133,10 @@ def row(msg: Message) -> list[str]:
 
 def block_lines(stamp_ns: int, tick: int, table: np.ndarray) -> list[str]:
     """The CSV lines of N samples sharing a stamp and a tick whose other cells are the float
-    columns of `table` (N, C): byte for byte what `row` gives for each, in one format call
-    (as `fmt` writes them) instead of N x C Python calls."""
-    n, width = table.shape
-    line = f"{int(stamp_ns)},{int(tick)}," + ",".join([FLOAT] * width) + "\n"
-    text = (line * n) % tuple(table.ravel().tolist())
-    return text.splitlines(keepends=True)
+    columns of `table` (N, C): byte for byte what `row` gives for each (as `fmt` writes
+    them), a C-level `map(repr)` per row instead of N x C Python calls. Measured fastest of
+    the shortest-round-trip ways (one `%r` format, the repr of the nested list); 2.5x the
+    `%.12g` format it replaced (0.35 -> 0.9 ms for 101 rows of 19)."""
+    head = f"{int(stamp_ns)},{int(tick)},"
+    rows = np.asarray(table, dtype=np.float64).tolist()
+    return [head + ",".join(map(repr, r)) + "\n" for r in rows]

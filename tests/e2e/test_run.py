@@ -54,8 +54,17 @@ def test_default_run_writes_run_folder_and_floats_at_archimedes_draft(out: Path)
     metrics = json.loads((run / "metrics.json").read_text())["vessels"]["ego"]
     assert abs(metrics["final_position_m"][0] - float(data[-1][2])) < 1e-9
     assert metrics["distance_m"] >= float(data[-1][2])
-    topics = {m.topic for m in read_mcap_messages(run / "run.mcap")}
-    assert {"/ego/odom", "/tf"} <= topics
+    messages = read_mcap_messages(run / "run.mcap")
+    assert {"/ego/odom", "/tf"} <= {m.topic for m in messages}
+    # the script's steps recorded as the commands they are, where an external one would be
+    thrust = csv_rows(run / "vessel.ego.cmd.thrust.csv")
+    assert thrust == [
+        ["stamp_ns", "tick", "thrust_0", "thrust_1"],
+        ["0", "0", "0.0", "0.0"],
+        ["2000000000", "200", "0.8", "0.8"],
+    ]  # fmt: skip (25 s: after the end)
+    sent = [(m.log_time, list(m.decoded.data)) for m in messages if m.topic == "/ego/thrust"]
+    assert sent == [(0, [0.0, 0.0]), (2 * 10**9, [0.8, 0.8])]
     cpu = json.loads((run / "log" / "run.json").read_text())["cpu_s"]
     assert set(cpu) == {"physics", "sensors", "recorder"} and all(s > 0 for s in cpu.values())
 

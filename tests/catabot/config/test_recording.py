@@ -21,6 +21,7 @@ def _scenario(recording: dict[str, Any], *sensors: dict[str, Any]) -> dict[str, 
 def test_defaults_make_no_rrd_and_no_export() -> None:
     rec = parse_scenario(_scenario({})).recording
     assert (rec.rerun, rec.export, rec.dataset_rate_hz) == (False, [], None)
+    assert rec.mcap_compression == "zstd"
 
 
 def test_everything_asked_for_with_its_sources() -> None:
@@ -38,6 +39,11 @@ def test_everything_asked_for_with_its_sources() -> None:
         ({"export": ["kitti"]}, [CAMERA], "recording.export: 'kitti' needs a lidar"),
         ({"export": ["coco"], "dataset": False}, [CAMERA], "'coco' needs recording.dataset: true"),
         ({"export": ["voc"]}, [CAMERA], "recording.export.0: must be one of 'yolo', 'coco'"),
+        (
+            {"mcap_compression": "gzip"},
+            [],
+            "recording.mcap_compression: must be one of 'zstd', 'lz4' or 'none' (got 'gzip')",
+        ),
         ({"dataset_rate_hz": 3.0}, [CAMERA], "recording.dataset_rate_hz: period 333333333 ns"),
         ({"dataset_rate_hz": 0}, [CAMERA], "recording.dataset_rate_hz: must be > 0"),
         ({"rerun": "yes"}, [], "recording.rerun: must be true or false"),

@@ -1,20 +1,26 @@
-"""McapWriter writes files that the reference `mcap` reader accepts, CRCs and summary."""
+"""McapWriter writes chunked, indexed files that the reference `mcap` reader accepts: CRCs,
+summary, chunk and message indexes, every compression."""
 
 from __future__ import annotations
 
+import io
+import struct
 from pathlib import Path
 
 import numpy as np
 import pytest
 from mcap.reader import make_reader
+from mcap.records import Chunk, MessageIndex
 from mcap.stream_reader import CRCValidationError, StreamReader
 
+from catabot.run.mcap_compression import decompress
+from services.recorder.mcap_read import read_mcap_messages
 from services.recorder.mcap_writer import McapWriter
 
 
-def _write(path: Path) -> None:
+def _write(path: Path, compression: str = "none") -> None:
     with open(path, "wb") as f:
-        writer = McapWriter(f, profile="", library="test")
+        writer = McapWriter(f, profile="", library="test", compression=compression)
         schema = writer.register_schema("s", "jsonschema", b"{}")
         a = writer.register_channel("/a", "json", schema)
         b = writer.register_channel("/b", "json", schema)
@@ -24,9 +30,10 @@ def _write(path: Path) -> None:
         writer.finish()
 
 
-def test_reader_sees_every_message_and_the_statistics(tmp_path: Path) -> None:
+@pytest.mark.parametrize("compression", ["none", "zstd", "lz4"])
+def test_reader_sees_every_message_and_the_statistics(tmp_path: Path, compression: str) -> None:
     path = tmp_path / "t.mcap"
-    _write(path)
+    _write(path, compression)
     with open(path, "rb") as f:
         reader = make_reader(f, validate_crcs=True)
         summary = reader.get_summary()
@@ -35,6 +42,10 @@ def test_reader_sees_every_message_and_the_statistics(tmp_path: Path) -> None:
         assert (stats.message_count, stats.channel_count, stats.schema_count) == (3, 2, 1)
         assert (stats.message_start_time, stats.message_end_time) == (100, 200)
         assert stats.channel_message_counts == {1: 2, 2: 1}
+        assert stats.chunk_count == len(summary.chunk_indexes) == 1
+        (index,) = summary.chunk_indexes
+        assert index.compression == {"none": ""}.get(compression, compression)
+        assert sorted(index.message_index_offsets) == [1, 2]
         got = [(c.topic, m.sequence, m.log_time, m.data) for _, c, m in reader.iter_messages()]
     assert got == [
         ("/a", 0, 100, b'{"x":1}'),
@@ -48,8 +59,14 @@ def test_crcs_are_checked_and_right(tmp_path: Path) -> None:
     _write(path)
     records = list(StreamReader(str(path), validate_crcs=True).records)  # raises on a bad CRC
     assert type(records[-1]).__name__ == "Footer"
-    data = bytearray(path.read_bytes())
-    data[data.index(b'{"y":2}')] ^= 0xFF  # one flipped byte in the data section
+    good = path.read_bytes()
+    data = bytearray(good)
+    data[data.index(b'{"y":2}')] ^= 0xFF  # one flipped byte in a chunk
+    path.write_bytes(bytes(data))
+    with pytest.raises(CRCValidationError, match="crc validation failed in Chunk"):
+        list(StreamReader(str(path), validate_crcs=True).records)
+    data = bytearray(good)
+    data[good.index(b"\x07", good.index(b'{"x":3}'))] ^= 0x40  # the message index record
     path.write_bytes(bytes(data))
     with pytest.raises(CRCValidationError, match="crc validation failed in DataEnd"):
         list(StreamReader(str(path), validate_crcs=True).records)
@@ -89,3 +106,81 @@ def test_a_block_writes_the_same_bytes_as_one_message_at_a_time(tmp_path: Path) 
         (2, 0, bytes(payloads[1])),
         (1, 6, bytes(payloads[2])),
     ]
+
+
+def _many(path: Path, compression: str, chunk_bytes: int, ticks: int = 40) -> None:
+    """`ticks` ticks of two small messages and, every 10th tick, one bulk (100 kB) one."""
+    with open(path, "wb") as f:
+        writer = McapWriter(
+            f, profile="", library="test", compression=compression, chunk_bytes=chunk_bytes
+        )
+        schema = writer.register_schema("s", "jsonschema", b"{}")
+        small = [writer.register_channel(t, "json", schema) for t in ("/a", "/b")]
+        big = writer.register_channel("/img", "json", schema)
+        for tick in range(ticks):
+            payloads = [b'{"t":%d}' % tick + b" " * 200] * 2
+            writer.add_messages(small, [tick, tick], tick * 10, payloads)
+            if tick % 10 == 0:
+                writer.add_messages([big], [tick // 10], tick * 10, [bytes(100_000)])
+        writer.finish()
+
+
+@pytest.mark.parametrize("compression", ["none", "zstd", "lz4"])
+def test_chunks_are_bounded_indexed_and_read_by_topic_and_time(
+    tmp_path: Path, compression: str
+) -> None:
+    path = tmp_path / "t.mcap"
+    _many(path, compression, chunk_bytes=2000)
+    records = list(StreamReader(str(path), validate_crcs=True, emit_chunks=True).records)
+    chunks = [r for r in records if isinstance(r, Chunk)]
+    assert len(chunks) > 8
+    for chunk in chunks:  # closed before the message that would start past the bound
+        assert chunk.uncompressed_size < 2000 + 2 * 250 or chunk.uncompressed_size == 100_031
+    indexes = [r for r in records if isinstance(r, MessageIndex)]
+    assert sum(len(i.records) for i in indexes) == 40 * 2 + 4
+    owner = {id(i): c for c in chunks for i in _indexes_after(records, c)}
+    for index in indexes:  # every entry points at a message of its channel and log time
+        chunk = owner[id(index)]
+        data = decompress(chunk.data, chunk.compression, chunk.uncompressed_size)
+        for log_time, offset in index.records:
+            opcode, _, channel, _, at = struct.unpack_from("<BQHIQ", data, offset)
+            assert (opcode, channel, at) == (0x05, index.channel_id, log_time)
+    with open(path, "rb") as f:
+        reader = make_reader(f, validate_crcs=True)
+        summary = reader.get_summary()
+        assert summary is not None and len(summary.chunk_indexes) == len(chunks)
+        bulk = [c for c in summary.chunk_indexes if c.uncompressed_size > 90_000]
+        assert len(bulk) == 4 and all(list(c.message_index_offsets) == [3] for c in bulk)
+        got = [(c.topic, m.log_time) for _, c, m in reader.iter_messages("/a", starting_at=300)]
+    assert got == [("/a", t) for t in range(300, 400, 10)]
+
+
+def _indexes_after(records: list[object], chunk: Chunk) -> list[MessageIndex]:
+    """The message index records that follow `chunk` in the file."""
+    out = []
+    for record in records[records.index(chunk) + 1 :]:
+        if not isinstance(record, MessageIndex):
+            break
+        out.append(record)
+    return out
+
+
+def test_same_messages_same_bytes_and_compression_is_checked(tmp_path: Path) -> None:
+    for name in ("one", "two"):
+        _many(tmp_path / name, "zstd", chunk_bytes=3000)
+    assert (tmp_path / "one").read_bytes() == (tmp_path / "two").read_bytes()
+    with pytest.raises(ValueError, match="compression 'gzip'; allowed: none, zstd, lz4"):
+        McapWriter(io.BytesIO(), profile="", library="test", compression="gzip")
+
+
+def test_the_tail_is_the_open_chunks_readable_without_a_summary(tmp_path: Path) -> None:
+    out = io.BytesIO()
+    writer = McapWriter(out, profile="", library="test", compression="zstd", chunk_bytes=400)
+    schema = writer.register_schema("s", "jsonschema", b"{}")
+    chan = writer.register_channel("/a", "json", schema)
+    for tick in range(5):
+        writer.add_messages([chan], [tick], tick, [b'{"x":%d}' % tick + b" " * 150])
+    (tmp_path / "killed.mcap").write_bytes(out.getvalue() + writer.tail())
+    messages = read_mcap_messages(tmp_path / "killed.mcap")  # no DataEnd, no summary
+    assert [m.sequence for m in messages] == [0, 1, 2, 3, 4]
+    assert messages[-1].decoded == {"x": 4}

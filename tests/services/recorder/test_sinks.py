@@ -3,9 +3,11 @@ bag (profile ros2, CDR only), JSON only in the extras file."""
 
 from __future__ import annotations
 
+import errno
 import math
 import shutil
 from pathlib import Path
+from typing import Any
 
 import pytest
 from mcap.reader import make_reader
@@ -16,7 +18,8 @@ from rosbags.typesys import Stores, get_typestore
 from catabot.bus.messages import Message, ThrustCmd, TwistCmd, VesselState
 from catabot.ros2 import cdr, cdr_more, types
 from catabot.ros2.convert import thrust
-from services.recorder.csv_sink import CsvSink, RecorderError
+from catabot.run.mcap_index import McapIndex
+from services.recorder.csv_sink import CsvSink, DiskError, RecorderError
 from services.recorder.mcap_read import read_mcap_messages
 from services.recorder.mcap_sink import McapSink
 
@@ -62,9 +65,9 @@ ODOM, TWIST_TOPIC, THRUST_TOPIC = "/ego/odom", "/ego/cmd_vel", "/ego/thrust"
 ODOMETRY = cdr.odometry_encoder("map", "ego/base_link")
 
 
-def _record_mcap(path: Path, ticks: int = 5, *, close: bool = True) -> McapSink:
+def _record_mcap(path: Path, ticks: int = 5, *, close: bool = True, **kw: Any) -> McapSink:
     """Per tick an Odometry, a Twist and a thrust array, as the recorder writes them."""
-    sink = McapSink(path)
+    sink = McapSink(path, **kw)
     for k in range(ticks):
         stamp = k * DT
         sink.write(ODOM, types.ODOMETRY, ODOMETRY(_state(k), stamp), stamp_ns=stamp)
@@ -93,7 +96,7 @@ def test_csv_files_headers_and_rows(tmp_path: Path) -> None:
     assert thrust[0] == "stamp_ns,tick,thrust_0,thrust_1"
     assert thrust[2] == "100000000,1,0.1,-0.1"
     twist = (tmp_path / "vessel.ego.cmd.twist.csv").read_text().splitlines()
-    assert twist[:2] == ["stamp_ns,tick,surge[m/s],yaw_rate[rad/s]", "0,0,0.333333333333,nan"]
+    assert twist[:2] == ["stamp_ns,tick,surge[m/s],yaw_rate[rad/s]", "0,0,0.3333333333333333,nan"]
 
 
 def test_csv_is_byte_identical_for_identical_writes(tmp_path: Path) -> None:
@@ -188,8 +191,9 @@ def test_truncated_mcap_reads_up_to_last_flush(tmp_path: Path) -> None:
 
 
 def test_torn_tail_is_ignored(tmp_path: Path) -> None:
+    """A torn chunk is lost whole; what came before it reads (here a chunk a message)."""
     path = tmp_path / "run.mcap"
-    _record_mcap(path, ticks=2, close=False)
+    _record_mcap(path, ticks=2, close=False, chunk_bytes=1)
     data = path.read_bytes()
     full = len(read_mcap_messages(path))
     for cut in range(len(data) - 1, len(data) - 60, -1):  # a record torn mid-write
@@ -224,3 +228,36 @@ def test_extras_are_json_with_a_schema(tmp_path: Path) -> None:
         {"a": 1},
         5,
     )
+
+
+class _FullDisk:
+    """A file with `room` bytes left: a write past it writes what fits, then fails."""
+
+    def __init__(self, file: Any, room: int) -> None:
+        self._file, self._room = file, room
+
+    def write(self, data: Any) -> int:
+        if self._room <= 0:
+            raise OSError(errno.ENOSPC, "No space left on device")
+        written = int(self._file.write(data[: self._room]))
+        self._room -= written
+        return written
+
+    def __getattr__(self, name: str) -> Any:
+        return getattr(self._file, name)
+
+
+def test_a_full_disk_cuts_the_mcap_back_to_its_last_whole_chunk(tmp_path: Path) -> None:
+    """A failed flush is cut back off: the file ends with the last finished chunk."""
+    path = tmp_path / "run.mcap"
+    sink = _record_mcap(path, ticks=6, close=False, chunk_bytes=1500)  # chunks of ~5 messages
+    finished = [m.log_time for m in read_mcap_messages(path)]
+    sink.write(ODOM, types.ODOMETRY, ODOMETRY(_state(6), 6 * DT), stamp_ns=6 * DT)
+    sink._out._file = _FullDisk(sink._out._file, room=100)  # type: ignore[assignment]
+    with pytest.raises(DiskError, match="No space left on device"):
+        sink.flush()
+    left = read_mcap_messages(path)
+    assert 0 < len(left) < len(finished)  # the finished chunks, not the open one
+    assert path.stat().st_size == sink._out._size  # cut back to the last whole chunk
+    assert [m.log_time for m in left] == finished[: len(left)]
+    assert McapIndex(path).channel(ODOM) is not None

@@ -57,7 +57,7 @@ def test_variable_length_vector_takes_width() -> None:
 def test_sample_columns_size_by_sample() -> None:
     cmd = ThrustCmd(thrust=(0.5, -0.5, 0.0), tick=3, stamp_ns=300)
     assert tabular.sample_columns(cmd) == tabular.columns(ThrustCmd, width=3)
-    assert tabular.row(cmd) == ["300", "3", "0.5", "-0.5", "0"]
+    assert tabular.row(cmd) == ["300", "3", "0.5", "-0.5", "0.0"]
 
 
 def test_scalars_with_units() -> None:
@@ -65,7 +65,7 @@ def test_scalars_with_units() -> None:
     assert tabular.row(TwistCmd(surge=2.0, yaw_rate=-0.1, tick=1, stamp_ns=10)) == [
         "10",
         "1",
-        "2",
+        "2.0",
         "-0.1",
     ]
 
@@ -92,10 +92,10 @@ def test_formatting_is_deterministic_for_numpy_and_specials() -> None:
     assert tabular.fmt(True) == "true"
 
 
-def test_floats_have_twelve_significant_digits() -> None:
-    assert tabular.fmt(1 / 3) == "0.333333333333"
-    assert tabular.fmt(123456.789012345) == "123456.789012"
-    assert tabular.fmt(1e-7) == "1e-07"
+def test_floats_are_the_shortest_text_that_reads_back_exactly() -> None:
+    assert tabular.fmt(1 / 3) == "0.3333333333333333"
+    assert tabular.fmt(123456.789012345) == "123456.789012345"
+    assert tabular.fmt(1e-7) == "1e-07" and tabular.fmt(2.0) == "2.0"
 
 
 def test_block_lines_equal_row_by_row_formatting() -> None:

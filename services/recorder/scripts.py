@@ -1,0 +1,43 @@
+"""The scenario's scripted commands, recorded as the commands they are (issue #17).
+
+Physics applies a vessel's script step at the first tick at or after its `t_s`
+(services/physics/commands.py); the recorder writes that step, at that tick, on the stream
+an external command of its kind uses (`vessel/<id>/cmd/thrust` or `.../cmd/twist`), so the
+CSV and `/<ns>/thrust` or `/<ns>/cmd_vel` in run.mcap hold every command a vessel was given,
+scripted or sent. Stamp: the tick's, as for an external command (the tick physics applies
+it at). Steps that fall on one tick: the last, the one physics follows.
+"""
+
+from __future__ import annotations
+
+from catabot.bus.clock import NS_PER_S
+from catabot.bus.messages import Message, ThrustCmd, TwistCmd
+from catabot.config.scenario import ScriptStep
+from catabot.world.world import World
+
+
+class ScriptedCommands:
+    """Every vessel's script steps by the tick they take effect at."""
+
+    def __init__(self, world: World) -> None:
+        dt = world.scenario.dt_ns
+        self._due: dict[int, dict[str, ScriptStep]] = {}
+        for vessel in world.vessels:
+            for step in sorted(vessel.script, key=lambda s: s.t_s):
+                tick = -(-round(step.t_s * NS_PER_S) // dt)  # the first tick at or after t_s
+                self._due.setdefault(tick, {})[vessel.id] = step
+        self._keys = world.keys
+
+    def due(self, tick: int, stamp_ns: int) -> list[tuple[str, Message]]:
+        """(stream, command) of every step that takes effect at `tick`."""
+        out: list[tuple[str, Message]] = []
+        for vessel, step in self._due.get(tick, {}).items():
+            if step.thrust is not None:
+                key = self._keys.cmd_thrust(vessel)
+                out.append((key, ThrustCmd(tuple(step.thrust), tick=tick, stamp_ns=stamp_ns)))
+            elif step.twist is not None:
+                key = self._keys.cmd_twist(vessel)
+                twist = step.twist
+                cmd = TwistCmd(twist.surge_mps, twist.yaw_rate_radps, tick=tick, stamp_ns=stamp_ns)
+                out.append((key, cmd))
+        return [(self._keys.relative(key), cmd) for key, cmd in out]

@@ -1,0 +1,25 @@
+"""Script steps become the commands physics follows, at the tick it follows them."""
+
+from __future__ import annotations
+
+from catabot.bus.messages import ThrustCmd, TwistCmd
+from catabot.config.load import parse_scenario
+from catabot.world.world import World
+from services.recorder.scripts import ScriptedCommands
+
+SCRIPT = [
+    {"t_s": 0.0, "thrust": [0.1, 0.1]},
+    {"t_s": 0.015, "thrust": [0.2, 0.2]},  # between ticks 1 and 2: applied at tick 2
+    {"t_s": 0.02, "thrust": [0.3, 0.3]},  # the same tick: this one wins (physics follows it)
+    {"t_s": 0.05, "twist": {"surge_mps": 1.0, "yaw_rate_radps": -0.5}},
+]
+
+
+def test_steps_land_on_the_first_tick_at_or_after_their_time() -> None:
+    world = World.resolve(parse_scenario({"vessels": [{"id": "ego", "script": SCRIPT}]}))
+    scripts = ScriptedCommands(world)
+    due = {k: scripts.due(k, k * 10_000_000) for k in range(8)}
+    assert due[0] == [("vessel/ego/cmd/thrust", ThrustCmd((0.1, 0.1), 0, 0))]
+    assert due[2] == [("vessel/ego/cmd/thrust", ThrustCmd((0.3, 0.3), 2, 20_000_000))]
+    assert due[5] == [("vessel/ego/cmd/twist", TwistCmd(1.0, -0.5, 5, 50_000_000))]
+    assert [k for k, d in due.items() if d] == [0, 2, 5]
