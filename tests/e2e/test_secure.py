@@ -123,14 +123,14 @@ def test_an_observer_cannot_drive_the_clock_or_a_vessel(
     clean = _run(tmp_path, folder, "clean")
     attacked = _run(tmp_path, folder, "observer", "viewer")
     assert [name for name in clean if clean[name] != attacked.get(name)] == []
-    assert "vessel.ego.cmd.thrust.csv" not in attacked
+    assert set(attacked) == set(clean)  # the observer's thrust not even recorded
 
 
 def test_a_commanding_client_commands(tmp_path: Path, profile: tuple[Path, str]) -> None:
     folder, _ = profile
     files = _run(tmp_path, folder, "autopilot", "autopilot")
     rows = files["vessel.ego.cmd.thrust.csv"].decode().splitlines()
-    assert len(rows) > 1 and rows[1].endswith(",1,-1")
+    assert any(row.endswith(",1.0,-1.0") for row in rows[1:])  # beside the scripted ones
     assert files["config.changes.csv"].decode().splitlines()[1].endswith(",rain,50.0")
 
 

@@ -91,7 +91,8 @@ def test_send_thrust_is_recorded_and_applied(run: type[Run]) -> None:
     assert sent.returncode == 0, sent.stderr
     rows = (sim.finish() / "vessel.ego.cmd.thrust.csv").read_text().splitlines()
     assert rows[0] == "stamp_ns,tick,thrust_0,thrust_1"
-    assert [r.split(",")[2:] for r in rows[1:]] == [["0.5", "-0.25"]] * 3
+    sent_rows = [r.split(",")[2:] for r in rows[1:] if r.split(",")[2:] == ["0.5", "-0.25"]]
+    assert len(sent_rows) == 3  # beside the default scenario's scripted thrust
 
 
 def test_send_thrust_says_when_no_simulation_listens() -> None:

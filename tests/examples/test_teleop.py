@@ -156,5 +156,5 @@ def test_a_person_drives_with_the_keys_and_takes_a_screenshot(
     rows = (run_dir / "vessel.ego.cmd.thrust.csv").read_text().splitlines()[1:]
     sent = [tuple(r.split(",")[2:]) for r in rows]
     assert ("0.5", "0.5") in sent and ("0.4", "0.5") in sent
-    assert sent[-1] == ("0", "0")  # Q stops the thrusters before leaving
+    assert sent[-1] == ("0.0", "0.0")  # Q stops the thrusters before leaving
     assert sent.index(("0.5", "0.5")) < sent.index(("0.4", "0.5"))
