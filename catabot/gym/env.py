@@ -49,7 +49,7 @@ class CataBotEnv(gym.Env[Obs, np.ndarray]):
         self.world = f"{base}-gym{os.getpid()}x{next(_INSTANCES)}"
         n = len(self._draw.model.thrusters) if o.action == "thrust" else 2
         self.action_space = gym.spaces.Box(-1.0, 1.0, (n,), np.float32)
-        self.observation_space = observation_space(o)
+        self.observation_space = observation_space(o)  # type: ignore[assignment]
         self._runner = Runner(o, self._draw, self.world)
         self._origin = EnuFrame(**self._draw.base.origin.model_dump())
         self._episode: Episode | None = None
@@ -70,11 +70,13 @@ class CataBotEnv(gym.Env[Obs, np.ndarray]):
         live = self._runner.start(episode_seed, upcoming)
         self._episode, world = live.episode, live.world
         self._judge = Judge(world, self._draw.vessel, self.options)
-        names = dict(zip(self.options.sensors, self._draw.sensor_names(), strict=True))
+        names: dict[str, str] = dict(
+            zip(self.options.sensors, self._draw.sensor_names(), strict=True)
+        )
         self._observer = Observer(self.options, world.body(self._draw.vessel).row, names,
                                   self._origin)  # fmt: skip
         self._observer.goal = self._episode.goal
-        self._runner.act(self._command(np.zeros(self.action_space.shape)))
+        self._runner.act(self._command(np.zeros(self.action_space.shape or (0,))))
         frame = self._runner.observe()
         self._judge.start(self._episode.goal, frame.bodies)
         self._steps, self._over = 0, False

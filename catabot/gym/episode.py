@@ -23,7 +23,7 @@ from catabot.config.vessel import VesselModel, load_vessel_model
 from catabot.gym.options import EnvOptions, EnvOptionsError
 from catabot.world import seeding
 from catabot.world.placement import CLEARANCE_M, footprint_m, keel_depth_m, resolve_poses
-from catabot.world.terrain import Terrain, load_terrain
+from catabot.world.terrain import load_terrain
 from catabot.world.world import BUOY_MODEL
 
 TRIES = 4096  # candidate starts (and goals) drawn before giving up: a region with no water
@@ -92,9 +92,8 @@ class Draw:
         low, high = self.options.goal_distance_m
         dist, bearing = rng.uniform(low, high, TRIES), rng.uniform(-math.pi, math.pi, TRIES)
         xs, ys = start.x_m + dist * np.cos(bearing), start.y_m + dist * np.sin(bearing)
-        clear = self.radius + self.options.goal_radius_m
         for x, y in zip(xs.tolist(), ys.tolist(), strict=True):
-            if self._open(x, y, clear):
+            if self._open(x, y, self.radius + KEEP_CLEAR_M):
                 return Goal(x, y, 0.0)
         raise EnvOptionsError(
             f"no goal in open water {low:g}..{high:g} m from the start ({start.x_m:.1f}, "
@@ -137,7 +136,8 @@ class Draw:
                            "command": o.action},
             "sensors": self.sensors(ego["sensors"]),
         }  # fmt: skip
-        return parse_scenario(data, source=f"episode {seed} of {o.scenario if isinstance(o.scenario, str) else 'the given scenario'}")
+        where = o.scenario if isinstance(o.scenario, str) else "the env's scenario"
+        return parse_scenario(data, source=f"episode {seed} of {where}")
 
     def sensors(self, own: list[dict[str, Any]]) -> list[dict[str, Any]]:
         """The observed sensors: the scenario's own of each kind, else the env's default;

@@ -70,7 +70,8 @@ class Judge:
         reward = w.progress * (self.last_distance - d) - w.distance * d - w.time
         reward -= w.energy * float(np.mean(np.square(action)))
         if w.heading:
-            reward -= w.heading * abs(math.remainder(self._yaw(bodies) - self.goal.yaw_rad, math.tau))
+            off = math.remainder(self._yaw(bodies) - self.goal.yaw_rad, math.tau)
+            reward -= w.heading * abs(off)
         self.last_distance = d
         hit, grounded = self.collision(bodies), self.grounded(bodies)
         reached = o.task == "navigate" and d <= o.goal_radius_m

@@ -13,6 +13,7 @@ a small part of a 10-tick control period).
 
 from __future__ import annotations
 
+import json
 import queue
 import threading
 import time
@@ -20,16 +21,19 @@ from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
 from typing import Protocol
 
+import zenoh
+
 from catabot.bus.clock import ClockError
 from catabot.bus.inbox import Inputs
 from catabot.bus.messages import BodyStates, End, Message, ThrustCmd, Tick, TwistCmd
 from catabot.bus.participant import Participant
-from catabot.bus.session import Connection, open_session
+from catabot.bus.session import Connection
 from catabot.errors import CataBotError
 from catabot.world.world import World
 
 Command = ThrustCmd | TwistCmd
 POLL_S = 0.25  # how often a blocked wait looks whether the link was closed
+RETRY = {"period_init_ms": 20, "period_max_ms": 100, "period_increase_factor": 1.5}
 
 
 class LinkError(CataBotError, RuntimeError):
@@ -53,16 +57,14 @@ class Frame:
 
 class Link(Protocol):
     def observe(self, timeout_s: float) -> Frame: ...
-    def act(self, command: Command | None) -> None: ...
+    def act(self, command: Command) -> None: ...
     def close(self) -> None: ...
 
 
 class ParticipantLink:
     """The env as the participant that controls `vessel` at its controller's rate."""
 
-    def __init__(
-        self, world: World, vessel: str, sensors: Sequence[str], endpoint: str
-    ) -> None:
+    def __init__(self, world: World, vessel: str, sensors: Sequence[str], endpoint: str) -> None:
         me = world.body(vessel)
         if me.controller is None:
             raise LinkError(f"vessel {vessel!r} has no controller to take the seat of")
@@ -79,9 +81,8 @@ class ParticipantLink:
         self._commands: queue.SimpleQueue[Command | None] = queue.SimpleQueue()
         self._closed = threading.Event()
         self._pending = False  # a frame was handed out and waits for its command
-        self._last: Command | None = None
         self._ended: End | None = None
-        self._session = open_session(Connection(connect=(endpoint,)))
+        self._session = _session(endpoint)
         self._participant = Participant(
             self._session, world.keys, self.name, inputs=streams, peers=world.participants,
             limits=world.clock_limits, drain_s=0.5,
@@ -108,19 +109,19 @@ class ParticipantLink:
         if tick.tick % (self._control.period or 1):
             return
         self._frames.put(Frame(tick.tick, tick.stamp_ns, self._latest, dict(self._newest)))
-        command = self._wait_command()
-        self._last = command if command is not None else self._last
-        if self._last is None:  # physics waits for a command every control tick
-            raise LinkError(f"{self.name}: no command yet to keep at tick {tick.tick}")
-        self._participant.publish(self._control.key, _tagged(self._last, tick))
+        command = self._wait_command()  # physics waits for one every control tick
+        self._participant.publish(self._control.key, _tagged(command, tick))
 
-    def _wait_command(self) -> Command | None:
+    def _wait_command(self) -> Command:
         while True:
             try:
-                return self._commands.get(timeout=POLL_S)
+                command = self._commands.get(timeout=POLL_S)
             except queue.Empty:
-                if self._closed.is_set():
-                    raise _Closed from None
+                command = None
+            if self._closed.is_set():
+                raise _Closed
+            if command is not None:
+                return command
 
     # -- the env's side ---------------------------------------------------------------------
 
@@ -143,7 +144,8 @@ class ParticipantLink:
                     ) from None
         if isinstance(item, End):
             self._ended = item
-            raise LinkError(f"the run ended ({item.reason}{': ' + item.error if item.error else ''})")
+            why = f"{item.reason}: {item.error}" if item.error else item.reason
+            raise LinkError(f"the run ended ({why})")
         if isinstance(item, ClockError | CataBotError):
             raise LinkError(str(item)) from item
         if isinstance(item, BaseException):
@@ -151,8 +153,8 @@ class ParticipantLink:
         self._pending = True
         return item
 
-    def act(self, command: Command | None) -> None:
-        """The command of the tick last observed (None: keep the previous one)."""
+    def act(self, command: Command) -> None:
+        """The command of the tick last observed."""
         if not self._pending:
             raise LinkError("act() without a frame observed first")
         self._pending = False
@@ -160,9 +162,24 @@ class ParticipantLink:
 
     def close(self) -> None:
         self._closed.set()
+        self._commands.put(None)  # wakes a participant waiting for a command
         self._thread.join(timeout=2.0)
         self._participant.close()
         self._session.close()
+
+
+def _session(endpoint: str) -> zenoh.Session:
+    """A peer connecting to the run's conductor, which may not listen yet: Zenoh retries
+    every 20 ms (its default waits 1 s, then 2 s, ...: a reset took a whole retry longer),
+    and opens at once (a peer's default is to scout for 0.5 s first; the env knows its one
+    endpoint and waits for the run's tokens anyway)."""
+    config = Connection(connect=(endpoint,)).config()
+    config.insert_json5("connect/retry", json.dumps(RETRY))
+    config.insert_json5("scouting/delay", "0")
+    try:
+        return zenoh.open(config)
+    except Exception as exc:
+        raise LinkError(f"cannot open zenoh to the run at {endpoint}: {exc}") from None
 
 
 class _Closed(Exception):

@@ -38,7 +38,7 @@ class Rewards(Strict):
 class EnvOptions(Strict):
     task: Task = "navigate"
     scenario: str | dict[str, Any] = Field(
-        "harbour", description="a bundled scenario's name, a scenario file, or its JSON as a dict"
+        "navigate", description="a bundled scenario's name, a scenario file, or its JSON as a dict"
     )
     vessel: VesselId | None = Field(None, description="the vessel the env drives: the first")
     world: WorldName | None = Field(None, description="key prefix catabot/<world>-gym<pid>x<n>")
@@ -69,7 +69,9 @@ class EnvOptions(Strict):
             raise ValueError(f"goal_distance_m must be 0 < min <= max (got {low}, {high})")
         rows, cols = self.lidar_shape
         if not (1 <= rows <= 256 and 1 <= cols <= 4096):
-            raise ValueError(f"lidar_shape must be 1..256 rows, 1..4096 columns (got {rows}, {cols})")
+            raise ValueError(
+                f"lidar_shape must be 1..256 rows, 1..4096 columns (got {rows}x{cols})"
+            )
         if len(set(self.sensors)) != len(self.sensors):
             raise ValueError(f"sensors must not repeat (got {list(self.sensors)})")
         return self

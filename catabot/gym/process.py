@@ -9,6 +9,7 @@ service cleanly); a run that does not end in time is killed with its whole proce
 
 from __future__ import annotations
 
+import contextlib
 import os
 import signal
 import subprocess
@@ -86,15 +87,9 @@ def _child_env() -> dict[str, str]:
 
 def _kill_tree(pid: int) -> None:
     """SIGKILL `pid` and every descendant (the services run in sessions of their own)."""
-    for child in reversed(_descendants(pid)):
-        try:
-            os.kill(child, signal.SIGKILL)
-        except ProcessLookupError:
-            pass
-    try:
-        os.kill(pid, signal.SIGKILL)
-    except ProcessLookupError:
-        pass
+    for victim in [*reversed(_descendants(pid)), pid]:
+        with contextlib.suppress(ProcessLookupError):
+            os.kill(victim, signal.SIGKILL)
 
 
 def _descendants(pid: int) -> list[int]:

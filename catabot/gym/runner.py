@@ -76,7 +76,9 @@ class Runner:
             except LinkTimeout:
                 if not live.run.alive or time.monotonic() > limit:
                     self.end()
-                    raise RunError(f"the episode's run did not start: {live.run.failure()}")
+                    raise RunError(
+                        f"the episode's run did not start: {live.run.failure()}"
+                    ) from None
 
     def observe(self) -> Frame:
         live = self._current()
