@@ -4,21 +4,17 @@ The scenario names this program as the vessel's controller (`"controller": {"par
 "stack", "rate_hz": 10}`); the run waits for it, and every command is applied at the same
 tick on every run, so two runs record the same bytes. This one steers to a goal point with
 differential thrust (thruster 0 port, 1 starboard): copy it and put your stack in `decide`.
+It needs no scenario file: the world, the vessel and its controller come from the run.
 
 catabot run examples/stack.json --listen tcp/127.0.0.1:7447 &
-python examples/lockstep_stack.py examples/stack.json --connect tcp/127.0.0.1:7447 --goal 40 20
+python examples/lockstep_stack.py --connect tcp/127.0.0.1:7447 --goal 40 20
 """
 
 import math
 
-from common import parser, session
+from common import parser
 
-from catabot.bus.inbox import Inputs
-from catabot.bus.messages import BodyStates, ThrustCmd, Tick
-from catabot.bus.participant import Participant
-from catabot.config.load import load_scenario
-from catabot.world import rotations
-from catabot.world.world import World
+from catabot.client import Client, Observation, Thrust
 
 
 def decide(x: float, y: float, yaw: float, goal: tuple[float, float]) -> tuple[float, float]:
@@ -30,39 +26,32 @@ def decide(x: float, y: float, yaw: float, goal: tuple[float, float]) -> tuple[f
     return max(ahead - turn, -1.0), min(ahead + turn, 1.0)
 
 
+def yaw_of(q: tuple[float, ...]) -> float:
+    """ENU heading of a quaternion (x, y, z, w)."""
+    x, y, z, w = q
+    return math.atan2(2.0 * (w * z + x * y), 1.0 - 2.0 * (y * y + z * z))
+
+
 def main() -> None:
     p = parser(__doc__)
-    p.add_argument("scenario", help="the scenario file the run was started with")
+    p.add_argument("--name", default="stack", help="the participant name the scenario expects")
     p.add_argument("--goal", type=float, nargs=2, default=(40.0, 20.0), metavar=("X", "Y"))
+    p.add_argument("--timeout", type=float, default=30.0, help="seconds to wait for the run")
+    p.set_defaults(world=None)  # the one world running
     args = p.parse_args()
-    world = World.resolve(load_scenario(args.scenario))
-    me = world.body(args.vessel)
-    if me.controller is None:
-        raise SystemExit(f"vessel {me.id!r} has no controller in {args.scenario}")
-    (commands,) = [s for s in world.streams.controls if world.keys.vessel_of(s.key) == me.id]
-    latest = world.start_states()
+    goal = (args.goal[0], args.goal[1])
+    seen = [(0.0, 0.0)]
 
-    with session(args) as s:
-        stack = Participant(
-            s, world.keys, me.controller.participant, inputs=[world.streams.states],
-            peers=world.participants, limits=world.clock_limits,
-        )  # fmt: skip
+    def step(obs: Observation) -> Thrust:
+        assert obs.state is not None  # the state at the start of this control period
+        x, y, _ = obs.state.position
+        seen[0] = (x, y)
+        return Thrust(decide(x, y, yaw_of(obs.state.orientation), goal))
 
-        def step(tick: Tick, inputs: Inputs) -> None:
-            nonlocal latest
-            for batch in inputs.get(world.streams.states.key, []):
-                assert isinstance(batch, BodyStates)
-                latest = batch  # the state at the start of this tick (tagged tick - 1)
-            if tick.tick % commands.period:
-                return
-            x, y, _ = latest.position[me.row].tolist()
-            yaw = float(rotations.yaw_of_quaternions(latest.orientation[me.row : me.row + 1])[0])
-            thrust = decide(x, y, yaw, tuple(args.goal))
-            stack.publish(commands.key, ThrustCmd(thrust, tick=tick.tick, stamp_ns=tick.stamp_ns))
-
-        end = stack.run(step)
-        x, y, _ = latest.position[me.row].tolist()
-        print(f"run ended at tick {end.tick} ({end.reason}); {me.id} at ({x:.2f}, {y:.2f})")
+    with Client.from_args(args) as sim:
+        end = sim.run_lockstep(args.name, step, vessel=args.vessel)
+        x, y = seen[0]
+        print(f"run ended at tick {end.tick} ({end.reason}); {args.vessel} at ({x:.2f}, {y:.2f})")
 
 
 if __name__ == "__main__":

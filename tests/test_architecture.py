@@ -15,6 +15,7 @@ LAYERS = {  # what each part of the library may import from the project, besides
     "catabot.config": {"catabot.errors", "catabot.bus"},
     "catabot.world": {"catabot.errors", "catabot.bus", "catabot.config"},
     "catabot.ros2": {"catabot.errors", "catabot.bus", "catabot.config", "catabot.world"},
+    "catabot.client": {"catabot.errors", "catabot.bus"},  # a stack needs no scenario file
     "catabot.run": {
         "catabot.errors",
         "catabot.bus",

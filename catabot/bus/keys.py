@@ -31,6 +31,11 @@ def check_name(kind: str, name: str) -> str:
     return name
 
 
+def world_infos() -> str:
+    """Every running world's `world/info` queryable: how a client finds the worlds."""
+    return f"{ROOT}/*/world/info"
+
+
 @dataclass(frozen=True)
 class Keys:
     """The key expressions of one world: `catabot/<world>/...`."""
@@ -97,6 +102,10 @@ class Keys:
 
     def env_state(self) -> str:
         return f"{self.prefix}/env/state"
+
+    def world_info(self) -> str:
+        """Queryable of the conductor: the resolved world as JSON (catabot/run/world_info.py)."""
+        return f"{self.prefix}/world/info"
 
     def config(self, name: str) -> str:
         return f"{self.prefix}/config/{check_name('config', name)}"

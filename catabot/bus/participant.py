@@ -40,6 +40,10 @@ EndFn = Callable[[End, Inputs], None]
 Event = tuple[str, str, bytes, str]  # kind, key, payload, sender zid
 
 
+class Stopped(ClockError):
+    """`run()` was stopped from another thread before the run ended (a client leaving)."""
+
+
 class Participant(Outputs):
     def __init__(
         self,
@@ -105,6 +109,8 @@ class Participant(Outputs):
         """Step every granted tick until the conductor ends the run; returns the end message."""
         while True:
             event = self._next()
+            if event[0] == "stop":
+                raise Stopped(f"{self.name} left the run at tick {self.next_tick}")
             end = self._take(event)
             if end is not None:
                 return self._finish(end, on_end)
@@ -281,6 +287,11 @@ class Participant(Outputs):
         if on_end is not None:
             on_end(end, self.inbox.release(end.tick + 1))
         return end
+
+    def stop(self) -> None:
+        """Make `run()` raise `Stopped` at its next event (from another thread: a client
+        stack leaving mid-run); the services never call it."""
+        self.events.put(("stop", "", b"", ""))
 
     def close(self) -> None:
         self._token.undeclare()

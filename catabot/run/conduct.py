@@ -31,6 +31,7 @@ from catabot.config.scenario import Scenario, participants
 from catabot.errors import CataBotError
 from catabot.run.service import quiet_gc
 from catabot.run.settings_desk import SettingsDesk
+from catabot.run.world_info import WorldInfoDesk
 
 log = logging.getLogger("catabot.bus.conductor")
 
@@ -91,6 +92,7 @@ def main(argv: list[str] | None = None) -> int:
         session, keys, clock_spec(scenario), roster=args.roster, settings=schedule
     )
     desk = SettingsDesk(session, keys, scenario, schedule)
+    info = WorldInfoDesk(session, scenario, args.roster, schedule)  # for stacks: catabot.client
     quiet_gc()
     for sig in (signal.SIGINT, signal.SIGTERM):
         signal.signal(sig, lambda *_: conductor.stop("interrupted"))
@@ -104,6 +106,7 @@ def main(argv: list[str] | None = None) -> int:
 
     result = conductor.run(progress)
     desk.close()
+    info.close()
     stop.set()
     rejected = conductor.rejections.totals + desk.rejections.totals
     settings = [live.entry(c, scenario.dt_ns) for c in schedule.applied()]

@@ -40,7 +40,8 @@ OWN = {  # keys each process may put besides its ack and its liveliness token
 }
 COMMANDS = ["vessel/*/cmd/**"]
 READ = ["declare_subscriber", "declare_liveliness_subscriber", "liveliness_query"]
-ASK = ["catabot/*/config/settings"]  # everyone may read the settings (`catabot get`)
+# everyone may read the settings (`catabot get`) and the world (a stack's Client.connect)
+ASK = ["catabot/*/config/settings", "catabot/*/world/info"]
 SET = ["catabot/*/config/set"]  # commanding clients may change them (`catabot set`)
 
 
@@ -133,7 +134,7 @@ def _acl(writers: list[str], clients: list[str], observers: list[str]) -> dict[s
         _rule("ask", ["query"], ["ingress"], ASK),
         _rule("set", ["query"], ["ingress"], SET),
         _rule("desk", ["declare_queryable", "query", "reply"], ["ingress", "egress"],
-              ["catabot/*/config/**"]),
+              ["catabot/*/config/**", "catabot/*/world/info"]),
     ]  # fmt: skip
     policies = [
         {"rules": ["read", "receive", "ask"], "subjects": ["everyone"]},

@@ -9,6 +9,7 @@ from __future__ import annotations
 from dataclasses import dataclass, replace
 from typing import TYPE_CHECKING
 
+from catabot.bus import checks
 from catabot.bus.clock import Stream
 from catabot.bus.messages import (
     BodyStates,
@@ -20,7 +21,6 @@ from catabot.bus.messages import (
 )
 from catabot.config.scenario import guidance_period_ticks, rate_in_ticks
 from catabot.config.sensors import SENSOR_TYPES
-from catabot.world import checks
 
 if TYPE_CHECKING:
     from catabot.world.world import Body, World

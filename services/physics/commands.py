@@ -101,7 +101,7 @@ class CommandBook:
 
     def take(self, vessel: str, msgs: list[Message]) -> None:
         """Adopt the newest command from the bus (checked on arrival: one finite value per
-        thruster, a finite twist: catabot/world/checks.py). A lockstep twist (tick >= 0) is a
+        thruster, a finite twist: catabot/bus/checks.py). A lockstep twist (tick >= 0) is a
         set-point; an outside command (tick -1) takes the vessel over."""
         for msg in msgs:
             if isinstance(msg, WaypointsCmd):

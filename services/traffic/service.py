@@ -87,7 +87,7 @@ class TrafficService:
 
     def _take_waypoints(self, i: int, msg: WaypointsCmd) -> None:
         """Adopt a path from outside, or release the boat (paths are checked on arrival:
-        catabot/world/checks.py)."""
+        catabot/bus/checks.py)."""
         if msg.mode == "release":
             self.behaviours.release(i)
             return

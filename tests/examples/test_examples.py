@@ -97,8 +97,8 @@ def test_lockstep_stack_reaches_its_goal_and_records_the_same_bytes_twice(
     recorded = []
     for _ in range(2):
         sim = run("examples/stack.json")
-        stack = example("lockstep_stack.py", "examples/stack.json", "--connect", sim.endpoint,
-                        "--goal", "40", "20", timeout=120)  # fmt: skip
+        stack = example("lockstep_stack.py", "--connect", sim.endpoint, "--goal", "40", "20",
+                        timeout=120)  # fmt: skip
         assert stack.returncode == 0, stack.stderr
         assert "run ended at tick 2999 (completed)" in stack.stdout
         run_dir = sim.finish()

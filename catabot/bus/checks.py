@@ -3,7 +3,9 @@
 The codec has already checked every field's type; these check what only the world knows
 (which bodies, how many thrusters) and values the services cannot use (a NaN command, a
 path with an odd number of coordinates). A sample that fails is refused and counted by the
-receiving participant (catabot/bus/inbox.py), so no step ever sees it.
+receiving participant (catabot/bus/inbox.py), so no step ever sees it. They live in the bus
+layer because a client (catabot/client/) runs the same checks on what it is about to send,
+so a bad command is an error in the stack's own process, not a silent drop in physics.
 """
 
 from __future__ import annotations

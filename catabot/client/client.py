@@ -1,0 +1,217 @@
+"""`Client`: one Zenoh session to one running world, for an autonomy stack.
+
+    with Client.connect(connect=["tcp/127.0.0.1:7447"]) as sim:
+        ego = sim.vessel("ego")
+        ego.send(Thrust([0.5, 0.5]))
+
+The world is discovered by a query (`world/info`, catabot/client/discover.py), never read
+from a scenario file; everything after that is typed: `WorldInfo`, vessel handles with
+their sensors, commands checked before they leave, and two ways to run a stack: joined to
+the lockstep (`join`, `run_lockstep`: deterministic) or free-running (`run_free`).
+"""
+
+from __future__ import annotations
+
+import argparse
+from collections.abc import Callable, Sequence
+from types import TracebackType
+
+import zenoh
+
+from catabot.bus.keys import Keys
+from catabot.bus.messages import End
+from catabot.bus.outputs import Outputs
+from catabot.bus.session import Connection, connection_from_args, open_session
+from catabot.client.commands import Command
+from catabot.client.discover import find_world
+from catabot.client.errors import NotAParticipant, RunEnded, TooLate, UnknownVessel
+from catabot.client.free import run_free
+from catabot.client.info import SensorInfo, VesselInfo, WorldInfo
+from catabot.client.lockstep import Joined, Observation
+from catabot.client.vessel import Vessel
+from catabot.client.watch import Watch
+
+Step = Callable[[Observation], Command | None]
+
+
+class Client:
+    def __init__(self, session: zenoh.Session, info: WorldInfo, where: str, timeout_s: float):
+        self.session, self.info, self._where, self.timeout_s = session, info, where, timeout_s
+        self.keys = Keys(info.name)
+        self.watch = Watch(session, self.keys, info.new_roster())
+        self._outputs = Outputs(session)
+        self._vessels: dict[str, Vessel] = {}
+        self._joined: list[Joined] = []
+
+    @classmethod
+    def connect(
+        cls,
+        connect: Sequence[str] = (),
+        *,
+        world: str | None = None,
+        timeout_s: float = 5.0,
+        listen: Sequence[str] = (),
+        mode: str | None = None,
+        zenoh_config: str | None = None,
+    ) -> Client:
+        """Open a session (an embedded peer on loopback by default; `connect` endpoints of
+        `catabot run --listen` or a router) and find the world: `world`, or the only one
+        running. SimulatorNotFound after `timeout_s` if none answers."""
+        conn = Connection(tuple(connect), tuple(listen), mode, None, zenoh_config)
+        return cls.open(conn, world=world, timeout_s=timeout_s)
+
+    @classmethod
+    def from_args(cls, args: argparse.Namespace, *, timeout_s: float | None = None) -> Client:
+        """After `catabot.bus.session.add_connection_args(parser)`; `--world` and
+        `--timeout` are used when the parser has them."""
+        world = getattr(args, "world", None)
+        timeout = timeout_s if timeout_s is not None else getattr(args, "timeout", None)
+        return cls.open(connection_from_args(args), world=world, timeout_s=timeout or 5.0)
+
+    @classmethod
+    def open(cls, conn: Connection, *, world: str | None, timeout_s: float) -> Client:
+        where = f"connect {list(conn.connect) or 'none'}, mode {conn.mode or 'peer'}"
+        session = open_session(conn)
+        try:
+            info = find_world(session, world, timeout_s, where)
+        except BaseException:
+            session.close()
+            raise
+        return cls(session, info, where, timeout_s)
+
+    # -- observing and commanding ----------------------------------------------------------
+
+    def vessel(self, vessel_id: str) -> Vessel:
+        """A scenario vessel's handle; UnknownVessel (listing the ids) if there is none."""
+        if vessel_id not in self._vessels:
+            self._vessels[vessel_id] = Vessel(self.watch, self._outputs, self._vessel(vessel_id))
+        return self._vessels[vessel_id]
+
+    def _vessel(self, vessel_id: str) -> VesselInfo:
+        info = self.info.vessels.get(vessel_id)
+        if info is None:
+            boats = " (a traffic boat: its keys take commands, but it has no sensors)"
+            extra = boats if vessel_id in self.info.traffic else ""
+            known = ", ".join(self.info.vessels) or "none"
+            raise UnknownVessel(
+                f"world {self.info.name!r} has no vessel {vessel_id!r}{extra}; its vessels: {known}"
+            )
+        return info
+
+    # -- the lockstep ----------------------------------------------------------------------
+
+    def join(
+        self,
+        name: str,
+        *,
+        vessel: str | None = None,
+        sensors: Sequence[str] = (),
+        rate_hz: float | None = None,
+    ) -> Joined:
+        """Join the lockstep as participant `name` (the scenario must expect it: a vessel's
+        `controller.participant` or `clock.external_participants`). `vessel`: the one to
+        observe and, if `name` is its controller, to command (default: the vessel `name`
+        controls); `sensors`: that vessel's sensors to wait for. The control period is the
+        controller's rate, else `rate_hz` (default every tick)."""
+        info = find_world(self.session, self.info.name, self.timeout_s, self._where)  # fresh
+        self._expected(info, name)
+        target = self._target(info, name, vessel)
+        mounted = [target.sensor(s) for s in sensors] if target is not None else []
+        if sensors and target is None:
+            raise UnknownVessel(f"sensors {list(sensors)} asked for without a vessel")
+        self._not_taken(info, name)
+        period = self._period(info, name, target, rate_hz)
+        joined = Joined(self.session, self.watch, info, name, target, mounted, period)
+        self._joined.append(joined)
+        return joined
+
+    def _expected(self, info: WorldInfo, name: str) -> None:
+        if name not in info.external:
+            raise NotAParticipant(
+                f"world {info.name!r} does not expect a participant {name!r}; it expects "
+                f"{', '.join(info.external) or 'no external participant'} (name yours in the "
+                "scenario's clock.external_participants or a vessel's controller.participant)"
+            )
+
+    def _target(self, info: WorldInfo, name: str, vessel: str | None) -> VesselInfo | None:
+        if vessel is not None:
+            return self._vessel(vessel)
+        driven = [
+            v for v in info.vessels.values() if v.controller and v.controller.participant == name
+        ]
+        return driven[0] if driven else None
+
+    def _not_taken(self, info: WorldInfo, name: str) -> None:
+        """TooLate once the clock has started (the run went on without `name`) or while
+        another session holds the name."""
+        if info.granted >= 0:
+            raise TooLate(
+                f"the run of world {info.name!r} has started (tick {info.granted} granted): "
+                f"participant {name!r} joined too late, or left it; start the stack before "
+                "the run's clock.start_timeout_s runs out"
+            )
+        holder = self.watch.members.present.get(name)
+        if holder is not None:
+            raise TooLate(f"participant {name!r} of world {info.name!r} is already joined "
+                          f"(session {holder})")  # fmt: skip
+
+    def _period(self, info: WorldInfo, name: str, target: VesselInfo | None,
+                rate_hz: float | None) -> int:  # fmt: skip
+        c = target.controller if target is not None else None
+        if c is not None and c.participant == name:
+            return c.period_ticks
+        if rate_hz is None:
+            return 1
+        ticks = round(1e9 / rate_hz / info.dt_ns)
+        if ticks < 1 or abs(ticks * info.dt_ns - 1e9 / rate_hz) > 1:
+            raise ValueError(f"rate_hz {rate_hz} is not the tick rate divided by a whole number")
+        return ticks
+
+    def run_lockstep(
+        self, name: str, step: Step, *, vessel: str | None = None, sensors: Sequence[str] = (),
+        rate_hz: float | None = None,
+    ) -> End:  # fmt: skip
+        """Join as `name` and call `step(observation) -> command | None` every control
+        period until the run ends; returns its End."""
+        joined = self.join(name, vessel=vessel, sensors=sensors, rate_hz=rate_hz)
+        try:
+            while True:
+                try:
+                    obs = joined.observe()
+                except RunEnded as ended:
+                    if ended.end is None:
+                        raise
+                    return ended.end
+                joined.act(step(obs))
+        finally:
+            joined.close()
+
+    def run_free(
+        self, step: Step, *, rate_hz: float, vessel: str, sensors: Sequence[str] = (),
+        max_steps: int | None = None,
+    ) -> End | None:  # fmt: skip
+        """Call `step(observation)` `rate_hz` times a wall-clock second with the newest
+        state and samples, and send what it returns (never blocks the clock). Returns the
+        End when the run ends, None after `max_steps`."""
+        target = self._vessel(vessel)
+        mounted: list[SensorInfo] = [target.sensor(s) for s in sensors]
+        return run_free(self.watch, self.info, self.vessel(vessel), mounted, step,
+                        rate_hz=rate_hz, max_steps=max_steps)  # fmt: skip
+
+    # -- the session -----------------------------------------------------------------------
+
+    def close(self) -> None:
+        try:
+            for joined in self._joined:
+                joined.close()
+            self.watch.close()
+        finally:
+            self.session.close()
+
+    def __enter__(self) -> Client:
+        return self
+
+    def __exit__(
+        self, kind: type[BaseException] | None, exc: BaseException | None, tb: TracebackType | None
+    ) -> None:
+        self.close()

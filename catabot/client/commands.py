@@ -1,0 +1,89 @@
+"""The commands a stack sends: Thrust, Twist, Waypoints, checked before they leave.
+
+Physics refuses a command it cannot take (catabot/bus/checks.py) and logs why; a stack would
+only see its vessel not move. So the client runs the same checks on the message it is
+about to send, with this vessel's thruster count, and raises `CommandError` in the stack.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from dataclasses import dataclass
+
+from catabot.bus import checks
+from catabot.bus.messages import Message, ThrustCmd, TwistCmd, WaypointsCmd
+from catabot.client.errors import CommandError
+from catabot.client.info import VesselInfo
+
+
+@dataclass(frozen=True)
+class Thrust:
+    """One value per thruster, -1 (full reverse) .. 1 (full forward); the vessel's
+    `thrusters` tells how many (the catamaran: 0 port, 1 starboard)."""
+
+    values: Sequence[float]
+
+
+@dataclass(frozen=True)
+class Twist:
+    """Surge speed (m/s, forward) and yaw rate (rad/s, positive turns left) for the
+    vessel's velocity controller."""
+
+    surge: float
+    yaw_rate: float
+
+
+@dataclass(frozen=True)
+class Waypoints:
+    """A path in `map` (ENU, m) to follow at `speed` m/s, each point reached within
+    `tolerance` m; `mode` "back_and_forth", "loop", or "release" (hand the vessel back)."""
+
+    points: Sequence[tuple[float, float]]
+    speed: float = 1.0
+    tolerance: float = 2.0
+    mode: str = "back_and_forth"
+
+
+Command = Thrust | Twist | Waypoints
+KINDS: dict[type, str] = {Thrust: "thrust", Twist: "twist", Waypoints: "waypoints"}
+
+
+def kind_of(command: Command) -> str:
+    kind = KINDS.get(type(command))
+    if kind is None:
+        raise CommandError(
+            f"{type(command).__name__} is not a command: send Thrust, Twist or Waypoints "
+            "(catabot.client)"
+        )
+    return kind
+
+
+def message(command: Command, vessel: VesselInfo, *, tick: int = -1, stamp_ns: int = 0) -> Message:
+    """The bus message of `command` for `vessel`, checked as physics will check it."""
+    kind = kind_of(command)
+    try:
+        if isinstance(command, Thrust):
+            msg: Message = ThrustCmd(_floats(command.values), tick, stamp_ns)
+            checks.thrust(vessel.thrusters)(msg)
+        elif isinstance(command, Twist):
+            msg = TwistCmd(float(command.surge), float(command.yaw_rate), tick, stamp_ns)
+            checks.twist(msg)
+        else:
+            assert isinstance(command, Waypoints)
+            points = _floats([c for p in command.points for c in _pair(p)])
+            msg = WaypointsCmd(points, float(command.speed), float(command.tolerance),
+                               str(command.mode), tick, stamp_ns)  # fmt: skip
+            checks.waypoints(msg)
+    except (TypeError, ValueError) as exc:
+        raise CommandError(f"{kind} command for vessel {vessel.id!r}: {exc}") from None
+    return msg
+
+
+def _floats(values: Sequence[float]) -> tuple[float, ...]:
+    return tuple(float(v) for v in values)
+
+
+def _pair(point: Sequence[float]) -> tuple[float, float]:
+    if len(point) != 2:
+        raise ValueError(f"a waypoint is (x, y) in m, not {tuple(point)!r}")
+    return float(point[0]), float(point[1])

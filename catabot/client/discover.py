@@ -1,0 +1,68 @@
+"""Finding a running world: the conductor's `world/info` queryable, asked until it answers.
+
+Peers need a moment to meet after a session opens (a router answers at once), and the
+conductor serves the queryable once it has resolved the world, so the query is repeated
+until `timeout_s`. With no world named, `catabot/*/world/info` finds every running world:
+exactly one must answer, or the error lists them.
+"""
+
+from __future__ import annotations
+
+import json
+import time
+from typing import Any
+
+import zenoh
+
+from catabot.bus.keys import ROOT, Keys, world_infos
+from catabot.client.errors import SeveralWorlds, SimulatorNotFound
+from catabot.client.info import WorldInfo, parse
+
+RETRY_S = 0.2
+
+
+def find_world(
+    session: zenoh.Session, world: str | None, timeout_s: float, where: str
+) -> WorldInfo:
+    """The `WorldInfo` of `world` (or of the only world running); `where` names the
+    endpoints in the error."""
+    selector = Keys(world).world_info() if world else world_infos()
+    limit = time.monotonic() + timeout_s
+    while True:
+        answers = _ask(session, selector, max(min(limit - time.monotonic(), 2.0), 0.1))
+        if answers:
+            break
+        if time.monotonic() >= limit:
+            what = f"world {world!r}" if world else "any world"
+            raise SimulatorNotFound(
+                f"no simulation of {what} answered on {selector} within {timeout_s:g} s "
+                f"({where}); is `catabot run` running, and does it listen where this client "
+                "connects (`catabot run --listen tcp/127.0.0.1:7447`, then connect="
+                '["tcp/127.0.0.1:7447"] or --connect tcp/127.0.0.1:7447)?'
+            )
+        time.sleep(RETRY_S)
+    worlds = sorted(answers)
+    if len(worlds) > 1:
+        raise SeveralWorlds(
+            f"several simulations answer ({', '.join(worlds)}): choose one with world= (--world)"
+        )
+    key, data = answers[worlds[0]]
+    return parse(data, key)
+
+
+def _ask(session: zenoh.Session, selector: str, timeout_s: float) -> dict[str, tuple[str, Any]]:
+    """World name -> (key, decoded answer) of every valid reply (error replies and
+    non-JSON are skipped: they name no world)."""
+    out: dict[str, tuple[str, Any]] = {}
+    for reply in session.get(selector, timeout=timeout_s):
+        if reply.ok is None:
+            continue
+        key = str(reply.ok.key_expr)
+        try:
+            data = json.loads(reply.ok.payload.to_bytes().decode("utf-8"))
+        except (UnicodeDecodeError, ValueError, RecursionError):
+            continue
+        name = data.get("world") if isinstance(data, dict) else None
+        if isinstance(name, str) and key == f"{ROOT}/{name}/world/info":  # its own world's key
+            out[name] = (key, data)
+    return out

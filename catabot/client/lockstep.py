@@ -1,0 +1,227 @@
+"""Joining the lockstep as a named participant, pull style: `observe()`, then `act(command)`.
+
+The protocol is the bus's own `Participant` (catabot/bus/participant.py: Jacobi inputs,
+acks, End, sender checks), run on a thread of its own; its step hands each control
+period's observation to the stack through a queue and waits for the stack's command on
+another. So the stack's loop is plain code (what a Gymnasium env needs), and the
+determinism is the participant's: at control tick k the observation holds the state at
+t_k (the `BodyStates` tagged k-1; the start poses at k = 0) and the newest sample of each
+sensor tagged before k, and the command goes out tagged k on the vessel's clocked command
+stream, applied by physics from tick k+1 on every run.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import queue
+import threading
+from dataclasses import dataclass, field
+from typing import Any
+
+import zenoh
+
+from catabot.bus.inbox import Inputs
+from catabot.bus.keys import Keys
+from catabot.bus.messages import BodyStates, End, Message, ThrustCmd, Tick, TwistCmd, VesselState
+from catabot.bus.participant import Participant, Stopped
+from catabot.client.commands import Command, Thrust, Twist, kind_of, message
+from catabot.client.errors import ClientError, CommandError, NoData, RunEnded
+from catabot.client.info import SensorInfo, VesselInfo, WorldInfo
+from catabot.client.watch import Watch
+
+END_GRACE_S = 7.0  # longer than a participant's drain after an End (5 s)
+_LEAVE = object()  # put on the command queue by close(): the step gives up its wait
+
+
+@dataclass(frozen=True)
+class Observation:
+    """What a stack sees at the start of control period `tick` (time `time_s`): its vessel's
+    `state` (None when joined without a vessel), every body's state in `bodies` (rows in
+    `WorldInfo.body_ids` order), the newest sample of each sensor asked for (None before the
+    first) and every sample since the previous observation in `samples`."""
+
+    tick: int
+    stamp_ns: int
+    state: VesselState | None
+    bodies: BodyStates
+    sensors: dict[str, Any]
+    samples: dict[str, list[Any]] = field(default_factory=dict, repr=False)
+
+    @property
+    def time_s(self) -> float:
+        return self.stamp_ns / 1e9
+
+
+class Joined:
+    """A stack in the lockstep: `observe()` blocks until the next control period's inputs
+    are in, `act(command)` sends its command; RunEnded when the run is over."""
+
+    def __init__(
+        self,
+        session: zenoh.Session,
+        watch: Watch,
+        info: WorldInfo,
+        name: str,
+        vessel: VesselInfo | None,
+        sensors: list[SensorInfo],
+        period: int,
+    ) -> None:
+        self.name, self.info, self.vessel, self.period = name, info, vessel, period
+        self._watch = watch
+        self._sensors = {s.key: s.name for s in sensors}
+        self._control = vessel.control_stream() if vessel is not None else None
+        if self._control is not None and self._control.producer != name:
+            self._control = None  # another participant drives this vessel: observe only
+        states = info.states_stream()
+        self.participant = Participant(
+            session, Keys(info.name), name, inputs=[states, *(s.stream() for s in sensors)],
+            peers=info.participants, roster=info.new_roster(), limits=info.limits,
+        )  # fmt: skip
+        self._bodies = info.start
+        self._newest: dict[str, Any] = {s.name: None for s in sensors}
+        self._since: dict[str, list[Any]] = {s.name: [] for s in sensors}
+        self._last: Message | None = None
+        self._observations: queue.SimpleQueue[tuple[str, Any]] = queue.SimpleQueue()
+        self._commands: queue.SimpleQueue[Any] = queue.SimpleQueue()
+        self._pending: Observation | None = None  # observed, not yet acted on
+        self.end: End | None = None
+        self._closed = False
+        self._thread = threading.Thread(target=self._run, name=f"lockstep-{name}", daemon=True)
+        self._thread.start()
+
+    # -- the participant's thread -------------------------------------------------------
+
+    def _run(self) -> None:
+        try:
+            end = self.participant.run(self._step)
+            self._observations.put(("end", end))
+        except Stopped:
+            self._observations.put(("left", None))
+        except Exception as exc:  # a ClockError (conductor gone) or a bug: the stack hears it
+            self._observations.put(("error", exc))
+
+    def _step(self, tick: Tick, inputs: Inputs) -> None:
+        for msg in inputs.get(self.info.states_key, ()):
+            assert isinstance(msg, BodyStates)
+            self._bodies = msg  # the state at the start of this tick (tagged tick - 1)
+        for key, name in self._sensors.items():
+            samples = inputs.get(key)
+            if samples:
+                self._since[name].extend(samples)
+                self._newest[name] = samples[-1]
+        if tick.tick % self.period:
+            return
+        self._observations.put(("obs", self._observation(tick)))
+        command = self._commands.get()  # the stack's act(); the conductor's deadline runs
+        if command is _LEAVE:
+            raise Stopped(f"{self.name} left the run at tick {tick.tick}")
+        if self._control is not None:
+            self.participant.publish(self._control.key, command)
+
+    def _observation(self, tick: Tick) -> Observation:
+        since, self._since = self._since, {name: [] for name in self._since}
+        state = self._bodies.row(self.vessel.row) if self.vessel is not None else None
+        return Observation(tick.tick, tick.stamp_ns, state, self._bodies, dict(self._newest),
+                           since)  # fmt: skip
+
+    # -- the stack's thread --------------------------------------------------------------
+
+    def observe(self, timeout_s: float | None = None) -> Observation:
+        """The next control period's observation; blocks until it is granted and its inputs
+        are in. RunEnded when the run ends first (the End's reason), NoData after
+        `timeout_s` (None: wait as long as the run goes on). Without an act() since the
+        previous observation, act(None) is implied."""
+        if self.end is not None:
+            raise RunEnded(f"the run of world {self.info.name!r} has ended ({self.end.reason})",
+                           self.end)  # fmt: skip
+        if self._pending is not None:
+            self.act(None)
+        kind, value = self._wait(timeout_s)
+        if kind == "obs":
+            self._pending = value
+            return value
+        if kind == "end":
+            self.end = value
+            raise RunEnded(
+                f"the run of world {self.info.name!r} ended at tick {value.tick} "
+                f"({value.reason}{': ' + value.error if value.error else ''})", value
+            )  # fmt: skip
+        if kind == "left":
+            raise ClientError(f"participant {self.name!r} has left the run (close())")
+        raise RunEnded(f"{self.name}: {value}") from value
+
+    def _wait(self, timeout_s: float | None) -> tuple[str, Any]:
+        """The participant's next word; if the client saw the run end (or the conductor
+        vanish) and the participant says nothing within its drain time, it is stopped and
+        the stack hears why: a participant that never saw the conductor cannot end alone."""
+        waited, ended_at = 0.0, None
+        while True:
+            try:
+                return self._observations.get(timeout=0.25)
+            except queue.Empty:
+                waited += 0.25
+            ended = self._watch.ended()
+            if ended is not None:
+                ended_at = waited if ended_at is None else ended_at
+                if waited - ended_at > END_GRACE_S:
+                    self.participant.stop()
+                    raise ended
+            if timeout_s is not None and waited >= timeout_s:
+                raise NoData(f"{self.name}: no control period granted within {timeout_s:g} s")
+
+    def act(self, command: Command | None) -> None:
+        """The command for the period last observed, tagged with its tick: applied from the
+        next tick on every run. None keeps the last command (zero thrust, or a zero twist,
+        before the first)."""
+        obs = self._pending
+        if obs is None:
+            raise ClientError(f"{self.name}: act() before observe(): nothing to answer")
+        msg = self._message(command, obs) if self._control is not None else None
+        if command is not None and self._control is None:
+            raise CommandError(
+                f"participant {self.name!r} drives no vessel's commands in this world "
+                "(a vessel's controller.participant names the one that does); send free "
+                "commands with Client.vessel(id).send()"
+            )
+        self._pending = None
+        self._last = msg if msg is not None else self._last
+        self._commands.put(msg)
+
+    def _message(self, command: Command | None, obs: Observation) -> Message:
+        vessel, control = self.vessel, self._control
+        assert vessel is not None and control is not None and vessel.controller is not None
+        kind = vessel.controller.command
+        if command is None:
+            command = self._neutral(kind) if self._last is None else self._restate(kind)
+        elif kind_of(command) != kind:
+            raise CommandError(
+                f"vessel {vessel.id!r} takes {kind} commands in lockstep (its controller's "
+                f"`command`), not {kind_of(command)}"
+            )
+        return message(command, vessel, tick=obs.tick, stamp_ns=obs.stamp_ns)
+
+    def _neutral(self, kind: str) -> Command:
+        assert self.vessel is not None
+        if kind == "thrust":
+            return Thrust([0.0] * self.vessel.thrusters)
+        return Twist(0.0, 0.0)
+
+    def _restate(self, kind: str) -> Command:
+        last = self._last
+        if isinstance(last, ThrustCmd):
+            return Thrust(last.thrust)
+        assert isinstance(last, TwistCmd), kind
+        return Twist(last.surge, last.yaw_rate)
+
+    def close(self) -> None:
+        """Leave the run (mid-run the conductor names this participant gone and, by the
+        scenario's policy, ends the run or drops it)."""
+        if self._closed:
+            return
+        self._closed = True
+        if self._thread.is_alive():
+            self._commands.put(_LEAVE)
+            self.participant.stop()
+            self._thread.join(timeout=5.0)
+        with contextlib.suppress(zenoh.ZError):  # the session closed first
+            self.participant.close()

@@ -1,0 +1,83 @@
+"""A vessel as a stack sees it outside the lockstep: its state, its sensors, its commands.
+
+An observer never blocks the clock (DESIGN.md §4): states and samples are whatever physics
+and the sensors publish, the newest kept; a command sent here is free-running (tick -1),
+applied at the next tick boundary after it arrives. For commands applied at the same tick
+on every run, join the lockstep (`Client.join`).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from typing import Any
+
+from catabot.bus.clock import Stream
+from catabot.bus.messages import Message, VesselState
+from catabot.bus.outputs import Outputs
+from catabot.client.commands import Command, kind_of, message
+from catabot.client.errors import CommandError
+from catabot.client.info import SensorInfo, VesselInfo
+from catabot.client.watch import Latest, Watch
+
+
+class Sensor:
+    """One sensor of a vessel: `latest(timeout_s)` and `on_sample(callback)`; samples are the
+    typed messages of catabot.bus.messages (LidarScan, ImuSample, GpsFix, CameraFrame,
+    RadarSweep) with NumPy arrays."""
+
+    def __init__(self, watch: Watch, vessel: str, info: SensorInfo) -> None:
+        self.info = info
+        stream = Stream(info.key, info.message, info.producer, None)  # observed: no tags
+        self._latest = Latest(watch, stream, f"sample of sensor {vessel}/{info.name}")
+
+    def latest(self, timeout_s: float = 2.0) -> Any:
+        return self._latest.wait(timeout_s)
+
+    def on_sample(self, callback: Callable[[Any], None]) -> None:
+        """`callback(sample)` for every sample from now on (on a Zenoh thread: be quick)."""
+        self._latest.add(callback)
+
+
+class Vessel:
+    def __init__(self, watch: Watch, outputs: Outputs, info: VesselInfo) -> None:
+        self.info, self.id = info, info.id
+        self._watch, self._outputs = watch, outputs
+        self._state: Latest | None = None
+        self._sensors: dict[str, Sensor] = {}
+
+    def _states(self) -> Latest:
+        if self._state is None:
+            stream = Stream(self.info.state_key, VesselState, "physics", None)
+            self._state = Latest(self._watch, stream, f"state of vessel {self.id!r}")
+        return self._state
+
+    def state(self, timeout_s: float = 2.0) -> VesselState:
+        """The newest state (pose in `map`, body-frame twist and acceleration); waits up to
+        `timeout_s` for the first one (NoData), RunEnded once the run is over."""
+        msg = self._states().wait(timeout_s)
+        assert isinstance(msg, VesselState)
+        return msg
+
+    def on_state(self, callback: Callable[[VesselState], None]) -> None:
+        """`callback(state)` for every state from now on (on a Zenoh thread: be quick)."""
+        self._states().add(callback)
+
+    def sensor(self, name: str) -> Sensor:
+        """UnknownSensor (listing this vessel's sensors) if it has none by that name."""
+        if name not in self._sensors:
+            self._sensors[name] = Sensor(self._watch, self.id, self.info.sensor(name))
+        return self._sensors[name]
+
+    def send(self, command: Command) -> None:
+        """Send a Thrust, Twist or Waypoints now (free-running); CommandError if the vessel
+        cannot take it."""
+        kind = kind_of(command)
+        controller = self.info.controller
+        if controller is not None and controller.command == kind:
+            raise CommandError(
+                f"vessel {self.id!r}'s {kind} is driven in lockstep by participant "
+                f"{controller.participant!r}: send it with act() after "
+                f"join({controller.participant!r}); a free {kind} on that key would be refused"
+            )
+        msg: Message = message(command, self.info)
+        self._outputs.publish(self.info.command_keys[kind], msg)

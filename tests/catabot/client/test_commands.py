@@ -1,0 +1,50 @@
+"""Commands are checked in the stack, before they leave: the checks physics would apply
+(catabot/bus/checks.py) with the vessel's own thruster count, as a CommandError."""
+
+from __future__ import annotations
+
+import pytest
+
+from catabot.bus.messages import ThrustCmd, TwistCmd, WaypointsCmd
+from catabot.client import CommandError, Thrust, Twist, Waypoints
+from catabot.client.commands import Command, kind_of, message
+from catabot.client.info import parse
+from tests.catabot.client.fixtures import answer
+
+EGO = parse(answer(), "test").vessels["ego"]
+NAN, INF = float("nan"), float("inf")
+
+
+def test_good_commands_become_their_messages() -> None:
+    assert message(Thrust([0.5, -1]), EGO, tick=10, stamp_ns=100) == ThrustCmd((0.5, -1.0), 10, 100)
+    assert message(Twist(1.0, -0.2), EGO) == TwistCmd(1.0, -0.2, -1, 0)
+    way = message(Waypoints([(10, 0), (20, 5)], speed=1.5), EGO)
+    assert way == WaypointsCmd((10.0, 0.0, 20.0, 5.0), 1.5, 2.0, "back_and_forth", -1, 0)
+    assert message(Waypoints([], mode="release"), EGO).mode == "release"  # type: ignore[attr-defined]
+    assert [kind_of(c) for c in (Thrust([0, 0]), Twist(0, 0), Waypoints([]))] == [
+        "thrust", "twist", "waypoints"]  # fmt: skip
+
+
+@pytest.mark.parametrize(
+    ("command", "why"),
+    [
+        (Thrust([0.5]), "thrust command for vessel 'ego': 1 values for 2 thrusters"),
+        (Thrust([0.5, 0.5, 0.5]), "3 values for 2 thrusters"),
+        (Thrust([NAN, 0.0]), "a thrust value is not finite"),
+        (Thrust(["fast", 0.0]), "could not convert string to float"),  # type: ignore[list-item]
+        (Twist(INF, 0.0), "twist command for vessel 'ego': surge inf m/s"),
+        (Twist(1.0, NAN), "not finite"),
+        (Waypoints([(1, 2, 3)]), r"a waypoint is \(x, y\) in m"),
+        (Waypoints([(1, 2)], speed=0), "speed 0.0 and tolerance 2.0 must be > 0"),
+        (Waypoints([(1, NAN)]), "an even number of finite values"),
+        (Waypoints([(1, 2)], mode="zigzag"), "mode 'zigzag' is not one of"),
+    ],
+)
+def test_bad_commands_are_refused_in_the_stack(command: Command, why: str) -> None:
+    with pytest.raises(CommandError, match=why):
+        message(command, EGO)
+
+
+def test_something_else_is_no_command() -> None:
+    with pytest.raises(CommandError, match="ThrustCmd is not a command: send Thrust, Twist"):
+        kind_of(ThrustCmd((0.0, 0.0)))  # type: ignore[arg-type]

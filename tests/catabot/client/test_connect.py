@@ -1,0 +1,123 @@
+"""Finding a world and joining it, against the conductor's real `world/info` queryable in
+this process (no run): the errors a stack meets before it steps, each naming what is wrong."""
+
+from __future__ import annotations
+
+import json
+import time
+from collections.abc import Iterator
+
+import pytest
+import zenoh
+
+from catabot.bus.session import Connection, free_port, open_session
+from catabot.bus.settings import Schedule
+from catabot.client import (
+    Client,
+    CommandError,
+    NotAParticipant,
+    SeveralWorlds,
+    SimulatorNotFound,
+    TooLate,
+    Twist,
+    UnknownSensor,
+    UnknownVessel,
+)
+from catabot.run.world_info import WorldInfoDesk
+from tests.catabot.client.fixtures import ROSTER, scenario
+
+
+class Served:
+    """A world's `world/info` desk on its own session, listening on its own port."""
+
+    def __init__(self, name: str) -> None:
+        self.endpoint = f"tcp/127.0.0.1:{free_port()}"
+        self.session = open_session(Connection(listen=(self.endpoint,)))
+        world = scenario(name)
+        self.schedule = Schedule(ticks=world.ticks)
+        self.desk = WorldInfoDesk(self.session, world, ROSTER, self.schedule)
+        assert self.desk.served.wait(30)
+
+    def close(self) -> None:
+        self.desk.close()
+        self.session.close()
+
+
+@pytest.fixture
+def served() -> Iterator[Served]:
+    s = Served("info")
+    yield s
+    s.close()
+
+
+def test_no_simulation_is_a_clear_error_after_the_timeout() -> None:
+    lonely = f"tcp/127.0.0.1:{free_port()}"
+    started = time.monotonic()
+    with pytest.raises(SimulatorNotFound, match=r"no simulation of any world answered on "
+                       r"catabot/\*/world/info within 0.6 s \(connect \['tcp/127"):  # fmt: skip
+        Client.connect([lonely], timeout_s=0.6)
+    assert 0.6 <= time.monotonic() - started < 5.0
+    with pytest.raises(SimulatorNotFound, match="no simulation of world 'harbour'"):
+        Client.connect(timeout_s=0.3, world="harbour")
+
+
+def test_the_one_world_is_found_and_several_must_be_chosen(served: Served) -> None:
+    with Client.connect([served.endpoint], timeout_s=10) as sim:
+        assert sim.info.name == "info" and list(sim.info.vessels) == ["ego", "other"]
+    second = Served("info2")
+    try:
+        both = [served.endpoint, second.endpoint]
+        with pytest.raises(SeveralWorlds, match=r"several simulations answer \(info, info2\)"):
+            Client.connect(both, timeout_s=10).close()
+        with Client.connect(both, world="info2", timeout_s=10) as sim:
+            assert sim.info.name == "info2"
+    finally:
+        second.close()
+
+
+def test_a_reply_for_another_worlds_key_or_not_json_is_ignored(served: Served) -> None:
+    data = json.dumps({"v": 1, "world": "info"})
+
+    def liar(query: zenoh.Query) -> None:
+        query.reply("catabot/fake/world/info", data)  # claims world 'info' on another key
+
+    def junk(query: zenoh.Query) -> None:
+        query.reply("catabot/junk/world/info", b"\xff not json")
+
+    fakes = [served.session.declare_queryable("catabot/fake/world/info", liar),
+             served.session.declare_queryable("catabot/junk/world/info", junk)]  # fmt: skip
+    try:
+        with Client.connect([served.endpoint], timeout_s=10) as sim:
+            assert sim.info.name == "info" and sim.info.vessels["ego"].thrusters == 2
+    finally:
+        for fake in fakes:
+            fake.undeclare()
+
+
+def test_unknown_vessels_sensors_and_participants(served: Served) -> None:
+    with Client.connect([served.endpoint], timeout_s=10) as sim:
+        with pytest.raises(UnknownVessel, match="no vessel 'nope'; its vessels: ego, other"):
+            sim.vessel("nope")
+        with pytest.raises(UnknownVessel, match=r"'boat_000' \(a traffic boat"):
+            sim.vessel("boat_000")
+        with pytest.raises(UnknownSensor, match="vessel 'ego' has no sensor 'cam'"):
+            sim.vessel("ego").sensor("cam")
+        for name in ("nobody", "physics"):  # a service is no external participant
+            with pytest.raises(NotAParticipant, match=f"does not expect a participant '{name}'; "
+                               "it expects watcher, stack"):  # fmt: skip
+                sim.join(name)
+        with pytest.raises(UnknownVessel, match="no vessel 'nope'"):
+            sim.join("stack", vessel="nope")
+        with pytest.raises(UnknownSensor, match="no sensor 'sonar'"):
+            sim.join("stack", sensors=["gps", "sonar"])
+        with pytest.raises(
+            CommandError, match="twist is driven in lockstep by participant 'stack'"
+        ):
+            sim.vessel("ego").send(Twist(1.0, 0.0))
+
+
+def test_a_run_that_has_started_is_too_late_to_join(served: Served) -> None:
+    served.schedule.grant(3)
+    late = r"has started \(tick 3 granted\): participant 'stack'"
+    with Client.connect([served.endpoint], timeout_s=10) as sim, pytest.raises(TooLate, match=late):
+        sim.join("stack")

@@ -1,0 +1,97 @@
+"""The `world/info` answer as the client reads it: every field a stack needs, typed, equal
+to what the resolved World says; a malformed or foreign answer is a clear ClientError."""
+
+from __future__ import annotations
+
+from typing import Any
+
+import numpy as np
+import pytest
+
+from catabot.bus.messages import LidarScan, TwistCmd
+from catabot.client import ClientError, UnknownSensor
+from catabot.client.info import parse
+from catabot.world.world import World
+from tests.catabot.client.fixtures import DEG, ROSTER, answer, scenario
+
+
+def test_the_answer_describes_the_resolved_world() -> None:
+    info, world = parse(answer(), "test"), World.resolve(scenario())
+    assert (info.name, info.seed, info.dt_s, info.duration_s, info.ticks) == (
+        "info",
+        5,
+        0.01,
+        2.0,
+        200,
+    )
+    assert info.limits == world.clock_limits
+    assert info.participants == tuple(world.participants)
+    assert info.external == ("watcher", "stack")
+    assert dict(info.roster) == ROSTER.fixed
+    assert info.body_ids == world.body_ids
+    assert info.traffic == ("boat_000", "boat_001") and list(info.vessels) == ["ego", "other"]
+    assert [(b.id, b.row, b.x_m, b.y_m) for b in info.buoys] == [("b1", 4, 30.0, -5.0)]
+    assert info.states_stream() == world.streams.states  # key, producer, period, stamp
+    assert info.granted == -1 and info.scenario["name"] == "info"
+
+
+def test_start_states_are_the_worlds() -> None:
+    info, world = parse(answer(), "test"), World.resolve(scenario())
+    start, expected = info.start, world.start_states()
+    assert start.ids == expected.ids and start.tick == -1
+    for got, want in zip(start.arrays(), expected.arrays(), strict=True):
+        np.testing.assert_array_equal(got, want)
+
+
+def test_a_vessel_its_controller_and_sensors() -> None:
+    ego = parse(answer(), "test").vessels["ego"]
+    assert (ego.model, ego.row, ego.thrusters, ego.command) == ("catabot", 0, 2, "twist")
+    assert ego.controller is not None
+    assert (ego.controller.participant, ego.controller.period_ticks) == ("stack", 5)
+    control = ego.control_stream()
+    assert control is not None and control.message is TwistCmd and control.producer == "stack"
+    assert control.key == "catabot/info/vessel/ego/cmd/twist" and control.period == 5
+    lidar = ego.sensor("lidar")
+    assert (lidar.type, lidar.rate_hz, lidar.period_ticks, lidar.message) == (
+        "lidar",
+        10.0,
+        10,
+        LidarScan,
+    )
+    assert lidar.frame == "ego/lidar" and lidar.key == "catabot/info/sensor/ego/lidar"
+    assert lidar.mount_xyz == (0.5, 0.0, 1.5)
+    assert lidar.mount_rpy == pytest.approx((0.0, -10 * DEG, 90 * DEG))
+    assert lidar.params["channels"] == 32  # every default filled in
+    assert ego.sensor("gps").stream().producer == "sensors"
+    with pytest.raises(UnknownSensor, match="no sensor 'radar'; its sensors: gps, lidar"):
+        ego.sensor("radar")
+    other = parse(answer(), "test").vessels["other"]
+    assert other.controller is None and other.control_stream() is None and other.sensors == {}
+
+
+def _without(data: dict[str, Any], *path: str) -> dict[str, Any]:
+    node = data
+    for key in path[:-1]:
+        node = node[key]
+    del node[path[-1]]
+    return data
+
+
+@pytest.mark.parametrize(
+    ("spoil", "why"),
+    [
+        (lambda d: d.update(v=2), "layout version 2"),
+        (lambda d: _without(d, "clock"), "KeyError 'clock'"),
+        (lambda d: d["vessels"][0]["controller"].update(command="fly"), "command 'fly'"),
+        (lambda d: d["vessels"][0]["sensors"][0].update(message="nope"), "KeyError 'nope'"),
+        (lambda d: d.update(bodies="x"), "TypeError"),
+        (lambda d: d["clock"].update(ticks="many"), "ValueError"),
+    ],
+)
+def test_a_malformed_answer_is_a_clear_error(spoil: Any, why: str) -> None:
+    data = answer()
+    spoil(data)
+    with pytest.raises(
+        ClientError, match=f"malformed world info from catabot/info/world/info: .*{why}"
+    ):
+        parse(data, "catabot/info/world/info")

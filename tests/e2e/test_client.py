@@ -1,0 +1,151 @@
+"""The client API against real runs (`catabot run --listen`): a stack that observes and
+commands, one whose run ends while it waits, late and unexpected joiners, and a lockstep
+stack reading sensors whose run records the same bytes twice."""
+
+from __future__ import annotations
+
+import json
+import subprocess
+import time
+from pathlib import Path
+from typing import Any
+
+import pytest
+from conftest import files_of, only_run_dir, scenario_file, start
+
+from catabot.bus.messages import GpsFix, ImuSample, VesselState
+from catabot.bus.session import free_port
+from catabot.client import (
+    Client,
+    CommandError,
+    NotAParticipant,
+    Observation,
+    RunEnded,
+    Thrust,
+    TooLate,
+)
+
+pytestmark = pytest.mark.timeout(180)
+SENSORS = [{"name": "gps", "type": "gps", "rate_hz": 10.0},
+           {"name": "imu", "type": "imu", "rate_hz": 50.0}]  # fmt: skip
+
+
+class Run:
+    def __init__(self, tmp: Path, data: dict[str, Any], *flags: str) -> None:
+        self.endpoint, self.out = f"tcp/127.0.0.1:{free_port()}", tmp / "out"
+        tmp.mkdir(parents=True, exist_ok=True)
+        path = scenario_file(tmp, data)
+        self.proc = start("run", str(path), "--quiet", "--out", str(self.out),
+                          "--listen", self.endpoint, *flags)  # fmt: skip
+
+    def finish(self, code: int = 0) -> Path:
+        out, err = self.proc.communicate(timeout=120)
+        assert self.proc.returncode == code, out + err
+        return only_run_dir(self.out)
+
+    def kill(self) -> None:
+        if self.proc.poll() is None:
+            self.proc.kill()
+            self.proc.wait()
+
+
+def _run(tmp: Path, data: dict[str, Any], *flags: str) -> Run:
+    return Run(tmp, data, *flags)
+
+
+def test_a_free_running_stack_observes_and_commands(tmp_path: Path) -> None:
+    data = {"name": "free", "seed": 1, "duration_s": 16.0, "clock": {"realtime_factor": 2.0},
+            "vessels": [{"id": "ego", "sensors": SENSORS}]}  # fmt: skip
+    run = _run(tmp_path, data)
+    try:
+        with Client.connect([run.endpoint], timeout_s=30) as sim:
+            ego = sim.vessel("ego")
+            assert isinstance(ego.state(timeout_s=10), VesselState)
+            assert isinstance(ego.sensor("gps").latest(timeout_s=5), GpsFix)
+            imu: list[ImuSample] = []
+            ego.sensor("imu").on_sample(imu.append)
+            with pytest.raises(CommandError, match="1 values for 2 thrusters"):
+                ego.send(Thrust([0.5]))
+            seen: list[Observation] = []
+
+            def step(obs: Observation) -> Thrust:
+                seen.append(obs)
+                return Thrust([0.25, -0.5])
+
+            assert sim.run_free(step, rate_hz=10, vessel="ego", sensors=["gps"], max_steps=5) is None
+            assert len(seen) == 5 and all(o.state is not None for o in seen)
+            assert seen[-1].tick > seen[0].tick and isinstance(seen[-1].sensors["gps"], GpsFix)
+            assert len(imu) > 10 and all(isinstance(s, ImuSample) for s in imu)
+            started = time.monotonic()
+            with pytest.raises(RunEnded, match=r"ended at tick 1599 \(completed\)"):
+                while True:  # polling after the end is RunEnded, never a stale state forever
+                    ego.state(timeout_s=2)
+                    time.sleep(0.1)
+            assert time.monotonic() - started < 30
+        run_dir = run.finish()
+    finally:
+        run.kill()
+    rows = (run_dir / "vessel.ego.cmd.thrust.csv").read_text().splitlines()
+    assert [r.split(",")[2:] for r in rows[1:]] == [["0.25", "-0.5"]] * 5
+    assert json.loads((run_dir / "log" / "run.json").read_text())["rejected"] == {}
+
+
+def test_the_run_ending_while_a_stack_waits_is_run_ended(tmp_path: Path) -> None:
+    data = {"name": "ending", "duration_s": 2.0, "vessels": [{"id": "ego"}],
+            "clock": {"external_participants": ["stack", "absent"], "start_timeout_s": 5.0}}  # fmt: skip
+    run = _run(tmp_path, data)
+    try:
+        with Client.connect([run.endpoint], timeout_s=30) as sim:
+            with pytest.raises(NotAParticipant, match="expects stack, absent"):
+                sim.join("intruder")
+            stack = sim.join("stack")
+            with Client.connect([run.endpoint], timeout_s=10) as other:
+                time.sleep(0.5)  # its tokens arrive
+                with pytest.raises(TooLate, match="'stack' of world 'ending' is already joined"):
+                    other.join("stack")
+            started = time.monotonic()
+            with pytest.raises(RunEnded, match="never joined within 5 s: absent") as ended:
+                stack.observe()
+            assert ended.value.reason == "fault" and time.monotonic() - started < 20
+            with pytest.raises(RunEnded, match="has ended"):
+                stack.observe()
+        run.finish(code=1)
+    finally:
+        run.kill()
+
+
+def _lockstep(tmp: Path) -> tuple[dict[str, bytes], list[Observation]]:
+    ego = {"id": "ego", "sensors": SENSORS,
+           "controller": {"participant": "stack", "rate_hz": 10.0, "command": "thrust"}}  # fmt: skip
+    run = _run(tmp, {"name": "steps", "seed": 4, "duration_s": 3.0, "vessels": [ego]})
+    seen: list[Observation] = []
+
+    def step(obs: Observation) -> Thrust:
+        seen.append(obs)
+        gps = obs.sensors["gps"]
+        turn = 0.0 if gps is None else (gps.latitude * 1e4) % 1.0 - 0.5  # noisy: sensors matter
+        return Thrust([0.6 - 0.4 * turn, 0.6 + 0.4 * turn + 0.01 * len(obs.samples["imu"])])
+
+    try:
+        with Client.connect([run.endpoint], timeout_s=30) as sim:
+            end = sim.run_lockstep("stack", step, sensors=["gps", "imu"])
+        assert (end.tick, end.reason) == (299, "completed")
+        return files_of(run.finish()), seen
+    finally:
+        run.kill()
+
+
+def test_a_lockstep_stack_with_sensors_records_the_same_bytes_twice(tmp_path: Path) -> None:
+    first, seen = _lockstep(tmp_path / "a")
+    second, _ = _lockstep(tmp_path / "b")
+    assert sorted(first) == sorted(second) and "vessel.ego.cmd.thrust.csv" in first
+    assert [n for n in first if first[n] != second[n]] == []
+    assert [o.tick for o in seen] == list(range(0, 300, 10))
+    # Jacobi: the observation of tick k holds the state at t_k and samples tagged before k
+    assert seen[0].bodies.tick == -1 and seen[0].sensors == {"gps": None, "imu": None}
+    for obs in seen[1:]:
+        assert obs.bodies.tick == obs.tick - 1 and obs.stamp_ns == obs.tick * 10**7
+        assert obs.sensors["gps"].tick == obs.tick - 10
+        assert [s.tick for s in obs.samples["imu"]] == list(range(obs.tick - 10, obs.tick, 2))
+    commands = first["vessel.ego.cmd.thrust.csv"].decode().splitlines()
+    assert [c.split(",")[1] for c in commands[1:]] == [str(k) for k in range(0, 300, 10)]
