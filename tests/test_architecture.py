@@ -25,7 +25,13 @@ LAYERS = {  # what each part of the library may import from the project, besides
     },
     # the Gymnasium env starts runs and reads the resolved World (terrain, hull boxes) like a
     # run shell, but never the launcher: a run is a child process (`catabot run`)
-    "catabot.gym": {"catabot.errors", "catabot.bus", "catabot.config", "catabot.world"},
+    "catabot.gym": {
+        "catabot.errors",
+        "catabot.bus",
+        "catabot.client",
+        "catabot.config",
+        "catabot.world",
+    },
 }
 PROJECT = ("catabot", "services")
 

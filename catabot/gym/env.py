@@ -18,7 +18,7 @@ import gymnasium as gym
 import numpy as np
 from gymnasium.error import ResetNeeded
 
-from catabot.bus.messages import ThrustCmd, TwistCmd
+from catabot.client import Thrust, Twist
 from catabot.errors import CataBotError
 from catabot.gym.episode import Draw, Episode
 from catabot.gym.judge import Judge
@@ -142,9 +142,9 @@ class CataBotEnv(gym.Env[Obs, np.ndarray]):
     def _command(self, a: np.ndarray) -> Command:
         values = a.tolist()
         if self.options.action == "thrust":
-            return ThrustCmd(tuple(values))
+            return Thrust(values)
         o = self.options
-        return TwistCmd(values[0] * o.max_surge_mps, values[1] * o.max_yaw_rate_radps)
+        return Twist(values[0] * o.max_surge_mps, values[1] * o.max_yaw_rate_radps)
 
     def _info(self, frame: Frame) -> dict[str, Any]:
         assert self._episode is not None and self._judge is not None

@@ -15,7 +15,7 @@ import time
 from dataclasses import dataclass
 
 from catabot.gym.episode import Draw, Episode
-from catabot.gym.link import Command, Frame, LinkError, LinkTimeout, ParticipantLink
+from catabot.gym.link import ClientLink, Command, Frame, LinkError, LinkTimeout
 from catabot.gym.options import EnvOptions
 from catabot.gym.process import RunError, SimProcess
 from catabot.world.world import World
@@ -28,7 +28,7 @@ class Live:
     episode: Episode
     world: World
     run: SimProcess
-    link: ParticipantLink | None = None
+    link: ClientLink | None = None
 
 
 class Runner:
@@ -47,10 +47,17 @@ class Runner:
         else:
             live = self._launch(seed)
         self.live = live
-        live.link = ParticipantLink(
-            live.world, self.draw.vessel, self.draw.sensor_names(), live.run.endpoint
-        )
-        self._first(live)
+        try:
+            live.link = ClientLink(
+                live.world, self.draw.vessel, self.draw.sensor_names(), live.run.endpoint,
+                alive=lambda: live.run.alive, timeout_s=self.options.start_timeout_s,
+            )  # fmt: skip
+            self._first(live)
+        except LinkError as exc:
+            self.end()
+            raise RunError(
+                f"the episode's run did not start ({exc}): {live.run.failure()}"
+            ) from None
         if upcoming is not None and (self.next is None or self.next.episode.seed != upcoming):
             self._retire(self.next)
             self.next = self._launch(upcoming)
@@ -75,10 +82,7 @@ class Runner:
                 return
             except LinkTimeout:
                 if not live.run.alive or time.monotonic() > limit:
-                    self.end()
-                    raise RunError(
-                        f"the episode's run did not start: {live.run.failure()}"
-                    ) from None
+                    raise
 
     def observe(self) -> Frame:
         live = self._current()

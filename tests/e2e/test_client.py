@@ -72,7 +72,9 @@ def test_a_free_running_stack_observes_and_commands(tmp_path: Path) -> None:
                 seen.append(obs)
                 return Thrust([0.25, -0.5])
 
-            assert sim.run_free(step, rate_hz=10, vessel="ego", sensors=["gps"], max_steps=5) is None
+            assert (
+                sim.run_free(step, rate_hz=10, vessel="ego", sensors=["gps"], max_steps=5) is None
+            )
             assert len(seen) == 5 and all(o.state is not None for o in seen)
             assert seen[-1].tick > seen[0].tick and isinstance(seen[-1].sensors["gps"], GpsFix)
             assert len(imu) > 10 and all(isinstance(s, ImuSample) for s in imu)
