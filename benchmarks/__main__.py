@@ -13,6 +13,7 @@ BENCHMARKS = {
     "table2": "benchmarks.table2",
     "ros": "benchmarks.ros",
     "viewer": "benchmarks.viewer",
+    "gym": "benchmarks.gym",
 }
 
 

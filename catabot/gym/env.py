@@ -80,7 +80,8 @@ class CataBotEnv(gym.Env[Obs, np.ndarray]):
         frame = self._runner.observe()
         self._judge.start(self._episode.goal, frame.bodies)
         self._steps, self._over = 0, False
-        return self._observer(frame), self._info(frame)
+        run_dir = live.run.run_dir() if self.options.runs_dir is not None else None
+        return self._observer(frame), self._info(frame) | {"run_dir": run_dir}
 
     def step(self, action: Any) -> tuple[Obs, float, bool, bool, dict[str, Any]]:
         if self._over or self._judge is None or self._observer is None:

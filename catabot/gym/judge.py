@@ -24,9 +24,12 @@ from catabot.bus.messages import BodyStates
 from catabot.gym.episode import Goal
 from catabot.gym.options import EnvOptions
 from catabot.world import rotations
+from catabot.world.terrain import Terrain
+from catabot.world.terrain_grid import any_in_window
 from catabot.world.world import World
 
 PROBES = (5, 3)  # along, across the hull box bottom
+SINK_M = 3.0  # deepest a hull dips below its rest draft (heave in a heavy sea)
 
 
 @dataclass(frozen=True)
@@ -50,7 +53,10 @@ class Judge:
         self.centre = (lo + hi)[:, :2] / 2  # each box's centre in its body frame (x, y)
         self.half = (hi - lo)[:, :2] / 2
         self.others = np.array([i != me.row for i in range(len(world.bodies))])
+        # a body's box lies within this of its origin: pairs farther apart are not tested
+        self.reach = np.hypot(*np.abs(self.centre).T) + np.hypot(*self.half.T)
         self.probes = _probes(lo[me.row], hi[me.row])
+        self.shallow = _shallow(world.terrain, self.probes)
         self.goal = Goal(0.0, 0.0, 0.0)
         self.last_distance = 0.0
 
@@ -87,26 +93,35 @@ class Judge:
     def collision(self, bodies: BodyStates) -> str | None:
         """The first other body whose hull box overlaps the ego's in the plane (None):
         two boxes are apart when one of their four edge directions separates them."""
-        yaw = rotations.yaw_of_quaternions(bodies.orientation)
-        fwd = np.stack([np.cos(yaw), np.sin(yaw)], -1)  # (N, 2) each body's x axis
+        i, xy = self.row, bodies.position[:, :2]
+        apart = np.hypot(*(xy - xy[i]).T)
+        rows = np.flatnonzero(self.others & (apart <= self.reach + self.reach[i]))
+        if not len(rows):
+            return None  # the usual case: nothing within reach
+        rows = np.concatenate([[i], rows])  # the ego first, then the bodies within reach
+        yaw = rotations.yaw_of_quaternions(bodies.orientation[rows])
+        fwd = np.stack([np.cos(yaw), np.sin(yaw)], -1)  # (n, 2) each body's x axis
         lat = np.stack([-fwd[:, 1], fwd[:, 0]], -1)
-        centre = bodies.position[:, :2] + self.centre[:, :1] * fwd + self.centre[:, 1:] * lat
-        i = self.row
-        gap = centre - centre[i]
-        me = (fwd[i : i + 1], lat[i : i + 1], self.half[i : i + 1])
-        them = (fwd, lat, self.half)
-        overlap = self.others.copy()
-        for axis in (np.broadcast_to(fwd[i], fwd.shape), np.broadcast_to(lat[i], fwd.shape),
+        offset = self.centre[rows]
+        centre = xy[rows] + offset[:, :1] * fwd + offset[:, 1:] * lat
+        gap = centre - centre[0]
+        me = (fwd[:1], lat[:1], self.half[i : i + 1])
+        them = (fwd, lat, self.half[rows])
+        overlap = np.ones(len(rows), dtype=bool)
+        for axis in (np.broadcast_to(fwd[0], fwd.shape), np.broadcast_to(lat[0], fwd.shape),
                      fwd, lat):  # fmt: skip
-            apart = np.abs(_dot(gap, axis)) > _reach(*me, axis) + _reach(*them, axis)
-            overlap &= ~apart
-        hits = np.flatnonzero(overlap)
+            overlap &= np.abs(_dot(gap, axis)) <= _reach(*me, axis) + _reach(*them, axis)
+        hits = rows[1:][overlap[1:]]
         return self.ids[int(hits[0])] if len(hits) else None
 
     def grounded(self, bodies: BodyStates) -> bool:
         """Any hull-bottom probe at or below the ground under it."""
-        if self.terrain is None:
+        if self.terrain is None or self.shallow is None:
             return False
+        x, y = bodies.position[self.row, :2].tolist()
+        mpp, (ny, nx) = self.terrain.metres_per_pixel, self.shallow.shape
+        if not self.shallow[min(max(int(y / mpp), 0), ny - 1), min(max(int(x / mpp), 0), nx - 1)]:
+            return False  # deep water all around: no probe can reach the ground
         rot = rotations.matrices(bodies.orientation[self.row : self.row + 1])[0]
         points = bodies.position[self.row] + self.probes @ rot.T
         ground = self.terrain.height(points[:, 0], points[:, 1])
@@ -119,6 +134,16 @@ def _probes(lo: np.ndarray, hi: np.ndarray) -> np.ndarray:
     ys = np.linspace(lo[1], hi[1], PROBES[1])
     gx, gy = np.meshgrid(xs, ys)
     return np.stack([gx.ravel(), gy.ravel(), np.full(gx.size, lo[2])], -1)
+
+
+def _shallow(terrain: Terrain | None, probes: np.ndarray) -> np.ndarray | None:
+    """Pixels from which a probe could touch the ground: ground higher than the hull's
+    bottom at rest less `SINK_M` within the probes' reach (plus a pixel)."""
+    if terrain is None:
+        return None
+    reach = float(np.hypot(probes[:, 0], probes[:, 1]).max())
+    high = terrain.elevation_m > float(probes[0, 2]) - SINK_M
+    return any_in_window(high, math.ceil(reach / terrain.metres_per_pixel) + 1)
 
 
 def _dot(a: np.ndarray, b: np.ndarray) -> np.ndarray:

@@ -11,6 +11,7 @@ run describes (`world/info`).
 from __future__ import annotations
 
 import json
+import os
 import time
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field
@@ -36,6 +37,14 @@ from catabot.world.world import World
 Command = Thrust | Twist
 ASK_S = 0.5  # how long one look for the run's world/info waits before the run is checked
 RETRY = {"period_init_ms": 20, "period_max_ms": 100, "period_increase_factor": 1.5}
+_zenoh = {"opened": False, "forked": False}  # this process opened a session; then forked
+
+
+def _forked() -> None:
+    _zenoh["forked"] = _zenoh["opened"]
+
+
+os.register_at_fork(after_in_child=_forked)
 
 
 class LinkError(CataBotError, RuntimeError):
@@ -118,6 +127,14 @@ def _session(endpoint: str) -> zenoh.Session:
     every 20 ms (its default waits 1 s, then 2 s, ...: a reset took a whole retry longer),
     and opens at once (a peer's default is to scout for 0.5 s first; the env knows its one
     endpoint and waits for the run's tokens anyway)."""
+    if _zenoh["forked"]:
+        raise LinkError(
+            "this process was forked from one that had opened Zenoh sessions, and Zenoh does "
+            "not run in such a child (it hangs): make vector envs with "
+            "AsyncVectorEnv(..., context='spawn') or gymnasium.make_vec(..., "
+            "vector_kwargs={'context': 'spawn'})"
+        )
+    _zenoh["opened"] = True
     config = Connection(connect=(endpoint,)).config()
     config.insert_json5("connect/retry", json.dumps(RETRY))
     config.insert_json5("scouting/delay", "0")

@@ -55,6 +55,9 @@ class EnvOptions(Strict):
     max_surge_mps: float = Field(2.0, gt=0, description="twist actions: surge at |a| = 1")
     max_yaw_rate_radps: float = Field(0.5, gt=0, description="twist: yaw rate at |a| = 1")
     recording: Literal["off", "csv"] = Field("off", description="the episode's run folder")
+    runs_dir: str | None = Field(
+        None, description="keep each episode's run folder (logs, CSV) here; None: deleted"
+    )
     rewards: Rewards = Rewards()
     step_timeout_s: float = Field(60.0, gt=0, description="wait for the run at most this")
     start_timeout_s: float = Field(120.0, gt=0, description="wait for the run to start")
@@ -72,6 +75,8 @@ class EnvOptions(Strict):
             raise ValueError(
                 f"lidar_shape must be 1..256 rows, 1..4096 columns (got {rows}x{cols})"
             )
+        if self.recording != "off" and self.runs_dir is None:
+            raise ValueError(f"recording {self.recording!r} needs runs_dir (where to keep it)")
         if len(set(self.sensors)) != len(self.sensors):
             raise ValueError(f"sensors must not repeat (got {list(self.sensors)})")
         return self

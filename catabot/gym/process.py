@@ -32,16 +32,17 @@ class RunError(CataBotError, RuntimeError):
 class SimProcess:
     """One `catabot run` of one episode's scenario, in a temporary folder of its own."""
 
-    def __init__(self, scenario: Scenario, *, keep_folder: bool = False) -> None:
+    def __init__(self, scenario: Scenario, *, out: str | None = None) -> None:
         self._tmp = tempfile.TemporaryDirectory(prefix=f"catabot-{scenario.name}-")
         self.folder = Path(self._tmp.name)
-        self.keep_folder = keep_folder
+        self.out = Path(out) if out is not None else self.folder / "runs"
+        self.name = scenario.name
         self.file = self.folder / "episode.json"
         self.file.write_text(scenario.model_dump_json(indent=1) + "\n")
         self.endpoint = f"tcp/127.0.0.1:{free_port()}"
         self.log = self.folder / "run.log"
         cmd = [sys.executable, "-m", "catabot", "run", str(self.file), "--quiet",
-               "--listen", self.endpoint, "--out", str(self.folder / "runs")]  # fmt: skip
+               "--listen", self.endpoint, "--out", str(self.out.resolve())]  # fmt: skip
         with self.log.open("w") as log:
             self.proc = subprocess.Popen(
                 cmd, stdin=subprocess.DEVNULL, stdout=log, stderr=subprocess.STDOUT,
@@ -59,9 +60,12 @@ class SimProcess:
         status = "still running" if code is None else f"exit code {code}"
         return f"catabot run ({status}, log {self.log}): " + " | ".join(tail)
 
-    def runs(self) -> list[Path]:
-        out = self.folder / "runs"
-        return sorted(p for p in out.iterdir() if p.is_dir()) if out.is_dir() else []
+    def run_dir(self) -> Path | None:
+        """The run folder `catabot run` made for this run (None before it has)."""
+        if not self.out.is_dir():
+            return None
+        mine = [p for p in self.out.iterdir() if p.name.startswith(f"{self.name}-2")]
+        return mine[0] if len(mine) == 1 else None
 
     def stop(self) -> None:
         """End the run as Ctrl-C does and wait for every process of it; kill on a hang."""
@@ -72,8 +76,7 @@ class SimProcess:
             except subprocess.TimeoutExpired:
                 _kill_tree(self.proc.pid)
                 self.proc.wait()
-        if not self.keep_folder:
-            self._tmp.cleanup()
+        self._tmp.cleanup()
 
 
 def _child_env() -> dict[str, str]:

@@ -37,6 +37,7 @@ class Runner:
         self.live: Live | None = None
         self.next: Live | None = None
         self._ending: list[threading.Thread] = []
+        self._launched = 0
 
     def start(self, seed: int, upcoming: int | None) -> Live:
         """The episode of `seed` joined at tick 0 (its frame taken: act next); with
@@ -64,13 +65,12 @@ class Runner:
         return live
 
     def _launch(self, seed: int) -> Live:
-        episode = self.draw.episode(seed, self.world)
+        """A run of the episode of `seed`, named `<world>-<n>` (n counts this env's runs):
+        its keys, its run folder and its port are its own, whatever else still runs."""
+        self._launched += 1
+        episode = self.draw.episode(seed, f"{self.world}-{self._launched}")
         world = World.resolve(episode.scenario)
-        return Live(episode, world, SimProcess(episode.scenario, keep_folder=self._keep))
-
-    @property
-    def _keep(self) -> bool:
-        return self.options.recording != "off"
+        return Live(episode, world, SimProcess(episode.scenario, out=self.options.runs_dir))
 
     def _first(self, live: Live) -> None:
         """Tick 0's frame, waiting as long as the run starts up (and failing if it exits)."""
