@@ -77,7 +77,7 @@ class Breakdown:
 
     def _run(self) -> dict[str, tuple[float, str]]:
         what = {
-            "physics": "10 ticks of DART and hydrodynamics, publishing states, waiting for the command",
+            "physics": "10 ticks: DART, hydrodynamics, states out, the command in",
             "conductor": "the clock: grants, acks, the world/info and settings desks",
             "catabot run": "the launcher: progress lines, supervision",
         }
