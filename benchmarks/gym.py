@@ -41,7 +41,7 @@ def resets(n: int, *, prelaunch: bool) -> float:
         for _ in range(n):
             for _ in range(5):
                 env.step(np.array([0.5, 0.5], np.float32))
-            time.sleep(1.0)  # an episode's worth of time for the prelaunched run to get ready
+            time.sleep(3.0)  # an episode's play: the prelaunched run gets ready meanwhile
             started = time.perf_counter()
             env.reset()
             times.append(time.perf_counter() - started)

@@ -14,6 +14,7 @@ from gymnasium.utils.env_checker import check_env
 
 import catabot.gym  # noqa: F401 - registers the envs
 from catabot.gym import ActionError, CataBotEnv
+from catabot.gym.link import LinkError
 
 pytestmark = pytest.mark.timeout(240)
 FORWARD = np.array([0.6, 0.5], np.float32)
@@ -99,3 +100,19 @@ def test_close_leaves_no_process_behind() -> None:
     left = [p for p in started if psutil.pid_exists(p) and psutil.Process(p).status() != "zombie"]
     assert not left, [psutil.Process(p).cmdline() for p in left]
     env.close()  # twice is fine
+
+
+def test_a_run_that_fails_mid_episode_is_a_clear_error_and_reset_recovers(env: gym.Env) -> None:
+    env.reset(seed=4)
+    env.step(FORWARD)
+    live = env.unwrapped._runner.live  # type: ignore[attr-defined]
+    launcher = psutil.Process(live.run.proc.pid)
+    (physics,) = [p for p in launcher.children(recursive=True) if "services.physics" in p.cmdline()]
+    physics.kill()
+    with pytest.raises(LinkError, match="physics"):
+        for _ in range(50):
+            env.step(FORWARD)
+    with pytest.raises(ResetNeeded):
+        env.step(FORWARD)
+    obs, _ = env.reset(seed=4)
+    assert env.observation_space.contains(obs)
