@@ -16,25 +16,30 @@ from typing import Any
 import gymnasium as gym
 import numpy as np
 import psutil
+from gymnasium.utils import seeding
 
 from catabot.gym import CataBotEnv
+from catabot.gym.env import SEED_HIGH
 from catabot.gym.episode import Draw
 from catabot.gym.options import env_options
 from catabot.gym.runner import Runner
 
 WARMUP = 30  # steps before the clock starts
+SEED = 1
 FORWARD = [0.5, 0.45]
 
 
-def bare_periods_per_s(seconds: float) -> float:
-    """The episode's own scenario run by `catabot run` with the ego scripted (no env, no
-    external participant, nothing recorded): lockstep ticks/s (run.json: start-up excluded)
-    over the 10 ticks of a control period."""
-    scenario = Draw(env_options()).episode(0, "gym_bare").scenario
+def bare_periods_per_s(seconds: float, **options: Any) -> float:
+    """The scenario of the episode the env plays after reset(seed=SEED), run by `catabot
+    run` with the ego scripted (no env, no external participant, nothing recorded), about
+    `seconds` of wall time: lockstep ticks/s (run.json: start-up excluded) over the 10 ticks
+    of a control period."""
+    episode_seed = int(seeding.np_random(SEED)[0].integers(0, SEED_HIGH))
+    scenario = Draw(env_options(**options)).episode(episode_seed, "gym_bare").scenario
     data = scenario.model_dump(mode="json")
     ego = data["vessels"][0]
     ego["controller"], ego["script"] = None, [{"t_s": 0.0, "thrust": FORWARD}]
-    data["duration_s"] = seconds
+    data["duration_s"] = 10.0 * seconds  # the bare run steps 10-20 simulated s a second
     with tempfile.TemporaryDirectory(prefix="gym-bare-") as tmp:
         path = Path(tmp) / "bare.json"
         path.write_text(json.dumps(data))
@@ -42,8 +47,9 @@ def bare_periods_per_s(seconds: float) -> float:
         subprocess.run(cmd, capture_output=True, check=True, stdin=subprocess.DEVNULL)
         (result,) = [json.loads(p.read_text()) for p in Path(tmp).glob("*/log/run.json")]
     ticks_per_s = float(result["ticks"]) / float(result["wall_s"])
-    print(f"  bare run: {ticks_per_s:.0f} ticks/s = {ticks_per_s / 10:.0f} control periods/s",
-          flush=True)  # fmt: skip
+    label = ", ".join(f"{k}={v}" for k, v in options.items()) or "Navigate-v0's scenario"
+    print(f"  bare run ({label}): {ticks_per_s:.0f} ticks/s = {ticks_per_s / 10:.0f} "
+          "control periods/s", flush=True)  # fmt: skip
     return ticks_per_s / 10
 
 
@@ -95,7 +101,7 @@ def steps_per_s(env_id: str, seconds: float, *, breakdown: bool = False, **kwarg
     env = gym.make(env_id, **kwargs)
     action = np.array(FORWARD, np.float32)
     try:
-        env.reset(seed=1)
+        env.reset(seed=SEED)
         for _ in range(WARMUP):
             env.step(action)
         probe = _Probe(env.unwrapped) if breakdown else None
@@ -123,7 +129,7 @@ def vector_steps_per_s(
                         **kwargs)  # fmt: skip
     actions = np.tile(np.array(FORWARD, np.float32), (n, 1))
     try:
-        envs.reset(seed=1)
+        envs.reset(seed=SEED)
         for _ in range(WARMUP):
             envs.step(actions)
         steps, started = 0, time.perf_counter()

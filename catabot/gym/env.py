@@ -56,6 +56,7 @@ class CataBotEnv(gym.Env[Obs, np.ndarray]):
         self._judge: Judge | None = None
         self._observer: Observer | None = None
         self._steps = 0
+        self._upcoming: int | None = None  # the next seedless episode's seed (prelaunch)
         self._over = True  # no episode to step: reset first
 
     # -- Gymnasium's API ---------------------------------------------------------------
@@ -64,10 +65,14 @@ class CataBotEnv(gym.Env[Obs, np.ndarray]):
         self, *, seed: int | None = None, options: dict[str, Any] | None = None
     ) -> tuple[Obs, dict[str, Any]]:
         super().reset(seed=seed)
-        episode_seed = int(self.np_random.integers(0, SEED_HIGH))
-        upcoming = int(self.np_random.integers(0, SEED_HIGH)) if self.options.prelaunch else None
+        if seed is not None or self._upcoming is None:
+            episode_seed = int(self.np_random.integers(0, SEED_HIGH))
+        else:  # drawn at the previous reset, its run started then
+            episode_seed = self._upcoming
+        prelaunch = self.options.prelaunch
+        self._upcoming = int(self.np_random.integers(0, SEED_HIGH)) if prelaunch else None
         self._over = True
-        live = self._runner.start(episode_seed, upcoming)
+        live = self._runner.start(episode_seed, self._upcoming)
         self._episode, world = live.episode, live.world
         self._judge = Judge(world, self._draw.vessel, self.options)
         names: dict[str, str] = dict(

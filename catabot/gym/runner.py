@@ -43,10 +43,23 @@ class Runner:
         """The episode of `seed` joined at tick 0 (its frame taken: act next); with
         `upcoming`, that episode's run starts now in the background."""
         self.end()
-        if self.next is not None and self.next.episode.seed == seed and self.next.run.alive:
-            live, self.next = self.next, None
+        early, self.next = self.next, None
+        if early is not None and early.episode.seed == seed and early.run.alive:
+            try:
+                self._join(early)  # started early; it may have given up waiting meanwhile
+            except RunError:
+                early = None
         else:
-            live = self._launch(seed)
+            self._retire(early)
+            early = None
+        live = early or self._join(self._launch(seed))
+        if upcoming is not None:
+            self.next = self._launch(upcoming)
+        return live
+
+    def _join(self, live: Live) -> Live:
+        """Take the controller's seat in `live` and its tick-0 frame; RunError if the run
+        does not get there (its console's last lines say why)."""
         self.live = live
         try:
             live.link = ClientLink(
@@ -59,9 +72,6 @@ class Runner:
             raise RunError(
                 f"the episode's run did not start ({exc}): {live.run.failure()}"
             ) from None
-        if upcoming is not None and (self.next is None or self.next.episode.seed != upcoming):
-            self._retire(self.next)
-            self.next = self._launch(upcoming)
         return live
 
     def _launch(self, seed: int) -> Live:

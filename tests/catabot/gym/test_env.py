@@ -3,6 +3,7 @@ seed, the usual errors after an episode ends and for bad actions, nothing left r
 
 from __future__ import annotations
 
+import time
 from collections.abc import Iterator
 
 import gymnasium as gym
@@ -88,18 +89,27 @@ def test_the_episode_is_truncated_at_max_steps(env: gym.Env) -> None:
         env.step(FORWARD)
 
 
-def test_close_leaves_no_process_behind() -> None:
-    before = run_processes()
-    env = CataBotEnv(max_steps=5, prelaunch=True)
+def test_prelaunched_episodes_are_the_episodes_and_close_leaves_no_process(
+    env: gym.Env,
+) -> None:
+    """With prelaunch the next seedless episode's run starts early: the episodes are the
+    same as without, and close() ends both runs, every process of each."""
     env.reset(seed=3)
-    env.step(FORWARD)
+    expected, _ = env.reset()  # the second episode after seed 3, started at the reset
+    before = run_processes()
+    early = CataBotEnv(max_steps=5, prelaunch=True)
+    early.reset(seed=3)
+    early.step(FORWARD)
+    time.sleep(1.0)  # the next episode's run starts meanwhile
+    obs, _ = early.reset()
+    np.testing.assert_array_equal(obs["state"], expected["state"])
     started = run_processes() - before
     names = {" ".join(psutil.Process(p).cmdline()[1:3]) for p in started}
     assert {"-m catabot", "-m catabot.run.conduct", "-m services.physics"} <= names, names
-    env.close()
+    early.close()
     left = [p for p in started if psutil.pid_exists(p) and psutil.Process(p).status() != "zombie"]
     assert not left, [psutil.Process(p).cmdline() for p in left]
-    env.close()  # twice is fine
+    early.close()  # twice is fine
 
 
 def test_a_run_that_fails_mid_episode_is_a_clear_error_and_reset_recovers(env: gym.Env) -> None:
