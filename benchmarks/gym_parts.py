@@ -64,6 +64,15 @@ class Breakdown:
     waiting_s: float
     run_cpu_s: dict[str, float]
 
+    def __add__(self, other: Breakdown) -> Breakdown:
+        run = {k: self.run_cpu_s.get(k, 0.0) + other.run_cpu_s.get(k, 0.0)
+               for k in {**self.run_cpu_s, **other.run_cpu_s}}  # fmt: skip
+        return Breakdown(
+            self.steps + other.steps, self.wall_s + other.wall_s,
+            self.main_cpu_s + other.main_cpu_s, self.lockstep_cpu_s + other.lockstep_cpu_s,
+            self.process_cpu_s + other.process_cpu_s, self.waiting_s + other.waiting_s, run,
+        )  # fmt: skip
+
     def rows(self) -> list[tuple[str, float, str]]:
         per = 1000.0 / self.steps
         zenoh = self.process_cpu_s - self.main_cpu_s - self.lockstep_cpu_s
@@ -106,16 +115,19 @@ def steps_per_s(env_id: str, seconds: float, *, breakdown: bool = False, **kwarg
         for _ in range(WARMUP):
             env.step(action)
         probe = _Probe(env.unwrapped) if breakdown else None
-        steps, wall = 0, 0.0
+        parts: list[Breakdown] = []
+        steps, wall, part = 0, 0.0, (0, 0.0)
         while wall < seconds:
             started = time.perf_counter()
             _, _, terminated, truncated, _ = env.step(action)
-            wall += time.perf_counter() - started
-            steps += 1
+            took = time.perf_counter() - started
+            steps, wall, part = steps + 1, wall + took, (part[0] + 1, part[1] + took)
             if terminated or truncated:  # grounded on a shore: a new episode, not timed
-                assert probe is None, "the breakdown's episode ended; use a longer one"
+                parts += [probe.finish(*part)] if probe else []
                 env.reset()
-        result = Result(steps / wall, probe.finish(steps, wall) if probe else None)
+                probe, part = (_Probe(env.unwrapped) if probe else None), (0, 0.0)
+        parts += [probe.finish(*part)] if probe and part[0] else []
+        result = Result(steps / wall, sum(parts[1:], parts[0]) if parts else None)
     finally:
         env.close()
     label = ", ".join(f"{k}={v}" for k, v in kwargs.items() if k != "max_steps") or "state only"
