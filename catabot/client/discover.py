@@ -15,7 +15,7 @@ from typing import Any
 import zenoh
 
 from catabot.bus.keys import ROOT, Keys, world_infos
-from catabot.client.errors import SeveralWorlds, SimulatorNotFound
+from catabot.client.errors import ClientError, SeveralWorlds, SimulatorNotFound
 from catabot.client.info import WorldInfo, parse
 
 RETRY_S = 0.2
@@ -54,7 +54,10 @@ def _ask(session: zenoh.Session, selector: str, timeout_s: float) -> dict[str, t
     """World name -> (key, decoded answer) of every valid reply (error replies and
     non-JSON are skipped: they name no world)."""
     out: dict[str, tuple[str, Any]] = {}
-    for reply in session.get(selector, timeout=timeout_s):
+    # Every reply, not Zenoh's default consolidation (one per key): a second answer on a
+    # world's key must be seen to be refused.
+    replies = session.get(selector, timeout=timeout_s, consolidation=zenoh.ConsolidationMode.NONE)
+    for reply in replies:
         if reply.ok is None:
             continue
         key = str(reply.ok.key_expr)
@@ -63,6 +66,17 @@ def _ask(session: zenoh.Session, selector: str, timeout_s: float) -> dict[str, t
         except (UnicodeDecodeError, ValueError, RecursionError):
             continue
         name = data.get("world") if isinstance(data, dict) else None
-        if isinstance(name, str) and key == f"{ROOT}/{name}/world/info":  # its own world's key
-            out[name] = (key, data)
+        if not isinstance(name, str) or key != f"{ROOT}/{name}/world/info":  # its own key only
+            continue
+        if name in out and _static(out[name][1]) != _static(data):
+            raise ClientError(
+                f"two different answers on {key}: one is not its conductor's (on an open "
+                "network anyone may answer; the secure profile lets only the conductor)"
+            )
+        out[name] = (key, data)
     return out
+
+
+def _static(data: dict[str, Any]) -> dict[str, Any]:
+    """An answer without what changes between two queries (the clock's grant)."""
+    return {k: v for k, v in data.items() if k != "granted"}

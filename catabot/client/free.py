@@ -13,6 +13,8 @@ import time
 from collections.abc import Callable, Sequence
 from typing import Any
 
+import zenoh
+
 from catabot.bus.clock import Stream
 from catabot.bus.messages import BodyStates, End
 from catabot.client.commands import Command
@@ -31,9 +33,10 @@ class _Samples:
         self._lock = threading.Lock()
         self.newest: dict[str, Any] = {s.name: None for s in sensors}
         self.since: dict[str, list[Any]] = {s.name: [] for s in sensors}
+        self.subs: list[zenoh.Subscriber] = []
         for s in sensors:
             stream = Stream(s.key, s.message, s.producer, None)
-            watch.subscribe(stream, self._taker(s.name))
+            self.subs.append(watch.subscribe(stream, self._taker(s.name)))
 
     def _taker(self, name: str) -> Callable[[Any], None]:
         def take(msg: Any) -> None:
@@ -64,9 +67,24 @@ def run_free(
     states = Latest(watch, Stream(info.states_key, BodyStates, info.states_producer, None,
                                   check=info.states_stream().check), "world state")  # fmt: skip
     samples = _Samples(watch, sensors)
+    try:
+        return _loop(watch, states, samples, vessel, step, 1.0 / rate_hz, max_steps)
+    finally:  # a stack may run free again: leave no subscription behind
+        for sub in [states.sub, *samples.subs]:
+            watch.unsubscribe(sub)
+
+
+def _loop(
+    watch: Watch,
+    states: Latest,
+    samples: _Samples,
+    vessel: Vessel,
+    step: Callable[[Observation], Command | None],
+    period: float,
+    max_steps: int | None,
+) -> End | None:
     states.wait(FIRST_STATE_S)
-    period, steps = 1.0 / rate_hz, 0
-    next_at = time.monotonic()
+    steps, next_at = 0, time.monotonic()
     while max_steps is None or steps < max_steps:
         if watch.end is not None:
             return watch.end

@@ -164,7 +164,7 @@ def _parse(d: Mapping[str, Any]) -> WorldInfo:
         limits=ClockLimits(int(c["dt_ns"]), int(c["ticks"]), int(c["window"])),
         participants=tuple(map(str, p["stepping"])),
         external=tuple(map(str, p["external"])),
-        roster={str(k): str(v) for k, v in d["roster"].items()},
+        roster=Roster({str(k): str(v) for k, v in d["roster"].items()}).fixed,  # zids checked
         states_key=str(d["states"]["key"]),
         states_producer=str(d["states"]["producer"]),
         body_ids=tuple(str(b["id"]) for b in bodies),

@@ -26,6 +26,7 @@ from catabot.bus.inbox import checked
 from catabot.bus.keys import Keys
 from catabot.bus.members import Members
 from catabot.bus.messages import End, Message
+from catabot.bus.participant import ORPHAN_GRACE_S
 from catabot.bus.rejections import Rejected, Rejections
 from catabot.client.errors import NoData, RunEnded
 
@@ -42,7 +43,7 @@ class Watch:
         self.rejections = Rejections(log, "client")
         self.changed = threading.Condition()  # notified on every sample, end and leave
         self.end: End | None = None
-        self.conductor_gone = False
+        self.gone_at = 0.0  # when the conductor's token vanished (0: it has not)
         self._subs = [
             session.declare_subscriber(keys.end(), self._on_end),
             session.liveliness().declare_subscriber(keys.lives(), self._on_live, history=True),
@@ -53,7 +54,7 @@ class Watch:
         with self.changed:
             name = self.members.token(str(sample.key_expr), alive=alive)
             if name == CONDUCTOR and not alive:
-                self.conductor_gone = True
+                self.gone_at = time.monotonic()
             self.changed.notify_all()
 
     def _on_end(self, sample: zenoh.Sample) -> None:
@@ -73,13 +74,15 @@ class Watch:
             self.changed.notify_all()
 
     def ended(self) -> RunEnded | None:
-        """The error a waiting stack gets once the run is over (None while it runs)."""
+        """The error a waiting stack gets once the run is over (None while it runs). The
+        End may trail the conductor's token on another route: a vanished conductor counts
+        only after the participant's grace (ORPHAN_GRACE_S)."""
         if self.end is not None:
             e = self.end
             why = f": {e.error}" if e.error else ""
             return RunEnded(f"the run of world {self.keys.world!r} ended at tick {e.tick} "
                             f"({e.reason}{why})", e)  # fmt: skip
-        if self.conductor_gone:
+        if self.gone_at and time.monotonic() - self.gone_at > ORPHAN_GRACE_S:
             return RunEnded(f"the conductor of world {self.keys.world!r} vanished without "
                             "ending the run")  # fmt: skip
         return None
@@ -108,6 +111,12 @@ class Watch:
         self._subs.append(sub)
         return sub
 
+    def unsubscribe(self, sub: zenoh.Subscriber) -> None:
+        if sub in self._subs:
+            self._subs.remove(sub)
+            with contextlib.suppress(zenoh.ZError):
+                sub.undeclare()
+
     def close(self) -> None:
         for sub in self._subs:
             with contextlib.suppress(zenoh.ZError):  # the session is already closed
@@ -123,7 +132,7 @@ class Latest:
         self.message: Message | None = None
         self.count = 0
         self._callbacks: list[Callback] = []
-        watch.subscribe(stream, self._on)
+        self.sub = watch.subscribe(stream, self._on)
 
     def _on(self, msg: Message) -> None:
         with self.watch.changed:

@@ -5,13 +5,14 @@ stack reading sensors whose run records the same bytes twice."""
 from __future__ import annotations
 
 import json
-import subprocess
+import os
+import signal
 import time
 from pathlib import Path
 from typing import Any
 
 import pytest
-from conftest import files_of, only_run_dir, scenario_file, start
+from conftest import files_of, only_run_dir, scenario_file, service_pid, start
 
 from catabot.bus.messages import GpsFix, ImuSample, VesselState
 from catabot.bus.session import free_port
@@ -21,8 +22,11 @@ from catabot.client import (
     NotAParticipant,
     Observation,
     RunEnded,
+    SimulatorNotFound,
     Thrust,
     TooLate,
+    UnknownSensor,
+    UnknownVessel,
 )
 
 pytestmark = pytest.mark.timeout(180)
@@ -53,13 +57,24 @@ def _run(tmp: Path, data: dict[str, Any], *flags: str) -> Run:
     return Run(tmp, data, *flags)
 
 
+def test_no_simulation_running_is_simulator_not_found_after_the_timeout() -> None:
+    started = time.monotonic()
+    with pytest.raises(SimulatorNotFound, match="no simulation of any world answered"):
+        Client.connect([f"tcp/127.0.0.1:{free_port()}"], timeout_s=1.0)
+    assert 1.0 <= time.monotonic() - started < 5.0
+
+
 def test_a_free_running_stack_observes_and_commands(tmp_path: Path) -> None:
     data = {"name": "free", "seed": 1, "duration_s": 16.0, "clock": {"realtime_factor": 2.0},
             "vessels": [{"id": "ego", "sensors": SENSORS}]}  # fmt: skip
     run = _run(tmp_path, data)
     try:
         with Client.connect([run.endpoint], timeout_s=30) as sim:
+            with pytest.raises(UnknownVessel, match="no vessel 'ego2'; its vessels: ego"):
+                sim.vessel("ego2")
             ego = sim.vessel("ego")
+            with pytest.raises(UnknownSensor, match="no sensor 'lidar'; its sensors: gps, imu"):
+                ego.sensor("lidar")
             assert isinstance(ego.state(timeout_s=10), VesselState)
             assert isinstance(ego.sensor("gps").latest(timeout_s=5), GpsFix)
             imu: list[ImuSample] = []
@@ -93,8 +108,8 @@ def test_a_free_running_stack_observes_and_commands(tmp_path: Path) -> None:
 
 
 def test_the_run_ending_while_a_stack_waits_is_run_ended(tmp_path: Path) -> None:
-    data = {"name": "ending", "duration_s": 2.0, "vessels": [{"id": "ego"}],
-            "clock": {"external_participants": ["stack", "absent"], "start_timeout_s": 5.0}}  # fmt: skip
+    clock = {"external_participants": ["stack", "absent"], "start_timeout_s": 5.0}
+    data = {"name": "ending", "duration_s": 2.0, "vessels": [{"id": "ego"}], "clock": clock}
     run = _run(tmp_path, data)
     try:
         with Client.connect([run.endpoint], timeout_s=30) as sim:
@@ -116,9 +131,50 @@ def test_the_run_ending_while_a_stack_waits_is_run_ended(tmp_path: Path) -> None
         run.kill()
 
 
+def test_a_conductor_that_dies_while_a_stack_waits_is_run_ended(tmp_path: Path) -> None:
+    ego = {"id": "ego", "controller": {"participant": "stack", "rate_hz": 10.0}}
+    run = _run(tmp_path, {"name": "dies", "duration_s": 60.0, "vessels": [ego],
+                          "clock": {"realtime_factor": 1.0}})  # fmt: skip
+    try:
+        with Client.connect([run.endpoint], timeout_s=30) as sim:
+            stack = sim.join("stack")
+            for _ in range(3):
+                stack.observe()
+                stack.act(Thrust([0.2, 0.2]))
+            os.kill(service_pid(run.proc.pid, "catabot.run.conduct"), signal.SIGKILL)
+            started = time.monotonic()
+            with pytest.raises(RunEnded, match="conductor disappeared without ending the run"):
+                while True:
+                    stack.observe()  # act(None) implied: keep the last command
+            assert time.monotonic() - started < 15
+        run.proc.wait(timeout=60)
+        assert run.proc.returncode != 0
+    finally:
+        run.kill()
+
+
+def test_a_stack_leaving_mid_run_is_named_and_the_run_ends(tmp_path: Path) -> None:
+    ego = {"id": "ego", "controller": {"participant": "stack", "rate_hz": 10.0}}
+    run = _run(tmp_path, {"name": "leaves", "duration_s": 60.0, "vessels": [ego]})
+    try:
+        with Client.connect([run.endpoint], timeout_s=30) as sim:
+            stack = sim.join("stack")
+            for _ in range(3):
+                stack.observe()
+                stack.act(Thrust([0.2, 0.2]))
+            stack.observe()
+            started = time.monotonic()
+            stack.close()  # while the participant waits for this period's command
+            assert time.monotonic() - started < 6
+        out, err = run.proc.communicate(timeout=60)
+        assert run.proc.returncode == 1 and "participant 'stack' left the run" in err, out + err
+    finally:
+        run.kill()
+
+
 def _lockstep(tmp: Path) -> tuple[dict[str, bytes], list[Observation]]:
-    ego = {"id": "ego", "sensors": SENSORS,
-           "controller": {"participant": "stack", "rate_hz": 10.0, "command": "thrust"}}  # fmt: skip
+    controller = {"participant": "stack", "rate_hz": 10.0, "command": "thrust"}
+    ego = {"id": "ego", "sensors": SENSORS, "controller": controller}
     run = _run(tmp, {"name": "steps", "seed": 4, "duration_s": 3.0, "vessels": [ego]})
     seen: list[Observation] = []
 

@@ -18,6 +18,7 @@ from catabot.bus import codec
 from catabot.bus.keys import Keys
 from catabot.bus.messages import Ack, End, ThrustCmd, Tick
 from catabot.bus.session import Connection, SessionError, free_port, open_session
+from catabot.client import Client
 
 pytestmark = pytest.mark.skipif(shutil.which("openssl") is None, reason="needs openssl")
 KEYS = Keys("secure")
@@ -144,3 +145,28 @@ def test_a_process_without_a_login_is_refused_before_anything_starts(
                    str(tmp_path / "out"))  # fmt: skip
     assert done.returncode == 2 and "no login for physics" in done.stderr
     assert not (tmp_path / "out").exists()
+
+
+def test_an_observer_finds_the_world_only_the_conductor_serves(
+    tmp_path: Path, profile: tuple[Path, str]
+) -> None:
+    """Everyone may query `world/info`; a client may not serve one (its queryable is denied,
+    so no second answer reaches the observer)."""
+    folder, _ = profile
+    data = json.loads(_scenario(tmp_path).read_text()) | {"duration_s": 20.0}
+    proc = start("run", str(scenario_file(tmp_path, data, "long.json")), "--secure", str(folder),
+                 "--out", str(tmp_path / "out"), "--quiet")  # fmt: skip
+    try:
+        with open_session(Connection(mode="client", file=str(folder / "autopilot.json5"))) as s:
+            lie = json.dumps({"v": 1, "world": "secure"})  # refused if it ever arrived
+            fake = s.declare_queryable(KEYS.world_info(), lambda q: q.reply(q.key_expr, lie))
+            viewer = str(folder / "viewer.json5")
+            with Client.connect(mode="client", zenoh_config=viewer, timeout_s=30) as sim:
+                assert sim.info.name == "secure" and list(sim.info.vessels["ego"].sensors) == [
+                    "imu"
+                ]
+                assert {"conductor", "physics", "sensors"} <= set(sim.info.roster)
+            fake.undeclare()
+    finally:
+        proc.terminate()
+        proc.communicate(timeout=60)

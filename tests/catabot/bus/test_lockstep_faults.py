@@ -12,7 +12,7 @@ from catabot.bus import codec
 from catabot.bus.clock import Policy, Stream
 from catabot.bus.inbox import Inputs
 from catabot.bus.messages import Tick, VesselState
-from catabot.bus.participant import Participant
+from catabot.bus.participant import Participant, Stopped
 from tests.catabot.bus.lockstep_world import Step, World, _fix, _state
 
 # -- (c) deadline -------------------------------------------------------------------------
@@ -191,3 +191,31 @@ def test_malformed_input_is_logged_and_the_participant_goes_on(
     assert key in malformed[0] and malformed[0].startswith("cons:")
     assert "not a msgpack payload" in malformed[0]
     assert cons.participant.rejections.totals == {"malformed": 2}
+
+
+def test_a_participant_stopped_from_another_thread_leaves_the_run(world: World) -> None:
+    """`Participant.stop()` (a client stack leaving): run() raises Stopped, and the
+    conductor names the participant when its token goes."""
+
+    def step(tick: Tick, _inputs: Inputs) -> None:
+        if tick.tick == 5:
+            threading.Thread(target=world.members["a"].participant.stop).start()
+
+    world.member("a", step, peers=["a", "b"])
+    world.member("b", peers=["a", "b"])
+    closer = threading.Thread(target=_close_when_stopped, args=(world,), daemon=True)
+    closer.start()
+    result = world.run(["a", "b"], 10_000, deadline_s=5.0, start_timeout_s=5.0)
+    a = world.members["a"]
+    a.join()
+    assert isinstance(a.error, Stopped) and "a left the run at tick" in str(a.error)
+    assert 5 <= result.ticks_done < 10_000 and "a" in result.error
+    world.members["b"].join()
+    assert world.members["b"].end is not None and world.members["b"].end.reason == "fault"
+
+
+def _close_when_stopped(world: World) -> None:
+    a = world.members["a"]
+    while a.error is None:
+        time.sleep(0.01)
+    a.participant.close()  # its token goes: the conductor notices at once

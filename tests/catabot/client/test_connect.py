@@ -14,6 +14,7 @@ from catabot.bus.session import Connection, free_port, open_session
 from catabot.bus.settings import Schedule
 from catabot.client import (
     Client,
+    ClientError,
     CommandError,
     NotAParticipant,
     SeveralWorlds,
@@ -23,7 +24,8 @@ from catabot.client import (
     UnknownSensor,
     UnknownVessel,
 )
-from catabot.run.world_info import WorldInfoDesk
+from catabot.run.world_info import WorldInfoDesk, describe
+from catabot.world.world import World
 from tests.catabot.client.fixtures import ROSTER, scenario
 
 
@@ -121,3 +123,17 @@ def test_a_run_that_has_started_is_too_late_to_join(served: Served) -> None:
     late = r"has started \(tick 3 granted\): participant 'stack'"
     with Client.connect([served.endpoint], timeout_s=10) as sim, pytest.raises(TooLate, match=late):
         sim.join("stack")
+
+
+def test_a_second_different_answer_for_the_world_is_refused(served: Served) -> None:
+    def impostor(query: zenoh.Query) -> None:
+        data = json.loads(json.dumps(describe(World.resolve(scenario("info")), ROSTER)))
+        data["roster"]["conductor"] = "1234"  # its own session as the clock
+        query.reply("catabot/info/world/info", json.dumps(data))
+
+    fake = served.session.declare_queryable("catabot/info/world/info", impostor)
+    try:
+        with pytest.raises(ClientError, match="two different answers on catabot/info/world/info"):
+            Client.connect([served.endpoint], timeout_s=10).close()
+    finally:
+        fake.undeclare()

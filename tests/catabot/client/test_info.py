@@ -86,6 +86,7 @@ def _without(data: dict[str, Any], *path: str) -> dict[str, Any]:
         (lambda d: d["vessels"][0]["sensors"][0].update(message="nope"), "KeyError 'nope'"),
         (lambda d: d.update(bodies="x"), "TypeError"),
         (lambda d: d["clock"].update(ticks="many"), "ValueError"),
+        (lambda d: d["roster"].update(physics="0xZZ"), "RosterError zid '0xZZ' is not"),
     ],
 )
 def test_a_malformed_answer_is_a_clear_error(spoil: Any, why: str) -> None:
