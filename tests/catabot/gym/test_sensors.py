@@ -32,3 +32,15 @@ def test_sensors_and_twist_actions() -> None:
         assert state[7] > 0.1  # getting under way (0.8 s in)
     finally:
         env.close()
+
+
+def test_station_keeping_holds_the_start_pose_in_the_harbour() -> None:
+    env = gym.make("CataBot/StationKeep-v0", max_steps=3)
+    try:
+        obs, info = env.reset(seed=2)
+        assert info["distance_m"] < 0.5  # the goal is where it started, a period ago
+        assert obs["state"][5:7] == pytest.approx([0.0, 1.0], abs=0.05)  # its start heading
+        rewards = [env.step(np.zeros(2, np.float32))[1] for _ in range(3)]
+        assert all(np.isfinite(rewards)) and max(rewards) <= 0.1  # holding costs, never pays
+    finally:
+        env.close()
