@@ -15,6 +15,8 @@ BENCHMARKS = {
     "viewer": "benchmarks.viewer",
     "shards": "benchmarks.shards",
     "recording": "benchmarks.recording",
+    "gym": "benchmarks.gym",
+    "metrics": "benchmarks.metrics",
 }
 
 

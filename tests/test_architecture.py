@@ -23,6 +23,15 @@ LAYERS = {  # what each part of the library may import from the project, besides
         "catabot.world",
         "catabot.ros2",
     },
+    # the Gymnasium env starts runs and reads the resolved World (terrain, hull boxes) like a
+    # run shell, but never the launcher: a run is a child process (`catabot run`)
+    "catabot.gym": {
+        "catabot.errors",
+        "catabot.bus",
+        "catabot.client",
+        "catabot.config",
+        "catabot.world",
+    },
 }
 PROJECT = ("catabot", "services")
 

@@ -1,0 +1,40 @@
+"""Gymnasium environments over the simulator (`import catabot.gym` registers them).
+
+`CataBot/Navigate-v0`: reach a goal drawn 20-60 m from a random start in the bundled
+`navigate` scenario (a bay with an island and a shore, five buoys, a light current and a
+steady wind); `CataBot/StationKeep-v0`: hold a random start position and heading in the
+`harbour` scenario, against its current, gusty wind and chop. Every
+keyword of `catabot.gym.options.EnvOptions` may be given to `gymnasium.make`.
+"""
+
+from __future__ import annotations
+
+import gymnasium
+
+from catabot.gym.env import ActionError, CataBotEnv
+from catabot.gym.options import EnvOptions, EnvOptionsError
+
+__all__ = ["ActionError", "CataBotEnv", "EnvOptions", "EnvOptionsError"]
+
+ENTRY_POINT = "catabot.gym.env:CataBotEnv"
+MAX_STEPS = 600  # 60 s at 10 Hz
+
+if "CataBot/Navigate-v0" not in gymnasium.registry:
+    gymnasium.register(
+        "CataBot/Navigate-v0",
+        entry_point=ENTRY_POINT,
+        max_episode_steps=MAX_STEPS,
+        kwargs={"task": "navigate", "scenario": "navigate", "max_steps": MAX_STEPS},
+    )
+if "CataBot/StationKeep-v0" not in gymnasium.registry:
+    gymnasium.register(
+        "CataBot/StationKeep-v0",
+        entry_point=ENTRY_POINT,
+        max_episode_steps=MAX_STEPS,
+        kwargs={
+            "task": "station_keep",
+            "scenario": "harbour",
+            "max_steps": MAX_STEPS,
+            "rewards": {"progress": 1.0, "distance": 0.1, "heading": 0.5, "goal": 0.0},
+        },
+    )
