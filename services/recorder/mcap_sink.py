@@ -19,6 +19,7 @@ Why it is written this way:
 
 from __future__ import annotations
 
+import contextlib
 import io
 import json
 import os
@@ -33,7 +34,7 @@ from mcap.writer import LIBRARY_IDENTIFIER
 from numpy.typing import NDArray
 
 from catabot.ros2 import types
-from services.recorder.csv_sink import RecorderError, write_whole
+from services.recorder.csv_sink import DiskError, RecorderError, write_whole
 from services.recorder.mcap_chunks import CHUNK_BYTES
 from services.recorder.mcap_writer import McapWriter
 
@@ -70,11 +71,22 @@ class _TickBuffer(io.BufferedIOBase):
         self._pending.clear()
         before, self._tail = self._tail, b""  # a failed write cuts the file back to _size
         self._file.seek(self._size)
-        write_whole(self._file, data, self._size)
+        try:
+            write_whole(self._file, data, self._size)
+        except DiskError:
+            self._restore(before)  # the last flush's open chunks were on disk: keep them
+            raise
         self._size += len(data) - len(tail)
         if len(tail) < len(before):
             os.ftruncate(self._file.fileno(), self._size + len(tail))  # a longer tail before
         self._tail = tail
+
+    def _restore(self, tail: bytes) -> None:
+        """Put the previous provisional tail back after a failed flush (the space it took
+        was just freed), so the file keeps every tick flushed before the disk filled."""
+        with contextlib.suppress(DiskError):  # nothing written: the file ends at _size
+            write_whole(self._file, tail, self._size)
+            self._tail = tail
 
     def close(self) -> None:
         if not self._file.closed:
