@@ -5,6 +5,7 @@ from __future__ import annotations
 import json
 import subprocess
 import sys
+import time
 from collections.abc import Sequence
 from pathlib import Path
 from typing import Any
@@ -89,3 +90,15 @@ def files_of(
     run_dir: Path, patterns: Sequence[str] = ("*.csv", "*.mcap", "metrics.json")
 ) -> dict[str, bytes]:
     return {p.name: p.read_bytes() for pat in patterns for p in sorted(run_dir.glob(pat))}
+
+
+def matched_publisher(session: Any, key: str) -> Any:
+    """A publisher on `key` once the run's subscribers have matched it (a put before that
+    reaches nobody)."""
+    pub = session.declare_publisher(key)
+    for _ in range(100):
+        if pub.matching_status.matching:
+            break
+        time.sleep(0.05)
+    time.sleep(0.5)  # matching means one subscriber (the recorder); let physics match too
+    return pub

@@ -18,6 +18,7 @@ from conftest import (
     REPO,
     basic_scenario,
     csv_rows,
+    matched_publisher,
     only_run_dir,
     scenario_file,
     service_pid,
@@ -215,12 +216,7 @@ def test_malformed_and_non_finite_commands_are_logged_and_survived(
     wait_for_line(proc, "zenoh:")
     key = Keys("faults").cmd_thrust("ego")
     with open_session(Connection(connect=(endpoint,))) as session:
-        pub = session.declare_publisher(key)
-        for _ in range(100):
-            if pub.matching_status.matching:
-                break
-            time.sleep(0.05)
-        time.sleep(0.5)  # matching means one subscriber (the recorder); let physics match too
+        pub = matched_publisher(session, key)
         for payload in (
             b"\x93garbage",
             codec.encode(ThrustCmd(thrust=(math.nan, 0.5))),

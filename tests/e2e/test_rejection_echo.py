@@ -5,7 +5,14 @@ from __future__ import annotations
 import time
 from pathlib import Path
 
-from conftest import basic_scenario, only_run_dir, scenario_file, start, wait_for_line
+from conftest import (
+    basic_scenario,
+    matched_publisher,
+    only_run_dir,
+    scenario_file,
+    start,
+    wait_for_line,
+)
 
 from catabot.bus import codec
 from catabot.bus.keys import Keys
@@ -23,12 +30,7 @@ def test_the_first_refusal_of_each_kind_reaches_the_console_once(tmp_path: Path)
     key = Keys("echo").cmd_twist("ego")
     wrong = codec.pack({"v": 1, "type": "twist_cmd", "surge_mps": 1.0, "yaw_rate_radps": 0.1})
     with open_session(Connection(connect=(endpoint,))) as session:
-        pub = session.declare_publisher(key)
-        for _ in range(100):
-            if pub.matching_status.matching:
-                break
-            time.sleep(0.05)
-        time.sleep(0.5)  # matching means one subscriber (the recorder); let physics match too
+        pub = matched_publisher(session, key)
         for _ in range(5):
             pub.put(wrong)
             time.sleep(0.3)  # over a second: the log repeats the refusal, the console not
