@@ -112,7 +112,7 @@ export CATABOT_LISTEN=tcp/127.0.0.1:$port CATABOT_ROUTER=tcp/127.0.0.1:$port
 containers plain "$work/scenario/scenario.json" || { tail -n 5 "$work"/logs/plain/*.log; exit 1; }
 
 say "secure: a catabot secure init profile, TLS and a login per container"
-"$py" -m catabot secure init "$work/secure" --host catabot-router --port "$port" | head -n 1
+"$py" -m catabot secure init "$work/secure" --host catabot-router --port "$port" | sed -n 1p  # reads it all: no broken pipe under pipefail
 export CATABOT_LISTEN=tls/127.0.0.1:$port CATABOT_ROUTER=tls/localhost:$port  # in its certificate
 containers secure "$work/scenario/scenario.json" --secure "$work/secure" \
   || { tail -n 5 "$work"/logs/secure/*.log; exit 1; }
@@ -128,7 +128,7 @@ grep -q 'never joined within 3 s: stack' "$work/logs/missing/conductor.log" \
 say "compose: both files under podman-compose (PyPI), a podman network, the router by name"
 [ -x "$work/pc/bin/podman-compose" ] || { python3 -m venv "$work/pc" \
   && "$work/pc/bin/pip" install -q podman-compose >"$work/pc.log" 2>&1; }
-"$work/pc/bin/podman-compose" --version | head -n 1
+"$work/pc/bin/podman-compose" --version | sed -n 1p
 unset CATABOT_LISTEN CATABOT_ROUTER  # the files' defaults: the router's name in the network
 compose() {  # VARIANT ARGS...: podman-compose on $work/VARIANT.yml
   local variant=$1; shift
