@@ -106,10 +106,10 @@ def _twist_batches(world: World) -> tuple[Stream, ...]:
     blocks = world.traffic_blocks
     period = guidance_period_ticks(world.scenario) if blocks else 0
     return tuple(
-        Stream(twist_key(world, i), TwistBatch, name, period, check=checks.twist_batch(ids))
+        Stream(_twist_key(world, i), TwistBatch, name, period, check=checks.twist_batch(ids))
         for i, (name, ids) in enumerate(blocks.items())
     )
 
 
-def twist_key(world: World, shard: int) -> str:
+def _twist_key(world: World, shard: int) -> str:
     return world.keys.world_twists(shard if world.scenario.traffic.shards > 1 else None)

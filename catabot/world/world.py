@@ -19,7 +19,7 @@ from typing import Any, Literal
 
 import numpy as np
 
-from catabot.bus.clock import ClockLimits, period_in_ticks
+from catabot.bus.clock import NS_PER_S, ClockLimits, period_in_ticks
 from catabot.bus.keys import Keys
 from catabot.bus.messages import CLASS_BUOY, CLASS_VESSEL, BodyStates
 from catabot.config.pose import Velocity
@@ -58,7 +58,7 @@ class Body:
     model: VesselModel
     pose: Pose  # where it starts, at rest on the calm surface
     row: int  # its row in every `BodyStates`
-    script: tuple[ScriptStep, ...] = ()
+    script: tuple[ScriptStep, ...] = ()  # in time order (the World sorts it once)
     controller: ControllerConfig | None = None
     velocity: Velocity = field(default_factory=Velocity)  # body frame, at t = 0
 
@@ -70,6 +70,12 @@ class Body:
     @property
     def label_class(self) -> int:
         return CLASS_BUOY if self.kind == "buoy" else CLASS_VESSEL
+
+    @property
+    def script_ns(self) -> list[int]:
+        """Each script step's time: physics applies it from the first tick stamped at or
+        after it (physics, the recorder and its metrics read the script alike)."""
+        return [round(s.t_s * NS_PER_S) for s in self.script]
 
 
 @dataclass(frozen=True)
@@ -227,7 +233,7 @@ def _scenario_part(
     """What only a scenario vessel has: its script, its controller, its start velocity."""
     if config is None:
         return (), None, Velocity()
-    return tuple(config.script), config.controller, config.velocity
+    return tuple(sorted(config.script, key=lambda s: s.t_s)), config.controller, config.velocity
 
 
 def _unique(ids: list[str]) -> None:

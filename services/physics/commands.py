@@ -21,7 +21,6 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
-from catabot.bus.clock import NS_PER_S
 from catabot.bus.messages import Message, ThrustCmd, TwistBatch, TwistCmd, WaypointsCmd
 from catabot.config.scenario import ScriptStep
 from catabot.world.world import Body
@@ -48,10 +47,8 @@ class CommandBook:
         self.ids = tuple(v.id for v in vessels)
         self.row = {vid: i for i, vid in enumerate(self.ids)}
         self.thrusters = {v.id: len(v.model.thrusters) for v in vessels}
-        self.scripts = {v.id: sorted(v.script, key=lambda s: s.t_s) for v in vessels}
-        self.times = {
-            vid: [round(s.t_s * NS_PER_S) for s in steps] for vid, steps in self.scripts.items()
-        }
+        self.scripts = {v.id: v.script for v in vessels}  # in time order
+        self.times = {v.id: v.script_ns for v in vessels}
         self.scripted = [v.id for v in vessels if v.script]
         self.external: dict[str, Order] = {}
         self.set_point = np.zeros((len(self.ids), 2))  # (surge m/s, yaw rate rad/s)

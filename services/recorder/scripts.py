@@ -10,7 +10,6 @@ it at). Steps that fall on one tick: the last, the one physics follows.
 
 from __future__ import annotations
 
-from catabot.bus.clock import NS_PER_S
 from catabot.bus.messages import Message, ThrustCmd, TwistCmd
 from catabot.config.scenario import ScriptStep
 from catabot.world.world import World
@@ -23,8 +22,8 @@ class ScriptedCommands:
         dt = world.scenario.dt_ns
         self._due: dict[int, dict[str, ScriptStep]] = {}
         for vessel in world.vessels:
-            for step in sorted(vessel.script, key=lambda s: s.t_s):
-                tick = -(-round(step.t_s * NS_PER_S) // dt)  # the first tick at or after t_s
+            for step, t_ns in zip(vessel.script, vessel.script_ns, strict=True):
+                tick = -(-t_ns // dt)  # the first tick at or after the step's time
                 self._due.setdefault(tick, {})[vessel.id] = step
         self._keys = world.keys
 

@@ -20,7 +20,6 @@ from numpy.typing import NDArray
 
 from catabot.bus.clock import NS_PER_S
 from catabot.bus.messages import Message, ThrustCmd, TwistCmd
-from catabot.config.scenario import ScriptStep
 from catabot.config.task import TaskConfig
 from catabot.world.world import Body
 
@@ -112,7 +111,7 @@ class Thrust:
         self.dt_ns = dt_ns
         self.bodies = list(bodies)
         self.row = {b.id: i for i, b in enumerate(bodies)}
-        self.times = [[round(s.t_s * NS_PER_S) for s in _steps(b)] for b in bodies]
+        self.times = [b.script_ns for b in bodies]
         self.events = sorted({t for ts in self.times for t in ts})
         self.next_event = 0
         self.bus: dict[int, ThrustCmd | TwistCmd] = {}  # an order from the bus outranks a script
@@ -164,7 +163,7 @@ class Thrust:
             self.force[i], self.known[i] = 0.0, False
             return
         k = bisect.bisect_right(self.times[i], began) - 1
-        step = _steps(self.bodies[i])[k] if k >= 0 else None
+        step = self.bodies[i].script[k] if k >= 0 else None
         if step is not None and step.thrust is None:  # a scripted twist
             self.force[i], self.known[i] = 0.0, False
         else:
@@ -177,10 +176,6 @@ class Thrust:
         fwd = np.array([t.max_forward_n for t in thrusters])[: len(c)]
         rev = np.array([t.max_reverse_n for t in thrusters])[: len(c)]
         return float(np.where(c >= 0, c * fwd, -c * rev).sum())
-
-
-def _steps(body: Body) -> list[ScriptStep]:
-    return sorted(body.script, key=lambda s: s.t_s)
 
 
 def rowdot(a: Array, b: Array) -> Array:

@@ -31,7 +31,8 @@ class TrafficService:
     def __init__(self, ctx: ServiceContext) -> None:
         world = ctx.world
         self.ids = world.traffic_blocks[ctx.name]  # every boat, or this shard's block
-        boats = [b for b in world.traffic.boats if b.id in set(self.ids)]
+        mine = set(self.ids)
+        boats = [b for b in world.traffic.boats if b.id in mine]
         self.row = {vid: i for i, vid in enumerate(self.ids)}
         self.keys = ctx.keys
         self.behaviours = Behaviours(boats, hold_gain=ctx.scenario.traffic.hold.gain)
