@@ -31,6 +31,11 @@ def check_name(kind: str, name: str) -> str:
     return name
 
 
+def lives_of(participant: str) -> str:
+    """A participant's liveliness tokens in any world (a container's health check)."""
+    return f"{ROOT}/*/live/{check_name('participant', participant)}/*"
+
+
 def world_infos() -> str:
     """Every running world's `world/info` queryable: how a client finds the worlds."""
     return f"{ROOT}/*/world/info"

@@ -8,7 +8,6 @@ roster. It comes over Zenoh, so it is parsed as untrusted input: a malformed ans
 
 from __future__ import annotations
 
-import math
 from collections.abc import Mapping
 from dataclasses import dataclass, field
 from typing import Any
@@ -175,7 +174,7 @@ def _parse(d: Mapping[str, Any]) -> WorldInfo:
         ),
         granted=int(d.get("granted", -1)),
         scenario=dict(d["scenario"]),
-        start=_start_states(bodies),
+        start=_start_states(d["start"], tuple(str(b["id"]) for b in bodies)),
     )
 
 
@@ -224,13 +223,13 @@ def _sensor(s: Mapping[str, Any]) -> SensorInfo:
     )
 
 
-def _start_states(bodies: list[Mapping[str, Any]]) -> BodyStates:
-    """Every body at rest at its start pose, as physics starts (World.start_states)."""
-    n = len(bodies)
-    poses = [b["pose"] for b in bodies]
-    position = np.array([(float(p["x_m"]), float(p["y_m"]), 0.0) for p in poses]).reshape(n, 3)
-    halves = [float(p["yaw_rad"]) / 2 for p in poses]
-    quat = np.array([(0.0, 0.0, math.sin(h), math.cos(h)) for h in halves]).reshape(n, 4)
+def _start_states(d: Mapping[str, Any], ids: tuple[str, ...]) -> BodyStates:
+    """Every body's start as physics starts it (the conductor sends World.start_states)."""
+    n = len(ids)
+    widths = {"position": 3, "orientation": 4, "linear_velocity": 3, "angular_velocity": 3}
+    arrays = [np.asarray(d[k], dtype=np.float64).reshape(n, w) for k, w in widths.items()]
+    if not all(np.isfinite(a).all() for a in arrays):
+        raise ValueError("a start state is not finite")
+    position, orientation, linear, angular = arrays
     zero = np.zeros((n, 3))
-    ids = tuple(str(b["id"]) for b in bodies)
-    return BodyStates(-1, 0, ids, position, quat, zero, zero, zero, zero)
+    return BodyStates(-1, 0, ids, position, orientation, linear, angular, zero, zero)

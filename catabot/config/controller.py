@@ -44,7 +44,7 @@ def check_programs(controllers: Sequence[ControllerConfig | None], taken: Sequen
         if c is None:
             continue
         field = f"vessels.{index}.controller"
-        if c.program is not None and c.participant in taken:
+        if c.program is not None and c.participant.partition(".")[0] in taken:  # or a shard
             raise FieldProblem(
                 field, f"participant {c.participant!r} is a CataBot process's name; pick another"
             )

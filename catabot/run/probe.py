@@ -19,7 +19,7 @@ import argparse
 import socket
 import sys
 
-from catabot.bus.keys import check_name
+from catabot.bus.keys import lives_of
 from catabot.bus.session import Connection, check_endpoint, open_session
 from catabot.errors import CataBotError
 
@@ -49,7 +49,7 @@ def port_open(endpoint: str, timeout_s: float = TIMEOUT_S) -> str:
 
 def on_bus(endpoint: str, name: str, config: str | None, timeout_s: float = TIMEOUT_S) -> str:
     """'' when a liveliness token of `name` (in any world on this router) answers."""
-    key = f"catabot/*/live/{check_name('participant', name)}/*"
+    key = lives_of(name)
     session = open_session(Connection(connect=(endpoint,), mode="client", file=config))
     try:
         replies = session.liveliness().get(key, timeout=timeout_s)

@@ -38,6 +38,7 @@ from catabot.world.world import Body, MountedSensor, World
 
 log = logging.getLogger("catabot.run.world_info")
 VERSION = 1  # of the answer's layout; catabot/client/info.py refuses another
+START_FIELDS = ("position", "orientation", "linear_velocity", "angular_velocity")
 
 
 def describe(world: World, roster: Roster) -> dict[str, Any]:
@@ -74,6 +75,7 @@ def describe(world: World, roster: Roster) -> dict[str, Any]:
             "stamp_ticks": states.stamp_ticks,
         },
         "bodies": [_body(b) for b in world.bodies],
+        "start": _start(world),
         "vessels": [_vessel(world, names, v) for v in world.vessels if v.kind == "vessel"],
         "traffic": list(world.boat_ids),
         "buoys": [
@@ -113,11 +115,18 @@ def _vessel(world: World, names: Names, v: Body) -> dict[str, Any]:
             "waypoints": keys.cmd_waypoints(v.id),
         },
         "controller": controller,
-        "sensors": [_sensor(names, m) for m in world.sensors if m.vessel == v.id],
+        "sensors": [_sensor(world, names, m) for m in world.sensors if m.vessel == v.id],
     }
 
 
-def _sensor(names: Names, m: MountedSensor) -> dict[str, Any]:
+def _start(world: World) -> dict[str, list[list[float]]]:
+    """Every body's start as physics starts it (World.start_states: pose, tilt, velocity):
+    what a stack observes before the first state arrives."""
+    start = world.start_states()
+    return {name: getattr(start, name).tolist() for name in START_FIELDS}
+
+
+def _sensor(world: World, names: Names, m: MountedSensor) -> dict[str, Any]:
     xyz, rot = frames.mount(m)
     return {
         "name": m.config.name,
@@ -126,7 +135,7 @@ def _sensor(names: Names, m: MountedSensor) -> dict[str, Any]:
         "rate_hz": m.config.rate_hz,
         "period_ticks": m.period,
         "key": m.key,
-        "producer": "sensors",
+        "producer": world.sensor_owners[m.key],  # `sensors`, or its shard
         "frame": names.sensor_frame(m),
         "mount": {
             "xyz": list(xyz),

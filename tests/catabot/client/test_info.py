@@ -11,6 +11,8 @@ import pytest
 from catabot.bus.messages import LidarScan, TwistCmd
 from catabot.client import ClientError, UnknownSensor
 from catabot.client.info import parse
+from catabot.config.load import parse_scenario
+from catabot.run.world_info import describe
 from catabot.world.world import World
 from tests.catabot.client.fixtures import DEG, ROSTER, answer, scenario
 
@@ -96,3 +98,19 @@ def test_a_malformed_answer_is_a_clear_error(spoil: Any, why: str) -> None:
         ClientError, match=f"malformed world info from catabot/info/world/info: .*{why}"
     ):
         parse(data, "catabot/info/world/info")
+
+
+def test_start_states_off_rest_and_sharded_producers_are_the_worlds() -> None:
+    data = scenario().model_dump(mode="json")
+    data["vessels"][0]["pose"] |= {"z_m": 0.3, "roll_rad": 0.1, "pitch_rad": -0.05}
+    data["vessels"][0]["velocity"] = {"surge_mps": 1.5, "yaw_rate_radps": 0.2}
+    data["sensors"] = {"shards": 2}
+    world = World.resolve(parse_scenario(data))
+    info = parse(describe(world, ROSTER), "test")
+    for got, want in zip(info.start.arrays(), world.start_states().arrays(), strict=True):
+        np.testing.assert_array_equal(got, want)
+    producers = {s.key: s.producer for v in info.vessels.values() for s in v.sensors.values()}
+    assert producers == world.sensor_owners and set(producers.values()) == {
+        "sensors.0",
+        "sensors.1",
+    }
