@@ -18,6 +18,7 @@ from catabot.config.vessel import Hull, VesselModel
 
 Array = NDArray[np.float64]
 PROBE_SPACING_M = 0.5  # along and across each hull bottom
+CONTACT_M = 0.01  # hull boxes this close touch (physics resolves a contact within mm)
 
 
 def hull_probes(hull: Hull, spacing_m: float) -> Array:

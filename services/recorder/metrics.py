@@ -21,7 +21,7 @@ import numpy as np
 
 from catabot.bus.clock import NS_PER_S
 from catabot.bus.messages import BodyStates, Message
-from catabot.world.hulls import box_gaps, footprints
+from catabot.world.hulls import CONTACT_M, box_gaps, footprints
 from catabot.world.rotations import yaw_of_quaternions
 from catabot.world.world import World
 from services.recorder.episodes import Episodes
@@ -29,7 +29,6 @@ from services.recorder.metrics_json import write_metrics
 from services.recorder.seabed import Seabed
 from services.recorder.tasks import Goals, Routes, Thrust, rowdot
 
-CONTACT_M = 0.01  # hull boxes this close touch (physics resolves a contact within mm)
 EPISODE_GAP_S = 1.0  # a contact that stops for less than this is the same contact
 
 
