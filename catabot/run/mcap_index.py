@@ -27,9 +27,8 @@ import numpy as np
 from numpy.typing import NDArray
 
 from catabot.errors import CataBotError
-from catabot.run.mcap_compression import decompress
+from catabot.run.mcap_compression import ENTRY, MAGIC, decompress
 
-MAGIC = b"\x89MCAP0\r\n"
 _HEAD = struct.Struct("<BQ")  # opcode, length of the record's body
 _MESSAGE = struct.Struct("<HIQQ")  # channel id, sequence, log time, publish time
 _U16 = struct.Struct("<H")
@@ -37,7 +36,6 @@ _U32 = struct.Struct("<I")
 _U64 = struct.Struct("<Q")
 _FOOTER = struct.Struct("<BQQQI")  # opcode, length, summary start, summary offsets, crc
 _INDEX_PAIR = struct.Struct("<HQ")  # channel id, message index record offset
-_ENTRY = np.dtype([("log_time", "<u8"), ("offset", "<u8")])
 OP_CHUNK_INDEX = 0x08
 OP_FOOTER, OP_SCHEMA, OP_CHANNEL, OP_MESSAGE, OP_CHUNK, OP_DATA_END = (
     0x02,
@@ -267,7 +265,7 @@ def _from_summary(
     for at, offsets in chunks:
         for chan_id, where in offsets.items():
             (length,) = _U32.unpack_from(data, where + _HEAD.size + 2)
-            entries = np.frombuffer(data, _ENTRY, length // _ENTRY.itemsize, where + 15)
+            entries = np.frombuffer(data, ENTRY, length // ENTRY.itemsize, where + 15)
             found.setdefault(chan_id, []).append((entries["log_time"],
                                                    entries["offset"] + bases[at]))  # fmt: skip
     view = np.frombuffer(buffer, np.uint8)

@@ -43,7 +43,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from catabot.config.vessel import VesselModel
-from catabot.world.hulls import hull_probes
+from catabot.world.hulls import PROBE_SPACING_M, model_probes
 from catabot.world.terrain import Terrain
 from services.physics.hydro import Array
 
@@ -58,7 +58,7 @@ class ContactParams:
     sag_m: float = 0.005  # sink under the whole weight resting on `support_probes` probes
     support_probes: int = 4  # e.g. a hull on a rock under its four corners
     damping_ratio: float = 1.0  # of that heave mode: a grounding hull does not bounce
-    probe_spacing_m: float = 0.5  # along and across each hull bottom
+    probe_spacing_m: float = PROBE_SPACING_M  # along and across each hull bottom
 
 
 class Grounding:
@@ -77,10 +77,7 @@ class Grounding:
     ) -> None:
         self.terrain, self.params, self._dt = terrain, params or ContactParams(), float(dt_s)
         self._skeletons = list(skeletons)
-        per_vessel = [
-            np.concatenate([hull_probes(h, self.params.probe_spacing_m) for h in m.hulls])
-            for m in models
-        ]
+        per_vessel = [model_probes(m, self.params.probe_spacing_m) for m in models]
         n, width = len(models), max(len(q) for q in per_vessel)
         self.probes_m, self.valid = np.zeros((n, width, 3)), np.zeros((n, width), dtype=bool)
         for i, q in enumerate(per_vessel):

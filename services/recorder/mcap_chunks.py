@@ -24,13 +24,12 @@ from mcap.opcode import Opcode
 from mcap.records import ChunkIndex
 from numpy.typing import NDArray
 
-from catabot.run.mcap_compression import compress
+from catabot.run.mcap_compression import ENTRY, compress
 
 CHUNK_BYTES = 1 << 20  # uncompressed; the `mcap` writer's default
 BULK_BYTES = 1 << 16  # a message this long (an image, a cloud) goes to the bulk chunk
 _CHUNK_HEAD = struct.Struct("<BQQQQI")  # opcode, length, start, end, uncompressed size, crc
 _INDEX_HEAD = struct.Struct("<BQHI")  # opcode, length, channel id, bytes of entries
-_ENTRY = np.dtype([("log_time", "<u8"), ("offset", "<u8")])
 
 
 @dataclass(frozen=True)
@@ -135,7 +134,7 @@ def _message_indexes(
     ascending); and where each record starts, counted from the chunk's start (`at` = the
     chunk record's length, where the first index record goes)."""
     order = np.lexsort((offsets, times, channels))
-    entries = np.empty(len(order), _ENTRY)
+    entries = np.empty(len(order), ENTRY)
     entries["log_time"], entries["offset"] = times[order], offsets[order]
     ids, first, counts = np.unique(channels[order], return_index=True, return_counts=True)
     parts: list[bytes] = []

@@ -35,10 +35,9 @@ from mcap.records import (
 )  # fmt: skip
 from numpy.typing import NDArray
 
-from catabot.run.mcap_compression import COMPRESSIONS
+from catabot.run.mcap_compression import COMPRESSIONS, MAGIC
 from services.recorder.mcap_chunks import BULK_BYTES, CHUNK_BYTES, OpenChunk
 
-MAGIC = b"\x89MCAP0\r\n"
 # opcode, record length, channel id, sequence, log time, publish time; then the data
 _MESSAGE_HEAD = struct.Struct("<BQHIQQ")
 _MESSAGE_FIXED = _MESSAGE_HEAD.size - 9  # the record length counts what follows it
