@@ -18,6 +18,7 @@ from types import TracebackType
 
 import zenoh
 
+from catabot.bus.clock import NS_PER_S, ClockError, period_in_ticks
 from catabot.bus.keys import Keys
 from catabot.bus.messages import End
 from catabot.bus.outputs import Outputs
@@ -162,10 +163,10 @@ class Client:
             return c.period_ticks
         if rate_hz is None:
             return 1
-        ticks = round(1e9 / rate_hz / info.dt_ns)
-        if ticks < 1 or abs(ticks * info.dt_ns - 1e9 / rate_hz) > 1:
-            raise ValueError(f"rate_hz {rate_hz} is not the tick rate divided by a whole number")
-        return ticks
+        try:  # the rule every rate follows (DESIGN.md §4)
+            return period_in_ticks(round(NS_PER_S / rate_hz), info.dt_ns, what=f"rate_hz {rate_hz}")
+        except ClockError as exc:
+            raise ValueError(str(exc)) from None
 
     def run_lockstep(
         self, name: str, step: Step, *, vessel: str | None = None, sensors: Sequence[str] = (),

@@ -14,7 +14,7 @@ from typing import Any
 
 import zenoh
 
-from catabot.bus.keys import ROOT, Keys, world_infos
+from catabot.bus.keys import KeyNameError, Keys, world_infos
 from catabot.client.errors import ClientError, SeveralWorlds, SimulatorNotFound
 from catabot.client.info import WorldInfo, parse
 
@@ -65,9 +65,9 @@ def _ask(session: zenoh.Session, selector: str, timeout_s: float) -> dict[str, t
             data = json.loads(reply.ok.payload.to_bytes().decode("utf-8"))
         except (UnicodeDecodeError, ValueError, RecursionError):
             continue
-        name = data.get("world") if isinstance(data, dict) else None
-        if not isinstance(name, str) or key != f"{ROOT}/{name}/world/info":  # its own key only
+        if not isinstance(data, dict) or not _answers_its_own_key(data.get("world"), key):
             continue
+        name = data["world"]
         if name in out and _static(out[name][1]) != _static(data):
             raise ClientError(
                 f"two different answers on {key}: one is not its conductor's (on an open "
@@ -80,3 +80,11 @@ def _ask(session: zenoh.Session, selector: str, timeout_s: float) -> dict[str, t
 def _static(data: dict[str, Any]) -> dict[str, Any]:
     """An answer without what changes between two queries (the clock's grant)."""
     return {k: v for k, v in data.items() if k != "granted"}
+
+
+def _answers_its_own_key(name: object, key: str) -> bool:
+    """Whether an answer on `key` names the world that key belongs to."""
+    try:
+        return isinstance(name, str) and key == Keys(name).world_info()
+    except KeyNameError:
+        return False

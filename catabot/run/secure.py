@@ -27,7 +27,7 @@ from pathlib import Path
 from typing import Any
 
 from catabot.bus.clock import CONDUCTOR
-from catabot.bus.keys import check_name
+from catabot.bus.keys import check_name, world_infos
 from catabot.bus.session import LEASE_MS
 from catabot.config.sensors import shard_names
 from catabot.errors import CataBotError
@@ -42,7 +42,7 @@ OWN = {  # keys each process may put besides its ack and its liveliness token
 COMMANDS = ["vessel/*/cmd/**"]
 READ = ["declare_subscriber", "declare_liveliness_subscriber", "liveliness_query"]
 # everyone may read the settings (`catabot get`) and the world (a stack's Client.connect)
-ASK = ["catabot/*/config/settings", "catabot/*/world/info"]
+ASK = ["catabot/*/config/settings", world_infos()]
 SET = ["catabot/*/config/set"]  # commanding clients may change them (`catabot set`)
 
 
@@ -149,7 +149,7 @@ def _acl(own: dict[str, list[str]], clients: list[str], observers: list[str]) ->
         _rule("ask", ["query"], ["ingress"], ASK),
         _rule("set", ["query"], ["ingress"], SET),
         _rule("desk", ["declare_queryable", "query", "reply"], ["ingress", "egress"],
-              ["catabot/*/config/**", "catabot/*/world/info"]),
+              ["catabot/*/config/**", world_infos()]),
     ]  # fmt: skip
     policies = [
         {"rules": ["read", "receive", "ask"], "subjects": ["everyone"]},
