@@ -25,6 +25,7 @@ def parser(description: str | None) -> argparse.ArgumentParser:
     p.add_argument(
         "--participant", help="lockstep name (default: the vessel's controller.participant)"
     )
+    p.add_argument("--timeout", type=float, default=30.0, help="seconds to wait for the run")
     return p
 
 

@@ -77,7 +77,6 @@ def main() -> None:
         help="what to send when free-running (in lockstep: the controller's kind)",
     )
     p.add_argument("--rate", type=float, default=10.0, help="Hz when free-running")  # fmt: skip
-    p.add_argument("--timeout", type=float, default=30.0, help="seconds to wait for the run")
     args = p.parse_args()
     with clear_errors("follow_waypoints.py"), Client.from_args(args) as sim:
         vessel = sim.vessel(args.vessel).info

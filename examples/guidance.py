@@ -2,12 +2,9 @@
 sight guidance, and a catamaran's thrust for a (surge, yaw rate) wish. Pure functions, tested in
 tests/examples/test_guidance.py.
 
-A stack does not import the simulator's geodesy (catabot.world needs the scenario and more),
-so the fix goes to `map` (ENU, origin = the scenario's `origin`) by a local tangent-plane
-approximation: metres per radian of latitude and longitude from WGS84's meridian and
-prime-vertical radii at the origin. Against catabot/world/geo.py's exact ENU frame (tested)
-it is off by about d^2 tan(lat) / 2R: 2 cm at 500 m at 45 degrees, 6 cm at 70 degrees, far
-under the GPS noise.
+The fix goes to `map` (ENU, origin = the scenario's `origin`) through the simulator's own
+geodesy (catabot/world/geo.py's EnuFrame, which needs only NumPy): the inverse of what the
+GPS sensor did, exact.
 """
 
 from __future__ import annotations
@@ -21,8 +18,8 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
-WGS84_A = 6378137.0
-WGS84_E2 = (1.0 / 298.257223563) * (2.0 - 1.0 / 298.257223563)
+from catabot.world.geo import EnuFrame
+from catabot.world.rotations import yaw_of_quaternions
 
 
 @dataclass(frozen=True)
@@ -45,34 +42,26 @@ class LocalFrame:
         except (KeyError, TypeError, ValueError) as e:
             raise SystemExit(f"the world's scenario has no usable `origin` ({e!r})") from None
 
-    def _radii(self) -> tuple[float, float]:
-        """Metres per radian north (meridian radius) and east (parallel radius) at the origin."""
-        s = math.sin(math.radians(self.latitude_deg))
-        w = math.sqrt(1.0 - WGS84_E2 * s * s)
-        north = WGS84_A * (1.0 - WGS84_E2) / w**3 + self.altitude_m
-        east = (WGS84_A / w + self.altitude_m) * math.cos(math.radians(self.latitude_deg))
-        return north, east
+    @property
+    def _enu(self) -> EnuFrame:
+        return EnuFrame(self.latitude_deg, self.longitude_deg, self.altitude_m)
 
     def to_local(self, latitude_deg: float, longitude_deg: float) -> tuple[float, float]:
         """East, north (m) of a fix."""
-        north, east = self._radii()
-        dlon = (longitude_deg - self.longitude_deg + 180.0) % 360.0 - 180.0
-        return east * math.radians(dlon), north * math.radians(latitude_deg - self.latitude_deg)
+        east, north, _ = self._enu.to_enu(latitude_deg, longitude_deg, self.altitude_m)
+        return float(east), float(north)
 
     def to_fix(self, east_m: float, north_m: float) -> tuple[float, float]:
-        """Latitude, longitude (deg) of a local position (for tests and logs)."""
-        north, east = self._radii()
-        return (
-            self.latitude_deg + math.degrees(north_m / north),
-            self.longitude_deg + math.degrees(east_m / east),
-        )
+        """Latitude, longitude (deg) of a local position (for tests and logs); the longitude
+        continuous around the origin's (past 180 east of a point near the antimeridian)."""
+        lat, lon, _ = self._enu.to_geodetic(east_m, north_m, 0.0)
+        return float(lat), self.longitude_deg + (float(lon) - self.longitude_deg + 180) % 360 - 180
 
 
 def yaw_of(q: Sequence[float] | NDArray[np.float64]) -> float:
     """ENU heading (rad, 0 = east, counter-clockwise) of an orientation quaternion (x, y, z, w),
     the IMU's."""
-    x, y, z, w = (float(v) for v in q)
-    return math.atan2(2 * (w * z + x * y), 1 - 2 * (y * y + z * z))
+    return float(yaw_of_quaternions(np.asarray([q], dtype=np.float64))[0])
 
 
 def wrap(angle: float) -> float:

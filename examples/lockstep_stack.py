@@ -13,6 +13,7 @@ python examples/lockstep_stack.py --connect tcp/127.0.0.1:7447 --goal 40 20
 import math
 
 from common import parser
+from guidance import yaw_of
 
 from catabot.client import Client, Observation, Thrust
 
@@ -26,17 +27,10 @@ def decide(x: float, y: float, yaw: float, goal: tuple[float, float]) -> tuple[f
     return max(ahead - turn, -1.0), min(ahead + turn, 1.0)
 
 
-def yaw_of(q: tuple[float, ...]) -> float:
-    """ENU heading of a quaternion (x, y, z, w)."""
-    x, y, z, w = q
-    return math.atan2(2.0 * (w * z + x * y), 1.0 - 2.0 * (y * y + z * z))
-
-
 def main() -> None:
     p = parser(__doc__)
     p.add_argument("--name", default="stack", help="the participant name the scenario expects")
     p.add_argument("--goal", type=float, nargs=2, default=(40.0, 20.0), metavar=("X", "Y"))
-    p.add_argument("--timeout", type=float, default=30.0, help="seconds to wait for the run")
     p.set_defaults(world=None)  # the one world running
     args = p.parse_args()
     goal = (args.goal[0], args.goal[1])

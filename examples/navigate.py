@@ -89,7 +89,6 @@ def main() -> None:
     p.add_argument("--goal", type=float, nargs=2, metavar=("X", "Y"),
                    help="in map (m); default: the vessel's task.goal in the scenario")  # fmt: skip
     p.add_argument("--tolerance", type=float, default=3.0, help="m from the goal to stop")
-    p.add_argument("--timeout", type=float, default=30.0, help="seconds to wait for the run")
     args = p.parse_args()
     with clear_errors("navigate.py"), Client.from_args(args) as sim:
         vessel = sim.vessel(args.vessel).info

@@ -16,6 +16,8 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import NDArray
 
+from catabot.world import rotations
+
 F64 = NDArray[np.float64]
 
 
@@ -57,42 +59,15 @@ class Planner:
     w_speed: float = 0.1
 
 
-def quaternion_matrix(q: F64) -> F64:
-    """Rotation matrix of a unit quaternion (x, y, z, w): body vectors to the world frame."""
-    x, y, z, w = (float(v) for v in np.asarray(q, dtype=np.float64) / np.linalg.norm(q))
-    return np.array(
-        [
-            [1 - 2 * (y * y + z * z), 2 * (x * y - z * w), 2 * (x * z + y * w)],
-            [2 * (x * y + z * w), 1 - 2 * (x * x + z * z), 2 * (y * z - x * w)],
-            [2 * (x * z - y * w), 2 * (y * z + x * w), 1 - 2 * (x * x + y * y)],
-        ]
-    )
-
-
-def rpy_matrix(roll: float, pitch: float, yaw: float) -> F64:
-    """R = Rz(yaw) Ry(pitch) Rx(roll): a mount's rpy, sensor axes to body axes."""
-    cr, sr, cp, sp, cy, sy = (
-        np.cos(roll),
-        np.sin(roll),
-        np.cos(pitch),
-        np.sin(pitch),
-        np.cos(yaw),
-        np.sin(yaw),
-    )
-    return np.array(
-        [
-            [cy * cp, cy * sp * sr - sy * cr, cy * sp * cr + sy * sr],
-            [sy * cp, sy * sp * sr + cy * cr, sy * sp * cr - cy * sr],
-            [-sp, cp * sr, cp * cr],
-        ]
-    )
-
-
 def world_offsets(points: F64, mount_xyz: F64, mount_rpy: F64, orientation: F64) -> F64:
     """LiDAR returns (N, 3, sensor frame) as ENU offsets from the vessel's origin (N, 3):
     through the mount into the body frame, then levelled and turned by the IMU's attitude."""
-    body = np.asarray(points, np.float64) @ rpy_matrix(*mount_rpy).T + np.asarray(mount_xyz)
-    return body @ quaternion_matrix(orientation).T
+    mount = rotations.rpy(*np.degrees(np.asarray(mount_rpy, np.float64)))
+    body = np.asarray(points, np.float64) @ mount.T + np.asarray(mount_xyz)
+    attitude = rotations.matrix(orientation)
+    if attitude is None:
+        raise ValueError(f"orientation {list(orientation)} is not a rotation")
+    return body @ attitude.T
 
 
 def reflectivity(points: F64, intensity: F64) -> F64:

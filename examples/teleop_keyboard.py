@@ -121,7 +121,6 @@ def main() -> None:
     p.add_argument("--camera", default="camera", help="the camera Space saves")
     p.add_argument("--out", type=Path, default=Path("screenshots"), help="folder for the PNGs")
     p.add_argument("--rate", type=float, default=10.0, help="commands (and redraws) per second")
-    p.add_argument("--timeout", type=float, default=30.0, help="seconds to wait for the run")
     args = p.parse_args()
     with clear_errors("teleop_keyboard.py"), Client.from_args(args) as sim:
         ego = sim.vessel(args.vessel)

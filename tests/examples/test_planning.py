@@ -15,12 +15,13 @@ from planning import (
     choose,
     clearance,
     occupancy,
-    quaternion_matrix,
     reflectivity,
     rollout,
     window,
     world_offsets,
 )
+
+from catabot.world.rotations import matrix as quaternion_matrix
 
 SPEC = GridSpec()
 PLAN = Planner()
