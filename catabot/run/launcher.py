@@ -67,7 +67,7 @@ def prepare(opts: RunOptions) -> World:
         data["clock"]["realtime_factor"] = opts.realtime
     world = World.resolve(parse_scenario(data, source="command line"), progress=PlanningProgress())
     for name in world.services:
-        if name.partition(".")[0] not in SERVICE_MODULES:
+        if service_of(name, world.services)[0] not in SERVICE_MODULES:
             raise LaunchError(f"scenario needs service {name!r}, which this version does not have")
     programs.programs(world.scenario, opts.scenario)  # each controller's program is a file
     _check_logins(opts, world)
@@ -171,14 +171,11 @@ def _start(
     conductor = child(CONDUCTOR, "catabot.run.conduct", flags[0], stdout=True)
     stops.conductor = conductor.proc
     viewer = _viewer(opts, run_dir, [*flags[1], *_login("viewer", opts.zenoh_configs)])
-    services = {
-        name: child(
-            name,
-            SERVICE_MODULES[service_of(name, world.services)[0]],
-            ["--run-dir", str(run_dir), *flags[1], *service_of(name, world.services)[1]],
-        )
-        for name in world.services
-    }
+    services = {}
+    for name in world.services:
+        program, shard = service_of(name, world.services)  # a shard: --shard I/N
+        extra = ["--run-dir", str(run_dir), *flags[1], *shard]
+        services[name] = child(name, SERVICE_MODULES[program], extra)
     for stack in stacks:
         name = stack.participant
         own = [*flags[1], "--zid", str(roster.zid(name)), *_login(name, opts.zenoh_configs)]
