@@ -5,7 +5,7 @@ from __future__ import annotations
 import json
 import subprocess
 import sys
-import time
+import threading
 from collections.abc import Sequence
 from pathlib import Path
 from typing import Any
@@ -92,13 +92,17 @@ def files_of(
     return {p.name: p.read_bytes() for pat in patterns for p in sorted(run_dir.glob(pat))}
 
 
-def matched_publisher(session: Any, key: str) -> Any:
-    """A publisher on `key` once the run's subscribers have matched it (a put before that
-    reaches nobody)."""
+def matched_publisher(session: Any, key: str, *, timeout: float = 60.0) -> Any:
+    """A publisher on `key` once the run is stepping: a world state means every participant
+    joined, and each declares its subscribers before it joins, so no put is lost to a
+    service still starting (a fixed wait was not enough on a loaded machine)."""
     pub = session.declare_publisher(key)
-    for _ in range(100):
-        if pub.matching_status.matching:
-            break
-        time.sleep(0.05)
-    time.sleep(0.5)  # matching means one subscriber (the recorder); let physics match too
+    world = key.split("/")[1]
+    stepping = threading.Event()
+    sub = session.declare_subscriber(f"catabot/{world}/vessel/*/state", lambda _s: stepping.set())
+    try:
+        if not stepping.wait(timeout):
+            raise TimeoutError(f"no vessel state on catabot/{world} within {timeout} s")
+    finally:
+        sub.undeclare()
     return pub
