@@ -11,8 +11,13 @@ FPS is the Unity frame rate; our nearest figure is the LiDAR scan rate, and the 
 factor says whether the run kept up with the clock at all. Sensor types not registered in
 catabot/sensor_types.py are left out, and the table says which.
 
-Usage: python -m benchmarks.table2 [seconds]  (simulated seconds per run, default 5), or
-`python -m benchmarks table2` (5 s).
+Every service costs more per tick later in a run than in its first seconds (heaps grow,
+boats spread), so a cell is 60 simulated seconds by default: steady state, not the start.
+The 0-boat cell is the reference every ratio divides by, printed beside it; the memory table
+gives each process's peak resident memory (the kernel's high-water mark, log/run.json).
+
+Usage: python -m benchmarks.table2 [seconds] [--columns 0,1,2] [--boats 0,100]
+(simulated seconds per cell, default 60), or `python -m benchmarks table2`.
 """
 
 from __future__ import annotations
@@ -106,22 +111,32 @@ def cpu_per_tick(result: dict[str, Any]) -> str:
     return ", ".join(f"{name} {1e3 * s / ticks:.2f} ms" for name, s in cpu.items()) or "n/a"
 
 
+def option(args: list[str], flag: str, default: list[int]) -> list[int]:
+    """A comma-separated list of integers after `flag` (the rows or columns to run)."""
+    if flag not in args:
+        return default
+    return [int(x) for x in args[args.index(flag) + 1].split(",")]
+
+
 def main(argv: list[str] | None = None) -> None:
     args = sys.argv[1:] if argv is None else argv
     numbers = [a for a in args if a.replace(".", "", 1).isdigit()]
-    seconds = float(numbers[0]) if numbers else 5.0
+    seconds = float(numbers[0]) if numbers and args.index(numbers[0]) == 0 else 60.0
     missing = sorted({"lidar", "radar", "camera"} - set(SENSOR_TYPES))
-    columns = [0] if "camera" not in SENSOR_TYPES else [0, 1, 2]
+    columns = option(args, "--columns", [0] if "camera" not in SENSOR_TYPES else [0, 1, 2])
+    boats_rows = option(args, "--boats", list(BOATS))
     print(f"Table II: {seconds:g} s simulated per run, recorder on, rain 10 mm/h")
     if missing:
         print(f"  sensor types not registered, left out: {', '.join(missing)}")
-    if len(columns) < 3:
+    if "camera" not in SENSOR_TYPES:
         print("  columns skipped (no camera): " + ", ".join(COLUMNS[1:]))
     has_lidar = "lidar" in SENSOR_TYPES
     usage: dict[str, str] = {}
-    rtf: dict[int, float] = {}
+    memory: dict[str, str] = {}
+    rtf: dict[str, float] = {}
     with tempfile.TemporaryDirectory(prefix="table2-") as tmp:
-        for boats, mix in [(b, CIRCLES) for b in BOATS] + [(100, MIX)]:
+        rows = [(b, CIRCLES) for b in BOATS if b in boats_rows]
+        for boats, mix in rows + ([(100, MIX)] if 100 in boats_rows else []):
             label = f"{boats:4d} boats" + (
                 f" (half on waypoints, {buoys(seconds)} buoys)" if mix is MIX else ""
             )
@@ -131,15 +146,41 @@ def main(argv: list[str] | None = None) -> None:
                 row.append(f"{COLUMNS[column]}: {cell(result, has_lidar)} "
                            f"(paper {PAPER[boats][column]} FPS)")  # fmt: skip
                 if column == 0:
-                    usage[label] = cpu_per_tick(result)
-                    if mix is CIRCLES and result.get("wall_s"):
-                        rtf[boats] = result["sim_s"] / result["wall_s"]
+                    usage[label], memory[label] = cpu_per_tick(result), peak_memory(result)
+                    if result.get("wall_s"):
+                        rtf[row_key(boats, mix)] = result["sim_s"] / result["wall_s"]
             print(" | ".join(row), flush=True)
-    if rtf.get(0) and 100 in rtf:
-        print(f"100 boats / 0 boats, no perception: {rtf[100] / rtf[0]:.2f} (paper 32/55 = 0.58)")
+    print_ratios(rtf)
     print("CPU per tick in each service's stepping loop (no perception column):")
     for label, text in usage.items():
         print(f"  {label}: {text}")
+    print("Peak resident memory per process, MiB (no perception column; target: stack < 1 GB):")
+    for label, text in memory.items():
+        print(f"  {label}: {text}")
+
+
+def row_key(boats: int, mix: dict[str, float]) -> str:
+    return "mix" if mix is MIX else str(boats)
+
+
+def peak_memory(result: dict[str, Any]) -> str:
+    """Each process's peak RSS and the stack's sum (log/run.json's peak_rss_mb)."""
+    rss = result.get("peak_rss_mb") or {}
+    return ", ".join(f"{name} {mb:.0f}" for name, mb in rss.items()) or "n/a"
+
+
+def print_ratios(rtf: dict[str, float]) -> None:
+    """The targets are ratios to the 0-boat cell measured in the same run (issue #17)."""
+    base = rtf.get("0")
+    if not base:
+        return
+    print(f"reference: 0 boats, no perception, RTF {base:.2f}")
+    if "100" in rtf:
+        print(f"100 boats / 0 boats: {rtf['100']:.2f} / {base:.2f} = {rtf['100'] / base:.2f}"
+              " (target >= 0.6; paper 32/55 = 0.58)")  # fmt: skip
+    if "mix" in rtf:
+        print(f"100 boats half on waypoints / 0 boats: {rtf['mix']:.2f} / {base:.2f} = "
+              f"{rtf['mix'] / base:.2f} (target >= 0.4)")  # fmt: skip
 
 
 if __name__ == "__main__":

@@ -9,7 +9,6 @@ from __future__ import annotations
 import argparse
 import cProfile
 import gc
-import json
 import logging
 import os
 import signal
@@ -42,6 +41,7 @@ from catabot.config.load import load_scenario
 from catabot.config.scenario import Scenario, shard_count
 from catabot.config.sensors import shard_names
 from catabot.errors import CataBotError
+from catabot.run.usage import write_usage
 from catabot.world.world import World
 
 log = logging.getLogger("catabot.run.service")
@@ -137,12 +137,6 @@ def quiet_gc() -> None:
     gc.set_threshold(70_000, 10, 10)
 
 
-def _write_usage(name: str, run_dir: Path, cpu_s: float) -> None:
-    """CPU seconds of the stepping loop (every thread, start-up excluded), for run.json."""
-    (run_dir / "log").mkdir(parents=True, exist_ok=True)
-    (run_dir / "log" / f"{name}.usage.json").write_text(json.dumps({"cpu_s": round(cpu_s, 3)}))
-
-
 class ShardError(CataBotError, ValueError):
     """A `--shard` that does not match the scenario's split."""
 
@@ -231,7 +225,7 @@ def _serve(ctx: ServiceContext, build: BuildFn) -> int:
         quiet_gc()
         cpu_start = time.process_time()
         end = _profiled(ctx.name, ctx.run_dir, lambda: participant.run(step, on_end))
-        _write_usage(ctx.name, ctx.run_dir, time.process_time() - cpu_start)
+        write_usage(ctx.name, ctx.run_dir, time.process_time() - cpu_start)
         participant.rejections.write(ctx.run_dir / "log" / f"{ctx.name}.rejected.json")
     except ClockError as exc:
         log.error("%s", exc)

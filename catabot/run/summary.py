@@ -16,6 +16,7 @@ from pathlib import Path
 
 from catabot.config.scenario import Scenario
 from catabot.run.metrics_summary import metrics_lines
+from catabot.run.usage import peak_rss_mb, read_usage
 
 
 def describe_exit(code: int | None) -> str:
@@ -26,14 +27,16 @@ def describe_exit(code: int | None) -> str:
     return f"exit code {code}"
 
 
-def _usage(run_dir: Path, services: Mapping[str, object]) -> dict[str, float]:
-    """Each service's CPU seconds in its stepping loop (start-up excluded), where reported."""
-    out: dict[str, float] = {}
-    for name in services:
-        path = run_dir / "log" / f"{name}.usage.json"
-        with contextlib.suppress(OSError, ValueError, KeyError):
-            out[name] = float(json.loads(path.read_text())["cpu_s"])
-    return out
+def _memory(
+    run_dir: Path, services: Mapping[str, object], result: Mapping[str, object]
+) -> dict[str, float]:
+    """Peak resident memory of every process of the run and of the whole stack, MiB (the
+    launcher's own measured now, the conductor's from its result line)."""
+    out = {"launcher": peak_rss_mb()}
+    with contextlib.suppress(KeyError, TypeError, ValueError):  # a conductor that died: none
+        out["conductor"] = float(result["peak_rss_mb"])  # type: ignore[arg-type]
+    out |= read_usage(run_dir, services, "peak_rss_mb")
+    return out | {"total": round(sum(out.values()), 1)}
 
 
 def _rejected(
@@ -89,7 +92,8 @@ def summarise(
         "error": error,
         "reason": result.get("reason", ""),
         "services": dict(service_codes),
-        "cpu_s": _usage(run_dir, service_codes),
+        "cpu_s": read_usage(run_dir, service_codes, "cpu_s"),
+        "peak_rss_mb": _memory(run_dir, service_codes, result),
         "rejected": _rejected(run_dir, service_codes, result),
     }
     try:

@@ -10,9 +10,11 @@ trees keep most of the speed (~0.07 ms) with a bounded contact cost (~0.7-1.4 ms
 same pile-up), measured with dartpy 6.20. Bodies of one skeleton only collide with each
 other when self-collision checking is on, so it is.
 
-Body i is tree i % GROUP of skeleton i // GROUP; its FreeJoint's 6 generalized coordinates
-follow the same conventions as a FreeJoint skeleton of its own, and the concatenation of
-the skeletons' vectors is the (N, 6) layout PhysicsWorld uses.
+Vessels fill skeletons GROUP at a time, then buoys start skeletons of their own (so one of
+buoys can rest as a whole, sleep.py): `slices[g]` are the rows of skeleton g. A body's
+FreeJoint's 6 generalized coordinates follow the same conventions as a FreeJoint skeleton
+of its own, and the concatenation of the skeletons' vectors is the (N, 6) layout
+PhysicsWorld uses.
 
 `TreeView` gives per-body access with the Skeleton methods other code uses on a vessel's own
 skeleton (positions, velocities, forces, mass matrix, Coriolis and gravity forces, body node).
@@ -38,12 +40,22 @@ GROUP = 8  # trees per skeleton, see the module docstring
 class Fleet:
     """The skeletons holding every body, and whole-fleet reads and writes of their vectors."""
 
-    def __init__(self, bodies: Sequence[tuple[str, VesselModel, StartPose]]) -> None:
+    def __init__(
+        self, bodies: Sequence[tuple[str, VesselModel, StartPose]], *, first_buoy: int | None = None
+    ) -> None:
+        """Rows from `first_buoy` on (buoys) start a skeleton of their own, so a skeleton of
+        buoys can rest as a whole (sleep.py)."""
+        n, split = len(bodies), len(bodies) if first_buoy is None else first_buoy
+        self.starts = [*range(0, split, GROUP), *range(split, n, GROUP)]
+        self.slices = [slice(a, b) for a, b in zip(self.starts, [*self.starts[1:], n], strict=True)]
+        self.group_of = np.repeat(
+            np.arange(len(self.starts)), [r.stop - r.start for r in self.slices]
+        )
         self.skeletons: list[dart.dynamics.Skeleton] = []
         self.views: list[TreeView] = []
-        for first in range(0, len(bodies), GROUP):
-            members = bodies[first : first + GROUP]
-            skel = dart.dynamics.Skeleton(f"fleet{first // GROUP}")
+        for g, rows in enumerate(self.slices):
+            members = bodies[rows]
+            skel = dart.dynamics.Skeleton(f"fleet{g}")
             for vessel_id, model, _ in members:
                 _add_body(skel, vessel_id, model)
             skel.setSelfCollisionCheck(True)
@@ -54,6 +66,7 @@ class Fleet:
             skel.setPositions(q)
             self.skeletons.append(skel)
             self.views.extend(TreeView(skel, k) for k in range(len(members)))
+        self._frozen: dict[int, tuple[Array, Array]] = {}  # group: its held q and v (sleep.py)
 
     def add_to(self, world: dart.simulation.World) -> None:
         for skel in self.skeletons:
@@ -61,24 +74,42 @@ class Fleet:
 
     def positions(self) -> Array:
         """Generalized positions of every body, (N, 6)."""
-        return np.concatenate([s.getPositions() for s in self.skeletons]).reshape(-1, 6)
+        held, skels = self._frozen, enumerate(self.skeletons)
+        parts = [held[g][0] if g in held else s.getPositions() for g, s in skels]
+        return np.concatenate(parts).reshape(-1, 6)
 
     def velocities(self) -> Array:
         """Generalized velocities of every body, (N, 6)."""
-        return np.concatenate([s.getVelocities() for s in self.skeletons]).reshape(-1, 6)
+        held, skels = self._frozen, enumerate(self.skeletons)
+        parts = [held[g][1] if g in held else s.getVelocities() for g, s in skels]
+        return np.concatenate(parts).reshape(-1, 6)
+
+    def freeze(self, group: int, *, frozen: bool) -> None:
+        """Skeleton `group` immobile, not collidable and at rest (a sleeping group of buoys,
+        sleep.py), or moving again; a frozen one is neither read nor written each step."""
+        skel = self.skeletons[group]
+        if frozen:
+            skel.setVelocities(np.zeros(skel.getNumDofs()))
+            self._frozen[group] = (skel.getPositions(), skel.getVelocities())
+        else:
+            self._frozen.pop(group, None)
+        skel.setMobile(not frozen)
+        for i in range(skel.getNumBodyNodes()):
+            skel.getBodyNode(i).setCollidable(not frozen)
 
     def place(self, rows: NDArray[np.intp], q: Array, v: Array) -> None:
         """Bodies `rows` to generalized positions `q` and velocities `v` (k, 6 each)."""
         pos, vel = self.positions(), self.velocities()
         pos[rows], vel[rows] = q, v
-        for g, skel in enumerate(self.skeletons):
-            skel.setPositions(pos[g * GROUP : (g + 1) * GROUP].ravel())
-            skel.setVelocities(vel[g * GROUP : (g + 1) * GROUP].ravel())
+        for part, skel in zip(self.slices, self.skeletons, strict=True):
+            skel.setPositions(pos[part].ravel())
+            skel.setVelocities(vel[part].ravel())
 
     def set_forces(self, generalized: Array) -> None:
         """Generalized forces of every body from an (N, 6) array."""
-        for g, skel in enumerate(self.skeletons):
-            skel.setForces(generalized[g * GROUP : (g + 1) * GROUP].ravel())
+        for g, (rows, skel) in enumerate(zip(self.slices, self.skeletons, strict=True)):
+            if g not in self._frozen:
+                skel.setForces(generalized[rows].ravel())
 
 
 def buoy_bodies(

@@ -29,3 +29,6 @@ def apply(
         world.loads.set_uniform_current((float(value[0]), float(value[1])))
     elif kind == "waves":
         world.set_waves(WaveField(live.wave_config(scenario, value), scenario.seed))
+    else:
+        return
+    world.wake()  # the loads changed: resting buoys move again

@@ -16,7 +16,6 @@ and velocities are those of the body origin, as the message contract expects.
 
 from __future__ import annotations
 
-import math
 from collections.abc import Sequence
 from dataclasses import dataclass
 
@@ -41,6 +40,8 @@ from services.physics.hydro import (
     water_height,
 )
 from services.physics.loads import EnvironmentLoads
+from services.physics.setup_check import check_setup
+from services.physics.sleep import Sleep
 
 StartPose = tuple[float, float, float, float]  # x, y, z (m, map ENU), yaw (rad)
 
@@ -97,7 +98,7 @@ class PhysicsWorld:
     ) -> None:
         self._n_vessels = len(vessels)  # buoys are extra bodies, rows after the vessels
         vessels = [*vessels, *buoy_bodies(buoys, buoy_model)]
-        _check_setup(vessels, dt_s, water_density, gravity)
+        check_setup(vessels, dt_s, water_density, gravity)
         self._ids = [vid for vid, _, _ in vessels]
         self._index = {vid: i for i, vid in enumerate(self._ids[: self._n_vessels])}
         models = [model for _, model, _ in vessels]
@@ -106,7 +107,8 @@ class PhysicsWorld:
         self._world = dart.simulation.World()
         self._world.setGravity([0.0, 0.0, -self._g])
         self._world.setTimeStep(self._dt)
-        self._fleet = Fleet(vessels)  # bodies as trees of a few skeletons (fleet.py)
+        # bodies as trees of a few skeletons (fleet.py), buoys in skeletons of their own
+        self._fleet = Fleet(vessels, first_buoy=self._n_vessels)
         self._fleet.add_to(self._world)
         self._skeletons = self._fleet.views  # per-body, skeleton-like access
         self._columns = build_columns(models)
@@ -125,6 +127,8 @@ class PhysicsWorld:
         self._ground = (
             Grounding(terrain, models, self._dt, self._skeletons) if terrain is not None else None
         )
+        radii = np.array([_radius(m) for m in models])
+        self._sleep = Sleep(self._fleet, radii, self._n_vessels, dt_s=self._dt)
         self._read_state()
         self._acc_w = np.zeros((len(models), 6))
         self._last_loads: dict[str, Array] = {}  # this step's loads by kind, for `diverged`
@@ -144,6 +148,16 @@ class PhysicsWorld:
     def set_waves(self, waves: WaveField) -> None:
         """A run-time change of the sea (`catabot set waves`), from the next step on."""
         self._surface, self._waves = waves.height, waves
+        self._sleep.wake_all()
+
+    def wake(self) -> None:
+        """Every resting buoy moves again (the environment changed: sleep.py)."""
+        self._sleep.wake_all()
+
+    @property
+    def asleep(self) -> NDArray[np.bool_]:
+        """Which bodies rest this step (rows of vessels then buoys; sleep.py)."""
+        return self._sleep.rows_asleep()
 
     @property
     def vessel_ids(self) -> list[str]:
@@ -192,6 +206,7 @@ class PhysicsWorld:
     def place(self, rows: NDArray[np.intp], pose: Array, velocity_w: Array) -> None:
         """Start bodies `rows` off rest: `pose` (k, 6) rotation vector and position in `map`,
         `velocity_w` (k, 6) angular and linear velocity in `map` (services/physics/setup.py)."""
+        self._sleep.wake_all()
         self._fleet.place(rows, pose, velocity_w)
         self._read_state()
 
@@ -211,6 +226,7 @@ class PhysicsWorld:
             generalized += contact
             self._last_loads["terrain contact"] = contact[:, [3, 4, 5, 0, 1, 2]]  # as [F, M]
         check_finite(self._ids, self._last_loads, generalized, self.time_s)
+        self._sleep.wake_near(self._pos, self._vel_w)
         self._fleet.set_forces(generalized)
         vel_before = self._vel_w
         self._world.step()
@@ -219,6 +235,7 @@ class PhysicsWorld:
         self._read_state()
         self._acc_w = (self._vel_w - vel_before) / self._dt
         check_state(self._ids, self._pos, self._vel_w, self._last_loads, self.time_s)
+        self._sleep.settle(self._pos, self._vel_w, steady=self._steady())
 
     def state_arrays(self) -> KinematicsArrays:
         """Every vessel's state as stacked arrays (copies), rows in `vessel_ids` order."""
@@ -319,26 +336,14 @@ class PhysicsWorld:
         loads["wind, moorings and added mass"] = total - base
         return total
 
+    def _steady(self) -> bool:
+        """Loads that do not change in time: no waves and no gusts (sleep.py)."""
+        wind = self._loads.wind
+        calm_sea = self._waves is None or self._waves.is_calm
+        return calm_sea and (wind is None or not np.any(wind.gust_std))
 
-def _check_setup(
-    vessels: Sequence[tuple[str, VesselModel, StartPose]],
-    dt_s: float,
-    water_density: float,
-    gravity: float,
-) -> None:
-    """Reject a set-up that would give a meaningless or non-deterministic world."""
-    if not vessels:
-        raise ValueError("PhysicsWorld needs at least one vessel")
-    if not (math.isfinite(dt_s) and dt_s > 0):
-        raise ValueError(f"dt_s must be a finite number > 0 (got {dt_s})")
-    if not (math.isfinite(water_density) and water_density > 0):
-        raise ValueError(f"water_density must be a finite number > 0 (got {water_density})")
-    if not (math.isfinite(gravity) and gravity >= 0):
-        raise ValueError(f"gravity must be a finite number >= 0 (got {gravity})")
-    seen: set[str] = set()
-    for vid, _, pose in vessels:
-        if not vid or vid in seen:
-            raise ValueError(f"vessel ids must be unique and non-empty (got {vid!r} twice)")
-        seen.add(vid)
-        if len(pose) != 4 or not all(math.isfinite(v) for v in pose):
-            raise ValueError(f"vessel {vid!r}: start pose must be 4 finite numbers (x, y, z, yaw)")
+
+def _radius(model: VesselModel) -> float:
+    """The plan-view circle around a body's hulls, about its origin."""
+    lo, hi = model.hull_box()
+    return float(np.hypot(max(-lo[0], hi[0]), max(-lo[1], hi[1])))

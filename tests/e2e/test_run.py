@@ -65,8 +65,12 @@ def test_default_run_writes_run_folder_and_floats_at_archimedes_draft(out: Path)
     ]  # fmt: skip (25 s: after the end)
     sent = [(m.log_time, list(m.decoded.data)) for m in messages if m.topic == "/ego/thrust"]
     assert sent == [(0, [0.0, 0.0]), (2 * 10**9, [0.8, 0.8])]
-    cpu = json.loads((run / "log" / "run.json").read_text())["cpu_s"]
+    usage = json.loads((run / "log" / "run.json").read_text())
+    cpu, rss = usage["cpu_s"], usage["peak_rss_mb"]
     assert set(cpu) == {"physics", "sensors", "recorder"} and all(s > 0 for s in cpu.values())
+    processes = {"launcher", "conductor", *cpu}
+    assert set(rss) == processes | {"total"} and all(20 < rss[p] < 1000 for p in processes)
+    assert rss["total"] == pytest.approx(sum(rss[p] for p in processes), abs=0.1)
 
 
 def column(

@@ -1,0 +1,41 @@
+"""What each process of a run cost: CPU seconds of its stepping loop and its peak memory.
+
+Each service writes `log/<name>.usage.json` when its loop ends; the conductor puts its own in
+its result line and `catabot run` adds its own, so `log/run.json` has one table of every
+process (the Table II benchmark prints it). Peak resident memory is the kernel's high-water
+mark (getrusage's ru_maxrss), so it catches a spike a sampler would miss and costs nothing
+while the run goes.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import json
+import resource
+from collections.abc import Iterable
+from pathlib import Path
+
+KIB_PER_MB = 1024.0
+
+
+def peak_rss_mb() -> float:
+    """This process's peak resident set size so far, in MiB (Linux reports KiB)."""
+    return round(resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / KIB_PER_MB, 1)
+
+
+def write_usage(name: str, run_dir: Path, cpu_s: float) -> None:
+    """CPU seconds of the stepping loop (every thread, start-up excluded) and peak memory."""
+    (run_dir / "log").mkdir(parents=True, exist_ok=True)
+    record = {"cpu_s": round(cpu_s, 3), "peak_rss_mb": peak_rss_mb()}
+    (run_dir / "log" / f"{name}.usage.json").write_text(json.dumps(record))
+
+
+def read_usage(run_dir: Path, names: Iterable[str], field: str) -> dict[str, float]:
+    """One field of each process's usage file, where it was written (a crashed service
+    writes none)."""
+    out: dict[str, float] = {}
+    for name in names:
+        path = run_dir / "log" / f"{name}.usage.json"
+        with contextlib.suppress(OSError, ValueError, KeyError, TypeError):
+            out[name] = float(json.loads(path.read_text())[field])
+    return out
