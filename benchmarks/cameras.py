@@ -23,6 +23,7 @@ import numpy as np
 
 from benchmarks.sensors import TERRAIN
 from catabot.bus.blas import single_thread_blas
+from catabot.bus.heap import keep_heap
 from catabot.bus.messages import CLASS_VESSEL, VesselState
 from catabot.config.sensors import CameraParams, RadarParams
 from catabot.config.waves import WaveConfig
@@ -132,7 +133,8 @@ def radar_row(world: Scene, sea: str) -> tuple[str, tuple[float, float, float]]:
 
 
 def main() -> None:
-    single_thread_blas()  # as every service does (catabot/blas.py)
+    single_thread_blas()  # as every service does (catabot/run/service.py)
+    keep_heap()
     print(f"camera and radar cost: bay terrain, {BOATS} boats in view, median of {REPEATS}")
     print(f"{'what':52} {'wall ms':>8} {'per s':>8} {'min ms':>8} {'CPU ms':>8}")
     for sea, waves in SEAS.items():

@@ -21,6 +21,7 @@ from pathlib import Path
 import numpy as np
 
 from catabot.bus.blas import single_thread_blas
+from catabot.bus.heap import keep_heap
 from catabot.bus.messages import CLASS_BUOY, CLASS_VESSEL, VesselState
 from catabot.config.sensors import LidarParams
 from catabot.config.terrain import TerrainConfig
@@ -102,7 +103,8 @@ def row(sea: str, rain: float) -> tuple[str, float, float, float, float, float, 
 
 
 def main() -> None:
-    single_thread_blas()  # as every service does (catabot/blas.py)
+    single_thread_blas()  # as every service does (catabot/run/service.py)
+    keep_heap()
     print(f"LiDAR 32 x 512, 100 m, bay.png terrain, {BOATS} boats + 1 buoy (median of {REPEATS})")
     head = ("sea", "rain mm/h", "scan ms", "scan min", "cast ms", "rain ms", "build ms", "returns")
     print("{:>8} {:>9} {:>8} {:>8} {:>8} {:>8} {:>9} {:>8}".format(*head))

@@ -20,6 +20,7 @@ import zenoh
 from catabot.bus.blas import single_thread_blas
 from catabot.bus.clock import Policy
 from catabot.bus.conductor import ClockSpec, Conductor, Progress
+from catabot.bus.heap import keep_heap
 from catabot.bus.identity import add_roster_args
 from catabot.bus.keys import Keys
 from catabot.bus.session import (
@@ -98,6 +99,7 @@ def main(argv: list[str] | None = None) -> int:
     stop = threading.Event()  # the heartbeat, from before the session (a login takes a while)
     threading.Thread(target=heartbeat, args=(stop,), name="heartbeat", daemon=True).start()
     single_thread_blas()
+    keep_heap()
     logging.basicConfig(level=logging.INFO, format="%(asctime)s %(name)s %(levelname)s %(message)s")
     try:
         scenario = load_scenario(args.scenario)

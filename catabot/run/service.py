@@ -23,6 +23,7 @@ import zenoh
 
 from catabot.bus.blas import single_thread_blas
 from catabot.bus.clock import ClockError, Stream
+from catabot.bus.heap import keep_heap
 from catabot.bus.identity import Roster, add_roster_args
 from catabot.bus.inbox import Inbox, Inputs
 from catabot.bus.keys import Keys
@@ -183,6 +184,7 @@ def run_service(
     args = parser.parse_args(argv)
     setup_logging()
     single_thread_blas()  # idle BLAS threads spin on the cores other services need
+    keep_heap()  # reuse freed arrays instead of faulting fresh pages in every tick
     signal.signal(signal.SIGTERM, lambda *_: sys.exit(143))
     try:
         batch_scheduling()  # before Zenoh starts its threads, so that they inherit it

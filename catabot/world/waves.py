@@ -183,15 +183,30 @@ class WaveField:
             for s, block in self._blocks(cols):
                 e = s + block.shape[0]
                 cos = np.cos(block)
-                eta = (cos @ self._height_w)[:, 0]
-                depth = np.minimum(z_flat[s:e] - eta, 0.0).astype(np.float32)
-                decay = np.exp(depth[:, None] * self._k32)
-                cos *= decay
-                sin = np.sin(block, out=block)
-                sin *= decay
-                out[s:e, :2] = cos @ self._orbital_w[:, :2]
-                out[s:e, 2] = sin @ self._orbital_w[:, 2]
+                out[s:e] = self.orbital(cos, np.sin(block, out=block), z_flat[s:e])
         return out.reshape((*shape, 3))
+
+    def orbital(self, cos: NDArray[np.float32], sin: NDArray[np.float32], z: Array) -> Array:
+        """`velocity` at points whose phases' cosines and sines are given, (P, M) float32
+        each (overwritten): for a caller that has them already (physics' sea sampler)."""
+        eta = (cos @ self._height_w)[:, 0]
+        depth = np.minimum(z - eta, 0.0).astype(np.float32)
+        decay = np.exp(depth[:, None] * self._k32)
+        cos *= decay
+        sin *= decay
+        out = np.empty((cos.shape[0], 3))
+        out[:, :2] = cos @ self._orbital_w[:, :2]
+        out[:, 2] = sin @ self._orbital_w[:, 2]
+        return out
+
+    def phases(self, x: ArrayLike, y: ArrayLike, t: ArrayLike = 0.0) -> NDArray[np.float32]:
+        """Every component's phase k . (x, y) - omega t + phi at each point, (P, M) float32
+        radians within half a turn: the one reduction rule of `height`, for callers that
+        build their own sums from the phases (physics' Taylor patches)."""
+        cols, _ = _columns(x, y, t)
+        cycles = cols @ self._cycles
+        cycles -= np.rint(cycles)
+        return np.multiply(cycles, 2.0 * math.pi, dtype=np.float32, casting="same_kind")
 
     def _blocks(self, cols: Array) -> Iterator[tuple[int, NDArray[np.float32]]]:
         """Yield (start, phases) per block of points: float32 radians within one turn.

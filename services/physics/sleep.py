@@ -21,6 +21,7 @@ from __future__ import annotations
 import numpy as np
 from numpy.typing import NDArray
 
+from catabot.config.vessel import VesselModel
 from services.physics.fleet import Fleet
 from services.physics.hydro import Array
 
@@ -101,3 +102,13 @@ def _near(
     limit = np.add.outer(radii[sleeping], reach)
     close = dx * dx + dy * dy < limit * limit
     return sleeping[close.any(axis=1)]
+
+
+def plan_radii(models: list[VesselModel]) -> Array:
+    """Each body's plan-view circle around its hulls, about its origin."""
+    return np.array([_plan_radius(m) for m in models])
+
+
+def _plan_radius(model: VesselModel) -> float:
+    lo, hi = model.hull_box()
+    return float(np.hypot(max(-lo[0], hi[0]), max(-lo[1], hi[1])))

@@ -37,11 +37,11 @@ from services.physics.hydro import (
     build_columns,
     buoyancy_wrench,
     damping_wrench,
-    water_height,
 )
 from services.physics.loads import EnvironmentLoads
+from services.physics.sea import SeaSampler
 from services.physics.setup_check import check_setup
-from services.physics.sleep import Sleep
+from services.physics.sleep import Sleep, plan_radii
 
 StartPose = tuple[float, float, float, float]  # x, y, z (m, map ENU), yaw (rad)
 
@@ -121,14 +121,13 @@ class PhysicsWorld:
         self._loads = EnvironmentLoads(
             models, gravity=self._g, current=current, wind=wind, anchors=anchors
         )
-        self._surface = waves.height if waves is not None else water_height  # eta(x, y, t)
-        self._waves = waves
+        self._sea = SeaSampler(models, self._columns.bottom_m.transpose(0, 2, 1))
+        self._sea.use(waves)  # eta at the columns, orbital velocity at the origins (sea.py)
         # Bottom contact with the terrain (grounding.py); buoyancy knows nothing about it.
         self._ground = (
             Grounding(terrain, models, self._dt, self._skeletons) if terrain is not None else None
         )
-        radii = np.array([_radius(m) for m in models])
-        self._sleep = Sleep(self._fleet, radii, self._n_vessels, dt_s=self._dt)
+        self._sleep = Sleep(self._fleet, plan_radii(models), self._n_vessels, dt_s=self._dt)
         self._read_state()
         self._acc_w = np.zeros((len(models), 6))
         self._last_loads: dict[str, Array] = {}  # this step's loads by kind, for `diverged`
@@ -147,12 +146,16 @@ class PhysicsWorld:
 
     def set_waves(self, waves: WaveField) -> None:
         """A run-time change of the sea (`catabot set waves`), from the next step on."""
-        self._surface, self._waves = waves.height, waves
+        self._sea.use(waves)
         self._sleep.wake_all()
 
     def wake(self) -> None:
         """Every resting buoy moves again (the environment changed: sleep.py)."""
         self._sleep.wake_all()
+
+    @property
+    def sea_method(self) -> str:
+        return self._sea.method
 
     @property
     def asleep(self) -> NDArray[np.bool_]:
@@ -312,10 +315,10 @@ class PhysicsWorld:
             axis=1,
         )
         self._current_w = self._loads.current_world(self._pos)
+        sea = self._sea.sample(self._pos, self.time_s)
         water_w = self._current_w  # plus the waves' orbital velocity at each body origin:
-        if self._waves is not None:  # damping acts on motion relative to the water
-            x, y, z = self._pos.T
-            water_w = water_w + self._waves.velocity(x, y, z, self.time_s)
+        if sea.velocity_w is not None:  # damping acts on motion relative to the water
+            water_w = water_w + sea.velocity_w
         current_b = np.einsum("nij,nj->ni", rot_t, water_w)
         loads = self._last_loads = {
             "buoyancy": buoyancy_wrench(
@@ -325,7 +328,7 @@ class PhysicsWorld:
                 density=self._rho,
                 gravity=self._g,
                 time_s=self.time_s,
-                surface=self._surface,
+                surface=sea.surface,
             ),
             "damping": damping_wrench(nu, self._lin, self._quad, current_b),
             "thrust": self._thrusters.wrench(),
@@ -339,11 +342,4 @@ class PhysicsWorld:
     def _steady(self) -> bool:
         """Loads that do not change in time: no waves and no gusts (sleep.py)."""
         wind = self._loads.wind
-        calm_sea = self._waves is None or self._waves.is_calm
-        return calm_sea and (wind is None or not np.any(wind.gust_std))
-
-
-def _radius(model: VesselModel) -> float:
-    """The plan-view circle around a body's hulls, about its origin."""
-    lo, hi = model.hull_box()
-    return float(np.hypot(max(-lo[0], hi[0]), max(-lo[1], hi[1])))
+        return self._sea.calm and (wind is None or not np.any(wind.gust_std))

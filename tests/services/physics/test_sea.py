@@ -1,0 +1,112 @@
+"""The sea physics samples (services/physics/sea.py, surface.py): every method stays within
+its bound of the exact surface, the cheapest one that can is chosen, calm water is untouched."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+from catabot.config.vessel import VesselModel, load_vessel_model
+from catabot.config.waves import WaveConfig
+from catabot.world import rotations
+from catabot.world.waves import WaveField
+from services.physics.hydro import build_columns, water_height
+from services.physics.sea import SeaSampler
+from services.physics.surface import TOLERANCE_M, choose_order
+
+MEDIUM = WaveConfig(preset="medium")
+CHOP = WaveConfig(significant_height_m=0.3, peak_period_s=4.0, direction_rad=1.2)
+SHORT = WaveConfig(significant_height_m=0.1, peak_period_s=1.2)
+
+
+def fleet(*names: str) -> list[VesselModel]:
+    return [load_vessel_model(n) for n in names]
+
+
+def columns_at(models: list[VesselModel], seed: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Body-frame column bottoms and their world points for random poses: far from the
+    origin, yawed any way, rolled and pitched up to ~0.3 rad."""
+    cols = build_columns(models)
+    rng = np.random.default_rng(seed)
+    n = len(models)
+    rotvec = rng.normal(0.0, 0.15, (n, 3))
+    rotvec[:, 2] = rng.uniform(-math.pi, math.pi, n)
+    pos = np.column_stack([rng.uniform(-3000, 3000, (n, 2)), rng.uniform(-1.0, 0.5, n)])
+    rot = rotations.matrices(rotations.from_rotvec(rotvec))
+    world = np.matmul(rot, cols.bottom_m) + pos[:, :, None]
+    return cols.bottom_m.transpose(0, 2, 1), world, pos
+
+
+@pytest.mark.parametrize(
+    ("sea", "models", "method"),
+    [
+        (MEDIUM, ("catabot", "monohull", "buoy"), "vessel expansions"),
+        (WaveConfig(preset="heavy"), ("wamv", "monohull"), "vessel expansions"),
+        (CHOP, ("catabot", "monohull", "wamv"), "hull patches"),
+        (SHORT, ("wamv", "catabot"), "exact sum"),
+    ],
+)
+def test_heights_at_the_columns_are_within_the_tolerance_of_the_exact_surface(
+    sea: WaveConfig, models: tuple[str, ...], method: str
+) -> None:
+    waves = WaveField(sea, 3)
+    vessels = fleet(*models) * 20
+    bottom, world, pos = columns_at(vessels, seed=len(models))
+    sampler = SeaSampler(vessels, bottom)
+    sampler.use(waves)
+    assert sampler.method.startswith(method)
+    real = build_columns(vessels).area_m2 > 0  # padding columns carry no buoyancy
+    for t in (0.0, 1234.56, 86_400.0):
+        got = sampler.sample(pos, t).surface(world[:, 0], world[:, 1], t)
+        exact = waves.height(world[:, 0], world[:, 1], t)
+        assert got.shape == exact.shape
+        assert np.abs(got - exact)[real].max() <= TOLERANCE_M + 1e-6  # + float32 rounding
+
+
+def test_the_velocity_is_the_orbital_velocity_at_each_origin() -> None:
+    waves = WaveField(MEDIUM, 5)
+    vessels = fleet("catabot", "monohull") * 10
+    bottom, _, pos = columns_at(vessels, seed=9)
+    sampler = SeaSampler(vessels, bottom)
+    sampler.use(waves)
+    got = sampler.sample(pos, 77.7).velocity_w
+    exact = waves.velocity(pos[:, 0], pos[:, 1], pos[:, 2], 77.7)
+    assert got is not None
+    np.testing.assert_allclose(got, exact, atol=1e-6)
+
+
+@pytest.mark.parametrize("sea", [None, WaveConfig(), WaveConfig(preset="calm")])
+def test_calm_water_is_zero_height_and_still_water(sea: WaveConfig | None) -> None:
+    vessels = fleet("catabot")
+    bottom, _, pos = columns_at(vessels, seed=1)
+    sampler = SeaSampler(vessels, bottom)
+    sampler.use(None if sea is None else WaveField(sea, 1))
+    sample = sampler.sample(pos, 3.0)
+    assert sampler.calm and sampler.method == "calm"
+    assert sample.velocity_w is None and sample.surface is water_height
+
+
+def test_a_change_of_sea_changes_the_method() -> None:
+    vessels = fleet("wamv")
+    sampler = SeaSampler(vessels, columns_at(vessels, seed=2)[0])
+    sampler.use(WaveField(MEDIUM, 1))
+    assert sampler.method.startswith("vessel expansions")
+    sampler.use(WaveField(SHORT, 1))
+    assert sampler.method == "exact sum"
+    sampler.use(None)
+    assert sampler.calm
+
+
+def test_the_order_is_the_least_whose_remainder_bound_holds() -> None:
+    """One long-crested component: the bound a (k r)^(n+1) / (n+1)! is exact enough to
+    check by hand, and the chosen order's worst error along the wave stays under it."""
+    waves = WaveField(WaveConfig(significant_height_m=1.0, peak_period_s=6.0, spreading=None,
+                                 frequency_components=1, direction_components=1), 1)  # fmt: skip
+    a, k = float(waves.amplitudes_m[0]), float(waves.wavenumbers_radpm[0])
+    r = 2.0
+    order = choose_order(waves, r)
+    assert order is not None
+    bound = [a * (k * r) ** (n + 1) / math.factorial(n + 1) for n in range(order + 1)]
+    assert bound[order] <= TOLERANCE_M < bound[order - 1]
