@@ -14,7 +14,8 @@ from typing import Any
 from pydantic import ValidationError
 
 from catabot.config.base import ScenarioError, explain, read_json
-from catabot.config.scenario import Scenario, check_rates
+from catabot.config.rates import check_rates
+from catabot.config.scenario import Scenario
 from catabot.config.settings_config import is_settings_config, map_settings_config
 
 BUNDLED = Path(__file__).parents[1] / "data" / "scenarios"

@@ -105,12 +105,20 @@ class McapIndex:
     def rows(self, chan: Channel) -> NDArray[np.uint8] | None:
         """Every payload of the channel as one (messages, length) array when all have one
         length (a batch decoder then reads fields at fixed offsets); None otherwise."""
+        groups = self.rows_by_length(chan)
+        return groups[0][1] if len(groups) == 1 else None
+
+    def rows_by_length(self, chan: Channel) -> list[tuple[NDArray[np.intp], NDArray[np.uint8]]]:
+        """The payloads grouped by length: (message indices, (k, length) array) per length,
+        shortest first (a /tf of every body and one of the scenario vessels alone)."""
         starts = np.asarray(chan.starts, dtype=np.int64)
         lengths = np.asarray(chan.ends, dtype=np.int64) - starts
-        if len(starts) == 0 or (lengths != lengths[0]).any():
-            return None
         buffer = np.frombuffer(self.data, dtype=np.uint8)
-        return buffer[starts[:, None] + np.arange(int(lengths[0]))]
+        out = []
+        for length in np.unique(lengths).tolist():
+            index = np.flatnonzero(lengths == length)
+            out.append((index, buffer[starts[index, None] + np.arange(length)]))
+        return out
 
 
 def _mapped(fileno: int) -> bytes | mmap.mmap:

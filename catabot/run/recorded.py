@@ -31,7 +31,7 @@ from catabot.config.load import load_scenario
 from catabot.config.ros import RosConfig
 from catabot.errors import CataBotError
 from catabot.ros2.names import TF, Names
-from catabot.run import cdr_columns
+from catabot.run import cdr_columns, recorded_poses
 from catabot.run.mcap_index import Channel, McapIndex
 from catabot.world.world import MountedSensor, World
 
@@ -49,8 +49,11 @@ class StateTrack:
     """Every body's pose at every recorded tick, and each vessel's body-frame twist.
 
     `position` (T, N, 3) and `orientation` (T, N, 4) come from `/tf` (every body, buoys
-    included); `twist` (T, N, 6) linear + angular from each vessel's Odometry, NaN for buoys
-    (no Odometry is recorded for them). Accelerations are not in the MCAP (the CSVs have them).
+    included; traffic and buoys, recorded at `recording.traffic_rate_hz`, are interpolated
+    between their samples: `sampled` (T, N) marks the recorded ones, recorded_poses.py);
+    `twist` (T, N, 6) linear + angular from each vessel's Odometry, NaN for buoys (no
+    Odometry is recorded for them) and where none was recorded. Accelerations are not in the
+    MCAP (the CSVs have them).
     """
 
     ids: tuple[str, ...]
@@ -58,6 +61,7 @@ class StateTrack:
     position: NDArray[np.float64]
     orientation: NDArray[np.float64]
     twist: NDArray[np.float64]
+    sampled: NDArray[np.bool_]
 
     def __len__(self) -> int:
         return len(self.stamp_ns)
@@ -120,21 +124,20 @@ class RecordedRun:
     def states(self) -> StateTrack:
         """Every body's recorded state (see `StateTrack`)."""
         tf = self.mcap.channel(TF)
-        rows = self.mcap.rows(tf) if tf is not None else None
-        if tf is None or rows is None:
+        if tf is None or len(tf.stamps) == 0:
             raise RunFolderError(f"{self.folder}: run.mcap has no readable /tf channel")
-        poses = cdr_columns.tf_poses(rows)
         ids = self.world.body_ids
         frames = [self.names.base_link(b) for b in ids]
-        if sorted(poses.frames) != sorted(frames):
-            raise RunFolderError(f"{self.folder}: /tf frames are not this scenario's bodies")
-        order = np.array([poses.frames.index(f) for f in frames], dtype=np.intp)
-        pose = poses.pose[:, order]
+        try:
+            poses = recorded_poses.track(self.mcap.rows_by_length(tf), frames, len(tf.stamps))
+        except ValueError as exc:
+            raise RunFolderError(f"{self.folder}: {exc}") from None
+        pose = poses.pose
         stamps = np.asarray(tf.stamps, dtype=np.int64)
         twist = np.full((len(stamps), len(ids), 6), np.nan)
         for row, body in enumerate(self.world.vessels):
             self._fill_twist(twist[:, row], stamps, body.id)
-        return StateTrack(ids, stamps, pose[..., :3], pose[..., 3:], twist)
+        return StateTrack(ids, stamps, pose[..., :3], pose[..., 3:], twist, poses.sampled)
 
     def _fill_twist(self, out: NDArray[np.float64], stamps: NDArray[np.int64], vid: str) -> None:
         chan = self.topic(self.names.odom(vid))

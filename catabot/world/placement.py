@@ -9,7 +9,8 @@ from __future__ import annotations
 
 import math
 
-from catabot.config.scenario import Pose, Scenario, ScenarioError
+from catabot.config.base import ScenarioError
+from catabot.config.scenario import Pose, Scenario
 from catabot.config.terrain import TerrainError
 from catabot.config.vessel import VesselModel, load_vessel_model
 from catabot.world.terrain import Terrain

@@ -19,7 +19,7 @@ from catabot.bus.messages import (
     VesselState,
     WaypointsCmd,
 )
-from catabot.config.scenario import guidance_period_ticks, rate_in_ticks
+from catabot.config.rates import guidance_period_ticks, rate_in_ticks
 from catabot.config.sensors import SENSOR_TYPES
 
 if TYPE_CHECKING:

@@ -13,7 +13,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from catabot.config.scenario import BuoyConfig, Pose, Scenario, ScenarioError
+from catabot.config.base import ScenarioError
+from catabot.config.scenario import BuoyConfig, Pose, Scenario
 from catabot.config.terrain import TerrainError
 from catabot.config.traffic import (
     BEHAVIOURS,

@@ -22,12 +22,12 @@ import numpy as np
 from catabot.bus.clock import NS_PER_S, ClockLimits, period_in_ticks
 from catabot.bus.keys import Keys
 from catabot.bus.messages import CLASS_BUOY, CLASS_VESSEL, BodyStates
+from catabot.config.base import ScenarioError
 from catabot.config.pose import Velocity
 from catabot.config.scenario import (
     ControllerConfig,
     Pose,
     Scenario,
-    ScenarioError,
     ScriptStep,
     SensorConfig,
     VesselConfig,

@@ -16,10 +16,18 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from catabot.bus.messages import BodyStates, Message, TwistBatch, TwistCmd, VesselState
+from catabot.bus.messages import (
+    BodyStates,
+    Message,
+    TwistBatch,
+    TwistCmd,
+    VesselState,
+    check_ids,
+)
 from catabot.ros2 import types
 from catabot.ros2.convert import Converter
 from services.recorder import tabular
+from services.recorder.thinning import Thinning
 
 
 @dataclass(frozen=True)
@@ -48,15 +56,29 @@ class BatchFormatter:
         self.state_streams = tuple(f"vessel/{b}/state" for b in world.body_ids)
         self.twist_streams = tuple(f"vessel/{b}/cmd/twist" for b in world.boat_ids)
         self.twist_blocks = _slices(list(world.traffic_blocks.values()))
+        self.thin = Thinning(convert)
 
     def states(self, batch: BodyStates) -> Block:
-        """Raises ValueError for a batch of other bodies (rows would land in wrong files)."""
+        """Raises ValueError for a batch of other bodies (rows would land in wrong files).
+        Between two traffic samples (thinning.py), the scenario vessels' rows only."""
+        if not self.thin.every_body(batch.tick):
+            check_ids("world/states", batch.tick, batch.ids, self.convert.world.body_ids)
+            return self._vessels_only(batch)
         groups = self.convert.odometry_groups(batch)  # checks the rows first
         table = np.concatenate(batch.arrays(), axis=1)  # VesselState's columns, (N, 19)
         lines = tabular.block_lines(batch.stamp_ns, batch.tick, table)
         return Block(
             VesselState, batch.stamp_ns, self.state_streams, lines,
             self.convert.odom_topics, types.ODOMETRY, groups, tf=self.convert.tf(batch),
+        )  # fmt: skip
+
+    def _vessels_only(self, batch: BodyStates) -> Block:
+        thin = self.thin
+        table = np.concatenate(batch.arrays(), axis=1)[thin.rows]
+        lines = tabular.block_lines(batch.stamp_ns, batch.tick, table)
+        return Block(
+            VesselState, batch.stamp_ns, thin.streams, lines, thin.topics, types.ODOMETRY,
+            thin.odometry_groups(batch), tf=thin.tf(batch),
         )  # fmt: skip
 
     def twists(self, batch: TwistBatch) -> Block:

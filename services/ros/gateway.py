@@ -26,8 +26,8 @@ from catabot.bus.clock import Stream
 from catabot.bus.inbox import Inputs
 from catabot.bus.messages import BodyStates, Message, ThrustCmd, Tick, TwistCmd, check_ids
 from catabot.bus.session import BLOCK
+from catabot.config.rates import rate_in_ticks
 from catabot.config.ros import GATEWAY, RosConfig
-from catabot.config.scenario import rate_in_ticks
 from catabot.ros2 import types
 from catabot.ros2.convert import Converter
 from catabot.ros2.convert_sensors import Out

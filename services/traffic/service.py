@@ -21,7 +21,7 @@ from catabot.bus.inbox import Inputs
 from catabot.bus.messages import BodyStates, Message, Tick, TwistBatch, WaypointsCmd
 from catabot.bus.settings import changes_of
 from catabot.config import live
-from catabot.config.scenario import guidance_period_ticks
+from catabot.config.rates import guidance_period_ticks
 from catabot.run.service import Built, ServiceContext, run_service
 from catabot.world import rotations
 from services.traffic.behaviours import Behaviours

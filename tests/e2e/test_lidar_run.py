@@ -34,6 +34,8 @@ def test_lidar_in_rain_is_recorded_as_point_clouds(tmp_path: Path, out: Path) ->
     assert (run / "vessel.b1.state.csv").is_file()  # buoys are published and recorded
     tf = [m for m in messages if m.topic == "/tf"]
     assert len(tf) == len(rows[1:]) * 10 and tf[0].schema_name == "tf2_msgs/msg/TFMessage"
-    frames = [t.child_frame_id for t in tf[-1].decoded.transforms]
+    frames = [t.child_frame_id for t in tf[0].decoded.transforms]
     assert "ego/base_link" in frames and "b1/base_link" in frames  # buoys only there
+    between = [t.child_frame_id for t in tf[-1].decoded.transforms]  # tick 99
+    assert between == ["ego/base_link"]  # buoys at recording.traffic_rate_hz (10 Hz)
     assert "/b1/odom" not in {m.topic for m in messages}

@@ -75,6 +75,7 @@ def _scenario() -> dict[str, Any]:
         "buoys": [{"id": "b1", "x_m": 9.0, "y_m": 0.0}],
         "traffic": {"count": 1, "region": {"center_m": [-200.0, -200.0], "size_m": [100, 100]}},
         "ros": {"mode": "both"},
+        "recording": {"traffic_rate_hz": None},  # every body every tick, as the gateway sends
     }  # fmt: skip
 
 

@@ -24,12 +24,15 @@ CIRCLE_RATE = math.radians(15.0)  # 5 m/s on the default 19.1 m circle
 
 
 def _traffic(name: str, count: int, **top: Any) -> dict[str, Any]:
+    """Traffic recorded every tick (`traffic_rate_hz: null`): these tests read its dynamics."""
+    recording = {"traffic_rate_hz": None, **top.pop("recording", {})}
     return {
         "name": name,
         "seed": 5,
         "duration_s": 3.0,
         "vessels": [{"id": "ego", "pose": {"x_m": 0.0, "y_m": 0.0}}],
         "traffic": {"count": count, "behaviour_mix": {"circle": 0.5, "waypoints": 0.5}},
+        "recording": recording,
         **top,
     }
 

@@ -50,7 +50,7 @@ def test_physics_and_sensors_take_the_sea() -> None:
     scenario = _scenario()
     world = build_world(World.resolve(scenario))
     physics_settings.apply(world, scenario, live.keys_of(scenario), Change(0, "waves", '"heavy"'))
-    assert world._waves is not None and not world._waves.is_calm
+    assert world.sea_method.startswith("vessel expansions")  # a sea, no longer calm
 
 
 def test_sensor_settings_switch_rain_sensors_and_outputs() -> None:

@@ -36,5 +36,5 @@ def faults(mode: str) -> int:
 @pytest.mark.skipif(platform.libc_ver()[0] != "glibc", reason="tunes glibc's malloc only")
 def test_a_kept_heap_reuses_freed_arrays_instead_of_faulting_pages_in() -> None:
     default, kept = faults("default"), faults("kept")
-    assert default > 50 * 1000  # ~1200 fresh pages a loop, zeroed by the kernel each time
-    assert kept < 200
+    assert default > 5_000  # hundreds of fresh pages a loop, zeroed by the kernel each time
+    assert kept < 200, (default, kept)  # none, once the heap has grown

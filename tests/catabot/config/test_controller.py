@@ -8,8 +8,8 @@ from typing import Any
 
 import pytest
 
+from catabot.config.base import ScenarioError
 from catabot.config.load import load_scenario, parse_scenario
-from catabot.config.scenario import ScenarioError
 
 
 def _data(*controllers: dict[str, Any]) -> dict[str, Any]:

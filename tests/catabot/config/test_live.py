@@ -8,8 +8,9 @@ from typing import Any
 import pytest
 
 from catabot.config import live
+from catabot.config.base import ScenarioError
 from catabot.config.load import parse_scenario
-from catabot.config.scenario import Scenario, ScenarioError
+from catabot.config.scenario import Scenario
 
 
 def _data(**top: Any) -> dict[str, Any]:

@@ -7,8 +7,8 @@ from typing import Any
 
 import pytest
 
+from catabot.config.base import ScenarioError
 from catabot.config.load import parse_scenario
-from catabot.config.scenario import ScenarioError
 
 CAMERA = {"name": "cam", "type": "camera", "rate_hz": 10.0}
 LIDAR = {"name": "lidar", "type": "lidar", "rate_hz": 10.0}

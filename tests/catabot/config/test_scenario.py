@@ -10,8 +10,9 @@ from typing import Any
 import jsonschema
 import pytest
 
+from catabot.config.base import ScenarioError
 from catabot.config.load import BUNDLED, json_schema, load_scenario, parse_scenario
-from catabot.config.scenario import Scenario, ScenarioError, guidance_period_ticks
+from catabot.config.scenario import Scenario
 
 
 def _base() -> dict[str, Any]:
@@ -210,50 +211,6 @@ def test_several_problems_are_reported_together() -> None:
     assert "seed:" in msg and "clock.deadline_s:" in msg
 
 
-def test_sensor_rate_not_a_whole_number_of_ticks() -> None:
-    data = _base()
-    data["vessels"][0]["sensors"][1]["rate_hz"] = 30.0  # period 33333333 ns at dt 10 ms
-    msg = _error(data)
-    assert "vessels.0.sensors.1.rate_hz" in msg
-    assert "ego/gps" in msg
-    assert "33333333" in msg
-    assert "whole number of ticks" in msg
-    assert "100 Hz divided by a whole number" in msg  # the allowed rates
-
-
-def test_sensor_rate_3_hz_refused() -> None:
-    data = _base()
-    data["vessels"][0]["sensors"][1]["rate_hz"] = 3.0
-    msg = _error(data)
-    assert "ego/gps" in msg and "whole number of ticks" in msg
-
-
-def test_sensor_period_not_a_whole_number_of_ns() -> None:
-    data = _base()
-    data["dt_ns"] = 33_333_333  # 30 Hz is then one tick, but 1/30 s is no whole number of ns
-    data["vessels"][0]["sensors"] = [{"name": "imu", "type": "imu", "rate_hz": 30.0}]
-    msg = _error(data)
-    assert "vessels.0.sensors.0.rate_hz (ego/imu)" in msg
-    assert "not a whole number of ns" in msg
-
-
-def test_slow_sensor_rates_are_accepted() -> None:
-    data = _base()
-    data["duration_s"] = 100.0
-    data["vessels"][0]["sensors"][1]["rate_hz"] = 0.1
-    data["vessels"][0]["sensors"][0]["rate_hz"] = 0.001
-    scenario = parse_scenario(data)
-    assert [s.period_ns for s in scenario.vessels[0].sensors] == [10**12, 10**10]
-
-
-def test_sensor_rate_of_exactly_one_tick_and_of_many() -> None:
-    data = _base()
-    data["vessels"][0]["sensors"][0]["rate_hz"] = 100.0
-    data["vessels"][0]["sensors"][1]["rate_hz"] = 2.5
-    scenario = parse_scenario(data)
-    assert [s.period_ns for s in scenario.vessels[0].sensors] == [10_000_000, 400_000_000]
-
-
 def test_invalid_json_file(tmp_path: Path) -> None:
     path = tmp_path / "bad.json"
     path.write_text('{"vessels": [}')
@@ -329,22 +286,3 @@ def test_a_setpoint_delay_that_is_not_a_whole_number_of_ticks(delay: object) -> 
     data = _base()
     data["traffic"] = {"count": 2, "setpoint_delay_ticks": delay}
     assert "traffic.setpoint_delay_ticks:" in _error(data)
-
-
-@pytest.mark.parametrize(
-    ("rate", "says"),
-    [(30.0, "not a whole number of ticks"), (0.0, "must be > 0"), ("fast", "must be a number")],
-)
-def test_a_guidance_rate_that_is_not_a_whole_number_of_ticks(rate: object, says: str) -> None:
-    data = _base()
-    data["traffic"] = {"count": 2, "guidance_hz": rate}
-    error = _error(data)
-    assert "traffic.guidance_hz" in error and says in error, error
-
-
-def test_the_guidance_rate_sets_the_period_of_the_set_points() -> None:
-    data = _base()
-    data["traffic"] = {"count": 2, "guidance_hz": 25.0}
-    assert guidance_period_ticks(parse_scenario(data)) == 4
-    data["traffic"] = {"count": 0, "guidance_hz": 30.0}  # no boats: nothing to refuse
-    assert parse_scenario(data).traffic.guidance_hz == 30.0

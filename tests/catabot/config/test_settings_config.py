@@ -9,8 +9,8 @@ from typing import Any
 
 import pytest
 
+from catabot.config.base import ScenarioError
 from catabot.config.load import load_scenario, parse_scenario
-from catabot.config.scenario import ScenarioError
 from catabot.config.settings_config import is_settings_config
 from catabot.world.world import World
 from tests.paths import BAY

@@ -7,8 +7,8 @@ from typing import Any
 
 import pytest
 
+from catabot.config.base import ScenarioError
 from catabot.config.load import parse_scenario
-from catabot.config.scenario import ScenarioError
 from catabot.world.shards import sensor_costs, split
 from catabot.world.world import World
 

@@ -9,8 +9,8 @@ import pytest
 
 from catabot.bus.keys import Keys
 from catabot.bus.messages import BodyStates, GpsFix, ImuSample
+from catabot.config.base import ScenarioError
 from catabot.config.load import parse_scenario
-from catabot.config.scenario import ScenarioError
 from catabot.world.world import World
 
 KEYS = Keys("w")

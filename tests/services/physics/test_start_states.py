@@ -12,8 +12,8 @@ from typing import Any
 import numpy as np
 import pytest
 
+from catabot.config.base import ScenarioError
 from catabot.config.load import parse_scenario
-from catabot.config.scenario import ScenarioError
 from catabot.config.vessel import load_vessel_model
 from catabot.world import rotations
 from catabot.world.world import World

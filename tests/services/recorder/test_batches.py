@@ -8,6 +8,7 @@ import numpy as np
 import pytest
 
 from catabot.bus.messages import BodyStates, TwistBatch, TwistCmd, VesselState
+from catabot.config.base import ConfigError
 from catabot.config.load import parse_scenario
 from catabot.ros2 import cdr, cdr_more, types
 from catabot.ros2.convert import Converter
@@ -17,12 +18,10 @@ from services.recorder.csv_sink import CsvSink, RecorderError
 from services.recorder.mcap_read import read_mcap_messages
 from services.recorder.mcap_sink import McapSink
 
-WORLD = World.resolve(
-    parse_scenario(
-        {"name": "b", "vessels": [{"id": "ego"}], "traffic": {"count": 1},
-         "buoys": [{"id": "buoy_0", "x_m": 50.0, "y_m": 0.0}]}
-    )
-)  # fmt: skip
+SCENARIO = {"name": "b", "vessels": [{"id": "ego"}], "traffic": {"count": 1},
+            "buoys": [{"id": "buoy_0", "x_m": 50.0, "y_m": 0.0}],
+            "recording": {"traffic_rate_hz": None}}  # fmt: skip
+WORLD = World.resolve(parse_scenario(SCENARIO))  # every body every tick
 IDS = ("ego", "boat_000", "buoy_0")
 BOATS = ("boat_000",)
 assert WORLD.body_ids == IDS and WORLD.boat_ids == BOATS
@@ -71,6 +70,37 @@ def test_states_block_equals_the_per_message_rows(tmp_path: Path) -> None:
     )
     assert fmt.states(batches[2]).tf == tf
     assert fmt.states(batches[2]).topics == ("/ego/odom", "/boat_000/odom")
+
+
+def test_traffic_and_buoys_are_recorded_at_their_rate_the_vessels_every_tick(
+    tmp_path: Path,
+) -> None:
+    thinned = World.resolve(parse_scenario({**SCENARIO, "recording": {"traffic_rate_hz": 10}}))
+    fmt = BatchFormatter(Converter(thinned))
+    batches = [_states(k) for k in range(21)]
+    with CsvSink(tmp_path / "block") as sink:
+        for batch in batches:
+            block = fmt.states(batch)
+            sink.write_lines(block.streams, block.cls, block.lines)
+    for i, vid in enumerate(IDS):
+        ticks = range(21) if vid == "ego" else (0, 10, 20)
+        expected = _csv_by_message(tmp_path / vid, f"vessel/{vid}/state",
+                                   [batches[k].row(i) for k in ticks])  # fmt: skip
+        assert (tmp_path / "block" / f"vessel.{vid}.state.csv").read_text() == expected
+    between = fmt.states(batches[7])  # the ego alone: its Odometry and its frame on /tf
+    assert between.topics == ("/ego/odom",)
+    odometry = cdr.odometry_encoder("map", "ego/base_link")
+    assert _payloads(between) == {0: odometry(batches[7].row(0), batches[7].stamp_ns)}
+    tf = cdr.TfBatch("map", ["ego/base_link"])
+    assert between.tf == tf.encode(batches[7].stamp_ns, batches[7].position[:1],
+                                   batches[7].orientation[:1])  # fmt: skip
+    with pytest.raises(ValueError, match="boat_000"):  # rows still checked between samples
+        fmt.states(BodyStates(7, 0, ("ego", "buoy_0", "boat_000"), *batches[7].arrays()))
+
+
+def test_a_traffic_rate_that_is_not_whole_ticks_is_refused() -> None:
+    with pytest.raises(ConfigError, match=r"recording.traffic_rate_hz.*null records every"):
+        World.resolve(parse_scenario({**SCENARIO, "recording": {"traffic_rate_hz": 30}}))
 
 
 def _payloads(block: Block) -> dict[int, bytes]:

@@ -154,7 +154,7 @@ def test_no_boat_starts_or_steers_on_land() -> None:
 
 
 def test_a_bad_mix_is_refused_naming_the_field() -> None:
-    from catabot.config.scenario import ScenarioError
+    from catabot.config.base import ScenarioError
 
     with pytest.raises(ScenarioError, match=r"traffic\.behaviour_mix"):
         parse_scenario(_scenario(3) | {"traffic": {"count": 3, "behaviour_mix": {"zigzag": 1}}})

@@ -1,0 +1,68 @@
+"""Rates as whole numbers of ticks (DESIGN.md §4): every rate a scenario sets is checked here
+once, when the scenario is loaded, and each consumer turns its rate into ticks the same way."""
+
+from __future__ import annotations
+
+import math
+
+from catabot.bus.clock import NS_PER_S, ClockError, period_in_ticks
+from catabot.config.base import ScenarioError
+from catabot.config.scenario import Scenario
+
+
+def check_rates(scenario: Scenario) -> None:
+    """Refuse sensor and guidance rates that are not a whole number of ticks (DESIGN.md §4),
+    and sensors too big to sample in memory."""
+    for v_index, vessel in enumerate(scenario.vessels):
+        for s_index, sensor in enumerate(vessel.sensors):
+            where = f"vessels.{v_index}.sensors.{s_index}.rate_hz ({vessel.id}/{sensor.name})"
+            rate_in_ticks(sensor.rate_hz, scenario.dt_ns, where=where)
+            problem = sensor.typed_params().memory_problem()
+            if problem:
+                at = f"vessels.{v_index}.sensors.{s_index}.params ({vessel.id}/{sensor.name})"
+                raise ScenarioError(f"{at}: {problem}")
+        if vessel.controller is not None:
+            where = f"vessels.{v_index}.controller.rate_hz ({vessel.id})"
+            rate_in_ticks(vessel.controller.rate_hz, scenario.dt_ns, where=where)
+    if scenario.traffic.count:
+        guidance_period_ticks(scenario)
+    if scenario.ros is not None and scenario.ros.clock_hz is not None:
+        rate_in_ticks(scenario.ros.clock_hz, scenario.dt_ns, where="ros.clock_hz")
+    if scenario.recording.traffic_rate_hz is not None and (
+        scenario.traffic.count or scenario.buoys
+    ):
+        traffic_record_period(scenario)
+    if scenario.recording.dataset_rate_hz is not None:
+        rate_in_ticks(
+            scenario.recording.dataset_rate_hz, scenario.dt_ns, where="recording.dataset_rate_hz"
+        )
+    try:
+        scenario.ticks  # noqa: B018 - validates duration against dt
+    except ClockError as exc:
+        raise ScenarioError(f"duration_s: {exc}") from None
+
+
+def rate_in_ticks(rate_hz: float, dt_ns: int, *, where: str) -> int:
+    """The period of a rate in ticks; ScenarioError naming `where` unless it is whole."""
+    try:  # first, so that e.g. 30 Hz at 10 ms names the allowed rates
+        ticks = period_in_ticks(round(NS_PER_S / rate_hz), dt_ns, what=where)
+    except ClockError as exc:
+        raise ScenarioError(str(exc)) from None
+    exact = NS_PER_S / rate_hz
+    if not math.isclose(exact, round(exact), rel_tol=1e-12, abs_tol=1e-6):
+        raise ScenarioError(f"{where}: {rate_hz} Hz is not a whole number of ns")
+    return ticks
+
+
+def guidance_period_ticks(scenario: Scenario) -> int:
+    """Ticks between two rounds of traffic set-points (`traffic.guidance_hz`)."""
+    return rate_in_ticks(scenario.traffic.guidance_hz, scenario.dt_ns, where="traffic.guidance_hz")
+
+
+def traffic_record_period(scenario: Scenario) -> int:
+    """Ticks between two recorded states of the traffic and the buoys (1: every tick)."""
+    rate = scenario.recording.traffic_rate_hz
+    if rate is None:
+        return 1
+    where = "recording.traffic_rate_hz (null records every tick)"
+    return rate_in_ticks(rate, scenario.dt_ns, where=where)

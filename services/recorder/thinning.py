@@ -1,0 +1,46 @@
+"""Traffic and buoys recorded at `recording.traffic_rate_hz`, scenario vessels every tick.
+
+Why: with 100 boats, formatting every body's CSV row, Odometry and /tf entry every tick was
+most of the recorder's time (Python's exact float text alone ≈0.9 ms a tick), and so of the
+whole stack's, for rows users rarely read at 100 Hz: the traffic is context, the scenario
+vessels are what is analysed. Metrics still see every tick (they read the bus, not files).
+On the ticks between two traffic samples a batch is recorded as its scenario vessels' rows
+only: their CSV lines, their Odometry and a /tf of their frames.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from catabot.bus.messages import BodyStates
+from catabot.config.rates import traffic_record_period
+from catabot.ros2.cdr import OdometryBatch, TfBatch
+from catabot.ros2.convert import Converter
+from catabot.ros2.names import MAP
+
+
+class Thinning:
+    """Which ticks record every body, and the encoders of the scenario vessels alone."""
+
+    def __init__(self, convert: Converter) -> None:
+        world, names = convert.world, convert.names
+        others = len(world.bodies) > sum(b.kind == "vessel" for b in world.bodies)
+        self.period = traffic_record_period(world.scenario) if others else 1
+        own = [b for b in world.bodies if b.kind == "vessel"]
+        self.rows = np.array([b.row for b in own], dtype=np.intp)
+        self.streams = tuple(f"vessel/{b.id}/state" for b in own)
+        self.topics = tuple(names.odom(b.id) for b in own)
+        frames = [names.base_link(b.id) for b in own]
+        self._odometry, self._tf = OdometryBatch(MAP, frames), TfBatch(MAP, frames)
+
+    def every_body(self, tick: int) -> bool:
+        return tick % self.period == 0
+
+    def odometry_groups(self, batch: BodyStates) -> list[tuple[np.ndarray, np.ndarray]]:
+        values = np.concatenate(batch.arrays()[:4], axis=1)[self.rows]
+        return self._odometry.encode_groups(batch.stamp_ns, values)
+
+    def tf(self, batch: BodyStates) -> bytes:
+        return self._tf.encode(
+            batch.stamp_ns, batch.position[self.rows], batch.orientation[self.rows]
+        )
