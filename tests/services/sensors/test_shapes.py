@@ -11,15 +11,16 @@ import numpy as np
 import open3d as o3d
 import pytest
 
-from catabot.bus.messages import CLASS_NONE, CLASS_VESSEL, VesselState
-from catabot.config.sensors import LidarParams
+from catabot.bus.messages import CLASS_NONE, CLASS_VESSEL, CLASS_WATER, CameraFrame, VesselState
+from catabot.config.sensors import CameraParams, LidarParams
 from catabot.config.vessel import load_vessel_model
 from catabot.config.waves import WaveConfig
 from catabot.world.shapes import ShapeMesh, vessel_mesh
 from catabot.world.waves import WaveField
+from services.sensors.camera import CameraModel
 from services.sensors.lidar import LidarModel
 from services.sensors.mount import Mount
-from services.sensors.scene import Body, Scene, SceneError
+from services.sensors.scene import Body, Hits, Scene, SceneError
 
 CALM = WaveField(WaveConfig(), 0)
 LEVEL = LidarParams(channels=3, vertical_fov_deg=10.0, columns=360, mount_xyz=(0.0, 0.0, 0.1))
@@ -170,3 +171,84 @@ def test_nothing_is_hit_beyond_range_or_before_a_nearer_body() -> None:
     )
     hits = both.cast(np.array([0.0, 0.0, 0.1]), np.array([[1.0, 0.04, 0.0]]), 50.0)
     assert hits.instance[0] == 3 and float(hits.range[0]) == pytest.approx(3.9 / 0.9992, abs=0.01)
+
+
+def _camera_frame(scene: Scene, **params: object) -> tuple[CameraModel, CameraFrame]:
+    cam = CameraModel(CameraParams.model_validate(params), Mount(scene=scene, seed=3, name="c"))
+    return cam, cam.sample(_state(), tick=0, stamp_ns=0)
+
+
+def test_the_masks_cover_the_hulls_and_not_the_water_between_them() -> None:
+    """A WAM-V 10 m ahead, bow away, seen from 0.6 m up: the vessel mask is exactly the
+    pixels whose rays meet its mesh before the water (an independent cast), so the water
+    between the pontoons under the frame is water, not vessel (a box hid it)."""
+    params = {"width": 480, "height": 360, "mount_xyz": (0.0, 0.0, 0.6)}
+    cam, frame = _camera_frame(_scene({"w": (10.0, 0.0, 0.0)}, _body("w", "wamv", 2)), **params)
+    _, boxed = _camera_frame(
+        _scene({"w": (10.0, 0.0, 0.0)}, _body("w", "wamv", 2, shape=False)), **params
+    )
+    origin, rot = cam.pose(_state())
+    dirs = cam.rays.astype(np.float64) @ rot.T
+    t = _independent(_mesh("wamv"), (10.0, 0.0, 0.0), origin, dirs)
+    expected = (np.isfinite(t) & (t < _water(origin, dirs))).reshape(360, 480)
+    mask = frame.segmentation == CLASS_VESSEL
+    assert expected.sum() > 800 and np.array_equal(mask, expected)
+    assert np.all(frame.instance[mask] == 2)
+    gap = _pixel(cam, (10.0 - 2.45, 0.0, 0.05))  # the middle of the gap at the stern
+    assert frame.segmentation[gap] == CLASS_WATER
+    assert boxed.segmentation[gap] == CLASS_VESSEL
+    hull = _pixel(cam, (10.0 - 2.45, 1.03, 0.124))  # the port pontoon's stern
+    assert frame.segmentation[hull] == CLASS_VESSEL
+
+
+def _pixel(cam: CameraModel, point: tuple[float, float, float]) -> tuple[int, int]:
+    origin, rot = cam.pose(_state())
+    p = (np.asarray(point) - origin) @ rot
+    u, v = cam.cam.fx * p[0] / p[2] + cam.cam.cx, cam.cam.fy * p[1] / p[2] + cam.cam.cy
+    return int(v), int(u)
+
+
+def test_boxes_and_flags_follow_the_shape() -> None:
+    """Bow-on, a WAM-V fills under a third of its projected bounding box (two pontoons and
+    a frame): it is not occluded, and its 2D box is its mask's. Behind a tall box that hides
+    three quarters of it, it is; at the image edge, its projected outline leaves the image:
+    truncated."""
+    wamv = _body("w", "wamv", 2)
+    params = {"width": 320, "height": 240, "mount_xyz": (0.0, 0.0, 1.5)}
+    _, alone = _camera_frame(_scene({"w": (20.0, 0.0, 0.0)}, wamv), **params)
+    row = np.flatnonzero(alone.boxes[:, 0] == 2)
+    assert row.size == 1 and alone.box_flags[row[0]].tolist() == [0, 0]
+    mask = np.argwhere(alone.instance == 2)
+    x0, y0 = mask[:, 1].min(), mask[:, 0].min()
+    x1, y1 = mask[:, 1].max() + 1, mask[:, 0].max() + 1
+    assert alone.boxes[row[0], 2:].tolist() == [x0, y0, x1, y1]
+    wall = Body("wall", CLASS_VESSEL, 3, (-0.2, -0.75, -0.1), (0.2, 0.75, 3.0))
+    _, hidden = _camera_frame(
+        _scene({"w": (20.0, 0.0, 0.0), "wall": (10.0, 0.3, 0.0)}, wamv, wall), **params
+    )
+    row = np.flatnonzero(hidden.boxes[:, 0] == 2)
+    assert row.size == 1 and hidden.box_flags[row[0], 1] == 1
+    edge_y = 18.0 * math.tan(math.radians(40.0))  # the left edge of the view at 18 m
+    _, edge = _camera_frame(_scene({"w": (20.0, edge_y, 0.0)}, wamv), **params)
+    row = np.flatnonzero(edge.boxes[:, 0] == 2)
+    assert row.size == 1 and edge.box_flags[row[0], 0] == 1
+
+
+def test_silhouettes_count_a_body_whatever_hides_it() -> None:
+    wamv = _body("w", "wamv", 2)
+    wall = Body("wall", CLASS_VESSEL, 3, (-0.2, -0.75, -0.1), (0.2, 0.75, 3.0))
+    cam, _ = _camera_frame(_scene({"w": (20.0, 0.0, 0.0)}, wamv), width=320, height=240)
+    origin, rot = cam.pose(_state())
+    dirs = np.dot(cam.rays, rot.T.astype(np.float32))
+    alone = _scene({"w": (20.0, 0.0, 0.0)}, wamv).cast(origin, dirs, 1e3, silhouettes=True)
+    both = _scene({"w": (20.0, 0.0, 0.0), "wall": (10.0, 0.3, 0.0)}, wamv, wall)
+    hidden = both.cast(origin, dirs, 1e3, silhouettes=True)
+    assert alone.silhouette is not None and hidden.silhouette is not None
+    assert alone.silhouette[0] == hidden.silhouette[0] == (alone.instance == 2).sum() > 50
+    assert (hidden.instance == 2).sum() < alone.silhouette[0] / 2
+    assert scene_without_silhouettes(wamv).silhouette is None
+
+
+def scene_without_silhouettes(body: Body) -> Hits:
+    scene = _scene({body.id: (20.0, 0.0, 0.0)}, body)
+    return scene.cast(np.array([0.0, 0.0, 1.0]), np.array([[1.0, 0.0, 0.0]]), 100.0)
