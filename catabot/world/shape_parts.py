@@ -7,8 +7,9 @@ reviewable source of a model's geometry; nothing is added to the package data; a
 building them needs no mesh reader (open3d is imported only for mesh files).
 
 Every primitive is a loft: closed cross-sections (S, P, 3) along the body x axis joined by
-quads, capped at both ends (fans: every section is convex). A section may shrink to a line
-or a point (a stem, a cone's tip); the zero-area triangles that leaves are dropped.
+quads, capped at both ends (fans: every section is convex), wound to face outwards. A
+section may shrink to a line or a point (a stem, a cone's tip); the zero-area triangles
+that leaves are dropped.
 Cylinders have SEGMENTS sides with a vertex on each axis, so their bounding box is the true
 cylinder's and a flat side lies at most r (1 - cos(pi / SEGMENTS)) inside it (1.8 mm for the
 WAM-V's 0.213 m pontoons).
@@ -39,6 +40,12 @@ def parts_mesh(parts: list[Part], hulls: list[Hull]) -> tuple[F64, I32]:
     vertices = np.concatenate([v for v, _ in meshes])
     triangles = np.concatenate([t + o for (_, t), o in zip(meshes, offsets, strict=True)])
     return vertices, _without_degenerate(vertices, triangles.astype(np.int32))
+
+
+def box_mesh(lo: F64, hi: F64) -> tuple[F64, I32]:
+    """The box lo..hi (body frame) as triangles: a model without a shape, drawn."""
+    (y, z), (width, height) = (lo[1:] + hi[1:]) / 2, hi[1:] - lo[1:]
+    return loft(_sections(float(lo[0]), float(hi[0] - lo[0]), 0.0, _rectangle(y, z, width, height)))
 
 
 def _part(part: Part, hulls: list[Hull]) -> tuple[F64, I32]:
@@ -98,8 +105,12 @@ def _sections(stern_x: float, length: float, bow: float, yz: F64, *, tip: bool =
 
 
 def loft(sections: F64) -> tuple[F64, I32]:
-    """A closed surface through convex sections (S, P, 3): quads between consecutive
-    sections, a fan over each end."""
+    """A closed surface through convex sections (S, P, 3) along +x: quads between
+    consecutive sections, a fan over each end, every triangle wound counter-clockwise seen
+    from outside (so its right-hand normal points out: the viewer lights it)."""
+    y, z = sections[0, :, 1], sections[0, :, 2]
+    if np.dot(y, np.roll(z, -1)) < np.dot(np.roll(y, -1), z):  # clockwise seen from +x
+        sections = sections[:, ::-1]
     s, p = sections.shape[:2]
     index = np.arange(s * p).reshape(s, p)
     a, c = index[:-1], index[1:]

@@ -14,6 +14,8 @@ import open3d as o3d
 import pytest
 
 from catabot.config.vessel import VesselModel, bundled_vessel_names, load_vessel_model
+from catabot.config.vessel_shape import BoxPart
+from catabot.world.shape_parts import parts_mesh
 from catabot.world.shapes import MeshFileError, ShapeMesh, vessel_mesh
 
 CELL_M = 0.01  # the waterplane is measured on a grid this fine
@@ -130,3 +132,18 @@ def test_a_mesh_file_removed_after_loading_is_refused_naming_it(tmp_path: Path) 
 def test_a_model_without_shape_has_no_mesh() -> None:
     data = load_vessel_model("catabot").model_copy(update={"shape": None})
     assert vessel_mesh(data, source="catabot") is None
+
+
+@pytest.mark.parametrize("name", bundled_vessel_names())
+def test_every_part_is_closed_and_wound_outwards(name: str) -> None:
+    """Each primitive encloses its volume with triangles facing out (the viewer lights the
+    outside): the divergence theorem gives the part's volume, positive."""
+    model = load_vessel_model(name)
+    assert model.shape is not None and model.shape.parts is not None
+    for part in model.shape.parts:
+        vertices, triangles = parts_mesh([part], model.hulls)
+        a, b, c = (vertices[triangles[:, k]] for k in range(3))
+        volume = np.einsum("ij,ij->i", a, np.cross(b, c)).sum() / 6.0
+        if isinstance(part, BoxPart):
+            assert volume == pytest.approx(np.prod(part.size_m))
+        assert volume > 0.0, (name, part)
