@@ -231,8 +231,10 @@ class Bodies:
         before = take(rng, ray_i)
         self._cast_shapes(body_i, ob, db, t, face_b, limit=None if silhouettes else before)
         if seen is not None:
-            z = take(o[:, 2], ray_i) + t * take(d[:, 2], ray_i)
-            seen += np.bincount(body_i[(t <= max_range) & (z > 0.0)], minlength=seen.size)
+            hit = np.flatnonzero(t <= max_range)  # misses are inf: inf x 0 would warn
+            rays = take(ray_i, hit)
+            z = take(o[:, 2], rays) + take(t, hit) * take(d[:, 2], rays)
+            seen += np.bincount(take(body_i, hit)[z > 0.0], minlength=seen.size)
         ok = np.flatnonzero((t <= max_range) & (t < before))
         ray_i, body_i, t = take(ray_i, ok), take(body_i, ok), take(t, ok)
         face = np.einsum("pij,pj->pi", take(rot, ok, axis=0), take(face_b, ok, axis=0))

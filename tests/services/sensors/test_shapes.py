@@ -22,6 +22,7 @@ from services.sensors.lidar import LidarModel
 from services.sensors.mount import Mount
 from services.sensors.scene import Body, Hits, Scene, SceneError
 
+pytestmark = pytest.mark.filterwarnings("error::RuntimeWarning")  # an inf x 0 is a bug here
 CALM = WaveField(WaveConfig(), 0)
 LEVEL = LidarParams(channels=3, vertical_fov_deg=10.0, columns=360, mount_xyz=(0.0, 0.0, 0.1))
 
@@ -252,3 +253,13 @@ def test_silhouettes_count_a_body_whatever_hides_it() -> None:
 def scene_without_silhouettes(body: Body) -> Hits:
     scene = _scene({body.id: (20.0, 0.0, 0.0)}, body)
     return scene.cast(np.array([0.0, 0.0, 1.0]), np.array([[1.0, 0.0, 0.0]]), 100.0)
+
+
+def test_level_rays_that_miss_count_no_silhouette_and_warn_nothing() -> None:
+    """Horizontal rays (a level LiDAR channel, a camera's middle row) that miss a shape in
+    its box: no silhouette pixel, no NaN from inf x 0."""
+    scene = _scene({"w": (5.0, 0.0, 0.0)}, _body("w", "wamv", 2))
+    dirs = np.array([[1.0, 0.0, 0.0], [1.0, 0.05, 0.0], [1.0, 0.5, 0.0], [1.0, 0.4, 0.0]])
+    hits = scene.cast(np.array([0.0, 0.0, 0.3]), dirs, 100.0, silhouettes=True)
+    assert np.isinf(hits.range[:3]).all() and hits.instance[3] == 2  # gap, gap, beside; hull
+    assert hits.silhouette is not None and hits.silhouette.tolist() == [1]
