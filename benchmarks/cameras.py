@@ -1,14 +1,19 @@
 """Camera frame and radar sample cost on the shared ray-casting scene.
 
 The scene: the bundled harbour terrain (catabot/data/terrain/bay.png, 600 m square) with the
-island in view, 20 boats spread 25-200 m ahead inside the camera's 80 deg view, calm water and
-the harbour's waves (Hs 0.3 m). Measured per sample, median of REPEATS:
+island in view, 100 boats of the bundled models (benchmarks/fleet.py), 20 of them spread
+25-200 m ahead inside the camera's 80 deg view and 80 scattered over the bay, and a buoy;
+calm water and the harbour's waves (Hs 0.3 m). Measured per sample, median of REPEATS:
 - camera 640 x 480, all four outputs (colour, depth, normals, segmentation + boxes);
 - the same camera with segmentation (and boxes) only, and at 320 x 240 for comparison;
 - its parts: the Scene cast alone (with the camera's projected-box cull, as `sample` casts,
   and with the scene's own rays x bodies cull) and the post-processing alone (cached hits);
-- the radar, one sample per 10 ms tick (2.4 beams x 33 rays).
-Target (issue "Sensor farm"): >= 15 camera frames/s with all four outputs on this machine.
+- the radar, one sample per 10 ms tick (2.4 beams x 33 rays);
+- the four-output camera with every body as its hull box and as its shape, side by side
+  (interleaved calls, benchmarks/fleet.py), and Embree alone on the terrain with the frame's
+  rays, for reference.
+Targets: >= 15 camera frames/s with all four outputs on this machine (issue "Sensor farm");
+shapes at most 1.2 x boxes (issue #17, "Vessel shapes").
 """
 
 from __future__ import annotations
@@ -21,10 +26,11 @@ from collections.abc import Callable
 
 import numpy as np
 
+from benchmarks.fleet import comparison_head, comparison_line, fleet, side_by_side
 from benchmarks.sensors import TERRAIN
 from catabot.bus.blas import single_thread_blas
 from catabot.bus.heap import keep_heap
-from catabot.bus.messages import CLASS_VESSEL, VesselState
+from catabot.bus.messages import VesselState
 from catabot.config.sensors import CameraParams, RadarParams
 from catabot.config.waves import WaveConfig
 from catabot.world.terrain import load_terrain
@@ -33,10 +39,12 @@ from services.sensors.camera import CameraModel
 from services.sensors.camera_boxes import candidate_rays
 from services.sensors.mount import Mount
 from services.sensors.radar import RadarModel
-from services.sensors.scene import Body, Scene
+from services.sensors.scene import Scene
 
-BOATS = 20
+BOATS = 100
+IN_VIEW = 20
 REPEATS = 15
+PAIRS = 30  # boxes-vs-shapes frames of each, interleaved
 EGO = (290.0, 300.0)
 HEADING = math.radians(15.0)
 AT = {"tick": 0, "stamp_ns": 0}
@@ -55,17 +63,18 @@ def ego_state() -> VesselState:
     return VesselState(0, 0, (*EGO, 0.0), quat(HEADING), zero, zero, zero, zero)
 
 
-def scene(waves: WaveConfig) -> Scene:
-    """The bay, the ego vessel and BOATS boats in front of it (seeded positions)."""
+def scene(waves: WaveConfig, *, shapes: bool = True) -> Scene:
+    """The bay, the ego vessel, IN_VIEW boats in front of it and the rest of the BOATS over
+    the bay (seeded positions), and a buoy; every body as its shape or its hull box."""
     rng = np.random.default_rng(7)
-    bodies = [Body("ego", CLASS_VESSEL, 1, (-0.95, -0.52, -0.06), (0.95, 0.52, 0.24))]
-    poses = {"ego": ((*EGO, 0.0), quat(HEADING))}
+    poses = {"ego": ((*EGO, 0.0), quat(HEADING)), "b1": ((320.0, 360.0, 0.0), quat(0.0))}
     for i in range(BOATS):
         dist, off = rng.uniform(25.0, 200.0), rng.uniform(-0.55, 0.55)
-        bid = f"boat{i}"
-        bodies.append(Body(bid, CLASS_VESSEL, 2 + i, (-3.0, -1.2, -0.3), (3.0, 1.2, 1.5)))
         x, y = EGO[0] + dist * math.cos(HEADING + off), EGO[1] + dist * math.sin(HEADING + off)
-        poses[bid] = ((x, y, 0.0), quat(rng.uniform(0, 2 * math.pi)))
+        if i >= IN_VIEW:
+            x, y = rng.uniform(50.0, 550.0, 2)
+        poses[f"v{i}"] = ((x, y, 0.0), quat(rng.uniform(0, 2 * math.pi)))
+    bodies = fleet(BOATS, shapes=shapes)
     world = Scene(terrain=load_terrain(TERRAIN), waves=WaveField(waves, 1), bodies=bodies)
     world.update(poses, 0.0)
     return world
@@ -98,7 +107,7 @@ def camera_rows(world: Scene, sea: str) -> list[tuple[str, tuple[float, float, f
     origin, rot = full.pose(state)
     dirs = np.dot(full.rays, rot.T.astype(np.float32))
     pairs = candidate_rays((world.corners() - origin) @ rot, full.cam)
-    hits = world.cast(origin, dirs, full.params.max_range_m, pairs)
+    hits = world.cast(origin, dirs, full.params.max_range_m, pairs, silhouettes=True)
     return [
         (f"camera 640x480, all outputs ({sea})", median_ms(lambda: full.sample(state, **AT))),
         (f"camera 640x480, segmentation only ({sea})", median_ms(lambda: seg.sample(state, **AT))),
@@ -132,10 +141,40 @@ def radar_row(world: Scene, sea: str) -> tuple[str, tuple[float, float, float]]:
     return f"radar, one 10 ms tick ({sea})", median_ms(one, repeats=200)
 
 
+def compared(sea: str) -> str:
+    """The four-output camera on the same scene with bodies as hull boxes and as shapes."""
+    frames = []
+    for shapes in (False, True):
+        world = scene(SEAS[sea], shapes=shapes)
+        camera = CameraModel(CameraParams(), Mount(scene=world, seed=1, name="ego/cam"))
+        frames.append(lambda camera=camera: camera.sample(ego_state(), **AT))
+    boxes, shapes_ms = side_by_side(frames[0], frames[1], PAIRS)
+    return comparison_line(f"camera 640 x 480, all four outputs, {sea}", boxes, shapes_ms)
+
+
+def embree_alone() -> str:
+    """Embree's own rate on the terrain scene with the frame's rays (float32, as cast)."""
+    import open3d as o3d
+
+    camera = CameraModel(CameraParams(), Mount(scene=scene(SEAS["calm"]), seed=1))
+    origin, rot = camera.pose(ego_state())
+    rays = np.empty((camera.rays.shape[0], 6), dtype=np.float32)
+    rays[:, :3], rays[:, 3:] = origin, np.dot(camera.rays, rot.T.astype(np.float32))
+    terrain = load_terrain(TERRAIN).raycasting_scene()
+    tensor = o3d.core.Tensor.from_numpy(rays)
+    ms = median_ms(lambda: terrain.cast_rays(tensor))[0]
+    n = rays.shape[0]
+    rate = f"{n / ms / 1e3:.1f} M rays/s"
+    return f"Embree alone, the frame's {n} rays on the terrain: {ms:.2f} ms, {rate}"
+
+
 def main() -> None:
     single_thread_blas()  # as every service does (catabot/run/service.py)
     keep_heap()
-    print(f"camera and radar cost: bay terrain, {BOATS} boats in view, median of {REPEATS}")
+    print(
+        f"camera and radar cost: bay terrain, {BOATS} boats ({IN_VIEW} in view) and a buoy, "
+        f"median of {REPEATS}"
+    )
     print(f"{'what':52} {'wall ms':>8} {'per s':>8} {'min ms':>8} {'CPU ms':>8}")
     for sea, waves in SEAS.items():
         start = time.perf_counter()
@@ -147,6 +186,11 @@ def main() -> None:
         for name, (ms, least, cpu) in [*camera_rows(world, sea), radar_row(world, sea)]:
             print(f"{name:52} {ms:8.2f} {1e3 / ms:8.1f} {least:8.2f} {cpu:8.2f}")
     print("target: camera all outputs >= 15 frames/s")
+    print(f"\nboxes vs shapes, {BOATS} boats (interleaved, median of {PAIRS}; ratio of medians)")
+    print(comparison_head())
+    for sea in SEAS:
+        print(compared(sea))
+    print(embree_alone())
     print(f"load average during the run: {os.getloadavg()[0]:.1f} on {os.cpu_count()} CPUs")
 
 

@@ -1,12 +1,17 @@
 """LiDAR scan cost (32 x 512, 100 m) on the shared ray-casting scene, with and without rain.
 
 The scene is the bundled harbour terrain (catabot/data/terrain/bay.png, 600 m square, as in
-the harbour scenario) plus 100 boats scattered over it, some within range, and one buoy.
+the harbour scenario) plus 100 boats scattered over it, some within range, and one buoy:
+the bundled models' shapes (benchmarks/fleet.py: monohulls, catamarans, WAM-Vs).
 Measured per scan, median of REPEATS: the whole `LidarModel.sample` (ray rotation, cast,
 noise, rain, packing the message) on calm water and with the harbour's waves (Hs 0.3 m) and
 a heavy swell, at 0 and 50 mm/h; and the parts: the cast alone and the rain model alone.
 The scene build (terrain mesh into Embree) is paid once per run and reported apart.
-Target (issue "Sensor farm"): a scan with rain within 5 ms.
+Then the same scans with every body as its hull box, side by side with the shapes
+(interleaved calls, benchmarks/fleet.py), and Embree alone on the terrain with the scan's
+rays, for reference.
+Targets: a scan with rain within 5 ms (issue "Sensor farm"); shapes at most 1.2 x boxes
+(issue #17, "Vessel shapes").
 """
 
 from __future__ import annotations
@@ -20,9 +25,10 @@ from pathlib import Path
 
 import numpy as np
 
+from benchmarks.fleet import comparison_head, comparison_line, fleet, side_by_side
 from catabot.bus.blas import single_thread_blas
 from catabot.bus.heap import keep_heap
-from catabot.bus.messages import CLASS_BUOY, CLASS_VESSEL, VesselState
+from catabot.bus.messages import VesselState
 from catabot.config.sensors import LidarParams
 from catabot.config.terrain import TerrainConfig
 from catabot.config.waves import WaveConfig
@@ -31,7 +37,7 @@ from catabot.world.waves import WaveField
 from services.sensors.lidar import LidarModel
 from services.sensors.mount import Mount
 from services.sensors.rain import RainParams, apply_rain
-from services.sensors.scene import Body, Scene
+from services.sensors.scene import Scene
 
 BAY = Path(__file__).resolve().parents[1] / "catabot" / "data" / "terrain" / "bay.png"
 TERRAIN = TerrainConfig(
@@ -39,6 +45,7 @@ TERRAIN = TerrainConfig(
 )
 BOATS = 100
 REPEATS = 30
+PAIRS = 100  # boxes-vs-shapes scans of each, interleaved: a ratio of 5% needs many
 EGO = (290.0, 300.0)
 SEAS = {
     "calm": WaveConfig(),
@@ -47,13 +54,11 @@ SEAS = {
 }
 
 
-def scene_of(waves: WaveConfig, rain: float) -> tuple[Scene, float]:
-    """The harbour scene with 100 boats and a buoy, and its build time in seconds."""
+def scene_of(waves: WaveConfig, rain: float, *, shapes: bool = True) -> tuple[Scene, float]:
+    """The harbour scene with 100 boats and a buoy (their shapes, or their hull boxes), and
+    its build time in seconds."""
     start = time.perf_counter()
-    boat = ((-1.0, -0.6, -0.1), (1.0, 0.6, 0.3))
-    bodies = [Body("ego", CLASS_VESSEL, 1, *boat)]
-    bodies += [Body(f"v{i}", CLASS_VESSEL, 2 + i, *boat) for i in range(BOATS)]
-    bodies.append(Body("b1", CLASS_BUOY, 2 + BOATS, (-0.2, -0.2, -0.15), (0.2, 0.2, 0.85)))
+    bodies = fleet(BOATS, shapes=shapes)
     scene = Scene(
         terrain=load_terrain(TERRAIN), waves=WaveField(waves, 1), bodies=bodies, rain_rate_mm_h=rain
     )
@@ -85,11 +90,15 @@ def times_ms(fn: Callable[[], object]) -> list[float]:
     return times
 
 
+def ego() -> VesselState:
+    zero = (0.0, 0.0, 0.0)
+    return VesselState(0, 0, (*EGO, 0.0), _yaw(1.57), zero, zero, zero, zero)
+
+
 def row(sea: str, rain: float) -> tuple[str, float, float, float, float, float, float, int]:
     scene, build_s = scene_of(SEAS[sea], rain)
     lidar = LidarModel(LidarParams(), Mount(scene=scene, seed=1, name="ego/lidar"))
-    zero = (0.0, 0.0, 0.0)
-    state = VesselState(0, 0, (*EGO, 0.0), _yaw(1.57), zero, zero, zero, zero)
+    state = ego()
     scans = times_ms(lambda: lidar.sample(state, tick=0, stamp_ns=0))
     scan_ms, scan_min = statistics.median(scans), min(scans)
     dirs = lidar.dirs @ lidar.mount_rot.T
@@ -100,6 +109,32 @@ def row(sea: str, rain: float) -> tuple[str, float, float, float, float, float, 
     rain_ms = median_ms(lambda: apply_rain(ranges, 100.0, rain, RainParams(), rng))
     returns = len(lidar.sample(state, tick=0, stamp_ns=0).points)
     return sea, rain, scan_ms, scan_min, cast_ms, rain_ms, build_s * 1e3, returns
+
+
+def compared(sea: str, rain: float) -> str:
+    """Scans of the same scene with every body as its hull box and as its shape."""
+    scans = []
+    for shapes in (False, True):
+        scene = scene_of(SEAS[sea], rain, shapes=shapes)[0]
+        lidar = LidarModel(LidarParams(), Mount(scene=scene, seed=1, name="ego/lidar"))
+        scans.append(lambda lidar=lidar: lidar.sample(ego(), tick=0, stamp_ns=0))
+    boxes, shapes_ms = side_by_side(scans[0], scans[1], PAIRS)
+    return comparison_line(f"LiDAR 32 x 512, {sea}, {rain:g} mm/h", boxes, shapes_ms)
+
+
+def embree_alone() -> str:
+    """Embree's own rate on the terrain scene with the scan's rays (float32, as cast)."""
+    import open3d as o3d
+
+    lidar = LidarModel(LidarParams(), Mount(scene=scene_of(SEAS["calm"], 0.0)[0], seed=1))
+    rays = np.empty((lidar.dirs.shape[0], 6), dtype=np.float32)
+    rays[:, :3], rays[:, 3:] = (*EGO, 1.0), lidar.dirs @ lidar.mount_rot.T
+    terrain = load_terrain(TERRAIN).raycasting_scene()
+    tensor = o3d.core.Tensor.from_numpy(rays)
+    ms = median_ms(lambda: terrain.cast_rays(tensor))
+    return f"Embree alone, the scan's {rays.shape[0]} rays on the terrain: {ms:.2f} ms, " + (
+        f"{rays.shape[0] / ms / 1e3:.1f} M rays/s"
+    )
 
 
 def main() -> None:
@@ -115,6 +150,12 @@ def main() -> None:
                 f"{sea_:>8} {rate:>9.0f} {scan:>8.2f} {low:>8.2f} {cast:>8.2f} {rain_ms:>8.2f} "
                 f"{build:>9.0f} {n:>8d}"
             )
+    print(f"\nboxes vs shapes, {BOATS} boats (interleaved, median of {PAIRS}; ratio of medians)")
+    print(comparison_head())
+    for sea in ("calm", "harbour"):
+        for rain in (0.0, 50.0):
+            print(compared(sea, rain))
+    print(embree_alone())
     print(f"load average during the run: {os.getloadavg()[0]:.1f} on {os.cpu_count()} CPUs")
 
 

@@ -11,7 +11,7 @@ from __future__ import annotations
 import json
 from functools import partial
 from pathlib import Path
-from typing import Annotated, Any
+from typing import Annotated, Any, get_args
 
 from pydantic import AfterValidator, BaseModel, ConfigDict, Field, StrictInt, ValidationError
 
@@ -123,27 +123,36 @@ def _short(value: Any) -> str:
 
 
 def _allowed_fields(model: type[BaseModel], loc: tuple[Any, ...]) -> list[str]:
-    """Field names of the model found by walking `loc` from `model` (for unknown keys)."""
+    """Field names of the model found by walking `loc` from `model` (for unknown keys); in
+    a tagged union (a list of parts told apart by `type`) the tag in `loc` picks the member."""
+    models = [model]
     for part in loc:
         if isinstance(part, int):
             continue
-        info = model.model_fields.get(str(part))
-        nested = _model_in(info.annotation) if info is not None else None
-        if nested is None:
+        tagged = [m for m in models if part in _tags(m)]
+        if tagged:
+            models = tagged
+            continue
+        info = next((m.model_fields[str(part)] for m in models if part in m.model_fields), None)
+        nested = _models_in(info.annotation) if info is not None else []
+        if not nested:
             break
-        model = nested
-    return list(model.model_fields)
+        models = nested
+    return list(models[0].model_fields)
 
 
-def _model_in(annotation: Any) -> type[BaseModel] | None:
-    """The BaseModel class inside an annotation such as `list[Hull]`, if any."""
+def _models_in(annotation: Any) -> list[type[BaseModel]]:
+    """The BaseModel classes inside an annotation such as `list[Hull]` or `A | B`."""
     if isinstance(annotation, type) and issubclass(annotation, BaseModel):
-        return annotation
-    for arg in getattr(annotation, "__args__", ()) or ():
-        found = _model_in(arg)
-        if found is not None:
-            return found
-    return None
+        return [annotation]
+    args = getattr(annotation, "__args__", ()) or ()
+    return [m for arg in args for m in _models_in(arg)]
+
+
+def _tags(model: type[BaseModel]) -> tuple[Any, ...]:
+    """The values of a model's `type: Literal[...]` field (its tag in a tagged union)."""
+    info = model.model_fields.get("type")
+    return get_args(info.annotation) if info is not None else ()
 
 
 MAX_FILE_BYTES = 64 * 2**20  # a scenario is a page of JSON; a bigger file is a mistake

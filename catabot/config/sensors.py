@@ -107,13 +107,13 @@ class CameraParams(SensorParams):
     hfov_deg: float = Field(80.0, gt=1, lt=170)
     mount_xyz: Vec3 = Field(
         (0.5, 0.0, 1.5),
-        description="m, body FLU; above the hull: rays from inside its box stop at 0",
+        description="m, body FLU; above the vessel's shape (which is in the scene)",
     )
     mount_rpy_deg: Vec3 = (0.0, 0.0, 0.0)
     outputs: CameraOutputs = CameraOutputs()
     max_range_m: float = Field(1000.0, gt=0)
     occluded_fraction: float = Field(
-        0.3, ge=0, le=1, description="occluded when visible px < fraction x projected box"
+        0.5, ge=0, le=1, description="occluded when visible px < fraction x its silhouette"
     )
 
     def rays_per_s(self, rate_hz: float) -> float:
@@ -135,7 +135,7 @@ class LidarParams(SensorParams):
     """A spinning LiDAR (paper III-B.2.a: OS1-like, 32 x 512, 45 deg vertical, 360 deg, 100 m)
     and the constants of its rain model (services/sensors/rain.py; paper defaults, Q at 905 nm).
     The rain rate itself is the scenario's `rain.rate_mm_h`. `preset: "os1"` is those figures.
-    The carrier's own hull box is in the scene: mount the sensor where it sees over it."""
+    The carrier's own shape is in the scene: mount the sensor where it sees over it."""
 
     preset: Literal["os1"] | None = "os1"
     channels: int = Field(32, ge=1, le=256)

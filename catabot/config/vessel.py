@@ -1,9 +1,10 @@
-"""Vessel model files: hull geometry, mass properties, damping and thruster layout.
+"""Vessel model files: hull geometry, mass properties, damping, thruster layout and shape.
 
 A vessel model is its own JSON file (DESIGN.md §6), referenced from a scenario by a bundled
 name (`"catabot"`, `"wamv"`) or by a path. The schema is strict (`extra="forbid"`) so that a
 misspelt key is an error, not a silently ignored setting; new optional fields (added mass,
-wind area, ...) extend it without breaking existing files.
+wind area, the shape sensors see: catabot/config/vessel_shape.py) extend it without
+breaking existing files.
 
 Frames and units (DESIGN.md §2): body frame FLU (x forward, y left, z up) with its origin at
 the waterline-level reference point on the centreline; SI units, named in the field names.
@@ -25,6 +26,7 @@ from pydantic import (
 from pydantic.types import FiniteFloat
 
 from catabot.config.base import ConfigError, FieldProblem, Strict, explain, read_json
+from catabot.config.vessel_shape import HullPart, Shape
 
 BUNDLED_DIR = Path(__file__).parents[1] / "data" / "vessels"
 
@@ -161,6 +163,7 @@ class VesselModel(Strict):
     # Added mass magnitudes (>= 0, i.e. -X_udot ...), diagonal, about the body origin (kg, kg m^2).
     added_mass: AddedMass6 = (0.0, 0.0, 0.0, 0.0, 0.0, 0.0)
     wind: WindArea | None = None  # None: the wind exerts no force on this vessel
+    shape: Shape | None = None  # what sensors see (catabot/config/vessel_shape.py); None: hull box
 
     @model_validator(mode="after")
     def _physical_inertia(self) -> VesselModel:
@@ -173,9 +176,30 @@ class VesselModel(Strict):
             )
         return self
 
+    @model_validator(mode="after")
+    def _shape_hulls(self) -> VesselModel:
+        """A `hull` part names one of this model's hulls, and its bow fits on it."""
+        parts = self.shape.parts if self.shape is not None and self.shape.parts else []
+        for i, part in enumerate(parts):
+            if not isinstance(part, HullPart):
+                continue
+            where = f"shape.parts.{i}"
+            if part.hull >= len(self.hulls):
+                raise FieldProblem(
+                    f"{where}.hull",
+                    f"must name one of the {len(self.hulls)} hulls (0 to {len(self.hulls) - 1}), "
+                    f"got {part.hull}",
+                )
+            if part.bow_m > self.hulls[part.hull].length_m:
+                length = self.hulls[part.hull].length_m
+                raise FieldProblem(
+                    f"{where}.bow_m", f"must be at most the hull's length ({length:g})"
+                )
+        return self
+
     def hull_box(self) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
         """The axis-aligned body-frame box (lo, hi corners, m) around every hull: the body's
-        collision shape in physics and its shape in the sensors' ray casts."""
+        collision shape in physics, and what sensors see of a model without a `shape`."""
         centre = np.array([h.center_m for h in self.hulls], dtype=np.float64)
         half = np.array([(h.length_m, h.beam_m, h.vertical_extent_m) for h in self.hulls]) / 2
         return (centre - half).min(axis=0), (centre + half).max(axis=0)
@@ -190,20 +214,41 @@ def load_vessel_model(ref: str, *, base_dir: Path | None = None) -> VesselModel:
     """Load a vessel model by bundled name or JSON path (relative to `base_dir` if given)."""
     path = _resolve(ref, base_dir)
     data = read_json(path, what=f"vessel model '{ref}':", error=VesselModelError)
-    return parse_vessel_model(data, source=ref)
+    return parse_vessel_model(data, source=ref, base_dir=path.parent)
 
 
-def parse_vessel_model(data: Any, *, source: str = "<data>") -> VesselModel:
-    """Validate already-decoded JSON data; errors name `source`, the field path and the rule."""
+def parse_vessel_model(
+    data: Any, *, source: str = "<data>", base_dir: Path | None = None
+) -> VesselModel:
+    """Validate already-decoded JSON data; errors name `source`, the field path and the rule.
+    A shape's mesh file is made absolute against `base_dir` (the model file's folder; the
+    current directory if None) and must exist: every process then finds the same file."""
     if not isinstance(data, dict):
         raise VesselModelError(
             f"vessel model '{source}': must be a JSON object (got {type(data).__name__})"
         )
     try:
-        return VesselModel.model_validate(data)
+        model = VesselModel.model_validate(data)
     except ValidationError as exc:
         message = explain(exc, model=VesselModel)
         raise VesselModelError(f"vessel model '{source}': {message}") from None
+    return _absolute_mesh(model, source, base_dir)
+
+
+def _absolute_mesh(model: VesselModel, source: str, base_dir: Path | None) -> VesselModel:
+    shape = model.shape
+    if shape is None or shape.mesh is None:
+        return model
+    mesh = shape.mesh
+    path = Path(mesh.file)
+    if not path.is_absolute():
+        path = (base_dir or Path.cwd()) / path
+    if not path.is_file():
+        raise VesselModelError(
+            f"vessel model '{source}': shape.mesh.file: no such file {str(path)!r}"
+        )
+    placed = mesh.model_copy(update={"file": str(path)})
+    return model.model_copy(update={"shape": shape.model_copy(update={"mesh": placed})})
 
 
 def _resolve(ref: str, base_dir: Path | None) -> Path:

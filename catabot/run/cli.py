@@ -127,6 +127,7 @@ def _scenario(args: argparse.Namespace) -> int:
         return generate(args)
     try:  # what `catabot run` checks before it starts anything, no less
         world = World.resolve(load_scenario(args.file), progress=PlanningProgress())
+        _ = world.shapes  # every mesh file read, as `catabot run` does
     except CataBotError as exc:
         print(f"catabot scenario validate: {exc}", file=sys.stderr)
         return 2

@@ -66,6 +66,7 @@ def prepare(opts: RunOptions) -> World:
     if opts.realtime is not None:
         data["clock"]["realtime_factor"] = opts.realtime
     world = World.resolve(parse_scenario(data, source="command line"), progress=PlanningProgress())
+    _ = world.shapes  # every mesh file read now: a broken one is refused before any start
     for name in world.services:
         if service_of(name, world.services)[0] not in SERVICE_MODULES:
             raise LaunchError(f"scenario needs service {name!r}, which this version does not have")

@@ -39,6 +39,7 @@ from catabot.config.vessel import VesselModel, load_vessel_model
 from catabot.world import rotations
 from catabot.world.environment.current import CurrentField
 from catabot.world.placement import resolve_poses
+from catabot.world.shapes import ShapeMesh, vessel_mesh
 from catabot.world.shards import blocks, sensor_owners
 from catabot.world.streams import Streams
 from catabot.world.terrain import Terrain, load_terrain
@@ -152,6 +153,15 @@ class World:
         """Sensor stream key -> the sensors process (shard) that produces it."""
         s = self.scenario
         return sensor_owners(self.sensors, s.sensors.shards, s.dt_ns)
+
+    @cached_property
+    def shapes(self) -> dict[str, ShapeMesh | None]:
+        """Each model's shape as a mesh, by model reference (None: seen as its hull box).
+        Read when first asked (mesh files: catabot/world/shapes.py), by the processes that
+        cast rays or draw, and by the launcher, which refuses an unreadable mesh file."""
+        refs = dict.fromkeys(b.model_ref for b in self.bodies)
+        models = {b.model_ref: b.model for b in self.bodies}
+        return {ref: vessel_mesh(models[ref], source=ref) for ref in refs}
 
     @cached_property
     def traffic_blocks(self) -> dict[str, tuple[str, ...]]:

@@ -50,9 +50,13 @@ class CastScene(Protocol):
         directions: np.ndarray,
         max_range: float,
         pairs: tuple[NDArray[np.intp], NDArray[np.intp]] | None = None,
+        *,
+        silhouettes: bool = False,
     ) -> Hits: ...
 
     def corners(self) -> F64: ...
+
+    def outlines(self, rows: NDArray[np.intp]) -> list[tuple[NDArray[np.intp], F64]]: ...
 
 
 def rpy_matrix(rpy_deg: Sequence[float]) -> F64:
@@ -91,6 +95,7 @@ class CameraModel:
         self.mount_rot = rpy_matrix(params.mount_rpy_deg) @ OPTICAL_TO_BODY
         self.mount_pos = np.asarray(params.mount_xyz, dtype=np.float64)
         self._rng = seeding.rng(seed, name)
+        self._row_of: NDArray[np.intp] | None = None  # scene row by instance, on first use
 
     def pose(self, state: VesselState) -> tuple[F64, F64]:
         """Optical frame in `map`: origin (3,) and rotation (v_map = R @ v_optical)."""
@@ -103,7 +108,7 @@ class CameraModel:
         dirs = np.dot(self.rays, rot.T.astype(np.float32))
         corners_cam = (self.scene.corners() - origin) @ rot
         pairs = cb.candidate_rays(corners_cam, self.cam)  # each box against its own pixels
-        hits = self.scene.cast(origin, dirs, self.params.max_range_m, pairs)
+        hits = self.scene.cast(origin, dirs, self.params.max_range_m, pairs, silhouettes=True)
         return self.frame(hits, dirs, origin, rot, tick=tick, stamp_ns=stamp_ns)
 
     def frame(
@@ -121,7 +126,7 @@ class CameraModel:
         seg = hits.cls.reshape(h, w)
         inst = hits.instance.reshape(h, w)
         color = self._color(hits, dirs, float(origin[2])) if out.color else EMPTY
-        boxes, box_flags = self._boxes(seg, inst, origin, rot)
+        boxes, box_flags = self._boxes(seg, inst, origin, rot, hits)
         return CameraFrame(
             tick=tick,
             stamp_ns=stamp_ns,
@@ -150,18 +155,33 @@ class CameraModel:
         return rgb
 
     def _boxes(
-        self, seg: NDArray[np.uint8], inst: NDArray[np.int32], origin: F64, rot: F64
+        self, seg: NDArray[np.uint8], inst: NDArray[np.int32], origin: F64, rot: F64, hits: Hits
     ) -> tuple[F32, NDArray[np.uint8]]:
-        """(K, 6) [instance, class, x0, y0, x1, y1] and (K, 2) [truncated, occluded]."""
+        """(K, 6) [instance, class, x0, y0, x1, y1] and (K, 2) [truncated, occluded]. An
+        instance that is no body of the scene keeps its mask's box and is never occluded."""
         vis = cb.visible_boxes(inst, seg)
         if vis.ids.size == 0:
             return np.empty((0, 6), np.float32), np.empty((0, 2), np.uint8)
-        row_of = {b.instance: i for i, b in enumerate(self.scene.bodies)}
-        known = np.array([i in row_of for i in vis.ids.tolist()])
-        all_corners = np.concatenate([self.scene.corners(), np.zeros((1, 8, 3))])
-        corners = all_corners[[row_of.get(i, -1) for i in vis.ids.tolist()]]
-        full, behind = cb.projected_boxes((corners - origin) @ rot, self.cam)
-        full = np.where(known[:, None], full, vis.box)  # unknown body: trust the mask
-        flags = cb.flags(vis, full, behind & known, self.cam, self.params.occluded_fraction)
+        if self._row_of is None:
+            self._row_of = _rows_by_instance(self.scene.bodies)
+        rows = self._row_of[np.minimum(vis.ids, self._row_of.size - 1)]
+        known = np.flatnonzero(rows >= 0)
+        full, behind = vis.box.copy(), np.zeros(vis.ids.size, dtype=bool)
+        for sel, points in self.scene.outlines(rows[known]):  # one group per kind of shape
+            box, back = cb.projected_boxes((points - origin) @ rot, self.cam)
+            full[known[sel]], behind[known[sel]] = box, back
+        silhouette = vis.count.copy()
+        if hits.silhouette is not None:
+            silhouette[known] = hits.silhouette[rows[known]]
+        p = self.params
+        flags = cb.flags(vis, full, behind, silhouette, cam=self.cam, fraction=p.occluded_fraction)
         table = np.column_stack([vis.ids, vis.cls, vis.box]).astype(np.float32)
         return table, flags
+
+
+def _rows_by_instance(bodies: Sequence[Body]) -> NDArray[np.intp]:
+    """Scene row of each instance id (-1: none; the last entry stands for every larger id)."""
+    ids = np.array([b.instance for b in bodies], dtype=np.intp)
+    table = np.full(int(ids.max(initial=0)) + 2, -1, dtype=np.intp)
+    table[ids] = np.arange(ids.size)
+    return table

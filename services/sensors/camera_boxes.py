@@ -1,13 +1,15 @@
 """2D bounding boxes of every visible instance, with KITTI-style truncated/occluded flags.
 
-The visible box comes from the instance mask itself (what a labeller would draw), computed
-for all instances at once with bincount histograms of occupied columns and rows, so a frame
-with many boats costs one pass over its labelled pixels and no Python loop per pixel.
-The flags compare it with the body's FULL box: its 8 corners projected by the pinhole.
-- truncated: the projected box leaves the image (or a corner is behind the camera);
-- occluded: fewer visible pixels than `fraction` x the projected box's area inside the image.
-The projected box of a 3D box is larger than the hull's silhouette, so `fraction` is well
-below 1 (0.3 by default: a boat seen whole fills more than that of its box).
+The visible box comes from the instance mask itself (what a labeller would draw, and the
+mask follows the body's shape), computed for all instances at once with bincount histograms
+of occupied columns and rows, so a frame with many boats costs one pass over its labelled
+pixels and no Python loop per pixel. The flags compare it with the WHOLE body:
+- truncated: the projected body leaves the image (or part of it is behind the camera): its
+  box is the box of its shape's outline points (Scene.outlines) projected by the pinhole;
+- occluded: fewer visible pixels than `fraction` x its silhouette, the pixels whose rays
+  meet its shape above the waterline whatever is in front (Scene.cast(silhouettes=True)),
+  counted within the image like the visible ones. A box's area would not do: a catamaran
+  seen bow-on fills a third of its box, the gap between its hulls being water.
 """
 
 from __future__ import annotations
@@ -82,18 +84,21 @@ def projected_boxes(corners_cam: F64, cam: Pinhole) -> tuple[F64, NDArray[np.boo
 
 
 def flags(
-    vis: Visible, full: F64, behind: NDArray[np.bool_], cam: Pinhole, fraction: float
+    vis: Visible,
+    full: F64,
+    behind: NDArray[np.bool_],
+    silhouette: NDArray[np.integer],
+    *,
+    cam: Pinhole,
+    fraction: float,
 ) -> NDArray[np.uint8]:
-    """(K, 2) uint8 [truncated, occluded] of the visible instances, given their full boxes."""
+    """(K, 2) uint8 [truncated, occluded] of the visible instances, given their full boxes
+    and silhouettes (pixels)."""
     out_of_image = (
         (full[:, 0] < 0) | (full[:, 1] < 0) | (full[:, 2] > cam.width) | (full[:, 3] > cam.height)
     )
     truncated = behind | out_of_image
-    clipped = np.clip(full, 0, [cam.width, cam.height, cam.width, cam.height])
-    area = (clipped[:, 2] - clipped[:, 0]) * (clipped[:, 3] - clipped[:, 1])
-    seen = (vis.box[:, 2] - vis.box[:, 0]) * (vis.box[:, 3] - vis.box[:, 1])
-    area = np.where(behind, seen, area)  # no full box: judge by the visible one
-    occluded = vis.count < fraction * area
+    occluded = vis.count < fraction * silhouette
     return np.stack([truncated, occluded], axis=1).astype(np.uint8)
 
 
@@ -143,14 +148,11 @@ def candidate_rays(corners_cam: F64, cam: Pinhole) -> tuple[NDArray[np.intp], ND
     size = np.array([cam.width, cam.height])
     lo = np.clip(np.floor(rect[:, :2]) - 1, 0, size)
     hi = np.clip(np.ceil(rect[:, 2:]) + 2, 0, size)
-    keep = np.isfinite(rect).all(axis=1) & (hi > lo).all(axis=1)
-    lo, hi = np.nan_to_num(lo).astype(np.intp), np.nan_to_num(hi).astype(np.intp)  # NaN: dropped
-    rays, bodies = [], []
-    for k in np.flatnonzero(keep).tolist():
-        (x0, y0), (x1, y1) = lo[k], hi[k]
-        pixels = (np.arange(y0, y1)[:, None] * cam.width + np.arange(x0, x1)).ravel()
-        rays.append(pixels)
-        bodies.append(np.full(pixels.size, k, dtype=np.intp))
-    if not rays:
-        return np.empty(0, np.intp), np.empty(0, np.intp)
-    return np.concatenate(rays), np.concatenate(bodies)
+    keep = np.flatnonzero(np.isfinite(rect).all(axis=1) & (hi > lo).all(axis=1))
+    lo, hi = lo[keep].astype(np.intp), hi[keep].astype(np.intp)  # NaN rows are dropped
+    width = hi[:, 0] - lo[:, 0]
+    count = width * (hi[:, 1] - lo[:, 1])  # each body's rectangle, row-major, one after another
+    j = np.arange(count.sum()) - np.repeat(np.cumsum(count) - count, count)
+    row, col = np.divmod(j, np.repeat(width, count))
+    pixels = (np.repeat(lo[:, 1], count) + row) * cam.width + np.repeat(lo[:, 0], count) + col
+    return pixels, np.repeat(keep, count)

@@ -1,4 +1,4 @@
-"""Which (ray, body) pairs can meet: the cheap pre-test before the exact slab test.
+"""Which (ray, body) pairs can meet: the cheap pre-test before the slab test of each box.
 
 A pair left out here is a hit lost, so every test is conservative; a pair let through only
 costs a slab test. Rays from ONE origin (a radar, any caller) are tested against each body's
@@ -14,6 +14,8 @@ their half-angles, and only the rays of bundles that pass are tested one by one.
 
 from __future__ import annotations
 
+from dataclasses import dataclass
+
 import numpy as np
 from numpy.typing import NDArray
 
@@ -22,6 +24,29 @@ Pairs = tuple[NDArray[np.intp], NDArray[np.intp]]
 CHUNK = 16  # rays per bundle: a LiDAR bundle spans ~11 deg of azimuth at 512 columns
 MIN_RAYS = 1024  # fewer rays (a radar's few beams): the full product is cheaper
 SLACK_RAD = 1e-6  # angles are compared with this margin for rounding
+
+
+@dataclass
+class Cones:
+    """Per body in range (`body`: index in Scene.bodies): the vector from the origin to its
+    box centre (`axis`, of length `dist`) and the cos of the half-angle of the cone about it
+    that holds the box (-1: every direction)."""
+
+    body: NDArray[np.intp]
+    axis: F64
+    dist: F64
+    cos_half: F64
+
+
+def corner_cone(rel: F64, oc: F64, dist: F64) -> F64:
+    """cos of the half-angle of the cone from the origin about each body's centre (`oc`, of
+    length `dist`) that holds its 8 corners (`rel` (K, 8, 3), from the origin), so holds the
+    box (-1: every direction, when that cone is not convex). Tighter than the bounding
+    sphere, and still a cull when the origin is inside the sphere (a LiDAR above its own
+    hull), where the sphere test passes every ray."""
+    cos = np.einsum("kcj,kj->kc", rel, oc) / (np.linalg.norm(rel, axis=2) * dist[:, None] + 1e-300)
+    cos_half = cos.min(axis=1) - 1e-9
+    return np.where(cos_half > 0.0, cos_half, -1.0)
 
 
 def cone_pairs(d: F64, axis: F64, dist: F64, cos_half: F64) -> Pairs:

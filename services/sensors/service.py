@@ -91,7 +91,7 @@ class SensorsService:
 
 
 def build_scene(world: World) -> Scene:
-    """The ray-casting world, built once: terrain, the physics' waves, every body as its box."""
+    """The ray-casting world, built once: terrain, the physics' waves, every body's shape."""
     scenario = world.scenario
     return Scene(
         terrain=world.terrain,
@@ -102,12 +102,15 @@ def build_scene(world: World) -> Scene:
 
 
 def scene_bodies(world: World) -> list[Body]:
-    """Every body of the world, in row order, as the box around its model's hulls."""
+    """Every body of the world, in row order, as its model's shape (catabot/world/shapes.py)
+    inside that shape's box, or as the box around its model's hulls for a model without
+    one. Bodies of one model share one mesh: the scene builds one Embree scene per model."""
     boxes = {}
     for b in world.bodies:
         if b.model_ref not in boxes:
-            lo, hi = b.model.hull_box()
-            boxes[b.model_ref] = (tuple(lo.tolist()), tuple(hi.tolist()))
+            mesh = world.shapes[b.model_ref]
+            lo, hi = (mesh.lo, mesh.hi) if mesh is not None else b.model.hull_box()
+            boxes[b.model_ref] = (tuple(lo.tolist()), tuple(hi.tolist()), mesh)
     return [Body(b.id, b.label_class, b.instance, *boxes[b.model_ref]) for b in world.bodies]
 
 

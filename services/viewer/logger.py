@@ -1,7 +1,8 @@
 """Bus messages into rerun, on the `sim_time` timeline: one logger for the live view and the
 replay (so `run.rrd`, `catabot view RUN` and `catabot run --view` show the same things).
 
-Per `BodyStates`: every body's box pose in one `Boxes3D` (one log call, not one per body),
+Per `BodyStates`: every body's pose as an instance of its model's mesh (one log call per
+model and colour, not one per body: `static.body_groups`),
 each scenario vessel's transform (its sensors hang below it, so a LiDAR scan is drawn from
 the pose it was taken at) and its speed and heading. At most every `TRAIL_S` of simulated
 time: the vessels' positions for the trails and the closest approach between two vessels;
@@ -26,7 +27,7 @@ from catabot.world.terrain_grid import grid_triangles
 from catabot.world.waves import WaveField
 from catabot.world.world import MountedSensor, World
 from services.viewer import palette, paths
-from services.viewer.static import hull_boxes, log_static
+from services.viewer.static import body_groups, log_static
 
 TRAIL_S = 0.2
 WATER_S = 0.25
@@ -36,7 +37,7 @@ WATER_HALF_M, WATER_CELLS = 80.0, 48
 class RunLogger:
     def __init__(self, rec: rr.RecordingStream, world: World) -> None:
         self.rec, self.world = rec, world
-        self.centre, _ = hull_boxes(world.bodies)
+        self.groups = body_groups(world)
         self.vessels = len(world.vessels)
         self.own = [world.body(v.id) for v in world.scenario.vessels]
         self.waves = WaveField(world.scenario.water.waves, world.scenario.seed)
@@ -75,12 +76,11 @@ class RunLogger:
     def states(self, batch: BodyStates) -> None:
         self.time(batch.stamp_ns)
         pos, quat = aligned(batch.position), aligned(batch.orientation)
-        rot = rotations.normalised_matrices(quat)
-        if rot is None:
+        if rotations.normalised_matrices(quat) is None:
             return  # a non-finite pose (a diverged body): nothing sensible to draw
-        centres = pos + np.einsum("nij,nj->ni", rot, self.centre)
-        boxes = rr.Boxes3D.from_fields(centers=centres, quaternions=quat)
-        self.rec.log(paths.BODIES, boxes)
+        for group in self.groups:
+            poses = rr.InstancePoses3D(translations=pos[group.rows], quaternions=quat[group.rows])
+            self.rec.log(group.path, poses)
         yaw = rotations.yaw_of_quaternions(quat[[b.row for b in self.own]])
         for body, heading in zip(self.own, yaw.tolist(), strict=True):
             r = body.row

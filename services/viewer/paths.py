@@ -3,7 +3,7 @@
 world                          annotation context (label classes), Z-up
 world/terrain                  the terrain mesh, coloured by height (static)
 world/water                    the wave surface near the first vessel (animated)
-world/bodies                   every vessel, boat and buoy as its hull box
+world/bodies/<role>-<model>    each model's shape (hull box without one), an instance a body
 world/trails                   vessel positions; the 3D view shows the last 30 s
 world/vessels/<id>             each scenario vessel's pose (its sensors hang below)
 world/vessels/<id>/<sensor>    LiDAR points, radar sector and echoes, camera + images
@@ -22,6 +22,11 @@ TRAILS = "world/trails"
 METRICS = "metrics"
 RTF = "series/rtf"
 CLOSEST = "series/closest_approach"
+
+
+def bodies(group: str) -> str:
+    """`world/bodies/<role>-<model>`: the bodies of one model drawn in one colour."""
+    return f"{BODIES}/{group}"
 
 
 def vessel(vid: str) -> str:

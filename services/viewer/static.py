@@ -1,7 +1,9 @@
 """What the viewer logs once, from the resolved World: terrain, body shapes, sensor mounts.
 
 Everything here is static (timeless) in rerun: the terrain mesh with its height colours,
-every body's hull box size and colour (their poses come per tick), each sensor's mount
+each model's shape as a mesh, once per colour it is drawn in (catabot/world/shapes.py; the
+hull box for a model without one), whose instances the logger poses per tick (rerun's
+InstancePoses3D: one log call per model and colour, not per body), each sensor's mount
 under its vessel (LiDAR and radar frames, each camera's pinhole in the ROS optical frame),
 the radar screens' range rings, the label classes' names and colours, and the scripted
 commands (known from the scenario before the run starts).
@@ -10,12 +12,18 @@ commands (known from the scenario before the run starts).
 from __future__ import annotations
 
 import math
+import re
+from dataclasses import dataclass
+from pathlib import Path
 
 import numpy as np
 import rerun as rr
+from numpy.typing import NDArray
 
 from catabot.config.sensors import CameraParams, LidarParams, RadarParams
 from catabot.world import rotations
+from catabot.world.shape_parts import box_mesh
+from catabot.world.shapes import ShapeMesh
 from catabot.world.terrain_grid import auto_resolution
 from catabot.world.world import Body, MountedSensor, World
 from services.viewer import palette, paths
@@ -49,32 +57,51 @@ def _terrain(rec: rr.RecordingStream, world: World) -> None:
     rec.log(paths.TERRAIN, mesh, static=True)
 
 
-def hull_boxes(bodies: tuple[Body, ...]) -> tuple[np.ndarray, np.ndarray]:
-    """(N, 3) box centres in each body's frame and (N, 3) half sizes."""
-    boxes = [b.model.hull_box() for b in bodies]
-    lo = np.array([b[0] for b in boxes]).reshape(-1, 3)
-    hi = np.array([b[1] for b in boxes]).reshape(-1, 3)
-    return (lo + hi) / 2, (hi - lo) / 2
+@dataclass(frozen=True)
+class BodyGroup:
+    """Bodies drawn alike (one model in one colour): their entity and their rows."""
+
+    path: str
+    rows: NDArray[np.intp]
+    mesh: ShapeMesh
+    color: tuple[int, int, int]
 
 
-def body_colors(world: World) -> np.ndarray:
+def body_groups(world: World) -> list[BodyGroup]:
+    """The bodies by model and role (scenario vessel, traffic boat, buoy: its colour), in
+    order of first row; each group's entity is `world/bodies/<role>-<model file name>`
+    (with its number where two model files share a name)."""
     scenario = {v.id for v in world.scenario.vessels}
-    table = {"vessel": palette.EGO, "boat": palette.BOAT, "buoy": palette.BUOY}
-    return np.array(
-        [palette.EGO if b.id in scenario else table[b.kind] for b in world.bodies], np.uint8
-    ).reshape(-1, 3)
+    roles = {"vessel": palette.EGO, "boat": palette.BOAT, "buoy": palette.BUOY}
+    rows: dict[tuple[str, str], list[int]] = {}
+    for b in world.bodies:  # once, at start
+        key = ("vessel" if b.id in scenario else b.kind, b.model_ref)
+        rows.setdefault(key, []).append(b.row)
+    groups: list[BodyGroup] = []
+    for (role, ref), members in rows.items():
+        body = world.bodies[members[0]]
+        mesh = world.shapes[ref] or ShapeMesh(*box_mesh(*body.model.hull_box()))
+        name = f"{role}-{re.sub(r'[^A-Za-z0-9_]+', '_', Path(ref).stem)}"
+        path = paths.bodies(name)
+        if any(g.path == path for g in groups):
+            path = paths.bodies(f"{name}-{len(groups)}")
+        groups.append(BodyGroup(path, np.array(members, np.intp), mesh, roles[role]))
+    return groups
 
 
 def _bodies(rec: rr.RecordingStream, world: World) -> None:
-    _, half = hull_boxes(world.bodies)
-    boxes = rr.Boxes3D(
-        half_sizes=half,
-        colors=body_colors(world),
-        labels=list(world.body_ids),
-        show_labels=False,
-        fill_mode=rr.components.FillMode.Solid,
-    )
-    rec.log(paths.BODIES, boxes, static=True)
+    """Each group's mesh, flat shaded: every triangle its own vertices and face normal."""
+    for group in body_groups(world):
+        corners = group.mesh.vertices[group.mesh.triangles]  # (T, 3, 3)
+        normal = np.cross(corners[:, 1] - corners[:, 0], corners[:, 2] - corners[:, 0])
+        normal /= np.linalg.norm(normal, axis=1, keepdims=True)
+        mesh = rr.Mesh3D(
+            vertex_positions=corners.reshape(-1, 3),
+            vertex_normals=np.repeat(normal, 3, axis=0),
+            triangle_indices=np.arange(corners.shape[0] * 3).reshape(-1, 3),
+            albedo_factor=(*group.color, 255),
+        )
+        rec.log(group.path, mesh, static=True)
 
 
 def _mount(rec: rr.RecordingStream, sensor: MountedSensor) -> None:

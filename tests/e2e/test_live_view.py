@@ -51,7 +51,7 @@ def test_view_attaches_to_a_running_simulation(tmp_path: Path) -> None:
             rows[chunk.entity_path] = rows.get(chunk.entity_path, 0) + chunk.num_rows
     # Paced at the wall clock for 5 s: the newest state 20 times a second (FPS), the newest
     # scan of the 10 a second, every IMU sample (small ones are all shown); it attached late.
-    assert 40 < rows["/world/bodies"] <= 5 * 20 + 1
+    assert 40 < rows["/world/bodies/boat-monohull"] <= 5 * 20 + 1
     assert 20 < rows["/world/vessels/ego/lidar"] <= 50
     assert 100 < rows["/series/imu_accel/ego.imu"] <= 250
     assert rows["/metrics"] == 1  # read from the run folder once the recorder wrote it

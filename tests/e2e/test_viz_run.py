@@ -76,7 +76,12 @@ def test_run_rrd_holds_every_stream_on_sim_time(run: Path) -> None:
     topics = _topic_counts(run)
     ticks = topics["/tf"]
     assert ticks == round(SECONDS * 100) and timelines == {"sim_time"}
-    assert rows["/world/bodies"] == ticks and rows["/world/vessels/ego"] == ticks
+    bodies = [
+        "/world/bodies/vessel-catabot",
+        "/world/bodies/boat-monohull",
+        "/world/bodies/buoy-buoy",
+    ]
+    assert all(rows[b] == ticks for b in bodies) and rows["/world/vessels/ego"] == ticks
     assert rows["/series/speed/ego"] == ticks and rows["/series/speed/other"] == ticks
     assert rows["/world/vessels/ego/lidar"] == topics["/ego/lidar/points"] == 20
     assert rows["/world/vessels/ego/cam/color"] == topics["/ego/cam/image_raw"] == 10
@@ -85,7 +90,7 @@ def test_run_rrd_holds_every_stream_on_sim_time(run: Path) -> None:
     assert rows["/minimap/ego.radar/echoes"] == sweeps == topics["/ego/radar/points"] == 40
     assert rows["/series/imu_accel/ego.imu"] == topics["/ego/imu/imu"] == 100
     assert rows["/world/trails"] == round(SECONDS / 0.2) and rows["/metrics"] == 1
-    assert {"/world/bodies", "/world/water", "/world/vessels/ego/cam"} <= static
+    assert {*bodies, "/world/water", "/world/vessels/ego/cam"} <= static  # the shapes, once
 
 
 def test_view_replays_the_run_into_the_same_rows(run: Path, tmp_path: Path) -> None:

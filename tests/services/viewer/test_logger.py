@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import json
 import math
 from pathlib import Path
 from typing import Any
@@ -13,9 +14,11 @@ import rerun as rr
 from catabot.bus import codec
 from catabot.bus.messages import BodyStates, LidarScan, RadarSweep
 from catabot.config.load import parse_scenario
+from catabot.config.vessel import load_vessel_model
 from catabot.world.world import World
 from services.viewer import palette
 from services.viewer.logger import RunLogger
+from services.viewer.static import body_groups
 
 
 def _world() -> World:
@@ -61,14 +64,26 @@ def _decoded_states(world: World, tick: int) -> BodyStates:
     return codec.decode(codec.encode(msg), BodyStates)
 
 
-def test_states_become_boxes_poses_and_series(tmp_path: Path) -> None:
+def test_states_become_shape_instances_poses_and_series(tmp_path: Path) -> None:
+    """Each model's shape once (static) per colour, its bodies as instances posed a tick."""
+
     def log(logger: RunLogger, world: World) -> None:
         for tick in range(30):
             logger.states(_decoded_states(world, tick))
 
     got = _record(tmp_path / "s.rrd", log)
-    centers = _column(got["/world/bodies"], ":centers")
-    assert len([c for c in centers if c]) == 30 and len(centers[-1]) == 3  # ego, boat, buoy
+    world = _world()
+    for entity, row in (("vessel-catabot", 0), ("boat-monohull", 1), ("buoy-buoy", 2)):
+        batches = got[f"/world/bodies/{entity}"]
+        poses = _column(batches, "InstancePoses3D:translations")
+        assert len(poses) == 30 and poses[-1] == [[3.0 * row, 3.0 * row + 1, 3.0 * row + 2]]
+        quat = _column(batches, "InstancePoses3D:quaternions")[-1][0]
+        assert np.allclose(quat, [0.0, 0.0, math.sin(0.25), math.cos(0.25)])
+        vertices = np.array(_column(batches, "Mesh3D:vertex_positions")[0])
+        mesh = world.shapes[world.bodies[row].model_ref]
+        assert mesh is not None and len(vertices) == 3 * len(mesh.triangles)  # flat shaded
+        assert np.allclose(vertices.min(axis=0), mesh.lo, atol=1e-6)  # the shape, not a box
+        assert np.allclose(vertices.max(axis=0), mesh.hi, atol=1e-6)
     assert len(_column(got["/world/vessels/ego"], ":translation")) == 30
     assert _column(got["/series/speed/ego"], ":scalars")[0] == [5.0]  # |(3, 4)| m/s
     heading = _column(got["/series/heading/ego"], ":scalars")[0][0]
@@ -107,3 +122,20 @@ def test_terrain_colours_tell_sea_from_land() -> None:
     colors = palette.terrain_colors(np.array([-10.0, -0.1, 0.1, 20.0]), -10.0, 20.0)
     sea, land = colors[:2].astype(int), colors[2:].astype(int)
     assert (sea[:, 2] > sea[:, 1]).all() and (land[:, 1] >= land[:, 2]).all()
+
+
+def test_a_model_without_a_shape_is_drawn_as_its_hull_box(tmp_path: Path) -> None:
+    model = load_vessel_model("catabot").model_dump(mode="json") | {"shape": None}
+    (tmp_path / "plain.json").write_text(json.dumps(model))
+    world = World.resolve(parse_scenario({
+        "seed": 2, "vessels": [{"id": "ego", "model": str(tmp_path / "plain.json")},
+                               {"id": "cat", "pose": {"x_m": 30.0, "y_m": 0.0}}],
+    }))  # fmt: skip
+    groups = {g.path: g for g in body_groups(world)}
+    assert set(groups) == {"world/bodies/vessel-plain", "world/bodies/vessel-catabot"}
+    box, shape = groups["world/bodies/vessel-plain"], groups["world/bodies/vessel-catabot"]
+    lo, hi = load_vessel_model("catabot").hull_box()
+    assert box.rows.tolist() == [0] and shape.rows.tolist() == [1]
+    assert len(box.mesh.triangles) == 12 and len(np.unique(box.mesh.vertices, axis=0)) == 8
+    assert np.allclose(box.mesh.lo, lo) and np.allclose(box.mesh.hi, hi)
+    assert len(shape.mesh.triangles) > 12
