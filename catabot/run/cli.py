@@ -9,7 +9,7 @@ import json
 import os
 import signal
 import sys
-import time
+import threading
 from pathlib import Path
 
 from catabot.bus.session import Connection, SessionError, add_connection_args, open_session
@@ -104,14 +104,14 @@ def _router(args: argparse.Namespace) -> int:
     except SessionError as exc:
         print(f"catabot router: {exc}", file=sys.stderr)
         return 2
-    where = ", ".join(listen) or f"the endpoints of {config}"
+    stop = threading.Event()  # SIGTERM (`docker stop`: PID 1 has no handler) or Ctrl-C
+    for sig in (signal.SIGTERM, signal.SIGINT):
+        signal.signal(sig, lambda *_: stop.set())
+    where = ", ".join(listen) or f"the endpoints of {config}"  # told only once it may stop
     print(f"zenoh router listening on {where} (Ctrl-C to stop)", flush=True)
-    signal.signal(signal.SIGTERM, signal.default_int_handler)  # `docker stop`: PID 1 has none
-    try:
-        while True:
-            time.sleep(3600)
-    except KeyboardInterrupt:
-        session.close()
+    while not stop.wait(0.2):  # a short wait: the handler runs between two
+        pass
+    session.close()
     return 0
 
 
