@@ -36,7 +36,8 @@ from catabot.world.waves import WaveField
 from services.sensors.bodies import Bodies, Body, Pairs, SceneError
 from services.sensors.cull import Cones
 from services.sensors.terrain_cast import TerrainCaster
-from services.sensors.water import calm_hits, wave_hits
+from services.sensors.water import calm_hits
+from services.sensors.wave_cast import WaveCaster
 
 F32 = NDArray[np.float32]
 F64 = NDArray[np.float64]
@@ -79,7 +80,7 @@ class Scene:
         self.rain_rate_mm_h = float(rain_rate_mm_h)  # the rain in force (LiDAR's rain model)
         self._terrain = TerrainCaster(terrain)
         self._waves = waves
-        self._amplitude = float(np.sum(waves.amplitudes_m))
+        self._water = WaveCaster(waves)
         self._bodies = Bodies(bodies)  # boxes, shapes, poses (bodies.py)
         self.bodies = self._bodies.bodies
         self.time_s = 0.0
@@ -87,7 +88,7 @@ class Scene:
     def set_waves(self, waves: WaveField) -> None:
         """A run-time change of the sea (`catabot set waves`): the surface rays hit."""
         self._waves = waves
-        self._amplitude = float(np.sum(waves.amplitudes_m))
+        self._water = WaveCaster(waves)
 
     def update(
         self, poses: Mapping[str, tuple[Sequence[float], Sequence[float]]], time_s: float
@@ -150,7 +151,7 @@ class Scene:
     def _cast_water(self, o: F64, d: F64, max_range: float, near: _Nearest) -> None:
         """Rays that meet the water before anything else get the water's hit."""
         rng, normal, cls, inst = near.rng, near.normal, near.cls, near.inst
-        if self._waves.is_calm or self._amplitude <= 0.0:
+        if self._waves.is_calm or self._water.amplitude <= 0.0:
             t = calm_hits(o, d, max_range)
             closer = t < rng
             np.copyto(rng, t, where=closer)
@@ -159,11 +160,7 @@ class Scene:
             np.copyto(cls, np.uint8(CLASS_WATER), where=closer)
             np.copyto(inst, 0, where=closer)
             return
-        limit = np.minimum(rng, max_range)
-        rows, t, nw = wave_hits(self._waves, self._amplitude, o, d, limit, self.time_s)
-        closer = t < rng[rows]
-        rows = rows[closer]
-        rng[rows], normal[rows], cls[rows], inst[rows] = t[closer], nw[closer], CLASS_WATER, 0
+        self._water.cast(o, d, max_range, near, self.time_s)
 
     def _cast_bodies(
         self,

@@ -64,19 +64,40 @@ def wave_hits(
     t_bottom = np.where(limited, limit, t_under)
     band = np.flatnonzero(t_top < t_bottom)
     rows, t_top, t_bottom, limited = rows[band], t_top[band], t_bottom[band], limited[band]
-    if rows.size == 0:
-        return rows, np.empty(0), np.empty((0, 3))
-    found, tr = np.zeros(rows.size, dtype=bool), np.empty(rows.size)
-    normal = np.zeros((rows.size, 3))
-    for s in range(0, rows.size, BLOCK):  # a block's phase tables stay in cache
-        blk = rows[s : s + BLOCK]
-        along = RaySurface(waves, rows_of(o, blk), np.take(d, blk, axis=0), time_s)
-        part = slice(s, s + BLOCK)
-        hit, t = _first_crossing(along, t_top[part], t_bottom[part], limited[part])
+    found, t, normal = march_hits(
+        waves, rows_of(o, rows), np.take(d, rows, axis=0), (t_top, t_bottom), limited, time_s
+    )
+    return rows[found], t, normal
+
+
+def march_hits(
+    waves: WaveField,
+    o: F64,
+    d: F64,
+    bracket: tuple[F64, F64],
+    limited: NDArray[np.bool_],
+    time_s: float,
+    over: NDArray[np.bool_] | None = None,
+) -> tuple[NDArray[np.intp], F64, F64]:
+    """The rays (of o, d) whose first crossing lies in [t0, t1] = `bracket`: their index,
+    distance and normal. f(t1) <= 0 is taken as known where t1 is not `limited` (the ray is
+    under every trough there) and f(t0) >= 0 where `over` (default: t0 > 0, the ray entering
+    the band +-A from above); elsewhere f(t0) is evaluated."""
+    t0, t1 = bracket
+    n = t0.size
+    if n == 0:
+        return np.empty(0, np.intp), np.empty(0), np.empty((0, 3))
+    over = t0 > 0.0 if over is None else over
+    found, tr = np.zeros(n, dtype=bool), np.empty(n)
+    normal = np.zeros((n, 3))
+    for s in range(0, n, BLOCK):  # a block's phase tables stay in cache
+        blk = slice(s, s + BLOCK)
+        along = RaySurface(waves, o[blk], d[blk], time_s)
+        hit, t = _first_crossing(along, t0[blk], t1[blk], limited[blk], over[blk])
         at = np.flatnonzero(hit)
-        found[s : s + BLOCK], tr[s : s + BLOCK] = hit, t
+        found[blk], tr[blk] = hit, t
         normal[s + at] = along.normal(at, t[at])
-    return rows[found], tr[found], normal[found]
+    return np.flatnonzero(found), tr[found], normal[found]
 
 
 class RaySurface:
@@ -131,7 +152,11 @@ class RaySurface:
 
 
 def _first_crossing(
-    surface: RaySurface, t0: F64, t1: F64, limited: NDArray[np.bool_]
+    surface: RaySurface,
+    t0: F64,
+    t1: F64,
+    limited: NDArray[np.bool_],
+    over: NDArray[np.bool_],
 ) -> tuple[NDArray[np.bool_], F64]:
     """(found, t): the first root of f in [t0, t1] per ray, marched then refined.
 
@@ -145,7 +170,7 @@ def _first_crossing(
     m = t0.size
     a, fa = t0.copy(), surface.oz + t0 * surface.dz
     b, fb = t1.copy(), surface.oz + t1 * surface.dz
-    inside = np.flatnonzero(t0 <= 0.0)  # starting within the wave band: f(t0) unknown
+    inside = np.flatnonzero(~over)  # starting within the wave band: f(t0) unknown
     fa[inside] = surface.gap(inside, t0[inside])
     found = fa <= 0.0  # already under water at the top of the bracket: t0
     b[found], fb[found] = a[found], fa[found]
