@@ -52,6 +52,11 @@ class GridSpec:
     grad_err: tuple[float, float]  # bounds on the error of the interpolated d eta/du, d eta/dv
 
     @property
+    def curvature_uv(self) -> F64:
+        """The curvature tensor in the grid frame (diagonal: its principal axes)."""
+        return self.rot @ self.curvature @ self.rot.T
+
+    @property
     def node_area(self) -> float:
         return self.hu * self.hv
 

@@ -99,7 +99,7 @@ class GridPass:
         # the planned band holds every covered ray's segment; the surface is within both
         self.top, self.bottom = min(grid.zmax + spec.eps, band), max(grid.zmin - spec.eps, -band)
         self.margin = TOLERANCE_M - spec.eps - wt.LAMBDA_M
-        self.curv = spec.rot @ spec.curvature @ spec.rot.T  # the grid frame's
+        self.curv = spec.curvature_uv
         self.to_cells = (spec.rot / [[grid.hu], [grid.hv]]).astype(np.float32)
         self.doubt: list[tuple[Idx, F32, F32, F32, F32, F32]] = []
         self.far: list[Idx] = []
@@ -253,7 +253,8 @@ class GridPass:
         root past them is the hit if they meet nothing); those with more than wt.CAP
         unclear intervals are marched exactly from where the search stopped."""
         rays = self._segments(idx)[0]
-        t, state, stop = wt.verify(self.grid, rays, start, end, known)
+        dip = TOLERANCE_M - 1e-4  # float32 rounding of the samples' f
+        t, state, stop = wt.verify(self.grid, rays, start, end, known, dip)
         found = np.flatnonzero(state == wt.HIT)
         tf = np.take(t, found)
         self._hits(np.take(idx, found), tf, wt.gradient(self.grid, rays.take(found), tf))

@@ -34,7 +34,7 @@ Idx = NDArray[np.intp]
 LAMBDA_M = 2e-4  # |f| at which a Newton step ends without the in-cell root
 NEWTON_STEPS = 5
 BRACKET_STEPS = 24  # a sign change is bracketed: bisection alone gets within 2^-24 of it
-FINE = 5  # samples of an unclear interval: about one a cell
+MAX_FINE = 17  # samples of an unclear interval at most (the medium sea needs 6, a chop 11)
 CAP = 16  # unclear intervals sampled per ray; a ray with more is marched exactly after
 HIT, MISS, FAIL = 1, 2, 0
 
@@ -234,12 +234,14 @@ def _intervals(
 
 
 def verify(
-    grid: WaveGrid, rays: GridRays, lo: F32, end: F32, known: F32
+    grid: WaveGrid, rays: GridRays, lo: F32, end: F32, known: F32, dip: float
 ) -> tuple[F32, NDArray[np.int8], F32]:
     """The first root of the interpolant in [lo, end] per ray, else `known` (inf: none):
     (t, state HIT / MISS / FAIL, where a FAIL ray's search stopped). The unclear intervals
-    of every ray are sampled together (FINE points each, at most CAP a ray): one pass,
-    whatever the number of false alarms before the root."""
+    of every ray are sampled together (at most CAP a ray): one pass, whatever the number of
+    false alarms before the root. Samples are close enough that a crossing of the sea
+    between two of them that see the ray above the interpolant dips at most `dip` under
+    it: f >= -eps at the samples and |f''| <= C, so the dip is under eps + C h^2 / 8."""
     t_out = np.array(known, dtype=np.float32)
     ray, ta, unclear, _, step = _intervals(grid, rays, lo, end)
     pick = np.flatnonzero(unclear)
@@ -249,7 +251,8 @@ def verify(
     pick, r = np.take(pick, cut), np.take(r, cut)
     ta = np.take(ta, pick)
     tb = np.minimum(ta + np.take(step, r), np.take(end, r))
-    found, t, solved = _fine(grid, rays.take(r), ta, tb)
+    count = _samples(grid, rays, step, dip)
+    found, t, solved = _fine(grid, rays.take(r), ta, tb, count)
     hit = np.flatnonzero(found)
     lead = np.take(hit, np.flatnonzero(np.diff(np.take(r, hit), prepend=-1)))  # first per ray
     first = np.take(r, lead)
@@ -266,18 +269,30 @@ def verify(
     return t_out, state, stop
 
 
+def _samples(grid: WaveGrid, rays: GridRays, step: F32, dip: float) -> int:
+    """Samples per interval of `step` so that eps + C h^2 / 8 <= dip on every ray (C its
+    curvature bound, h the spacing): one count for the whole call, the largest."""
+    k = grid.spec.curvature_uv
+    du, dv = rays.b[0] * np.float32(grid.hu), rays.b[1] * np.float32(grid.hv)
+    c = du * du * np.float32(k[0, 0]) + du * dv * np.float32(2.0 * k[0, 1])
+    c += dv * dv * np.float32(k[1, 1])
+    spacing = np.sqrt(8.0 * max(dip - grid.spec.eps, 1e-6) / np.maximum(c, 1e-12))
+    need = int(np.ceil(np.max(step / spacing, initial=1.0))) + 1
+    return min(max(need, 3), MAX_FINE)
+
+
 def _fine(
-    grid: WaveGrid, rays: GridRays, ta: F32, tb: F32
+    grid: WaveGrid, rays: GridRays, ta: F32, tb: F32, count: int
 ) -> tuple[NDArray[np.bool_], F32, NDArray[np.bool_]]:
-    """The first sign change of f among FINE samples of [ta, tb], solved by Newton within its
-    bracket: (found, t, solved); a bracket Newton does not settle (not seen on the bench
+    """The first sign change of f among `count` samples of [ta, tb], solved by Newton within
+    its bracket: (found, t, solved); a bracket Newton does not settle (not seen on the bench
     scenes) is left unsolved with t at its start, where the exact march resumes. Samples
-    are (FINE, n): NumPy reduces along the long axis ~50x faster than along a short one."""
+    are (count, n): NumPy reduces along the long axis ~50x faster than along a short one."""
     n = ta.size
-    frac = np.linspace(0.0, 1.0, FINE, dtype=np.float32)[:, None]
+    frac = np.linspace(0.0, 1.0, count, dtype=np.float32)[:, None]
     ts = ta + (tb - ta) * frac
-    wide = rays.take(np.tile(np.arange(n), FINE))
-    f = _cell(grid, wide, ts.ravel())[2].reshape(FINE, n)
+    wide = rays.take(np.tile(np.arange(n), count))
+    f = _cell(grid, wide, ts.ravel())[2].reshape(count, n)
     under = f <= 0.0
     found = under.any(axis=0)
     j = np.argmax(under, axis=0)
