@@ -34,6 +34,7 @@ Idx = NDArray[np.intp]
 BLOCK = 16384
 STEEP_MARGIN = 1e-5  # relative: a ray this close to the steepest slope counts as grazing
 TOLERANCE_M = 0.01  # a hit is proven first if no crossing before it dips deeper than this
+TABLE_RAYS_PER_CELL = 2.0  # rays (of any direction) per cell from which cell tables pay
 ROW = np.dtype((np.void, 12))  # a float32 normal as one item: a 1D scatter is 2x a 2D one
 
 
@@ -107,6 +108,8 @@ class GridPass:
     def run(self) -> Idx:
         """Every downward ray; returns those that leave the grid (for the exact march)."""
         n = self.rays.d.shape[0]
+        if n > TABLE_RAYS_PER_CELL * (self.grid.nu - 1) * (self.grid.nv - 1):
+            self.grid.tabulate()
         for s in range(0, n, BLOCK):
             self._block(s + np.flatnonzero(self.rays.d[s : s + BLOCK, 2] < -1e-12))
         if self.doubt:

@@ -55,31 +55,45 @@ class GridRays:
         return GridRays(f0, np.take(self.b, keep, axis=1), oz, np.take(self.dz, keep))
 
 
-def _corners(grid: WaveGrid, rays: GridRays, t: F32, which: Idx) -> tuple[F32, F32]:
-    """(weights (2, n) in the cell, node values flat[cell + which] (len(which), n)). The
-    index and value arrays are the grid's scratch (a block's (8, 16 k) int64 indices are
-    1 MB: fresh, they page-fault on every call); the values live until the next call."""
+def _place(grid: WaveGrid, rays: GridRays, t: F32) -> tuple[F32, F32]:
+    """(weights (2, n) of the position in its cell, the cell's (i, j) as floats)."""
     w = rays.b * t
     w += rays.f0
     base = np.floor(w)
     w -= base
+    return w, base
+
+
+def _corners(grid: WaveGrid, base: F32, which: Idx) -> F32:
+    """Node values flat[cell corner + which] (len(which), n). The index and value arrays are
+    the grid's scratch (a block's (8, 16 k) int64 indices are 1 MB: fresh, they page-fault
+    on every call); the values live until the next call."""
     at = (grid.weights @ base).astype(np.intp)  # i * row + j, exact in float32 below 2^24
-    shape = (which.shape[0], t.size)
+    shape = (which.shape[0], base.shape[1])
     idx = grid.scratch.get(f"corner_idx{shape[0]}", shape, np.intp)
     np.add(which, at, out=idx)
-    vals = grid.scratch.get(f"corner_val{shape[0]}", shape)
-    return w, np.take(grid.flat, idx, out=vals)
+    return np.take(grid.flat, idx, out=grid.scratch.get(f"corner_val{shape[0]}", shape))
+
+
+def _rows(table: F32, grid: WaveGrid, base: F32) -> F32:
+    """The tabulated cells' rows, transposed: (row width, n), strided."""
+    at = (grid.cell_weights @ base).astype(np.intp)[0]
+    return np.take(table, at, axis=0).T
 
 
 def _cell(grid: WaveGrid, rays: GridRays, t: F32) -> tuple[F32, F32, F32]:
     """(w, c, f): the weights, the cell's coefficients c0, cu, cv, cuv (rows of c, the
     surface g = c0 + wu (cu + wv cuv) + wv cv) and f = z - g."""
-    w, c = _corners(grid, rays, t, grid.corners)
-    c[3] -= c[1]
-    c[3] -= c[2]
-    c[3] += c[0]
-    c[1] -= c[0]
-    c[2] -= c[0]
+    w, base = _place(grid, rays, t)
+    if grid.val is not None:
+        c = _rows(grid.val, grid, base)
+    else:
+        c = _corners(grid, base, grid.corners)  # h00, h10, h01, h11 -> coefficients
+        c[3] -= c[1]
+        c[3] -= c[2]
+        c[3] += c[0]
+        c[1] -= c[0]
+        c[2] -= c[0]
     g = w[1] * c[3]
     g += c[1]
     g *= w[0]
@@ -188,14 +202,19 @@ def _quadratic_step(w: F32, c: F32, f: F32, rays: GridRays) -> tuple[F32, NDArra
 def gradient(grid: WaveGrid, rays: GridRays, t: F32) -> F32:
     """(2, n) d eta/du, d eta/dv at distance t along each ray: the bilinear interpolant of the
     exact node gradients (error <= GridSpec.grad_err per axis)."""
-    w, g = _corners(grid, rays, t, grid.grad_corners)
-    g = g.reshape(2, 4, -1)  # (axis, corner, ray)
-    out = w[1] * (g[:, 3] - g[:, 2] - g[:, 1] + g[:, 0])
-    out += g[:, 1]
-    out -= g[:, 0]
+    w, base = _place(grid, rays, t)
+    if grid.grad is not None:
+        c0, cu, cv, cuv = _rows(grid.grad, grid, base).reshape(4, 2, -1)  # (coef, axis, ray)
+    else:
+        h00, h10, h01, h11 = (
+            _corners(grid, base, grid.grad_corners).reshape(2, 4, -1).transpose(1, 0, 2)
+        )
+        c0, cu, cv, cuv = h00, h10 - h00, h01 - h00, h11 - h10 - h01 + h00
+    out = w[1] * cuv
+    out += cu
     out *= w[0]
-    out += g[:, 0]
-    out += w[1] * (g[:, 2] - g[:, 0])
+    out += c0
+    out += w[1] * cv
     return out
 
 
