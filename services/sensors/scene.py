@@ -85,6 +85,12 @@ class Scene:
         self.bodies = self._bodies.bodies
         self.time_s = 0.0
 
+    @property
+    def water_plan(self) -> str:
+        """What the last cast did with the water ("grid nu x nv, k rays exact", "exact";
+        empty for calm water): for benchmarks and tests."""
+        return self._water.last_plan
+
     def set_waves(self, waves: WaveField) -> None:
         """A run-time change of the sea (`catabot set waves`): the surface rays hit."""
         self._waves = waves
