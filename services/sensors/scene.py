@@ -12,11 +12,12 @@ Three kinds of geometry, each with the cheapest exact test for it:
   100 boats cost a fraction of
   a millisecond per 32 x 512 scan (benchmarks/sensors.py).
 - Water: the same surface as physics, z = WaveField.height(x, y, t). Calm water is the plane
-  z = 0. With waves, each downward ray is bracketed between z = +A and z = -A (A = the sum of
-  the component amplitudes bounds |eta|), marched in a few samples to find the FIRST sign
-  change of f(t) = z(t) - eta(x(t), y(t)), then refined by Illinois false position: the hit is
-  on the surface within a millimetre. Its cost is (downward rays x ~7 evaluations x
-  components) float32 cosines, ~8 ms per 32 x 512 LiDAR scan in harbour chop (water.py).
+  z = 0. With waves, a cast samples the surface once on a grid over its rays' footprint
+  (services/sensors/wave_cast.py: heights and gradients of every node from one matmul,
+  cells sized so that the bilinear surface is within 7 mm of the true one), solves each
+  ray's first crossing on it and proves it first (wave_trace.py, wave_pass.py); casts of a
+  few rays and rays leaving the grid take the exact march of water.py. A 32 x 512 LiDAR
+  scan in the medium swell: ~3 ms more than on calm water, a 640 x 480 camera ~28 ms.
 
 The nearest hit of the three wins. All work is vectorised over rays; no Python loop runs per
 ray, and loops over bodies run over no more than a handful of refinement steps.

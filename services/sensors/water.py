@@ -1,23 +1,33 @@
 """Ray hits on the water surface z = eta(x, y, t): the same WaveField physics floats on.
 
-Calm water is the plane z = 0: one division per ray. With waves, |eta| <= A (the sum of the
-component amplitudes), so a downward ray can only cross the surface between the heights
-z = +A and z = -A. That bracket (cut at the nearest other hit) is marched in MARCH_SAMPLES
-steps to find the FIRST sign change of f(t) = z(t) - eta(x(t), y(t), t_now) (a grazing ray
-can pass over a trough and meet the next crest), then refined by Illinois false position,
-which converges superlinearly on the smooth surface, until the point is within TOLERANCE_M
-(0.5 mm) of the surface. Rays pointing up or level never hit water from above.
+Calm water is the plane z = 0: one division per ray. With waves, most rays of a LiDAR scan
+or a camera frame are solved on a grid of the surface sampled once per cast
+(services/sensors/wave_cast.py); this module's exact march takes the rest: casts of a few
+rays (a radar tick), rays that leave the grid (a camera's few rays near the horizon) and
+seas whose grid would be too fine to pay.
+
+The exact march: |eta| <= A (the sum of the component amplitudes), so a downward ray can
+only cross the surface between the heights z = +A and z = -A. That bracket (cut at the
+nearest other hit) is sampled at MARCH_SAMPLES points to find the FIRST sign change of
+f(t) = z(t) - eta(x(t), y(t), t_now) (a grazing ray can pass over a trough and meet the next
+crest), then refined by Newton steps on the exact slope kept inside the bracket, until the
+point is within TOLERANCE_M (0.5 mm) of the surface. Rays pointing up or level never hit
+water from above. Eight samples over +-A are no proof of the first crossing: a crest that
+pokes through between two samples of a ray grazing it far away is missed (seen on rays
+within ~0.2 deg of the horizon beyond ~300 m); the grid's search proves it (wave_trace.py).
 
 A ray steeper than the steepest possible surface (slope sum a k) meets it exactly once:
 it skips the march, and one evaluation where it crosses z = 0 brackets its root tightly
 (the root is within |f| / (its minimum descent rate) of there). Known signs are not
 evaluated: at z = +A the ray is above every crest, at z = -A below every trough.
 
-Cost: (downward rays in bracket) x (~7 evaluations for grazing rays: ~4.5 march samples and
-~3 refinements; ~4 for steep ones) of the sum, each one float32 multiply-add and cosine per
+Cost: (downward rays in bracket) x (~6 evaluations for grazing rays: ~4.5 march samples and
+2-4 refinements; ~4 for steep ones) of the sum, each one float32 multiply-add and cosine per
 wave component along the ray (RaySurface), in blocks of BLOCK rays whose tables stay in
-cache; calm water costs nothing of the sort. On the benchmark's harbour chop (48
-components) a 32 x 512 LiDAR scan spends ~8 ms here, a 640 x 480 camera frame ~110 ms.
+cache: ~0.76 us a ray for 48 components. A few rays cost their NumPy calls rather than their
+cosines (a radar tick's ~150 downward rays: ~0.6 ms), so their march samples are taken in
+one evaluation and the refinement converges in 2-4 Newton steps (Illinois false position,
+which it replaced, took up to 16).
 """
 
 from __future__ import annotations

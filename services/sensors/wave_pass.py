@@ -1,13 +1,13 @@
-"""The gridded rays of one cast: Newton, normals, the first-root proof, the search, merging.
+"""The gridded rays of one cast: Newton, normals, the first-root proof, merging.
 
 Per block of at most BLOCK rays (larger temporaries cost more than they save): the band
 segment of every downward ray, its cell-unit form, Newton from where it crosses z = 0
 (services/sensors/wave_trace.py) and the normal at its root. A ray steeper than every slope
 of the interpolant along its direction crosses it once: its root is its hit. For the others
-the root is proven first, or searched, once per cast (`verify`): the block maxima clear the
-ray up to a window before the root, and the window is proven by the slope at the root
-(`_window`). The few rays the search cannot settle within its CAP intervals, and the rays
-leaving the grid, take the exact march (services/sensors/water.py).
+the root is proven first, or searched, once per cast (`wave_trace.verify`): the block maxima
+clear the ray up to a window before the root, and the window is proven by the slope at the
+root (`_window`). The few rays the search cannot settle within its CAP intervals, and the
+rays leaving the grid, take the exact march (services/sensors/water.py).
 
 Per-ray data stay contiguous and are picked with np.take: on 8 k rays a boolean-mask
 selection costs ~18 us, a row-and-column fancy index ~80 us, an add ~1.4 us.

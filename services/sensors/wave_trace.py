@@ -3,19 +3,22 @@
 Along a ray inside one cell the bilinear surface is a quadratic in t, so a step solves that
 quadratic exactly: if its root lies in the same cell it IS the root of the interpolant
 (|z - eta| <= eps there), otherwise it is the next guess (a Newton step that knows the
-cell's curvature). From where the ray crosses z = 0, 62% of a camera's rays end in one step
-and 99.6% in two (the benchmark frame, medium sea).
+cell's curvature). From where the ray crosses z = 0, 62% of a camera's steep rays end in one
+step and 99.6% in two (`steep_newton`); the others (`newton`) keep a bracket and bisect
+when a step would leave it, 3-5 steps.
 
 Which root. A ray steeper than any slope of the interpolant along its direction crosses it
 once; the others may pass over a trough and meet the next crest, so their root is checked
-(`first_unclear`): the ray is clear of the sea over an interval if its lowest point there
-is above the highest node of the blocks of BLOCK_CELLS x BLOCK_CELLS cells the interval
-touches. Near the root those blocks hold the root itself, so the last stretch is proven by
-the slope there instead (wave_cast._GridPass._window). Rays not proven are searched
-interval by interval (`search`): the first unclear interval is sampled at FINE points and
-the first sign change solved; a crossing hidden between two samples that both see the ray
-above the interpolant dips less than C h^2 / 8 under it (C the curvature bound along the
-ray, h the spacing: < 3 mm for the medium sea).
+(`verify`): the ray is clear of the sea over an interval if its lowest point there is above
+the highest node of the blocks of BLOCK_CELLS x BLOCK_CELLS cells the interval touches
+(`_intervals`). Near the root those blocks hold the root itself, so the last stretch is
+proven by the slope there instead (wave_pass.GridPass._window). The intervals left unclear
+are sampled (`_fine`) and the first sign change solved; a crossing hidden between two
+samples that both see the ray above the interpolant dips less than eps + C h^2 / 8 under
+the sea (C the curvature bound along the ray, h the spacing), so the samples are spaced
+(`_samples`) to keep that under the tolerance: 6 an interval for the medium sea, 11 for a
+harbour chop. In the benchmark frames 79% of the camera's and 80% of the LiDAR's non-steep
+rays are proven without sampling.
 
 NumPy over rays in float32 (cell units; t in metres), arrays of at most ~16 k rays.
 """
