@@ -9,6 +9,7 @@ import pytest
 from catabot.bus.messages import CLASS_VESSEL, CLASS_WATER
 from catabot.config.waves import WaveConfig
 from catabot.world.waves import WaveField
+from services.sensors import wave_pass
 from services.sensors import wave_trace as wt
 from services.sensors.scene import Body, Scene
 from services.sensors.water import wave_hits
@@ -185,3 +186,32 @@ def test_casts_are_deterministic() -> None:
             strict=True,
         ):
             assert a.tobytes() == b.tobytes()
+
+
+def test_rays_the_search_cannot_settle_are_marched_exactly(monkeypatch: pytest.MonkeyPatch) -> None:
+    """One unclear interval a ray and one bracket step: most doubtful rays are left to the
+    exact march from where the search stopped, and their hits are as good."""
+    monkeypatch.setattr(wt, "CAP", 1)
+    monkeypatch.setattr(wt, "BRACKET_STEPS", 1)
+    time_s, o = 7.25, np.array([12.0, 4.0, 1.2])
+    d = _fan(8000, 2, steepest_deg=4.0)
+    marched = []
+    march = wave_pass.march_hits
+
+    def spy(*args: object, **kwargs: object) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        out = march(*args, **kwargs)  # type: ignore[arg-type]
+        marched.append(out[0].size)
+        return out
+
+    monkeypatch.setattr(wave_pass, "march_hits", spy)
+    hits = _scene(MEDIUM, time_s).cast(o, d, 120.0)
+    usual = _scene(MEDIUM, time_s)
+    monkeypatch.undo()
+    reference = usual.cast(o, d, 120.0)
+    assert sum(marched) > 20
+    water = np.flatnonzero(hits.cls == CLASS_WATER)
+    assert (
+        np.abs(_off_surface(MEDIUM, o, d[water], hits.range[water], time_s)).max() <= ON_SURFACE_M
+    )
+    same = hits.cls == reference.cls
+    assert same.mean() > 0.99
