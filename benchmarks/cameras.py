@@ -11,9 +11,12 @@ calm water and the harbour's waves (Hs 0.3 m). Measured per sample, median of RE
 - the radar, one sample per 10 ms tick (2.4 beams x 33 rays);
 - the four-output camera with every body as its hull box and as its shape, side by side
   (interleaved calls, benchmarks/fleet.py), and Embree alone on the terrain with the frame's
-  rays, for reference.
+  rays, for reference;
+- the four-output camera and the radar on calm water, the medium swell and the harbour chop
+  side by side (interleaved), with what the water's ray cast chose (grid or exact march).
 Targets: >= 15 camera frames/s with all four outputs on this machine (issue "Sensor farm");
-shapes at most 1.2 x boxes (issue #17, "Vessel shapes").
+shapes at most 1.2 x boxes (issue #17, "Vessel shapes"); the four-output frame in the medium
+swell at most 1.25 x calm water (issue #17, "Sensors in waves").
 """
 
 from __future__ import annotations
@@ -27,7 +30,7 @@ from collections.abc import Callable
 import numpy as np
 
 from benchmarks.fleet import comparison_head, comparison_line, fleet, side_by_side
-from benchmarks.sensors import TERRAIN
+from benchmarks.sensors import TERRAIN, interleaved, sea_head, sea_lines
 from catabot.bus.blas import single_thread_blas
 from catabot.bus.heap import keep_heap
 from catabot.bus.messages import VesselState
@@ -48,8 +51,10 @@ PAIRS = 30  # boxes-vs-shapes frames of each, interleaved
 EGO = (290.0, 300.0)
 HEADING = math.radians(15.0)
 AT = {"tick": 0, "stamp_ns": 0}
+SEA_ROUNDS = 15  # frames of each sea, interleaved (radar: 20 ticks a round)
 SEAS = {
     "calm": WaveConfig(),
+    "medium": WaveConfig(preset="medium"),
     "harbour": WaveConfig(significant_height_m=0.3, peak_period_s=4.0, direction_rad=1.2),
 }
 
@@ -152,6 +157,40 @@ def compared(sea: str) -> str:
     return comparison_line(f"camera 640 x 480, all four outputs, {sea}", boxes, shapes_ms)
 
 
+def seas_compared() -> list[str]:
+    """The four-output camera and the radar on every sea, interleaved."""
+    frames: dict[str, Callable[[], object]] = {}
+    ticks: dict[str, Callable[[], object]] = {}
+    worlds = {sea: scene(waves) for sea, waves in SEAS.items()}
+    for sea, world in worlds.items():
+        camera = CameraModel(CameraParams(), Mount(scene=world, seed=1, name="ego/cam"))
+        frames[sea] = lambda camera=camera: camera.sample(ego_state(), **AT)
+        ticks[sea] = _radar_ticks(world)
+    plans = {}
+    times = interleaved(frames, SEA_ROUNDS)
+    for sea, world in worlds.items():
+        frames[sea]()
+        plans[sea] = world.water_plan
+    lines = sea_lines("camera 640 x 480, all four outputs", times, plans)
+    radar = interleaved(ticks, SEA_ROUNDS)
+    return lines + sea_lines("radar, 20 ticks of 10 ms", radar, {}, target=False)
+
+
+def _radar_ticks(world: Scene) -> Callable[[], object]:
+    """20 consecutive radar samples (a tick's sweep is too short to time alone)."""
+    radar = RadarModel(
+        RadarParams(), Mount(scene=world, period_ns=10_000_000, seed=1, name="ego/radar")
+    )
+    state, counter = ego_state(), iter(range(10**9))
+
+    def twenty() -> None:
+        for _ in range(20):
+            k = next(counter)
+            radar.sample(state, tick=k, stamp_ns=k * 10_000_000)
+
+    return twenty
+
+
 def embree_alone() -> str:
     """Embree's own rate on the terrain scene with the frame's rays (float32, as cast)."""
     import open3d as o3d
@@ -188,9 +227,12 @@ def main() -> None:
     print("target: camera all outputs >= 15 frames/s")
     print(f"\nboxes vs shapes, {BOATS} boats (interleaved, median of {PAIRS}; ratio of medians)")
     print(comparison_head())
-    for sea in SEAS:
+    for sea in ("calm", "harbour"):
         print(compared(sea))
     print(embree_alone())
+    print(f"\ncalm water vs the medium swell vs harbour chop (interleaved, {SEA_ROUNDS} each)")
+    print(sea_head())
+    print("\n".join(seas_compared()))
     print(f"load average during the run: {os.getloadavg()[0]:.1f} on {os.cpu_count()} CPUs")
 
 

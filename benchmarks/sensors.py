@@ -9,9 +9,12 @@ a heavy swell, at 0 and 50 mm/h; and the parts: the cast alone and the rain mode
 The scene build (terrain mesh into Embree) is paid once per run and reported apart.
 Then the same scans with every body as its hull box, side by side with the shapes
 (interleaved calls, benchmarks/fleet.py), and Embree alone on the terrain with the scan's
-rays, for reference.
+rays, for reference. Last, the scan on calm water, the medium swell and the harbour chop
+side by side (interleaved, SEA_ROUNDS each), with what the water's ray cast chose (grid or
+exact march).
 Targets: a scan with rain within 5 ms (issue "Sensor farm"); shapes at most 1.2 x boxes
-(issue #17, "Vessel shapes").
+(issue #17, "Vessel shapes"); a scan with 50 mm/h rain in the medium swell at most
+1.25 x calm water (issue #17, "Sensors in waves").
 """
 
 from __future__ import annotations
@@ -45,6 +48,8 @@ TERRAIN = TerrainConfig(
 )
 BOATS = 100
 REPEATS = 30
+SEA_ROUNDS = 40  # scans of each sea, interleaved
+SEA_TARGET = 1.25  # medium swell / calm water, issue #17
 PAIRS = 100  # boxes-vs-shapes scans of each, interleaved: a ratio of 5% needs many
 EGO = (290.0, 300.0)
 SEAS = {
@@ -122,6 +127,57 @@ def compared(sea: str, rain: float) -> str:
     return comparison_line(f"LiDAR 32 x 512, {sea}, {rain:g} mm/h", boxes, shapes_ms)
 
 
+def interleaved(fns: dict[str, Callable[[], object]], rounds: int) -> dict[str, list[float]]:
+    """Wall milliseconds of `rounds` calls of each, one of each in turn (load that comes and
+    goes then weighs on all alike), after a warm-up call of each."""
+    for fn in fns.values():
+        fn()
+    out: dict[str, list[float]] = {name: [] for name in fns}
+    for _ in range(rounds):
+        for name, fn in fns.items():
+            start = time.perf_counter()
+            fn()
+            out[name].append(1e3 * (time.perf_counter() - start))
+    return out
+
+
+def sea_lines(
+    what: str, times: dict[str, list[float]], plans: dict[str, str], target: bool = True
+) -> list[str]:
+    """Rows of the seas table: median and least ms, their ratios to calm water, the plan;
+    then (`target`) whether the medium swell meets SEA_TARGET (ratio of the medians)."""
+    calm, calm_min = statistics.median(times["calm"]), min(times["calm"])
+    lines = []
+    for sea, ms in times.items():
+        med = statistics.median(ms)
+        lines.append(
+            f"{what:34} {sea:8} {med:8.2f} {min(ms):8.2f} {med / calm:7.2f} "
+            f"{min(ms) / calm_min:7.2f}  {plans.get(sea, '')}"
+        )
+    if target:
+        ratio = statistics.median(times["medium"]) / calm
+        verdict = "met" if ratio <= SEA_TARGET else "NOT met"
+        lines.append(f"{what:34} medium / calm {ratio:.2f} <= {SEA_TARGET}: {verdict}")
+    return lines
+
+
+def sea_head() -> str:
+    head = ("what", "sea", "med ms", "min ms", "ratio", "min r.", "water cast")
+    return "{:34} {:8} {:>8} {:>8} {:>7} {:>7}  {}".format(*head)
+
+
+def seas_compared(rain: float) -> list[str]:
+    """The scan on every sea, interleaved."""
+    scans, scenes = {}, {}
+    for sea in ("calm", "medium", "harbour"):
+        scene = scenes[sea] = scene_of(SEAS[sea], rain)[0]
+        lidar = LidarModel(LidarParams(), Mount(scene=scene, seed=1, name="ego/lidar"))
+        scans[sea] = lambda lidar=lidar: lidar.sample(ego(), tick=0, stamp_ns=0)
+    times = interleaved(scans, SEA_ROUNDS)
+    plans = {sea: scene.water_plan for sea, scene in scenes.items()}
+    return sea_lines(f"LiDAR 32 x 512, {rain:g} mm/h", times, plans)
+
+
 def embree_alone() -> str:
     """Embree's own rate on the terrain scene with the scan's rays (float32, as cast)."""
     import open3d as o3d
@@ -156,6 +212,10 @@ def main() -> None:
         for rain in (0.0, 50.0):
             print(compared(sea, rain))
     print(embree_alone())
+    print(f"\ncalm water vs the medium swell vs harbour chop (interleaved, {SEA_ROUNDS} each)")
+    print(sea_head())
+    for rain in (0.0, 50.0):
+        print("\n".join(seas_compared(rain)))
     print(f"load average during the run: {os.getloadavg()[0]:.1f} on {os.cpu_count()} CPUs")
 
 

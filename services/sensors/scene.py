@@ -12,11 +12,12 @@ Three kinds of geometry, each with the cheapest exact test for it:
   100 boats cost a fraction of
   a millisecond per 32 x 512 scan (benchmarks/sensors.py).
 - Water: the same surface as physics, z = WaveField.height(x, y, t). Calm water is the plane
-  z = 0. With waves, each downward ray is bracketed between z = +A and z = -A (A = the sum of
-  the component amplitudes bounds |eta|), marched in a few samples to find the FIRST sign
-  change of f(t) = z(t) - eta(x(t), y(t)), then refined by Illinois false position: the hit is
-  on the surface within a millimetre. Its cost is (downward rays x ~7 evaluations x
-  components) float32 cosines, ~8 ms per 32 x 512 LiDAR scan in harbour chop (water.py).
+  z = 0. With waves, a cast samples the surface once on a grid over its rays' footprint
+  (services/sensors/wave_cast.py: heights and gradients of every node from one matmul,
+  cells sized so that the bilinear surface is within 7 mm of the true one), solves each
+  ray's first crossing on it and proves it first (wave_trace.py, wave_pass.py); casts of a
+  few rays and rays leaving the grid take the exact march of water.py. A 32 x 512 LiDAR
+  scan in the medium swell: ~3.5 ms more than on calm water, a 640 x 480 camera ~30 ms.
 
 The nearest hit of the three wins. All work is vectorised over rays; no Python loop runs per
 ray, and loops over bodies run over no more than a handful of refinement steps.
@@ -36,7 +37,8 @@ from catabot.world.waves import WaveField
 from services.sensors.bodies import Bodies, Body, Pairs, SceneError
 from services.sensors.cull import Cones
 from services.sensors.terrain_cast import TerrainCaster
-from services.sensors.water import calm_hits, wave_hits
+from services.sensors.water import calm_hits
+from services.sensors.wave_cast import WaveCaster
 
 F32 = NDArray[np.float32]
 F64 = NDArray[np.float64]
@@ -79,15 +81,21 @@ class Scene:
         self.rain_rate_mm_h = float(rain_rate_mm_h)  # the rain in force (LiDAR's rain model)
         self._terrain = TerrainCaster(terrain)
         self._waves = waves
-        self._amplitude = float(np.sum(waves.amplitudes_m))
+        self._water = WaveCaster(waves)
         self._bodies = Bodies(bodies)  # boxes, shapes, poses (bodies.py)
         self.bodies = self._bodies.bodies
         self.time_s = 0.0
 
+    @property
+    def water_plan(self) -> str:
+        """What the last cast did with the water ("grid nu x nv, k rays exact", "exact";
+        empty for calm water): for benchmarks and tests."""
+        return self._water.last_plan
+
     def set_waves(self, waves: WaveField) -> None:
         """A run-time change of the sea (`catabot set waves`): the surface rays hit."""
         self._waves = waves
-        self._amplitude = float(np.sum(waves.amplitudes_m))
+        self._water = WaveCaster(waves)
 
     def update(
         self, poses: Mapping[str, tuple[Sequence[float], Sequence[float]]], time_s: float
@@ -150,7 +158,7 @@ class Scene:
     def _cast_water(self, o: F64, d: F64, max_range: float, near: _Nearest) -> None:
         """Rays that meet the water before anything else get the water's hit."""
         rng, normal, cls, inst = near.rng, near.normal, near.cls, near.inst
-        if self._waves.is_calm or self._amplitude <= 0.0:
+        if self._waves.is_calm or self._water.amplitude <= 0.0:
             t = calm_hits(o, d, max_range)
             closer = t < rng
             np.copyto(rng, t, where=closer)
@@ -159,11 +167,7 @@ class Scene:
             np.copyto(cls, np.uint8(CLASS_WATER), where=closer)
             np.copyto(inst, 0, where=closer)
             return
-        limit = np.minimum(rng, max_range)
-        rows, t, nw = wave_hits(self._waves, self._amplitude, o, d, limit, self.time_s)
-        closer = t < rng[rows]
-        rows = rows[closer]
-        rng[rows], normal[rows], cls[rows], inst[rows] = t[closer], nw[closer], CLASS_WATER, 0
+        self._water.cast(o, d, max_range, near, self.time_s)
 
     def _cast_bodies(
         self,

@@ -1,23 +1,33 @@
 """Ray hits on the water surface z = eta(x, y, t): the same WaveField physics floats on.
 
-Calm water is the plane z = 0: one division per ray. With waves, |eta| <= A (the sum of the
-component amplitudes), so a downward ray can only cross the surface between the heights
-z = +A and z = -A. That bracket (cut at the nearest other hit) is marched in MARCH_SAMPLES
-steps to find the FIRST sign change of f(t) = z(t) - eta(x(t), y(t), t_now) (a grazing ray
-can pass over a trough and meet the next crest), then refined by Illinois false position,
-which converges superlinearly on the smooth surface, until the point is within TOLERANCE_M
-(0.5 mm) of the surface. Rays pointing up or level never hit water from above.
+Calm water is the plane z = 0: one division per ray. With waves, most rays of a LiDAR scan
+or a camera frame are solved on a grid of the surface sampled once per cast
+(services/sensors/wave_cast.py); this module's exact march takes the rest: casts of a few
+rays (a radar tick), rays that leave the grid (a camera's few rays near the horizon) and
+seas whose grid would be too fine to pay.
+
+The exact march: |eta| <= A (the sum of the component amplitudes), so a downward ray can
+only cross the surface between the heights z = +A and z = -A. That bracket (cut at the
+nearest other hit) is sampled at MARCH_SAMPLES points to find the FIRST sign change of
+f(t) = z(t) - eta(x(t), y(t), t_now) (a grazing ray can pass over a trough and meet the next
+crest), then refined by Newton steps on the exact slope kept inside the bracket, until the
+point is within TOLERANCE_M (0.5 mm) of the surface. Rays pointing up or level never hit
+water from above. Eight samples over +-A are no proof of the first crossing: a crest that
+pokes through between two samples of a ray grazing it far away is missed (seen on rays
+within ~0.2 deg of the horizon beyond ~300 m); the grid's search proves it (wave_trace.py).
 
 A ray steeper than the steepest possible surface (slope sum a k) meets it exactly once:
 it skips the march, and one evaluation where it crosses z = 0 brackets its root tightly
 (the root is within |f| / (its minimum descent rate) of there). Known signs are not
 evaluated: at z = +A the ray is above every crest, at z = -A below every trough.
 
-Cost: (downward rays in bracket) x (~7 evaluations for grazing rays: ~4.5 march samples and
-~3 refinements; ~4 for steep ones) of the sum, each one float32 multiply-add and cosine per
+Cost: (downward rays in bracket) x (~6 evaluations for grazing rays: ~4.5 march samples and
+2-4 refinements; ~4 for steep ones) of the sum, each one float32 multiply-add and cosine per
 wave component along the ray (RaySurface), in blocks of BLOCK rays whose tables stay in
-cache; calm water costs nothing of the sort. On the benchmark's harbour chop (48
-components) a 32 x 512 LiDAR scan spends ~8 ms here, a 640 x 480 camera frame ~110 ms.
+cache: ~0.76 us a ray for 48 components. A few rays cost their NumPy calls rather than their
+cosines (a radar tick's ~150 downward rays: ~0.6 ms), so their march samples are taken in
+one evaluation and the refinement converges in 2-4 Newton steps (Illinois false position,
+which it replaced, took up to 16).
 """
 
 from __future__ import annotations
@@ -30,7 +40,8 @@ from services.sensors.common import rows_of
 
 F64 = NDArray[np.float64]
 MARCH_SAMPLES = 8
-REFINE_STEPS = 16  # a cap: grazing rays (|dz| < 0.02) need up to ~14, most 2-4
+MARCH_TOGETHER = 4096  # (ray, sample) pairs evaluated in one call at most
+REFINE_STEPS = 16  # a cap: Newton in a bracket takes 2-4
 TOLERANCE_M = 5e-4  # vertical distance to the surface at which a ray is done: within 1 mm
 TWO_PI = 2.0 * np.pi
 BLOCK = 4096  # rays solved together: (rays x components) float32 tables of ~0.8 MB
@@ -64,19 +75,40 @@ def wave_hits(
     t_bottom = np.where(limited, limit, t_under)
     band = np.flatnonzero(t_top < t_bottom)
     rows, t_top, t_bottom, limited = rows[band], t_top[band], t_bottom[band], limited[band]
-    if rows.size == 0:
-        return rows, np.empty(0), np.empty((0, 3))
-    found, tr = np.zeros(rows.size, dtype=bool), np.empty(rows.size)
-    normal = np.zeros((rows.size, 3))
-    for s in range(0, rows.size, BLOCK):  # a block's phase tables stay in cache
-        blk = rows[s : s + BLOCK]
-        along = RaySurface(waves, rows_of(o, blk), np.take(d, blk, axis=0), time_s)
-        part = slice(s, s + BLOCK)
-        hit, t = _first_crossing(along, t_top[part], t_bottom[part], limited[part])
+    found, t, normal = march_hits(
+        waves, rows_of(o, rows), np.take(d, rows, axis=0), (t_top, t_bottom), limited, time_s
+    )
+    return rows[found], t, normal
+
+
+def march_hits(
+    waves: WaveField,
+    o: F64,
+    d: F64,
+    bracket: tuple[F64, F64],
+    limited: NDArray[np.bool_],
+    time_s: float,
+    over: NDArray[np.bool_] | None = None,
+) -> tuple[NDArray[np.intp], F64, F64]:
+    """The rays (of o, d) whose first crossing lies in [t0, t1] = `bracket`: their index,
+    distance and normal. f(t1) <= 0 is taken as known where t1 is not `limited` (the ray is
+    under every trough there) and f(t0) >= 0 where `over` (default: t0 > 0, the ray entering
+    the band +-A from above); elsewhere f(t0) is evaluated."""
+    t0, t1 = bracket
+    n = t0.size
+    if n == 0:
+        return np.empty(0, np.intp), np.empty(0), np.empty((0, 3))
+    over = t0 > 0.0 if over is None else over
+    found, tr = np.zeros(n, dtype=bool), np.empty(n)
+    normal = np.zeros((n, 3))
+    for s in range(0, n, BLOCK):  # a block's phase tables stay in cache
+        blk = slice(s, s + BLOCK)
+        along = RaySurface(waves, o[blk], d[blk], time_s)
+        hit, t = _first_crossing(along, t0[blk], t1[blk], limited[blk], over[blk])
         at = np.flatnonzero(hit)
-        found[s : s + BLOCK], tr[s : s + BLOCK] = hit, t
+        found[blk], tr[blk] = hit, t
         normal[s + at] = along.normal(at, t[at])
-    return rows[found], tr[found], normal[found]
+    return np.flatnonzero(found), tr[found], normal[found]
 
 
 class RaySurface:
@@ -114,6 +146,15 @@ class RaySurface:
         eta = np.dot(np.cos(phase, out=phase), self.amp)
         return np.take(self.oz, rows) + t * np.take(self.dz, rows) - eta
 
+    def gap_slope(self, rows: NDArray[np.intp], t: F64) -> tuple[F64, F64]:
+        """f and df/dt at distances t along the rays `rows`: d eta/dt = -sum a (k . d) sin."""
+        phase = self._phase(rows, t)
+        eta = np.dot(np.cos(phase), self.amp)
+        np.sin(phase, out=phase)
+        phase *= np.take(self.rate, rows, axis=0)
+        dz = np.take(self.dz, rows)
+        return np.take(self.oz, rows) + t * dz - eta, dz + np.dot(phase, self.amp)
+
     def normal(self, rows: NDArray[np.intp], t: F64) -> F64:
         """Unit upward surface normals (n, 3) at distances t along the rays `rows`, from the
         analytic gradient as WaveField.normal: -d(eta)/dx = sum a kx sin(phase)."""
@@ -131,7 +172,11 @@ class RaySurface:
 
 
 def _first_crossing(
-    surface: RaySurface, t0: F64, t1: F64, limited: NDArray[np.bool_]
+    surface: RaySurface,
+    t0: F64,
+    t1: F64,
+    limited: NDArray[np.bool_],
+    over: NDArray[np.bool_],
 ) -> tuple[NDArray[np.bool_], F64]:
     """(found, t): the first root of f in [t0, t1] per ray, marched then refined.
 
@@ -145,7 +190,7 @@ def _first_crossing(
     m = t0.size
     a, fa = t0.copy(), surface.oz + t0 * surface.dz
     b, fb = t1.copy(), surface.oz + t1 * surface.dz
-    inside = np.flatnonzero(t0 <= 0.0)  # starting within the wave band: f(t0) unknown
+    inside = np.flatnonzero(~over)  # starting within the wave band: f(t0) unknown
     fa[inside] = surface.gap(inside, t0[inside])
     found = fa <= 0.0  # already under water at the top of the bracket: t0
     b[found], fb[found] = a[found], fa[found]
@@ -155,6 +200,25 @@ def _first_crossing(
     found |= steep & (fb <= 0.0)
     _narrow(surface, np.flatnonzero(steep & found), a, fa, b, fb)
     live = np.flatnonzero(~found & ~steep)
+    march = _march_all if live.size * MARCH_SAMPLES <= MARCH_TOGETHER else _march_on
+    march(surface, live, (t0, t1), (a, fa, b, fb), found)
+    rows = np.flatnonzero(found)
+    t_hit = np.full(m, np.inf)
+    t_hit[rows] = _refine(surface, rows, a[rows], b[rows], fa[rows], fb[rows])
+    return found, t_hit
+
+
+def _march_on(
+    surface: RaySurface,
+    live: NDArray[np.intp],
+    span: tuple[F64, F64],
+    bracket: tuple[F64, F64, F64, F64],
+    found: NDArray[np.bool_],
+) -> None:
+    """March the rays `live` sample by sample, each dropped once under the surface (it costs
+    the samples up to its crossing), narrowing `bracket` (a, fa, b, fb) in place."""
+    t0, t1 = span
+    a, fa, b, fb = bracket
     step = (t1 - t0) / MARCH_SAMPLES
     for k in range(1, MARCH_SAMPLES + 1):
         if live.size == 0:
@@ -167,10 +231,34 @@ def _first_crossing(
         above = live[~under]
         a[above], fa[above] = t[~under], f[~under]
         live = above
-    rows = np.flatnonzero(found)
-    t_hit = np.full(m, np.inf)
-    t_hit[rows] = _illinois(surface, rows, a[rows], b[rows], fa[rows], fb[rows])
-    return found, t_hit
+
+
+def _march_all(
+    surface: RaySurface,
+    live: NDArray[np.intp],
+    span: tuple[F64, F64],
+    bracket: tuple[F64, F64, F64, F64],
+    found: NDArray[np.bool_],
+) -> None:
+    """The same march with every sample of every ray in one evaluation: for a few rays (a
+    radar tick's) the NumPy calls of eight steps cost more than the extra cosines."""
+    if live.size == 0:
+        return
+    t0, t1 = span
+    a, fa, b, fb = bracket
+    k = np.arange(1, MARCH_SAMPLES + 1)[:, None]
+    t = t0[live] + k * ((t1[live] - t0[live]) / MARCH_SAMPLES)  # (samples, rays)
+    f = surface.gap(np.tile(live, MARCH_SAMPLES), t.ravel()).reshape(t.shape)
+    under = f <= 0.0
+    first = np.argmax(under, axis=0)
+    cross = under.any(axis=0)
+    cols = np.arange(live.size)
+    last = np.where(cross, first - 1, MARCH_SAMPLES - 1)  # the last sample above the surface
+    seen = last >= 0
+    rows = live[seen]
+    a[rows], fa[rows] = t[last[seen], cols[seen]], f[last[seen], cols[seen]]
+    hit = live[cross]
+    b[hit], fb[hit], found[hit] = t[first[cross], cols[cross]], f[first[cross], cols[cross]], True
 
 
 def _narrow(surface: RaySurface, rows: NDArray[np.intp], a: F64, fa: F64, b: F64, fb: F64) -> None:
@@ -195,21 +283,28 @@ def _narrow(surface: RaySurface, rows: NDArray[np.intp], a: F64, fa: F64, b: F64
     fb[rows] = np.where(above, np.where(cut, guess, fb[rows]), f)
 
 
-def _illinois(surface: RaySurface, rows: NDArray[np.intp], a: F64, b: F64, fa: F64, fb: F64) -> F64:
-    """Illinois false position on brackets [a, b] with f(a) > 0 >= f(b), all rays at once;
-    rays whose estimate is within TOLERANCE_M of the surface drop out of later steps."""
+def _refine(surface: RaySurface, rows: NDArray[np.intp], a: F64, b: F64, fa: F64, fb: F64) -> F64:
+    """Newton steps with the exact slope on brackets [a, b] with f(a) > 0 >= f(b), all rays at
+    once, from the secant point; a step that would leave the bracket halves it instead. Rays
+    within TOLERANCE_M of the surface drop out: 2-4 steps (Illinois false position, which
+    this replaced, took up to 16 on grazing rays: a radar tick's ~70 rays paid ~25 us a step
+    in NumPy calls whatever their number)."""
     out = b.copy()
     live = np.arange(b.size)
+    span = fa - fb
+    c = np.where(span > 0.0, b + fb * (b - a) / np.where(span > 0.0, span, 1.0), b)
     for _ in range(REFINE_STEPS):
-        span = fa - fb
-        c = np.where(span > 0.0, b + fb * (b - a) / np.where(span > 0.0, span, 1.0), b)
-        fc = surface.gap(rows[live], c)
+        f, slope = surface.gap_slope(rows[live], c)
         out[live] = c
-        left = fc > 0.0  # root in [c, b]: a moves to c; halve the kept end's f (Illinois)
-        a, fa, fb = np.where(left, c, a), np.where(left, fc, fa * 0.5), np.where(left, fb * 0.5, fb)
-        b, fb = np.where(left, b, c), np.where(left, fb, fc)
-        todo = np.abs(fc) > TOLERANCE_M
-        if not todo.any():
+        todo = np.flatnonzero(np.abs(f) > TOLERANCE_M)
+        if todo.size == 0:
             break
-        live, a, b, fa, fb = live[todo], a[todo], b[todo], fa[todo], fb[todo]
+        live, c, f, slope = live[todo], c[todo], f[todo], slope[todo]
+        a, b = a[todo], b[todo]
+        above = f > 0.0
+        a, b = np.where(above, c, a), np.where(above, b, c)
+        with np.errstate(divide="ignore", invalid="ignore"):
+            step = c - f / slope
+        inside = (step > a) & (step < b)  # NaN and inf too
+        c = np.where(inside, step, 0.5 * (a + b))
     return out
