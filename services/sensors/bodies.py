@@ -18,13 +18,13 @@ from __future__ import annotations
 
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
-from typing import Protocol
 
 import numpy as np
 from numpy.typing import NDArray
 
 from catabot.world.shapes import ShapeMesh
 from services.sensors.common import (
+    Nearest,
     SensorError,
     rotation_from_quaternion,
     rotations_from_quaternions,
@@ -58,19 +58,6 @@ class Body:
     lo: Vec3
     hi: Vec3
     shape: ShapeMesh | None = None
-
-
-class Nearest(Protocol):
-    """The nearest hit so far of each ray (the scene's), updated in place."""
-
-    @property
-    def rng(self) -> F64: ...
-    @property
-    def normal(self) -> F32: ...
-    @property
-    def cls(self) -> NDArray[np.uint8]: ...
-    @property
-    def inst(self) -> NDArray[np.int32]: ...
 
 
 class Bodies:

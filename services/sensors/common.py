@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Sequence
+from typing import Protocol
 
 import numpy as np
 from numpy.typing import NDArray
@@ -67,3 +68,17 @@ def rows_of(a: Array, rows: NDArray[np.intp]) -> Array:
     if a.strides[0] == 0:
         return np.broadcast_to(a[0], (rows.size, a.shape[1]))
     return np.take(a, rows, axis=0)
+
+
+class Nearest(Protocol):
+    """The nearest hit so far of each ray (the scene's), updated in place by the bodies'
+    and the water's casts."""
+
+    @property
+    def rng(self) -> NDArray[np.float64]: ...
+    @property
+    def normal(self) -> NDArray[np.float32]: ...
+    @property
+    def cls(self) -> NDArray[np.uint8]: ...
+    @property
+    def inst(self) -> NDArray[np.int32]: ...

@@ -16,7 +16,6 @@ selection costs ~18 us, a row-and-column fancy index ~80 us, an add ~1.4 us.
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import Protocol
 
 import numpy as np
 from numpy.typing import NDArray
@@ -24,7 +23,7 @@ from numpy.typing import NDArray
 from catabot.bus.messages import CLASS_WATER
 from catabot.world.waves import WaveField
 from services.sensors import wave_trace as wt
-from services.sensors.common import rows_of
+from services.sensors.common import Nearest, rows_of
 from services.sensors.water import march_hits
 from services.sensors.wave_grid import WaveGrid
 
@@ -36,19 +35,6 @@ STEEP_MARGIN = 1e-5  # relative: a ray this close to the steepest slope counts a
 TOLERANCE_M = 0.01  # a hit is proven first if no crossing before it dips deeper than this
 TABLE_RAYS_PER_CELL = 2.0  # rays (of any direction) per cell from which cell tables pay
 ROW = np.dtype((np.void, 12))  # a float32 normal as one item: a 1D scatter is 2x a 2D one
-
-
-class Nearest(Protocol):
-    """The nearest hit so far of each ray (services/sensors/scene.py), updated in place."""
-
-    @property
-    def rng(self) -> F64: ...
-    @property
-    def normal(self) -> F32: ...
-    @property
-    def cls(self) -> NDArray[np.uint8]: ...
-    @property
-    def inst(self) -> NDArray[np.int32]: ...
 
 
 @dataclass(frozen=True)
