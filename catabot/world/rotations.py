@@ -34,12 +34,25 @@ def normalised_matrices(q: Array) -> Array | None:
 
 
 def _stack(x: Array, y: Array, z: Array, w: Array) -> Array:
-    rows = [
-        [1 - 2 * (y * y + z * z), 2 * (x * y - z * w), 2 * (x * z + y * w)],
-        [2 * (x * y + z * w), 1 - 2 * (x * x + z * z), 2 * (y * z - x * w)],
-        [2 * (x * z - y * w), 2 * (y * z + x * w), 1 - 2 * (x * x + y * y)],
-    ]
-    return np.stack([np.stack(r, axis=-1) for r in rows], axis=-2)
+    """Filled in place: nested np.stack calls cost more than the arithmetic for a few rows."""
+    out = np.empty((*np.shape(x), 3, 3))
+    out[..., 0, 0], out[..., 0, 1] = 1 - 2 * (y * y + z * z), 2 * (x * y - z * w)
+    out[..., 0, 2], out[..., 1, 0] = 2 * (x * z + y * w), 2 * (x * y + z * w)
+    out[..., 1, 1], out[..., 1, 2] = 1 - 2 * (x * x + z * z), 2 * (y * z - x * w)
+    out[..., 2, 0], out[..., 2, 1] = 2 * (x * z - y * w), 2 * (y * z + x * w)
+    out[..., 2, 2] = 1 - 2 * (x * x + y * y)
+    return out
+
+
+def cross(a: Array, b: Array) -> Array:
+    """a x b over the last axis, with np.cross's operations (the same bits) but none of its
+    axis handling, which costs more than the arithmetic for a few vectors: the one cross
+    product of physics and sensors."""
+    out = np.empty(np.broadcast_shapes(np.shape(a), np.shape(b)))
+    a0, a1, a2 = a[..., 0], a[..., 1], a[..., 2]
+    b0, b1, b2 = b[..., 0], b[..., 1], b[..., 2]
+    out[..., 0], out[..., 1], out[..., 2] = a1 * b2 - a2 * b1, a2 * b0 - a0 * b2, a0 * b1 - a1 * b0
+    return out
 
 
 def matrix(q: Sequence[float] | Array) -> Array | None:

@@ -41,14 +41,8 @@ from collections.abc import Sequence
 import numpy as np
 
 from catabot.config.vessel import VesselModel
+from catabot.world import rotations
 from services.physics.hydro import Array
-
-
-def cross(a: Array, b: Array) -> Array:
-    """Cross product over the last axis; cheaper than np.cross for small batches."""
-    a0, a1, a2 = a[..., 0], a[..., 1], a[..., 2]
-    b0, b1, b2 = b[..., 0], b[..., 1], b[..., 2]
-    return np.stack([a1 * b2 - a2 * b1, a2 * b0 - a0 * b2, a0 * b1 - a1 * b0], axis=-1)
 
 
 def rigid_body_matrix(model: VesselModel) -> Array:
@@ -126,7 +120,7 @@ class AddedMass:
         lhs, rhs = self._lhs, self._rhs  # pairs: w x p1, v x p1, w x p2, r_g x z_b, w x nu_c
         lhs[0], lhs[1], lhs[2], lhs[4] = nu[:, 3:], nu[:, :3], nu[:, 3:], nu[:, 3:]
         rhs[0], rhs[1], rhs[2], rhs[3], rhs[4] = p[:, :3], p[:, :3], p[:, 3:], z_b, nu_c
-        c = cross(lhs, rhs)
+        c = rotations.cross(lhs, rhs)
         turning = self.diag[:, :3] * c[4]  # A_lin (w x nu_c): the current turning with the hull
         weight = -self.gravity * self.mass
         total = other - coriolis_a

@@ -43,6 +43,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from catabot.config.vessel import VesselModel
+from catabot.world import rotations
 from catabot.world.hulls import PROBE_SPACING_M, model_probes
 from catabot.world.terrain import Terrain
 from services.physics.hydro import Array
@@ -222,12 +223,12 @@ def _mul(a: Array, b: Array) -> Array:
 
 def _point_velocity(vel: Array, r: Array) -> Array:
     """Velocity (A, P, 3) of points at offsets r from the origins moving with [w, v] (A, 6)."""
-    return vel[:, None, 3:] + _cross(vel[:, None, :3], r)
+    return vel[:, None, 3:] + rotations.cross(vel[:, None, :3], r)
 
 
 def _jt(force: Array, r: Array) -> Array:
     """Generalized force [sum r x F, sum F] (A, 6) of point forces (A, P, 3) at offsets r."""
-    return np.concatenate([_cross(r, force).sum(axis=1), force.sum(axis=1)], axis=1)
+    return np.concatenate([rotations.cross(r, force).sum(axis=1), force.sum(axis=1)], axis=1)
 
 
 def _jtj(w: Array, r: Array) -> Array:
@@ -250,13 +251,6 @@ def _skew(v: Array) -> Array:
     out[:, 0, 1], out[:, 0, 2], out[:, 1, 2] = -v[:, 2], v[:, 1], -v[:, 0]
     out[:, 1, 0], out[:, 2, 0], out[:, 2, 1] = v[:, 2], -v[:, 1], v[:, 0]
     return out
-
-
-def _cross(a: Array, b: Array) -> Array:
-    """Cross product over the last axis (np.cross costs more than the maths for small arrays)."""
-    a0, a1, a2 = a[..., 0], a[..., 1], a[..., 2]
-    b0, b1, b2 = b[..., 0], b[..., 1], b[..., 2]
-    return np.stack([a1 * b2 - a2 * b1, a2 * b0 - a0 * b2, a0 * b1 - a1 * b0], axis=-1)
 
 
 def _block_maxima(terrain: Terrain, reach_m: float) -> tuple[float, Array]:

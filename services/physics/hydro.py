@@ -14,6 +14,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from catabot.config.vessel import Hull, Thruster, VesselModel
+from catabot.world import rotations
 
 Array = NDArray[np.float64]
 WaterHeight = Callable[[Array, Array, float], Array]
@@ -135,7 +136,9 @@ def buoyancy_wrench(
     first_moment[:, 2] += np.einsum("nc,nc->n", force, along)
     up_body = rot[:, 2, :]  # world +z expressed in the body frame
     total = force.sum(axis=1)
-    return np.concatenate([total[:, None] * up_body, np.cross(first_moment, up_body)], axis=1)
+    return np.concatenate(
+        [total[:, None] * up_body, rotations.cross(first_moment, up_body)], axis=1
+    )
 
 
 # --- damping ----------------------------------------------------------------------------

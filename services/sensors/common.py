@@ -39,14 +39,6 @@ def non_negative(value: float, what: str) -> float:
     return float(value)
 
 
-def cross3(a: Array, b: Array) -> Array:
-    """a x b of two 3-vectors with np.cross's operations (same bits) but not its ~15 us of
-    axis handling: the IMU takes three a tick."""
-    return np.array(
-        [a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]]
-    )
-
-
 def rotation_from_quaternion(q: Sequence[float]) -> Array:
     """Body-to-map rotation of a unit quaternion (x, y, z, w), normalised first (a state rounded
     in transit still gives a proper rotation); a zero or non-finite one is refused."""

@@ -27,11 +27,10 @@ import numpy as np
 from catabot.bus.messages import ImuSample, Message, VesselState
 from catabot.config.sensors import ImuParams
 from catabot.config.waves import GRAVITY
-from catabot.world import seeding
+from catabot.world import rotations, seeding
 from services.sensors.common import (
     Array,
     SensorError,
-    cross3,
     finite_vector,
     non_negative,
     rotation_from_quaternion,
@@ -73,7 +72,7 @@ class ImuModel:
         alpha = finite_vector(state.angular_acceleration, "angular_acceleration (rad/s^2)")
         acc = finite_vector(state.linear_acceleration, "linear_acceleration (m/s^2)")
         r = self.lever_arm
-        acc_sensor = acc + cross3(alpha, r) + cross3(w, cross3(w, r))
+        acc_sensor = acc + rotations.cross(alpha, r) + rotations.cross(w, rotations.cross(w, r))
         return w, acc_sensor + self.gravity * (rot.T @ UP)  # f = a - g, g = -gravity * up
 
     def sample(
