@@ -263,12 +263,3 @@ def test_registry_builds_seeded_sensors() -> None:
     assert fix_position(fix) == pytest.approx(ORIGIN, abs=1e-9)
     with pytest.raises(SensorError, match="unknown sensor type 'sonar'"):
         model_class("sonar")
-
-
-def test_cross3_gives_the_bits_of_np_cross() -> None:
-    from services.sensors.common import cross3
-
-    rng = np.random.default_rng(11)
-    for _ in range(100):
-        a, b = rng.normal(size=3) * 10, rng.normal(size=3) * 1e-3
-        assert np.array_equal(cross3(a, b), np.cross(a, b))
