@@ -36,9 +36,11 @@ nu_c's derivative.
 
 from __future__ import annotations
 
+import copy
 from collections.abc import Sequence
 
 import numpy as np
+from numpy.typing import NDArray
 
 from catabot.config.vessel import VesselModel
 from catabot.world import rotations
@@ -74,6 +76,18 @@ class AddedMass:
         self._lhs = np.empty((5, len(chosen), 3))  # stacked cross-product operands
         self._rhs = np.empty((5, len(chosen), 3))
         self._lhs[3] = self.cog
+
+    def take(self, rows: NDArray[np.intp]) -> AddedMass:
+        """The same for bodies `rows` (sorted) alone, in that order (forces.py)."""
+        sub = copy.copy(self)
+        keep = np.flatnonzero(np.isin(self.rows, rows))
+        sub.count, sub.rows = len(rows), np.searchsorted(rows, self.rows[keep])
+        sub.all_rows = sub.rows.size == sub.count
+        for name in ("diag", "coriolis_diag", "mass", "cog", "m_rb", "inverse"):
+            setattr(sub, name, getattr(self, name)[keep])
+        sub._lhs, sub._rhs = np.empty((5, keep.size, 3)), np.empty((5, keep.size, 3))
+        sub._lhs[3] = sub.cog
+        return sub
 
     @property
     def active(self) -> bool:

@@ -52,6 +52,12 @@ class Columns:
         self._world = np.empty((n, 3, c))
         self._scratch = np.empty((3, n, c))
 
+    def take(self, rows: NDArray[np.intp]) -> Columns:
+        """The columns of vessels `rows`, with buffers of their own."""
+        return Columns(
+            self.bottom_m[rows].transpose(0, 2, 1), self.height_m[rows], self.area_m2[rows]
+        )
+
 
 def hull_columns(hull: Hull) -> tuple[Array, Array, Array]:
     """Discretise one hull into columns: (bottom points (K, 3), heights (K,), areas (K,)).

@@ -13,9 +13,11 @@ heel the buoy.
 
 from __future__ import annotations
 
+import copy
 from collections.abc import Sequence
 
 import numpy as np
+from numpy.typing import NDArray
 
 from catabot.config.vessel import VesselModel
 from catabot.world.environment import CurrentField, WindField
@@ -48,6 +50,19 @@ class EnvironmentLoads:
         self.mooring_n_per_m = float(mooring_n_per_m)
         self._zero_current = np.zeros((n, 3))
         self._still_air = np.zeros((n, 2))
+
+    def take(self, rows: NDArray[np.intp]) -> EnvironmentLoads:
+        """The loads of bodies `rows` (sorted) alone, sharing this one's fields (forces.py);
+        taken again after any run-time change."""
+        sub = copy.copy(self)
+        if self.wind_gains is not None:
+            sub.wind_gains = self.wind_gains[rows]
+        sub.added_mass = self.added_mass.take(rows)
+        pick = np.flatnonzero(np.isin(self.moored, rows))
+        sub.moored = np.searchsorted(rows, self.moored[pick])
+        sub.anchor_xy = self.anchor_xy[pick]
+        sub._zero_current, sub._still_air = np.zeros((len(rows), 3)), np.zeros((len(rows), 2))
+        return sub
 
     def set_uniform_current(self, velocity_mps: tuple[float, float]) -> None:
         """A run-time change of the uniform current (`catabot set current`); a map stays."""

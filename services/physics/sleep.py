@@ -10,10 +10,11 @@ sleeping (Bullet, PhysX).
 The unit is a fleet skeleton (fleet.py: GROUP trees), because DART skips a whole skeleton:
 one of buoys only falls asleep when every member has been still for REST_STEPS steps, the
 sea is steady and no moving body is near; it is made immobile and not collidable, its
-velocities zeroed. It wakes before a step in which a moving body comes within WAKE_MARGIN_M
-(plus what that body covers in WAKE_LOOKAHEAD_S) of a member's bounding circle, so contacts
-only ever happen between awake bodies, and all wake when a run-time setting changes the
-environment. Vessels never sleep: they have thrusters and orders.
+velocities zeroed, and the force model leaves its rows out (forces.py). It wakes at the
+start of a step (before that step's forces) in which a moving body comes within
+WAKE_MARGIN_M (plus what that body covers in WAKE_LOOKAHEAD_S) of a member's bounding
+circle, so contacts only ever happen between awake bodies, and all wake when a run-time
+setting changes the environment. Vessels never sleep: they have thrusters and orders.
 """
 
 from __future__ import annotations
@@ -43,6 +44,7 @@ class Sleep:
         self.still = np.zeros(len(self.radii), dtype=np.int64)  # consecutive still steps
         self.asleep = np.zeros(count, dtype=bool)
         self.every, self.steps = max(1, round(CHECK_S / dt_s)), 0
+        self.version = 0  # counts changes of the sleeping set (forces.AwakeTables)
 
     def rows_asleep(self) -> NDArray[np.bool_]:
         return self.asleep[self.group_of]
@@ -77,6 +79,7 @@ class Sleep:
         for g in np.flatnonzero(self.asleep):
             self._set(int(g), asleep=False)
         self.still[:] = 0
+        self.version += 1  # the environment changed: tables taken before are stale
 
     def _ready_groups(self) -> NDArray[np.intp]:
         """Awake buoy groups whose every member has been still long enough."""
@@ -87,6 +90,7 @@ class Sleep:
     def _set(self, group: int, *, asleep: bool) -> None:
         self.fleet.freeze(group, frozen=asleep)
         self.asleep[group] = asleep
+        self.version += 1
         self.still[self.group_of == group] = 0
 
 

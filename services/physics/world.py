@@ -30,14 +30,9 @@ from catabot.world.terrain import Terrain
 from catabot.world.waves import WaveField
 from services.physics.diverged import check_finite, check_state
 from services.physics.fleet import Fleet, buoy_bodies
+from services.physics.forces import AwakeTables, BodyMotion, Fluid, ForceTables, body_wrench, spread
 from services.physics.grounding import Grounding
-from services.physics.hydro import (
-    Array,
-    ThrusterBank,
-    build_columns,
-    buoyancy_wrench,
-    damping_wrench,
-)
+from services.physics.hydro import Array, ThrusterBank, build_columns
 from services.physics.loads import EnvironmentLoads
 from services.physics.sea import SeaSampler
 from services.physics.setup_check import check_setup
@@ -111,17 +106,17 @@ class PhysicsWorld:
         self._fleet = Fleet(vessels, first_buoy=self._n_vessels)
         self._fleet.add_to(self._world)
         self._skeletons = self._fleet.views  # per-body, skeleton-like access
-        self._columns = build_columns(models)
+        columns = build_columns(models)
         self._thrusters = ThrusterBank([m.thrusters for m in models], self._dt)
-        self._lin = np.array([m.damping.linear for m in models], dtype=np.float64)
-        self._quad = np.array([m.damping.quadratic for m in models], dtype=np.float64)
-        self._current_w = np.zeros((len(models), 3))  # steady current, world frame
         anchors = np.full((len(models), 2), np.nan)  # buoys are moored where they start
         anchors[self._n_vessels :] = np.reshape([xy for _, xy in buoys], (-1, 2))
         self._loads = EnvironmentLoads(
             models, gravity=self._g, current=current, wind=wind, anchors=anchors
         )
-        self._sea = SeaSampler(models, self._columns.bottom_m.transpose(0, 2, 1))
+        linear = np.array([m.damping.linear for m in models], dtype=np.float64)
+        quadratic = np.array([m.damping.quadratic for m in models], dtype=np.float64)
+        self._tables = AwakeTables(ForceTables(columns, linear, quadratic, self._loads))
+        self._sea = SeaSampler(models, columns.bottom_m.transpose(0, 2, 1))
         self._sea.use(waves)  # eta at the columns, orbital velocity at the origins (sea.py)
         # Bottom contact with the terrain (grounding.py); buoyancy knows nothing about it.
         self._ground = (
@@ -216,6 +211,7 @@ class PhysicsWorld:
     def step(self) -> None:
         """Advance every vessel by dt: compute all forces vectorised, apply, step DART.
         `PhysicsDiverged` names the body and the load when a state stops being finite."""
+        self._sleep.wake_near(self._pos, self._vel_w)  # first: one woken now gets its forces
         self._thrusters.advance()
         wrench_b = self._body_wrench()
         # Body-frame [F, M] about the origin -> DART's world-frame [M, F] generalized forces.
@@ -229,7 +225,6 @@ class PhysicsWorld:
             generalized += contact
             self._last_loads["terrain contact"] = contact[:, [3, 4, 5, 0, 1, 2]]  # as [F, M]
         check_finite(self._ids, self._last_loads, generalized, self.time_s)
-        self._sleep.wake_near(self._pos, self._vel_w)
         self._fleet.set_forces(generalized)
         vel_before = self._vel_w
         self._world.step()
@@ -305,38 +300,17 @@ class PhysicsWorld:
         self._rot = rotations.matrices(self._quat)
 
     def _body_wrench(self) -> Array:
-        """Sum of buoyancy, damping and thrust, body frame, Fossen order, about the origin."""
-        rot_t = self._rot.transpose(0, 2, 1)
-        nu = np.concatenate(
-            [
-                np.einsum("nij,nj->ni", rot_t, self._vel_w[:, 3:]),
-                np.einsum("nij,nj->ni", rot_t, self._vel_w[:, :3]),
-            ],
-            axis=1,
-        )
-        self._current_w = self._loads.current_world(self._pos)
-        sea = self._sea.sample(self._pos, self.time_s)
-        water_w = self._current_w  # plus the waves' orbital velocity at each body origin:
-        if sea.velocity_w is not None:  # damping acts on motion relative to the water
-            water_w = water_w + sea.velocity_w
-        current_b = np.einsum("nij,nj->ni", rot_t, water_w)
-        loads = self._last_loads = {
-            "buoyancy": buoyancy_wrench(
-                self._columns,
-                self._rot,
-                self._pos,
-                density=self._rho,
-                gravity=self._g,
-                time_s=self.time_s,
-                surface=sea.surface,
-            ),
-            "damping": damping_wrench(nu, self._lin, self._quad, current_b),
-            "thrust": self._thrusters.wrench(),
-        }
-        base = loads["buoyancy"] + loads["damping"] + loads["thrust"]
-        # then wind, moorings and added mass (which needs every other load):
-        total = self._loads.total(self._rot, self._pos, nu, self._current_w, base)
-        loads["wind, moorings and added mass"] = total - base
+        """Every load on the awake bodies (forces.py), body frame; zero rows for the rest."""
+        rows, tables = self._tables.of(self._sleep, calm=self._sea.calm)
+        motion, thrust = BodyMotion(self._rot, self._pos, self._vel_w), self._thrusters.wrench()
+        if rows is not None:
+            motion, thrust = motion.take(rows), thrust[rows]
+        fluid = Fluid(self._rho, self._g)
+        loads = body_wrench(tables, motion, self._sea, thrust, fluid=fluid, time_s=self.time_s)
+        if rows is not None:
+            loads = spread(loads, rows, len(self._ids))
+        total = loads.pop("total")
+        self._last_loads = loads
         return total
 
     def _steady(self) -> bool:

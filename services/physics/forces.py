@@ -1,0 +1,136 @@
+"""The force model's per-body tables and the body-frame wrench they give, for the awake bodies.
+
+Why: a sleeping buoy (sleep.py) is frozen in DART, so the forces on it are never applied;
+computing them anyway cost the waypoint row of Table II (101 boats, 275 buoys) ~0.35 ms a
+step, as much as 100 boats' hydrodynamics. `AwakeTables` keeps the tables (columns, damping,
+wind, moorings, added mass) of the awake bodies only, taken again whenever a body falls
+asleep or wakes; every law is row by row, so an awake body's wrench is the same, bit for
+bit, whoever else is awake. Sleeping bodies get zero rows. Waves never coexist with sleep
+(sleep.py needs a steady sea), so the sea is sampled for the rows given.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+from numpy.typing import NDArray
+
+from services.physics.hydro import Array, Columns, buoyancy_wrench, damping_wrench
+from services.physics.loads import EnvironmentLoads
+from services.physics.sea import SeaSampler
+from services.physics.sleep import Sleep
+
+Rows = NDArray[np.intp]
+OTHER = "wind, moorings and added mass"
+
+
+@dataclass(frozen=True)
+class ForceTables:
+    """Everything per body the force laws read: (N, ...) rows, one per body."""
+
+    columns: Columns
+    linear: Array  # (N, 6) damping coefficients
+    quadratic: Array
+    loads: EnvironmentLoads
+
+    def take(self, rows: Rows) -> ForceTables:
+        """The tables of bodies `rows` (sorted), in that order."""
+        return ForceTables(
+            self.columns.take(rows), self.linear[rows], self.quadratic[rows], self.loads.take(rows)
+        )
+
+
+@dataclass(frozen=True)
+class BodyMotion:
+    """The bodies' poses and world-frame velocities ([angular, linear], DART's order)."""
+
+    rot: Array  # (N, 3, 3) body to world
+    pos: Array  # (N, 3)
+    vel_w: Array  # (N, 6)
+
+    def take(self, rows: Rows) -> BodyMotion:
+        return BodyMotion(self.rot[rows], self.pos[rows], self.vel_w[rows])
+
+
+class AwakeTables:
+    """The tables of the awake bodies, taken again only when the sleeping set changes."""
+
+    def __init__(self, full: ForceTables) -> None:
+        self.full = full
+        self._version = -1
+        self._rows: Rows | None = None
+        self._part = full
+
+    def of(self, sleep: Sleep, *, calm: bool) -> tuple[Rows | None, ForceTables]:
+        """The awake rows (None: every body) and their tables. In waves every body counts
+        (the hull-patch surface is laid out for all rows; none sleeps there anyway)."""
+        version = sleep.version if calm else -2
+        if version != self._version:
+            self._version = version
+            asleep = sleep.rows_asleep()
+            self._rows = np.flatnonzero(~asleep) if calm and asleep.any() else None
+            self._part = self.full if self._rows is None else self.full.take(self._rows)
+        return self._rows, self._part
+
+
+@dataclass(frozen=True)
+class Fluid:
+    density: float
+    gravity: float
+
+
+def body_wrench(
+    tables: ForceTables,
+    motion: BodyMotion,
+    sea: SeaSampler,
+    thrust: Array,
+    *,
+    fluid: Fluid,
+    time_s: float,
+) -> dict[str, Array]:
+    """Each load's body-frame wrench (N, 6), Fossen order, about the origin, and their sum
+    under "total": buoyancy, damping against the water, thrust, then wind, moorings and
+    added mass (which needs every other load)."""
+    rot_t = motion.rot.transpose(0, 2, 1)
+    nu = np.concatenate(
+        [
+            np.einsum("nij,nj->ni", rot_t, motion.vel_w[:, 3:]),
+            np.einsum("nij,nj->ni", rot_t, motion.vel_w[:, :3]),
+        ],
+        axis=1,
+    )
+    current_w = tables.loads.current_world(motion.pos)
+    water = sea.sample(motion.pos, time_s)
+    water_w = current_w  # plus the waves' orbital velocity at each body origin:
+    if water.velocity_w is not None:  # damping acts on motion relative to the water
+        water_w = water_w + water.velocity_w
+    current_b = np.einsum("nij,nj->ni", rot_t, water_w)
+    loads = {
+        "buoyancy": buoyancy_wrench(
+            tables.columns,
+            motion.rot,
+            motion.pos,
+            density=fluid.density,
+            gravity=fluid.gravity,
+            time_s=time_s,
+            surface=water.surface,
+        ),
+        "damping": damping_wrench(nu, tables.linear, tables.quadratic, current_b),
+        "thrust": thrust,
+    }
+    base = loads["buoyancy"] + loads["damping"] + loads["thrust"]
+    total = tables.loads.total(motion.rot, motion.pos, nu, current_w, base)
+    loads[OTHER] = total - base
+    loads["total"] = total
+    return loads
+
+
+def spread(loads: dict[str, Array], rows: Rows, count: int) -> dict[str, Array]:
+    """Wrenches of bodies `rows` as (count, 6) arrays, zero elsewhere (sleeping bodies)."""
+    out = {}
+    for name, part in loads.items():
+        full = np.zeros((count, 6))
+        full[rows] = part
+        out[name] = full
+    return out
