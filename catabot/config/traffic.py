@@ -76,6 +76,23 @@ class HoldParams(Strict):
     max_speed_mps: float = Field(2.0, gt=0)
 
 
+class AvoidParams(Strict):
+    """Traffic boats keep clear of buoys and other vessels: a mark is rounded, not rammed."""
+
+    buoys: StrictBool = Field(
+        True, description="round the buoys at waypoints and steer around every other buoy"
+    )
+    vessels: StrictBool = Field(
+        True, description="steer around every other vessel ahead, the scenario's included"
+    )
+    lookahead_s: float = Field(
+        8.0, gt=0, le=60, description="how far ahead a boat looks, in seconds at its speed"
+    )
+    clearance_m: float = Field(
+        2.0, ge=0, le=50, description="free water kept between hulls, beyond their footprints"
+    )
+
+
 class BoatOverride(Strict):
     """Per-boat settings that replace the drawn ones (index = the boat's number)."""
 
@@ -101,6 +118,7 @@ class TrafficConfig(Strict):
     circle: CircleParams = CircleParams()
     waypoints: WaypointParams = WaypointParams()
     hold: HoldParams = HoldParams()
+    avoid: AvoidParams = AvoidParams()
     boats: list[BoatOverride] = []
     guidance_hz: float = Field(
         10.0,

@@ -17,6 +17,7 @@ from numpy.typing import NDArray
 
 from catabot.config.traffic import TrafficConfig
 from catabot.world.traffic_plan import Boat
+from services.traffic.avoid import KeepClear, Obstacles, corridor_turn, mark_aim, marks_on
 
 Array = NDArray[np.float64]
 CIRCLE, WAYPOINTS, HOLD = 0, 1, 2
@@ -28,6 +29,7 @@ CIRCLE_LOOKAHEAD_M = 8.0  # radial error at which the correction reaches 45 degr
 # fed forward: 1.0 left a limit cycle with set-points held 0.1 s (a 10 Hz guidance rate).
 CIRCLE_GAIN = 0.5
 HOLD_RADIUS_M = 3.0  # closer than this, hold the heading instead of turning to the point
+BACK_OFF_MPS = 1.0  # astern, while an obstacle is under the bow (avoid.py)
 PATROL_M = 100.0  # a boat set to waypoints with no path patrols this far ahead and back
 
 
@@ -91,10 +93,14 @@ def hold_law(
 class Behaviours:
     """Every boat's behaviour state; `command` gives all set-points for one tick."""
 
-    def __init__(self, boats: Sequence[Boat], *, hold_gain: float = 0.5) -> None:
+    def __init__(
+        self, boats: Sequence[Boat], *, hold_gain: float = 0.5, clear: KeepClear | None = None
+    ) -> None:
         n = len(boats)
         self.boats = list(boats)
         self.hold_gain = hold_gain
+        self.clear = clear or KeepClear(np.zeros((0, 2)), np.zeros(n), np.zeros(n), 0.0)
+        self.marked = np.zeros((n, 1), dtype=bool)  # path points that carry a buoy
         self.kind = np.array([KINDS[b.behaviour] for b in boats], dtype=np.int64)
         self.speed = np.array([b.speed_mps for b in boats], dtype=np.float64)
         self.centre = np.array([b.center for b in boats], dtype=np.float64).reshape(n, 2)
@@ -122,7 +128,13 @@ class Behaviours:
             wider = np.zeros((len(self.paths), len(points), 2))
             wider[:, : self.paths.shape[1]] = self.paths
             self.paths = wider
+            marked = np.zeros(wider.shape[:2], dtype=bool)
+            marked[:, : self.marked.shape[1]] = self.marked
+            self.marked = marked
         self.paths[i, : len(points)] = points
+        self.marked[i] = False
+        if self.clear.pass_m[i] > 0.0:
+            self.marked[i, : len(points)] = marks_on(points, self.clear.anchors)
         self.length[i] = max(len(points), 1)
         self.index[i], self.step[i] = 0, 1
 
@@ -155,8 +167,11 @@ class Behaviours:
             w = cfg.waypoints
             self.set_path(i, np.array(path), w.speed_mps, loop=w.mode == "loop", tol=w.tolerance_m)
 
-    def command(self, pos: Array, yaw: Array, velocity_b: Array) -> tuple[Array, Array]:
-        """Set-points for every boat: pos (N, 2) m, yaw (N,), body velocity (N, >=2)."""
+    def command(
+        self, pos: Array, yaw: Array, velocity_b: Array, obstacles: Obstacles | None = None
+    ) -> tuple[Array, Array]:
+        """Set-points for every boat: pos (N, 2) m, yaw (N,), body velocity (N, >=2); boats
+        under way keep clear of `obstacles` (avoid.py)."""
         chi = course(yaw, velocity_b)
         sog = np.hypot(velocity_b[:, 0], velocity_b[:, 1])
         surge, rate = np.zeros(len(yaw)), np.zeros(len(yaw))
@@ -164,7 +179,29 @@ class Behaviours:
             rows = np.flatnonzero(self.kind == kind)
             if rows.size:
                 surge[rows], rate[rows] = law(rows, pos[rows], yaw[rows], chi[rows], sog[rows])
+        if obstacles is not None and len(obstacles.xy):
+            surge, rate = self._keep_clear(pos, chi, sog, obstacles, (surge, rate))
         return surge, rate
+
+    def _keep_clear(
+        self, pos: Array, chi: Array, sog: Array, obstacles: Obstacles, order: tuple[Array, Array]
+    ) -> tuple[Array, Array]:
+        """Full turn away from the nearest obstacle in a boat's corridor, backing off while it
+        is under the bow (holding boats stay put)."""
+        surge, rate = order
+        speed = np.maximum(np.maximum(sog, self.speed), 1.0)
+        bend = rate / speed  # the arc the boat's own law has it on
+        reach = self.clear.lookahead_s * speed
+        marks = self._own_marks()
+        turn, stop = corridor_turn(pos, chi, bend, reach, self.clear.width, obstacles, marks)
+        turn[self.kind == HOLD], stop[self.kind == HOLD] = 0.0, False
+        surge = np.where(stop, -BACK_OFF_MPS, surge)
+        return surge, np.where(turn != 0.0, turn * MAX_YAW_RATE, rate)
+
+    def _own_marks(self) -> Array:
+        """(N, K, 2): the marks on each boat's path, nan where none (it rounds them)."""
+        on = self.marked & (self.kind == WAYPOINTS)[:, None]
+        return np.where(on[..., None], self.paths, np.nan)
 
     def _circle(
         self, rows: NDArray[np.intp], pos: Array, _: Array, chi: Array, sog: Array
@@ -182,10 +219,14 @@ class Behaviours:
         self, rows: NDArray[np.intp], pos: Array, _: Array, chi: Array, __: Array
     ) -> tuple[Array, Array]:
         target = self.paths[rows, self.index[rows]]
-        reached = rows[np.hypot(*(target - pos).T) < self.tol[rows]]
+        off = np.where(self.marked[rows, self.index[rows]], self.clear.pass_m[rows], 0.0)
+        reached = rows[np.hypot(*(target - pos).T) < self.tol[rows] + off]
         if reached.size:
             self._advance(reached)
             target = self.paths[rows, self.index[rows]]
+            off = np.where(self.marked[rows, self.index[rows]], self.clear.pass_m[rows], 0.0)
+        if off.any():  # marks are rounded, not rammed (avoid.py)
+            target = np.where(off[:, None] > 0.0, mark_aim(pos, target, off), target)
         return pursuit_law(pos, chi, target, self.speed[rows])
 
     def _advance(self, rows: NDArray[np.intp]) -> None:

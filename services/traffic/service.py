@@ -22,8 +22,12 @@ from catabot.bus.messages import BodyStates, Message, Tick, TwistBatch, Waypoint
 from catabot.bus.settings import changes_of
 from catabot.config import live
 from catabot.config.rates import guidance_period_ticks
+from catabot.config.traffic import AvoidParams
 from catabot.run.service import Built, ServiceContext, run_service
 from catabot.world import rotations
+from catabot.world.placement import footprint_m
+from catabot.world.world import Body, World
+from services.traffic.avoid import KeepClear, Obstacles
 from services.traffic.behaviours import Behaviours
 
 
@@ -35,7 +39,10 @@ class TrafficService:
         boats = [b for b in world.traffic.boats if b.id in mine]
         self.row = {vid: i for i, vid in enumerate(self.ids)}
         self.keys = ctx.keys
-        self.behaviours = Behaviours(boats, hold_gain=ctx.scenario.traffic.hold.gain)
+        avoid = ctx.scenario.traffic.avoid
+        clear, self.obstacles = _keep_clear(world, self.ids, avoid)
+        self.behaviours = Behaviours(boats, hold_gain=ctx.scenario.traffic.hold.gain, clear=clear)
+        self.obstacle_rows = np.array([b.row for b in _obstacles(world, avoid)], dtype=np.intp)
         n = len(boats)
         self.pos = np.array([(b.pose.x_m, b.pose.y_m) for b in boats], dtype=np.float64)
         self.yaw = np.array([b.pose.yaw_rad for b in boats], dtype=np.float64)
@@ -65,7 +72,7 @@ class TrafficService:
             self._guide(tick)
 
     def _guide(self, tick: Tick) -> None:
-        surge, rate = self.behaviours.command(self.pos, self.yaw, self.vel)
+        surge, rate = self.behaviours.command(self.pos, self.yaw, self.vel, self.obstacles)
         batch = TwistBatch(tick.tick, tick.stamp_ns, self.ids, surge, rate)
         self.participant.publish(self.twists_key, batch)
 
@@ -76,6 +83,9 @@ class TrafficService:
         self.pos = batch.position[rows, :2].copy()
         self.yaw = rotations.yaw_of_quaternions(batch.orientation[rows])
         self.vel = batch.linear_velocity[rows, :2].copy()
+        if self.obstacles is not None:
+            xy = batch.position[self.obstacle_rows, :2].copy()
+            self.obstacles = Obstacles(xy, self.obstacles.radius, self.obstacles.own)
 
     def _take_setting(self, key: str, value: object) -> None:
         """A boat's behaviour changed at run time, from its pose at the last guidance tick."""
@@ -94,6 +104,31 @@ class TrafficService:
             return
         points = np.array(msg.points, dtype=np.float64).reshape(-1, 2)
         self.behaviours.set_path(i, points, msg.speed, loop=msg.mode == "loop", tol=msg.tolerance)
+
+
+def _obstacles(world: World, avoid: AvoidParams) -> list[Body]:
+    """The bodies traffic boats keep clear of, in row order."""
+    return [b for b in world.bodies if (avoid.buoys if b.kind == "buoy" else avoid.vessels)]
+
+
+def _keep_clear(
+    world: World, ids: tuple[str, ...], avoid: AvoidParams
+) -> tuple[KeepClear, Obstacles | None]:
+    """How the boats `ids` keep clear (services/traffic/avoid.py), and what of, at the start."""
+    radius = {b.model_ref: footprint_m(b.model) for b in world.bodies}
+    own = np.array([radius[world.body(vid).model_ref] for vid in ids])
+    buoys = world.buoys if avoid.buoys else ()
+    anchors = np.array([(b.pose.x_m, b.pose.y_m) for b in buoys]).reshape(-1, 2)
+    buoy_r = max((radius[b.model_ref] for b in buoys), default=0.0)
+    pass_m = own + buoy_r + avoid.clearance_m if buoys else np.zeros(len(ids))
+    clear = KeepClear(anchors, pass_m, own + avoid.clearance_m, avoid.lookahead_s)
+    bodies = _obstacles(world, avoid)
+    if not bodies:
+        return clear, None
+    where = {b.id: k for k, b in enumerate(bodies)}
+    xy = np.array([(b.pose.x_m, b.pose.y_m) for b in bodies])
+    r = np.array([radius[b.model_ref] for b in bodies])
+    return clear, Obstacles(xy, r, np.array([where.get(vid, -1) for vid in ids], np.intp))
 
 
 def build(ctx: ServiceContext) -> Built:

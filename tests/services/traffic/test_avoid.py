@@ -1,0 +1,123 @@
+"""Traffic boats keep clear (services/traffic/avoid.py): the rules one by one, then boats in
+a real PhysicsWorld rounding their marks and steering round other buoys without touching."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from pydantic import ValidationError
+
+from catabot.config.scenario import Pose
+from catabot.config.traffic import AvoidParams, TrafficConfig
+from catabot.config.vessel import load_vessel_model
+from catabot.world import rotations
+from catabot.world.placement import footprint_m
+from catabot.world.traffic_plan import Boat
+from services.physics.control import TwistControllerBank
+from services.physics.world import PhysicsWorld
+from services.traffic.avoid import KeepClear, Obstacles, _on_arc, corridor_turn, mark_aim, marks_on
+from services.traffic.behaviours import Behaviours
+
+NO_MARKS = np.full((1, 1, 2), np.nan)
+
+
+def turn_for(xy: tuple[float, float], *, own: int = -1, marks: np.ndarray = NO_MARKS) -> tuple:
+    """One boat at the origin heading +x at 5 m/s (40 m ahead, 5 m wide), one obstacle."""
+    obstacles = Obstacles(np.array([xy], dtype=float), np.array([0.3]), np.array([own]))
+    zero, one = np.zeros(1), np.ones(1)
+    turn, stop = corridor_turn(zeros2(), zero, zero, 40.0 * one, 5.0 * one, obstacles, marks)
+    return float(turn[0]), bool(stop[0])
+
+
+def zeros2() -> np.ndarray:
+    return np.zeros((1, 2))
+
+
+def test_an_obstacle_dead_ahead_turns_the_boat_to_starboard() -> None:
+    assert turn_for((20.0, 0.5)) == (-1.0, False)  # COLREGs: to starboard first
+    assert turn_for((20.0, -0.5)) == (-1.0, False)
+    assert turn_for((20.0, -4.0)) == (1.0, False)  # well to starboard: round it to port
+
+
+def test_what_is_behind_beside_beyond_reach_or_its_own_is_no_threat() -> None:
+    assert turn_for((-20.0, 0.0)) == (0.0, False)  # astern
+    assert turn_for((20.0, 8.0)) == (0.0, False)  # clear of the corridor
+    assert turn_for((60.0, 0.0)) == (0.0, False)  # beyond reach
+    assert turn_for((20.0, 0.0), own=0) == (0.0, False)  # itself
+    assert turn_for((20.0, 0.0), marks=np.array([[[20.2, 0.1]]])) == (0.0, False)  # its mark
+
+
+def test_one_alongside_or_under_the_bow_is_met_at_once() -> None:
+    assert turn_for((0.5, 3.0)) == (-1.0, False)  # close on the port beam: away to starboard
+    assert turn_for((0.5, -3.0)) == (1.0, False)
+    assert turn_for((2.0, 0.3)) == (-1.0, True)  # under the bow: back off while turning
+
+
+def test_the_corridor_follows_the_arc_the_boat_turns_on() -> None:
+    along, off = _on_arc(np.array([10.0]), np.array([10.0]), np.array([0.1]))
+    np.testing.assert_allclose([along[0], off[0]], [5.0 * np.pi, 0.0], atol=1e-9)  # on it
+    obstacles = Obstacles(np.array([[10.0, 10.0]]), np.array([0.3]), np.array([-1]))
+    zero, one = np.zeros(1), np.ones(1)
+    bent = corridor_turn(zeros2(), zero, 0.1 * one, 40.0 * one, 5.0 * one, obstacles, NO_MARKS)
+    straight = corridor_turn(zeros2(), zero, zero, 40.0 * one, 5.0 * one, obstacles, NO_MARKS)
+    assert bent[0][0] != 0.0 and straight[0][0] == 0.0  # met on the arc, not on the line
+
+
+def test_marks_are_aimed_at_to_their_right() -> None:
+    path = np.array([[0.0, 0.0], [100.0, 0.0], [100.0, 50.0]])
+    np.testing.assert_array_equal(marks_on(path, np.array([[100.2, 0.1]])), [False, True, False])
+    aim = mark_aim(np.array([[0.0, 0.0]]), np.array([[100.0, 0.0]]), np.array([6.0]))
+    np.testing.assert_allclose(aim, [[100.0, -6.0]])  # the mark left to port
+
+
+def test_bad_settings_are_refused_by_name() -> None:
+    for bad in ({"lookahead_s": 0}, {"clearance_m": -1}, {"buoys": "yes"}):
+        with pytest.raises(ValidationError, match=next(iter(bad))):
+            TrafficConfig(avoid=AvoidParams(**bad))  # type: ignore[arg-type]
+
+
+DT = 0.01
+PATH = [(120.0, 0.0), (120.0, 80.0)]  # marks, each with a buoy; a stranger's buoy on leg 1
+BUOYS = [("m0", PATH[0]), ("m1", PATH[1]), ("stranger", (60.0, 0.4))]
+
+
+def _voyage(*, avoid: bool, seconds: float = 70.0) -> tuple[float, np.ndarray, int]:
+    """A monohull from the origin along PATH past three moored buoys; returns its least
+    gap to any buoy (hull footprint to buoy footprint), how far the buoys moved, and the
+    waypoints it reached."""
+    boat = Boat("b", "monohull", Pose(x_m=0.0, y_m=0.0), "waypoints", 5.0, path=tuple(PATH))
+    model, buoy = load_vessel_model("monohull"), load_vessel_model("buoy")
+    world = PhysicsWorld([("b", model, (0.0, 0.0, 0.0, 0.0))], dt_s=DT, buoys=BUOYS)
+    own_r, buoy_r = footprint_m(model), footprint_m(buoy)
+    anchors = np.array([xy for _, xy in BUOYS])
+    pass_m = np.array([own_r + buoy_r + 2.0 if avoid else 0.0])
+    clear = KeepClear(anchors if avoid else anchors[:0], pass_m, np.array([own_r + 2.0]), 8.0)
+    guide, bank = Behaviours([boat], clear=clear), TwistControllerBank([model], dt_s=DT)
+    gaps, reached, set_point = [], 0, np.zeros((1, 2))
+    for k in range(round(seconds / DT)):
+        s, b = world.state_arrays(), world.buoy_state_arrays()
+        if k % 10 == 0:
+            yaw = rotations.yaw_of_quaternions(s.orientation)
+            seen = Obstacles(b.position[:, :2], np.full(3, buoy_r), np.array([-1]))
+            surge, rate = guide.command(s.position[:, :2], yaw, s.linear_velocity,
+                                        seen if avoid else None)  # fmt: skip
+            set_point = np.stack([surge, rate], axis=1)
+            reached = max(reached, int(guide.index[0]) + (guide.step[0] < 0) * 2)
+        measured = np.stack([s.linear_velocity[:, 0], s.angular_velocity[:, 2]], axis=1)
+        world.set_thrusts(np.array([0]), bank.command(np.array([0]), set_point, measured))
+        world.step()
+        gaps.append(np.hypot(*(b.position[:, :2] - s.position[0, :2]).T).min())
+    moved = np.hypot(*(world.buoy_state_arrays().position[:, :2] - anchors).T)
+    return float(min(gaps)) - own_r - buoy_r, moved, reached
+
+
+def test_a_boat_rounds_its_marks_and_steers_round_a_stranger_without_touching() -> None:
+    gap, moved, reached = _voyage(avoid=True)
+    assert gap > 0.0  # the footprint circles never overlapped (the clearance is 2 m)
+    assert moved.max() < 1e-3  # no buoy was pushed
+    assert reached >= 2  # and it still sailed its path: both marks, then turned back
+
+
+def test_without_it_the_same_boat_rams_the_buoys() -> None:
+    gap, moved, _ = _voyage(avoid=False)
+    assert gap < 0.0 and moved.max() > 0.05
