@@ -107,8 +107,13 @@ def corridor_turn(
 
 def _near_pairs(pos: Array, far: Array, obstacles: Obstacles, rows: Rows) -> tuple[Rows, Rows]:
     """(boat, obstacle) pairs closer than `far` (N,) to each other."""
-    rel = obstacles.xy[None, :, :] - pos[rows, None, :]
-    i, j = np.nonzero(rel[..., 0] ** 2 + rel[..., 1] ** 2 < (far[rows] ** 2)[:, None])
+    xy = obstacles.xy.astype(np.float32)  # a coarse test: float32 halves the traffic
+    dx = np.subtract.outer(pos[rows, 0].astype(np.float32), xy[:, 0])  # (n, M), contiguous
+    dy = np.subtract.outer(pos[rows, 1].astype(np.float32), xy[:, 1])
+    dx *= dx
+    dy *= dy
+    dx += dy
+    i, j = np.nonzero(dx < ((far[rows] + 1.0) ** 2).astype(np.float32)[:, None])
     return rows[i], j
 
 
