@@ -4,7 +4,8 @@ A mixed fleet (catamarans and monohulls, both with added mass), a 50 x 50 curren
 of a uniform current, gusty wind with a circle and a polygon zone, a moored buoy; once on
 calm water and once with the "medium" sea state. Measures `PhysicsWorld.step()` plus reading
 every state back (`state_arrays()`), best of three repeats, in a process set up as every
-service is (one BLAS thread, the kept heap).
+service is (one BLAS thread, the kept heap). Then Table II's waypoint row in physics alone:
+101 vessels at rest among 275 moored buoys once these sleep, against the vessels alone.
 
 Reference beside it: bare DART, the same bodies in the same skeletons (fleet.py) stepped by
 DART alone, no gravity and no forces, with their positions and velocities read back: what
@@ -84,6 +85,25 @@ def step_cost(n: int, *, waves: bool) -> float:
     return timed(lambda: (world.step(), world.state_arrays()))
 
 
+def resting_buoys_cost(buoys: int) -> tuple[float, int]:
+    """101 vessels at rest among `buoys` moored buoys in a steady current and wind, after
+    the buoys fell asleep (services/physics/sleep.py); and how many sleep."""
+    vessels = fleet_of(101)
+    xy = np.random.default_rng(3).uniform(300.0, 900.0, (buoys, 2))
+    world = PhysicsWorld(
+        vessels,
+        dt_s=0.01,
+        current=CurrentField((0.2, 0.1)),
+        wind=WindField(WindConfig(speed_mps=3.0), seed=1),
+        buoys=[(f"b{i}", (float(x), float(y))) for i, (x, y) in enumerate(xy)],
+    )
+    for _ in range(2500):  # the moorings' swing dies down in ~20 s
+        world.step()
+    return timed(lambda: (world.step(), world.state_arrays(), world.buoy_state_arrays())), int(
+        world.asleep.sum()
+    )
+
+
 def bare_dart_cost(n: int) -> float:
     """The reference: the same bodies (and buoy) in DART alone."""
     models = fleet_of(n)
@@ -106,6 +126,10 @@ def main() -> None:
         print(f"| {n} | {bare * 1e3:.3f} | {calm * 1e3:.3f} | {1 / calm:.0f} | "
               f"{swell * 1e3:.3f} | {1 / swell:.0f} | {swell / calm:.2f} |")  # fmt: skip
     print(f"swell: {world_of(1, waves=True).sea_method}")
+    alone, _ = resting_buoys_cost(0)
+    among, asleep = resting_buoys_cost(275)
+    print(f"101 vessels at rest: {alone * 1e3:.3f} ms a step; among 275 moored buoys, "
+          f"{asleep} asleep: {among * 1e3:.3f} ms (+{(among - alone) * 1e3:.3f} ms)")  # fmt: skip
     print("targets: 101 vessels >= 1000 steps/s calm; swell / calm <= 1.25")
 
 

@@ -99,12 +99,19 @@ def horner(coef: NDArray[np.float32], row: Rows, dx: F32, dy: F32) -> F32:
     Horner in dx of Horners in dy, the fewest array operations (float32: the offsets are
     metres, the terms well within its precision)."""
     n = max(p for p, _ in row)
-    eta = coef[row[n, 0]]
+    if n == 0:
+        return coef[row[0, 0]]
+    eta = np.multiply(dx, coef[row[n, 0]])
+    inner = np.empty_like(eta)  # in place: the same operations, no temporaries
     for p in range(n - 1, -1, -1):
-        inner = coef[row[p, n - p]]
+        np.multiply(dy, coef[row[p, n - p]], out=inner)
         for q in range(n - p - 1, -1, -1):
-            inner = inner * dy + coef[row[p, q]]
-        eta = eta * dx + inner
+            inner += coef[row[p, q]]
+            if q:
+                inner *= dy
+        eta += inner
+        if p:
+            eta *= dx
     return eta
 
 
