@@ -77,13 +77,16 @@ class HoldParams(Strict):
 
 
 class AvoidParams(Strict):
-    """Traffic boats keep clear of buoys and other vessels: a mark is rounded, not rammed."""
+    """Traffic boats keep clear of buoys and of each other: a mark is rounded, not rammed.
+    The scenario's own vessels (the stacks under test) are not dodged unless asked: a test
+    of a stack's collision avoidance wants traffic that holds its course."""
 
     buoys: StrictBool = Field(
         True, description="round the buoys at waypoints and steer around every other buoy"
     )
+    boats: StrictBool = Field(True, description="steer around the other traffic boats ahead")
     vessels: StrictBool = Field(
-        True, description="steer around every other vessel ahead, the scenario's included"
+        False, description="steer around the scenario's vessels too (the ego and other stacks)"
     )
     lookahead_s: float = Field(
         8.0, gt=0, le=60, description="how far ahead a boat looks, in seconds at its speed"

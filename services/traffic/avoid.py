@@ -6,7 +6,8 @@ a minute, some dragged 15 m, and circling boats pushed each other round their ci
 Real traffic keeps clear (COLREGs rules 8 and 14: alter course early; head-on, both to
 starboard), and a buoy knocked about keeps physics busy for a minute (sleep.py).
 
-Two rules, vectorised over boats x obstacles, each obstacle a footprint circle:
+Two rules, vectorised over boats x obstacles (buoys and traffic boats by default; the
+scenario's vessels only with `traffic.avoid.vessels`), each a footprint circle:
 - Rounding: a waypoint with a buoy on it (a mark) is aimed at `pass_m` to the right of the
   line of sight, so the boat leaves the mark to port about that far off; it counts as
   reached within the tolerance plus `pass_m` of the mark.

@@ -108,7 +108,8 @@ class TrafficService:
 
 def _obstacles(world: World, avoid: AvoidParams) -> list[Body]:
     """The bodies traffic boats keep clear of, in row order."""
-    return [b for b in world.bodies if (avoid.buoys if b.kind == "buoy" else avoid.vessels)]
+    wanted = {"buoy": avoid.buoys, "boat": avoid.boats}
+    return [b for b in world.bodies if wanted.get(b.kind, avoid.vessels)]
 
 
 def _keep_clear(
