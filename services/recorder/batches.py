@@ -57,6 +57,8 @@ class BatchFormatter:
         self.twist_streams = tuple(f"vessel/{b}/cmd/twist" for b in world.boat_ids)
         self.twist_blocks = _slices(list(world.traffic_blocks.values()))
         self.thin = Thinning(convert)
+        self.every_line = tabular.BlockLines()  # every body's rows (resting buoys: the same)
+        self.vessel_line = tabular.BlockLines()  # the scenario vessels' rows between
 
     def states(self, batch: BodyStates) -> Block:
         """Raises ValueError for a batch of other bodies (rows would land in wrong files).
@@ -66,7 +68,7 @@ class BatchFormatter:
             return self._vessels_only(batch)
         groups = self.convert.odometry_groups(batch)  # checks the rows first
         table = np.concatenate(batch.arrays(), axis=1)  # VesselState's columns, (N, 19)
-        lines = tabular.block_lines(batch.stamp_ns, batch.tick, table)
+        lines = self.every_line(batch.stamp_ns, batch.tick, table)
         return Block(
             VesselState, batch.stamp_ns, self.state_streams, lines,
             self.convert.odom_topics, types.ODOMETRY, groups, tf=self.convert.tf(batch),
@@ -75,7 +77,7 @@ class BatchFormatter:
     def _vessels_only(self, batch: BodyStates) -> Block:
         thin = self.thin
         table = np.concatenate(batch.arrays(), axis=1)[thin.rows]
-        lines = tabular.block_lines(batch.stamp_ns, batch.tick, table)
+        lines = self.vessel_line(batch.stamp_ns, batch.tick, table)
         return Block(
             VesselState, batch.stamp_ns, thin.streams, lines, thin.topics, types.ODOMETRY,
             thin.odometry_groups(batch), tf=thin.tf(batch),

@@ -140,3 +140,28 @@ def block_lines(stamp_ns: int, tick: int, table: np.ndarray) -> list[str]:
     head = f"{int(stamp_ns)},{int(tick)},"
     rows = np.asarray(table, dtype=np.float64).tolist()
     return [head + ",".join(map(repr, r)) + "\n" for r in rows]
+
+
+class BlockLines:
+    """`block_lines` with a memory: a row bit for bit the same as that row in the last call
+    keeps its text. Why: a resting buoy's state does not change (services/physics/sleep.py),
+    and formatting the 275 buoys of Table II's waypoint row every tenth tick cost the
+    recorder ≈0.25 ms a tick. Bits, not values, decide: -0.0 == 0.0 but prints otherwise."""
+
+    def __init__(self) -> None:
+        self._bits: np.ndarray | None = None
+        self._tails: list[str] = []
+
+    def __call__(self, stamp_ns: int, tick: int, table: np.ndarray) -> list[str]:
+        table = np.ascontiguousarray(table, dtype=np.float64)
+        bits = table.view(np.uint64)
+        if self._bits is None or self._bits.shape != bits.shape:
+            tails = [",".join(map(repr, r)) + "\n" for r in table.tolist()]
+        else:
+            tails = list(self._tails)
+            changed = np.flatnonzero((bits != self._bits).any(axis=1))
+            for i, r in zip(changed.tolist(), table[changed].tolist(), strict=True):
+                tails[i] = ",".join(map(repr, r)) + "\n"
+        self._bits, self._tails = bits.copy(), tails
+        head = f"{int(stamp_ns)},{int(tick)},"
+        return [head + tail for tail in tails]

@@ -104,3 +104,18 @@ def test_block_lines_equal_row_by_row_formatting() -> None:
     assert lines == [
         "5,2," + ",".join(tabular.fmt(v) for v in row) + "\n" for row in table.tolist()
     ]
+
+
+def test_remembered_lines_are_the_bytes_of_fresh_ones() -> None:
+    """Rows that did not change keep their text, rows that did are formatted again, and
+    bits decide (-0.0 after 0.0, a NaN after a NaN)."""
+    lines = tabular.BlockLines()
+    rng = np.random.default_rng(4)
+    table = rng.normal(size=(6, 19))
+    table[4, 3], table[5, 0] = 0.0, float("nan")
+    for tick in range(4):
+        assert lines(10 * tick, tick, table) == tabular.block_lines(10 * tick, tick, table)
+        table = table.copy()
+        table[tick] = rng.normal(size=19)  # one row moves, the others rest
+        table[4, 3] = -table[4, 3]  # 0.0 <-> -0.0: equal values, different text
+    assert lines(99, 9, table[:3]) == tabular.block_lines(99, 9, table[:3])  # fewer rows
