@@ -74,36 +74,52 @@ def corridor_turn(
     marks: Array,
 ) -> tuple[Array, NDArray[np.bool_]]:  # fmt: skip
     """Per boat: -1 turn to starboard, +1 to port, 0 its corridor is clear; and whether it
-    must back off, an obstacle being right under its bow. The corridor
-    follows the arc the boat is turning on (curvature (N,), 1/m, left positive), `reach`
-    (N,) metres along it, `width` (N,) its footprint plus the clearance either side;
-    marks (N, K, 2): the marks on a boat's own path (nan: none), which it rounds instead."""
+    must back off, an obstacle being under its bow. The corridor follows the arc the boat is
+    turning on (curvature (N,), 1/m, left positive), `reach` (N,) metres along it, `width`
+    (N,) its footprint plus the clearance either side; marks (N, K, 2): the marks on a
+    boat's own path (nan: none), which it rounds instead."""
     out, stop = np.zeros(len(pos)), np.zeros(len(pos), dtype=bool)
     step = max(1, PAIRS // max(len(obstacles.xy), 1))
     for s in range(0, len(pos), step):
         rows = np.arange(s, min(s + step, len(pos)))
         boat, obs = _near_pairs(pos, reach + width + obstacles.radius.max(), obstacles, rows)
-        gap = obstacles.xy[obs][:, None, :] - marks[boat]  # (pairs, K, 2); nan: no mark
-        mark = np.any(gap[..., 0] ** 2 + gap[..., 1] ** 2 < MARK_M**2, axis=1)
-        keep = (obs != obstacles.own[boat]) & ~mark
-        boat, obs = boat[keep], obs[keep]
-        rel = obstacles.xy[obs] - pos[boat]
-        cos, sin = np.cos(chi[boat]), np.sin(chi[boat])
-        ahead, left = rel[:, 0] * cos + rel[:, 1] * sin, rel[:, 1] * cos - rel[:, 0] * sin
-        along, off = _on_arc(ahead, left, curvature[boat])
-        wide = width[boat] + obstacles.radius[obs]
-        hit = (along > 0.0) & (along < reach[boat] + wide) & (np.abs(off) < wide)
-        close = (ahead > -width[boat]) & (np.hypot(ahead, left) < wide)  # alongside too
-        along = np.where(close, 0.0, along)
-        hit |= close
-        bow = close & (ahead > 0.0) & (np.abs(left) < width[boat] / 2.0)
-        boat, along, left, wide, bow = boat[hit], along[hit], left[hit], wide[hit], bow[hit]
+        boat, obs = _others(boat, obs, obstacles, marks)
+        threat = _threats(boat, obs, (pos, chi, curvature, reach, width), obstacles)
+        boat, along, left, wide, bow = threat
         order = np.lexsort((along, boat))  # each boat's nearest threat first
         first = order[np.unique(boat[order], return_index=True)[1]]
         bias = np.where(along[first] > 0.0, wide[first] / 3.0, 0.0)  # far: starboard first
-        out[boat[first]] = np.where(left[first] < -bias, 1.0, -1.0)  # the side as it bears now
+        out[boat[first]] = np.where(left[first] < -bias, 1.0, -1.0)  # the side it bears now
         stop[boat[first]] = bow[first]
     return out, stop
+
+
+def _others(boat: Rows, obs: Rows, obstacles: Obstacles, marks: Array) -> tuple[Rows, Rows]:
+    """The pairs without a boat itself and the marks on its own path."""
+    gap = obstacles.xy[obs][:, None, :] - marks[boat]  # (pairs, K, 2); nan: no mark
+    mark = np.any(gap[..., 0] ** 2 + gap[..., 1] ** 2 < MARK_M**2, axis=1)
+    keep = (obs != obstacles.own[boat]) & ~mark
+    return boat[keep], obs[keep]
+
+
+def _threats(
+    boat: Rows, obs: Rows, boats: tuple[Array, ...], obstacles: Obstacles
+) -> tuple[Rows, Array, Array, Array, NDArray[np.bool_]]:
+    """The pairs where the obstacle is in the boat's corridor or close (distance 0 along
+    it), with where it lies ahead and to the left, the corridor's half-width and whether
+    it is under the bow."""
+    pos, chi, curvature, reach, width = boats
+    rel = obstacles.xy[obs] - pos[boat]
+    cos, sin = np.cos(chi[boat]), np.sin(chi[boat])
+    ahead, left = rel[:, 0] * cos + rel[:, 1] * sin, rel[:, 1] * cos - rel[:, 0] * sin
+    along, off = _on_arc(ahead, left, curvature[boat])
+    wide = width[boat] + obstacles.radius[obs]
+    hit = (along > 0.0) & (along < reach[boat] + wide) & (np.abs(off) < wide)
+    close = (ahead > -width[boat]) & (np.hypot(ahead, left) < wide)  # alongside too
+    bow = close & (ahead > 0.0) & (np.abs(left) < width[boat] / 2.0)
+    hit |= close
+    along = np.where(close, 0.0, along)
+    return boat[hit], along[hit], left[hit], wide[hit], bow[hit]
 
 
 def _near_pairs(pos: Array, far: Array, obstacles: Obstacles, rows: Rows) -> tuple[Rows, Rows]:
