@@ -45,6 +45,7 @@ from catabot.errors import CataBotError
 from catabot.run.usage import write_usage
 from catabot.world.world import World
 
+EXIT_CLOCK = 3  # the lockstep clock was lost (the conductor gone, a hung peer)
 log = logging.getLogger("catabot.run.service")
 
 
@@ -231,7 +232,7 @@ def _serve(ctx: ServiceContext, build: BuildFn) -> int:
         participant.rejections.write(ctx.run_dir / "log" / f"{ctx.name}.rejected.json")
     except ClockError as exc:
         log.error("%s", exc)
-        return 3
+        return EXIT_CLOCK
     except CataBotError as exc:
         log.critical("%s", exc)
         return 2

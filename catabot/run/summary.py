@@ -16,6 +16,7 @@ from pathlib import Path
 
 from catabot.config.scenario import Scenario
 from catabot.run.metrics_summary import metrics_lines
+from catabot.run.service import EXIT_CLOCK
 from catabot.run.usage import peak_rss_mb, read_usage
 
 
@@ -80,6 +81,8 @@ def summarise(
     error = str(result.get("error", "") or "")
     interrupted = result.get("reason") == "interrupted" or conductor_code == 130
     unjoined = stopped if interrupted and not ticks else set()  # stopped while still starting
+    if interrupted and not ticks:  # and those that saw the stopped conductor go first
+        unjoined = set(unjoined) | {n for n, c in service_codes.items() if c == EXIT_CLOCK}
     failed = {n: c for n, c in service_codes.items() if c not in (0, None) and n not in unjoined}
     if not result:
         error = error or f"the conductor ended without a result ({describe_exit(conductor_code)})"

@@ -79,7 +79,7 @@ class PatchSurface:
         coef = self._coefficients(cx, cy, time_s)  # (T, P, 1)
         xg -= cx[:, None]
         yg -= cy[:, None]
-        out = np.empty(x.size)
+        out = np.zeros(x.size)  # a vessel's padding columns are in no patch: finite, unused
         dx, dy = xg.astype(np.float32), yg.astype(np.float32)
         eta = np.broadcast_to(horner(coef, self._row, dx, dy), dx.shape)
         out[self._members] = eta  # a padding slot rewrites its member's own value
