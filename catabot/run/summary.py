@@ -80,9 +80,9 @@ def summarise(
     sim_s = ticks * scenario.dt_ns / 1e9
     error = str(result.get("error", "") or "")
     interrupted = result.get("reason") == "interrupted" or conductor_code == 130
-    unjoined = stopped if interrupted and not ticks else set()  # stopped while still starting
-    if interrupted and not ticks:  # and those that saw the stopped conductor go first
-        unjoined = set(unjoined) | {n for n, c in service_codes.items() if c == EXIT_CLOCK}
+    unjoined: set[str] = set()  # an interrupted start: stopped while still starting, or
+    if interrupted and not ticks:  # ended on seeing the stopped conductor go first
+        unjoined = set(stopped) | {n for n, c in service_codes.items() if c == EXIT_CLOCK}
     failed = {n: c for n, c in service_codes.items() if c not in (0, None) and n not in unjoined}
     if not result:
         error = error or f"the conductor ended without a result ({describe_exit(conductor_code)})"

@@ -6,7 +6,8 @@ step, as much as 100 boats' hydrodynamics. `AwakeTables` keeps the tables (colum
 wind, moorings, added mass) of the awake bodies only, taken again whenever a body falls
 asleep or wakes; every law is row by row, so an awake body's wrench is the same, bit for
 bit, whoever else is awake. Sleeping bodies get zero rows. Waves never coexist with sleep
-(sleep.py needs a steady sea), so the sea is sampled for the rows given.
+(sleep.py needs a steady sea and wakes every body when the sea changes), so the sea, whose
+hull patches are laid out for every row, is only ever sampled for a subset on calm water.
 """
 
 from __future__ import annotations
@@ -62,14 +63,12 @@ class AwakeTables:
         self._rows: Rows | None = None
         self._part = full
 
-    def of(self, sleep: Sleep, *, calm: bool) -> tuple[Rows | None, ForceTables]:
-        """The awake rows (None: every body) and their tables. In waves every body counts
-        (the hull-patch surface is laid out for all rows; none sleeps there anyway)."""
-        version = sleep.version if calm else -2
-        if version != self._version:
-            self._version = version
+    def of(self, sleep: Sleep) -> tuple[Rows | None, ForceTables]:
+        """The awake rows (None: every body) and their tables."""
+        if sleep.version != self._version:
+            self._version = sleep.version
             asleep = sleep.rows_asleep()
-            self._rows = np.flatnonzero(~asleep) if calm and asleep.any() else None
+            self._rows = np.flatnonzero(~asleep) if asleep.any() else None
             self._part = self.full if self._rows is None else self.full.take(self._rows)
         return self._rows, self._part
 

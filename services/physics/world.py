@@ -301,7 +301,7 @@ class PhysicsWorld:
 
     def _body_wrench(self) -> Array:
         """Every load on the awake bodies (forces.py), body frame; zero rows for the rest."""
-        rows, tables = self._tables.of(self._sleep, calm=self._sea.calm)
+        rows, tables = self._tables.of(self._sleep)
         motion, thrust = BodyMotion(self._rot, self._pos, self._vel_w), self._thrusters.wrench()
         if rows is not None:
             motion, thrust = motion.take(rows), thrust[rows]

@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Sequence
+from typing import Any
 
 import numpy as np
 from numpy.typing import NDArray
@@ -125,12 +126,10 @@ class Behaviours:
     def _store_path(self, i: int, points: Array) -> None:
         """Boat i's path into the padded array (widened when a longer path arrives)."""
         if len(points) > self.paths.shape[1]:
-            wider = np.zeros((len(self.paths), len(points), 2))
-            wider[:, : self.paths.shape[1]] = self.paths
-            self.paths = wider
-            marked = np.zeros(wider.shape[:2], dtype=bool)
-            marked[:, : self.marked.shape[1]] = self.marked
-            self.marked = marked
+            self.paths, self.marked = (
+                _wider(self.paths, len(points)),
+                _wider(self.marked, len(points)),
+            )
         self.paths[i, : len(points)] = points
         self.marked[i] = False
         if self.clear.pass_m[i] > 0.0:
@@ -218,16 +217,19 @@ class Behaviours:
     def _path(
         self, rows: NDArray[np.intp], pos: Array, _: Array, chi: Array, __: Array
     ) -> tuple[Array, Array]:
-        target = self.paths[rows, self.index[rows]]
-        off = np.where(self.marked[rows, self.index[rows]], self.clear.pass_m[rows], 0.0)
+        target, off = self._target(rows)
         reached = rows[np.hypot(*(target - pos).T) < self.tol[rows] + off]
         if reached.size:
             self._advance(reached)
-            target = self.paths[rows, self.index[rows]]
-            off = np.where(self.marked[rows, self.index[rows]], self.clear.pass_m[rows], 0.0)
+            target, off = self._target(rows)
         if off.any():  # marks are rounded, not rammed (avoid.py)
             target = np.where(off[:, None] > 0.0, mark_aim(pos, target, off), target)
         return pursuit_law(pos, chi, target, self.speed[rows])
+
+    def _target(self, rows: NDArray[np.intp]) -> tuple[Array, Array]:
+        """Each boat's waypoint now, and how far off it passes it (0 unless it is a mark)."""
+        k = self.index[rows]
+        return self.paths[rows, k], np.where(self.marked[rows, k], self.clear.pass_m[rows], 0.0)
 
     def _advance(self, rows: NDArray[np.intp]) -> None:
         """Next point: wrap round when looping, turn back at either end otherwise."""
@@ -236,3 +238,10 @@ class Behaviours:
         self.step[rows[back]] *= -1
         k[back] = self.index[rows[back]] + self.step[rows[back]]
         self.index[rows] = np.where(self.loop[rows], k % n, np.clip(k, 0, n - 1))  # 1 point
+
+
+def _wider(table: NDArray[Any], width: int) -> NDArray[Any]:
+    """A per-boat path table (N, K, ...) padded with zeros to `width` points."""
+    out = np.zeros((table.shape[0], width, *table.shape[2:]), dtype=table.dtype)
+    out[:, : table.shape[1]] = table
+    return out

@@ -14,8 +14,10 @@ that path instead, and `mode="release"` restores the scenario behaviour.
 from __future__ import annotations
 
 import sys
+from dataclasses import replace
 
 import numpy as np
+from numpy.typing import NDArray
 
 from catabot.bus.inbox import Inputs
 from catabot.bus.messages import BodyStates, Message, Tick, TwistBatch, WaypointsCmd
@@ -26,7 +28,7 @@ from catabot.config.traffic import AvoidParams
 from catabot.run.service import Built, ServiceContext, run_service
 from catabot.world import rotations
 from catabot.world.placement import footprint_m
-from catabot.world.world import Body, World
+from catabot.world.world import World
 from services.traffic.avoid import KeepClear, Obstacles
 from services.traffic.behaviours import Behaviours
 
@@ -40,9 +42,8 @@ class TrafficService:
         self.row = {vid: i for i, vid in enumerate(self.ids)}
         self.keys = ctx.keys
         avoid = ctx.scenario.traffic.avoid
-        clear, self.obstacles = _keep_clear(world, self.ids, avoid)
+        clear, self.obstacles, self.obstacle_rows = _keep_clear(world, self.ids, avoid)
         self.behaviours = Behaviours(boats, hold_gain=ctx.scenario.traffic.hold.gain, clear=clear)
-        self.obstacle_rows = np.array([b.row for b in _obstacles(world, avoid)], dtype=np.intp)
         n = len(boats)
         self.pos = np.array([(b.pose.x_m, b.pose.y_m) for b in boats], dtype=np.float64)
         self.yaw = np.array([b.pose.yaw_rad for b in boats], dtype=np.float64)
@@ -85,7 +86,7 @@ class TrafficService:
         self.vel = batch.linear_velocity[rows, :2].copy()
         if self.obstacles is not None:
             xy = batch.position[self.obstacle_rows, :2].copy()
-            self.obstacles = Obstacles(xy, self.obstacles.radius, self.obstacles.own)
+            self.obstacles = replace(self.obstacles, xy=xy)
 
     def _take_setting(self, key: str, value: object) -> None:
         """A boat's behaviour changed at run time, from its pose at the last guidance tick."""
@@ -106,16 +107,11 @@ class TrafficService:
         self.behaviours.set_path(i, points, msg.speed, loop=msg.mode == "loop", tol=msg.tolerance)
 
 
-def _obstacles(world: World, avoid: AvoidParams) -> list[Body]:
-    """The bodies traffic boats keep clear of, in row order."""
-    wanted = {"buoy": avoid.buoys, "boat": avoid.boats}
-    return [b for b in world.bodies if wanted.get(b.kind, avoid.vessels)]
-
-
 def _keep_clear(
     world: World, ids: tuple[str, ...], avoid: AvoidParams
-) -> tuple[KeepClear, Obstacles | None]:
-    """How the boats `ids` keep clear (services/traffic/avoid.py), and what of, at the start."""
+) -> tuple[KeepClear, Obstacles | None, NDArray[np.intp]]:
+    """How the boats `ids` keep clear (services/traffic/avoid.py), what of at the start, and
+    those bodies' rows in `BodyStates`."""
     radius = {b.model_ref: footprint_m(b.model) for b in world.bodies}
     own = np.array([radius[world.body(vid).model_ref] for vid in ids])
     buoys = world.buoys if avoid.buoys else ()
@@ -123,13 +119,16 @@ def _keep_clear(
     buoy_r = max((radius[b.model_ref] for b in buoys), default=0.0)
     pass_m = own + buoy_r + avoid.clearance_m if buoys else np.zeros(len(ids))
     clear = KeepClear(anchors, pass_m, own + avoid.clearance_m, avoid.lookahead_s)
-    bodies = _obstacles(world, avoid)
+    wanted = {"buoy": avoid.buoys, "boat": avoid.boats}
+    bodies = [b for b in world.bodies if wanted.get(b.kind, avoid.vessels)]
+    rows = np.array([b.row for b in bodies], dtype=np.intp)
     if not bodies:
-        return clear, None
+        return clear, None, rows
     where = {b.id: k for k, b in enumerate(bodies)}
     xy = np.array([(b.pose.x_m, b.pose.y_m) for b in bodies])
     r = np.array([radius[b.model_ref] for b in bodies])
-    return clear, Obstacles(xy, r, np.array([where.get(vid, -1) for vid in ids], np.intp))
+    own = np.array([where.get(vid, -1) for vid in ids], np.intp)
+    return clear, Obstacles(xy, r, own), rows
 
 
 def build(ctx: ServiceContext) -> Built:
