@@ -14,7 +14,7 @@ crest), then refined by Newton steps on the exact slope kept inside the bracket,
 point is within TOLERANCE_M (0.5 mm) of the surface. Rays pointing up or level never hit
 water from above. Eight samples over +-A are no proof of the first crossing: a crest that
 pokes through between two samples of a ray grazing it far away is missed (seen on rays
-within ~0.2 deg of the horizon beyond ~300 m); the grid's search proves it (wave_trace.py).
+within ~0.2 deg of the horizon beyond ~300 m); the grid's walk finds it (wave_kernel.py).
 
 A ray steeper than the steepest possible surface (slope sum a k) meets it exactly once:
 it skips the march, and one evaluation where it crosses z = 0 brackets its root tightly

@@ -9,7 +9,8 @@ the footprint of the rays' band segments, from a sample of ~4 k rays) by estimat
 its nodes (node_ns), the rays wholly inside it (GRID_NS each) and the rays that leave it,
 which take the exact march of services/sensors/water.py (exact_ns). A camera's few rays
 reaching past ~150 m go exact; a chop too short for a grid of affordable size goes exact
-altogether. The rays are then solved on the grid by services/sensors/wave_pass.py.
+altogether. The rays are then solved on the grid by services/sensors/wave_pass.py (its
+compiled loop, wave_kernel.py, ~70 ns a ray).
 """
 
 from __future__ import annotations
@@ -20,10 +21,12 @@ import numpy as np
 from numpy.typing import NDArray
 
 from catabot.world.waves import WaveField
-from services.sensors.common import rows_of
+from services.sensors.common import Nearest, rows_of
 from services.sensors.water import wave_hits
+from services.sensors.wave_bounds import band_ends
 from services.sensors.wave_grid import GridSpec, Scratch, WaveGrid, grid_spec
-from services.sensors.wave_pass import CastRays, GridPass, Nearest, merge
+from services.sensors.wave_kernel import warm_up
+from services.sensors.wave_pass import CastRays, cast_on_grid, merge
 
 F64 = NDArray[np.float64]
 Idx = NDArray[np.intp]
@@ -32,7 +35,7 @@ SAMPLE = 4096  # rays the plan looks at
 SMALL_CAST = 3072  # rays: fewer go to the exact march unplanned (measured crossover 2-4 k)
 MARGIN = 0.02  # of the sampled footprint, added around it
 MAX_NODES = 2_000_000  # 24 MB of node tables at most
-GRID_NS, GRID_FIXED_NS = 240.0, 900_000.0  # a gridded ray; the rest of a gridded cast
+GRID_NS, GRID_FIXED_NS = 70.0, 200_000.0  # a gridded ray; the rest of a gridded cast
 SIZES = 0.7 ** np.arange(12)  # grid boxes tried, as fractions of the whole footprint
 
 
@@ -65,6 +68,8 @@ class WaveCaster:
         self.waves = waves
         self.amplitude = float(np.sum(waves.amplitudes_m))
         self.spec: GridSpec | None = grid_spec(waves)
+        if self.spec is not None:
+            warm_up()  # the kernels load (or compile) now, not inside the first cast
         sigma = waves.config.significant_height_m / 4.0
         self.guess = min(self.amplitude, BAND_SIGMAS * sigma)
         self.scratch = Scratch()
@@ -93,7 +98,7 @@ class WaveCaster:
             if grid.zmax + spec.eps <= band and grid.zmin - spec.eps >= -band:
                 break
             band = self.amplitude  # the surface left the guessed band: plan with the bound
-        far = GridPass(grid, rays, near, band, (self.waves, time_s)).run()
+        far = cast_on_grid(grid, rays, near, band, max_range)
         self.last_plan = f"grid {grid.nu} x {grid.nv}, {far.size} rays exact"
         self._exact(near, o, d, limit, far, time_s)
 
@@ -111,7 +116,7 @@ class WaveCaster:
     def _plan(self, rays: CastRays, band: float, spec: GridSpec) -> tuple[F64, F64] | None:
         """The cheapest box, or None when no grid beats the march: squares shrinking by 0.7
         from the whole footprint."""
-        foot = _footprint(rays, band)
+        foot = _footprint(rays, band, self.scratch)
         if foot is None:
             return None
         m, n = self.waves.amplitudes_m.size, foot.rays
@@ -128,26 +133,14 @@ class WaveCaster:
         return lo[best], hi[best]
 
 
-def _footprint(rays: CastRays, band: float) -> _Footprint | None:
+def _footprint(rays: CastRays, band: float, scratch: Scratch) -> _Footprint | None:
     """The band segments of a sample of the downward rays (every k-th ray)."""
     n = rays.d.shape[0]
     step = max(1, n // SAMPLE)
-    sel = np.arange(0, n, step)
-    sel = sel[rays.d[sel, 2] < -1e-12]
-    oz = rays.oz if rays.uv.ndim == 1 else rays.o[sel, 2]
-    dz = rays.d[sel, 2]
-    ta = np.maximum((band - oz) / dz, 0.0)
-    tb = np.minimum((-band - oz) / dz, rays.limit[sel])
-    ok = ta < tb
-    if not ok.any():
+    radius = scratch.get("plan_radius", (n // step + 1,), np.float64)
+    m, box = band_ends((rays.o, rays.d, rays.limit), rays.frame, band, step, radius)
+    if m == 0:
         return None
-    sel, ta, tb = sel[ok], ta[ok], tb[ok]
-    duv = rays.rot @ rays.d[sel, :2].T
-    uv = rays.uv[:, None] if rays.uv.ndim == 1 else rays.uv[:, sel]
-    ends = np.concatenate([uv + ta * duv, uv + tb * duv], axis=1)
-    lo = np.minimum(ends.min(axis=1), rays.uv_min)
-    hi = np.maximum(ends.max(axis=1), rays.uv_max)
+    lo, hi = np.array(box[:2]), np.array(box[2:])
     margin = MARGIN * (hi - lo)  # for the rays between the sampled ones
-    lo, hi = lo - margin, hi + margin
-    radius = np.maximum(np.abs(ends[0]), np.abs(ends[1])).reshape(2, -1).max(axis=0)
-    return _Footprint(np.sort(radius), (lo, hi), float(ok.sum() * step))
+    return _Footprint(np.sort(radius[:m]), (lo - margin, hi + margin), float(m * step))

@@ -6,7 +6,7 @@ component (48 by default) per ray and per step of a root search; a ray-cast sens
 separates: cos(A_i + B_j) = cos A_i cos B_j - sin A_i sin B_j with A = k_u u + p, B = k_v v,
 so every node's height and gradient is one float32 matmul (nx, 2M) @ (2M, 3 ny) with only
 M (nx + ny) sines and cosines. 30 k nodes cost ~0.25 ms; a ray then costs a gather and a few
-multiply-adds per step (services/sensors/wave_trace.py).
+multiply-adds per cell it visits (services/sensors/wave_kernel.py).
 
 Error bound. Between nodes the surface is the bilinear interpolant of the node heights.
 For a tensor-product linear interpolant |g - eta| <= hu^2/8 max|eta_uu| + hv^2/8 max|eta_vv|
@@ -15,7 +15,7 @@ For a tensor-product linear interpolant |g - eta| <= hu^2/8 max|eta_uu| + hv^2/8
 principal axes of S = sum a k k^T (the spectrum's curvature tensor), and the cell sizes
 split the tolerance between them, hu = sqrt(4 eps / S_uu), hv = sqrt(4 eps / S_vv), which
 minimises the nodes for a given bound: the medium preset (S_uu 0.033, S_vv 0.003 1/m) gets
-0.78 x 2.8 m cells for eps = 5 mm, 45% fewer nodes than square ones. Gradients (normals)
+0.92 x 3.3 m cells for eps = 7 mm, 45% fewer nodes than square ones. Gradients (normals)
 are the bilinear interpolants of the exact node gradients: their error is bounded the same
 way by the third moments of the spectrum (GridSpec.grad_err, ~5e-4 for the medium sea).
 """
@@ -29,12 +29,13 @@ import numpy as np
 from numpy.typing import NDArray
 
 from catabot.world.waves import WaveField
+from services.sensors.wave_bounds import block_tops, surface_bounds
 
 F32 = NDArray[np.float32]
 F64 = NDArray[np.float64]
 EPS_M = 0.007  # bound on |bilinear - eta| a grid is built for (hits are roots of the bilinear)
 MAX_ASPECT = 16.0  # hv <= 16 hu: a long-crested sea (S_vv ~ 0) still gets a few rows
-BLOCK_CELLS = 4  # side of the blocks whose maximum height certifies a ray clear of the sea
+BLOCK_CELLS = 4  # side of the blocks whose highest node a ray passes over whole
 TWO_PI = 2.0 * math.pi
 
 
@@ -103,9 +104,9 @@ class Scratch:
 
 class WaveGrid:
     """The surface's nodes over the box lo..hi (grid frame, metres from `anchor`) at one
-    instant. Positions are in cell units, f = (uv - uv0) / (hu, hv); the corners of cell
-    (i, j) are flat[i * row + j + corners] (h00, h10, h01, h11), their gradients
-    flat[... + grad_corners] (d/du of the four, then d/dv)."""
+    instant, with the bounds a ray search needs: extremes, steepest rises, block maxima at
+    each block of cells. Positions are in cell units, f = (uv - uv0) / (hu, hv); node (i, j) is
+    flat[3 (i nv + j)], its d/du and d/dv the next two."""
 
     def __init__(
         self,
@@ -123,47 +124,20 @@ class WaveGrid:
         self.nu = math.ceil((hi[0] - lo[0]) / spec.hu) + 3
         self.nv = math.ceil((hi[1] - lo[1]) / spec.hv) + 3
         self.flat = self._nodes(waves, time_s, scratch)
-        self.row = 3 * self.nv  # flat index of node (i, j): i * row + j (+ nv: d/du, + 2 nv: d/dv)
-        height = self.flat.reshape(self.nu, 3, self.nv)[:, 0]
-        self.weights = np.array([[self.row, 1.0]], np.float32)  # (i, j) -> i * row + j
-        self.corners = np.array([0, self.row, 1, self.row + 1], np.intp)[:, None]
-        self.grad_corners = np.concatenate([self.corners + self.nv, self.corners + 2 * self.nv])
-        self.zmin, self.zmax = float(height.min()), float(height.max())
-        self.slope_u, self.slope_v = self._slopes(height)
-        self.blocks_v, self.block_max = _block_max(height, scratch)
-        self.val: F32 | None = None  # per-cell tables, when built (`tabulate`)
-        self.grad: F32 | None = None
-        self.cell_weights = np.array([[self.nv - 1, 1.0]], np.float32)  # (i, j) -> cell row
-
-    def tabulate(self) -> None:
-        """Per-cell rows of bilinear coefficients (c0, cu, cv, cuv; g = c0 + wu (cu + wv cuv)
-        + wv cv) for the height and, interleaved, the two gradients: a step then gathers one
-        16-byte row instead of four nodes on two rows of the node table (~25% a step, 45% a
-        normal). Built plane by plane, then interleaved (~0.35 ms for 20 k cells): it pays
-        when the rays outnumber the cells (a camera), not for a LiDAR."""
-        nodes = self.flat.reshape(self.nu, 3, self.nv).transpose(1, 0, 2)
-        cells = (self.nu - 1, self.nv - 1)
-        planes = self.scratch.get("grid_planes", (4, *cells))
-        val = self.scratch.get("grid_val", (*cells, 4))
-        grad = self.scratch.get("grid_grad", (*cells, 4, 2))
-        for field, dst in ((0, val), (1, grad[..., 0]), (2, grad[..., 1])):
-            low, high = nodes[field, :-1], nodes[field, 1:]  # node rows i and i + 1
-            planes[0] = low[:, :-1]
-            np.subtract(high[:, :-1], low[:, :-1], out=planes[1])
-            np.subtract(low[:, 1:], low[:, :-1], out=planes[2])
-            np.subtract(high[:, 1:], high[:, :-1], out=planes[3])
-            planes[3] -= planes[2]
-            np.copyto(dst, np.moveaxis(planes, 0, -1))
-        self.val, self.grad = val.reshape(-1, 4), grad.reshape(-1, 8)
+        low, high, rise_u, rise_v = surface_bounds(self.flat, (self.nu, self.nv))
+        self.zmin, self.zmax = float(low), float(high)
+        self.rise = (float(rise_u), float(rise_v))  # steepest rise per cell along u, v
+        top = block_tops(self.flat, (self.nu, self.nv), BLOCK_CELLS)
+        self.blocks = (top, top.shape, BLOCK_CELLS)
 
     @property
     def nodes(self) -> int:
         return self.nu * self.nv
 
     def _nodes(self, waves: WaveField, time_s: float, scratch: Scratch) -> F32:
-        """Height, d/du and d/dv of every node, flat: row i holds the nv heights of u-node i,
-        then their d/du, then their d/dv. M (nu + nv) trig calls and one matmul; a ray step
-        gathers its cell's four corners straight from it (no per-cell tables to build)."""
+        """Height, d/du and d/dv of every node, flat, node after node (row i: the nv nodes of
+        u-node i). M (nu + nv) trig calls and one matmul; a ray step gathers its cell's four
+        corners straight from it."""
         spec, m = self.spec, waves.amplitudes_m.size
         k, theta = waves.wavenumbers_radpm, waves.directions_rad
         shift = (
@@ -176,23 +150,14 @@ class WaveGrid:
         left = scratch.get("grid_left", (self.nu, 2 * m))
         left[:, :m], left[:, m:] = cos_a, sin_a
         a = waves.amplitudes_m.astype(np.float32)
-        right = scratch.get("grid_right", (2 * m, 3, self.nv))
-        right[:m, 0], right[m:, 0] = (a * cos_b).T, (-a * sin_b).T  # cos(A + B)
+        right = scratch.get("grid_right", (2 * m, self.nv, 3))
+        right[:m, :, 0], right[m:, :, 0] = (a * cos_b).T, (-a * sin_b).T  # cos(A + B)
         for field, k_axis in ((1, spec.k_u), (2, spec.k_v)):  # d/du: -k_u sin(A + B)
             ak = (a * k_axis).astype(np.float32)
-            right[:m, field], right[m:, field] = (-ak * sin_b).T, (-ak * cos_b).T
+            right[:m, :, field], right[m:, :, field] = (-ak * sin_b).T, (-ak * cos_b).T
         out = scratch.get("grid_nodes", (self.nu, 3 * self.nv))
         np.matmul(left, right.reshape(2 * m, -1), out=out)
         return out.ravel()
-
-    def _slopes(self, height: F32) -> tuple[float, float]:
-        """The interpolant's steepest rise per metre along u and along v: in a cell d g/du is
-        a convex combination of the node differences of its two u-edges."""
-        du = np.diff(height, axis=0)
-        dv = np.diff(height, axis=1)
-        su = max(float(du.max()), -float(du.min()))
-        sv = max(float(dv.max()), -float(dv.min()))
-        return su / self.hu, sv / self.hv
 
 
 def _trig(phase: F64) -> tuple[F32, F32]:
@@ -201,17 +166,3 @@ def _trig(phase: F64) -> tuple[F32, F32]:
     phase -= TWO_PI * np.rint(phase / TWO_PI)
     p32 = phase.astype(np.float32)
     return np.cos(p32), np.sin(p32)
-
-
-def _block_max(height: F32, scratch: Scratch) -> tuple[int, F32]:
-    """Highest node of each BLOCK_CELLS-square block of cells (its (B + 1)^2 nodes): the
-    bilinear surface over the block is no higher. Row-major, blocks_v per row."""
-    b = BLOCK_CELLS
-    nu, nv = height.shape
-    bu, bv = (nu - 2) // b + 1, (nv - 2) // b + 1  # blocks covering the nu - 1 x nv - 1 cells
-    pad = scratch.get("grid_pad", (bu * b + 1, bv * b + 1))
-    pad.fill(-np.inf)
-    pad[:nu, :nv] = height
-    rows = np.maximum(pad[:-1].reshape(bu, b, -1).max(axis=1), pad[b::b])
-    block = np.maximum(rows[:, :-1].reshape(bu, bv, b).max(axis=2), rows[:, b::b])
-    return bv, block.ravel()

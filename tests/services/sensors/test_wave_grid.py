@@ -7,7 +7,7 @@ import pytest
 
 from catabot.config.waves import WaveConfig
 from catabot.world.waves import WaveField
-from services.sensors import wave_trace as wt
+from services.sensors import wave_kernel as wk
 from services.sensors.wave_grid import EPS_M, Scratch, WaveGrid, grid_spec
 
 MEDIUM = WaveField(WaveConfig(preset="medium"), 1)
@@ -29,12 +29,17 @@ def _grid(waves: WaveField, anchor: tuple[float, float], time_s: float) -> WaveG
 
 
 def _interpolate(grid: WaveGrid, uv: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """Bilinear height and gradient at grid-frame points (2, n), through the ray code."""
-    n = uv.shape[1]
-    f0 = ((uv - [[grid.u0], [grid.v0]]) / [[grid.hu], [grid.hv]]).astype(np.float32)
-    rays = wt.GridRays(f0, np.zeros((2, n), np.float32), 0.0, np.zeros(n, np.float32))
-    zero = np.zeros(n, np.float32)
-    return -wt.cell_f(grid, rays, zero), wt.gradient(grid, rays, zero)
+    """Bilinear height and gradient at grid-frame points (2, n), through the kernel's own
+    cell lookup and interpolation."""
+    f0 = (uv - [[grid.u0], [grid.v0]]) / [[grid.hu], [grid.hv]]
+    cells, row = (grid.nu - 1, grid.nv - 1), 3 * grid.nv
+    height, grad = np.empty(f0.shape[1]), np.empty((2, f0.shape[1]))
+    for k, (fu, fv) in enumerate(f0.T):
+        ray = (fu, fv, 0.0, 0.0, 0.0, -1.0, -1.0)  # z = 0 at t = 0: f = -g
+        cell = wk._cell_of(cells, ray, 0.0)
+        height[k] = -wk._gap(grid.flat, row, cell, ray, 0.0)[0]
+        grad[:, k] = wk._gradient(grid.flat, row, cell, ray, 0.0)
+    return height, grad
 
 
 def test_calm_water_has_no_grid() -> None:
@@ -83,14 +88,14 @@ def test_interpolated_surface_is_within_its_bounds(
         assert np.abs(grad[axis] - true_grad[axis]).max() <= spec.grad_err[axis] + 1e-5
 
 
-def test_extremes_slopes_and_block_maxima_hold_the_interpolant() -> None:
+def test_extremes_rises_and_block_maxima_hold_the_interpolant() -> None:
     grid = _grid(MEDIUM, (10.0, 20.0), 3.0)
-    nodes = grid.flat.reshape(grid.nu, 3, grid.nv)[:, 0]
+    nodes = grid.flat.reshape(grid.nu, grid.nv, 3)[:, :, 0]
     assert grid.zmin == nodes.min() and grid.zmax == nodes.max()
-    assert grid.slope_u * grid.hu == pytest.approx(np.abs(np.diff(nodes, axis=0)).max())
-    assert grid.slope_v * grid.hv == pytest.approx(np.abs(np.diff(nodes, axis=1)).max())
-    blocks = grid.block_max.reshape(-1, grid.blocks_v)
-    b = 4
-    for i, j in [(0, 0), (3, 5), (blocks.shape[0] - 1, blocks.shape[1] - 1)]:
+    assert grid.rise[0] == pytest.approx(np.abs(np.diff(nodes, axis=0)).max())
+    assert grid.rise[1] == pytest.approx(np.abs(np.diff(nodes, axis=1)).max())
+    top, shape, b = grid.blocks
+    assert top.shape == shape == ((grid.nu - 2) // b + 1, (grid.nv - 2) // b + 1)
+    for i, j in [(0, 0), (3, 5), (shape[0] - 1, shape[1] - 1)]:
         held = nodes[i * b : i * b + b + 1, j * b : j * b + b + 1]
-        assert blocks[i, j] == held.max()
+        assert top[i, j] == held.max()
