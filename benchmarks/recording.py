@@ -30,6 +30,7 @@ from pathlib import Path
 import numpy as np
 from mcap.reader import NonSeekingReader, make_reader
 
+from catabot.run.usage import peak_rss_mb
 from services.recorder.mcap_sink import McapSink
 
 DT_NS = 10_000_000
@@ -81,14 +82,6 @@ def read(path: Path, how: str, topic: str) -> dict[str, float]:
                 size += len(block)
     seconds = time.perf_counter() - start
     return {"seconds": seconds, "rss_mb": peak_rss_mb(), "messages": count, "mb": size / 1e6}
-
-
-def peak_rss_mb() -> float:
-    """This process's peak resident set (VmHWM: not getrusage's ru_maxrss, which a child
-    started by fork and exec inherits from its parent)."""
-    status = Path("/proc/self/status").read_text().splitlines()
-    kb = next(line.split()[1] for line in status if line.startswith("VmHWM:"))
-    return int(kb) / 1024
 
 
 def measured(path: Path, how: str, topic: str) -> dict[str, float]:

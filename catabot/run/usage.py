@@ -3,8 +3,9 @@
 Each service writes `log/<name>.usage.json` when its loop ends; the conductor puts its own in
 its result line and `catabot run` adds its own, so `log/run.json` has one table of every
 process (the Table II benchmark prints it). Peak resident memory is the kernel's high-water
-mark (getrusage's ru_maxrss), so it catches a spike a sampler would miss and costs nothing
-while the run goes.
+mark, so it catches a spike a sampler would miss and costs nothing while the run goes: the
+process's own (VmHWM), not getrusage's ru_maxrss, which a process started by fork and exec
+inherits from its parent (`catabot run` launched from a 1 GB test session reported 1 GB).
 """
 
 from __future__ import annotations
@@ -19,7 +20,12 @@ KIB_PER_MB = 1024.0
 
 
 def peak_rss_mb() -> float:
-    """This process's peak resident set size so far, in MiB (Linux reports KiB)."""
+    """This process's peak resident set size so far, in MiB (Linux reports KiB); where there
+    is no /proc, getrusage's figure."""
+    with contextlib.suppress(OSError, StopIteration, ValueError, IndexError):
+        status = Path("/proc/self/status").read_text().splitlines()
+        kib = next(line.split()[1] for line in status if line.startswith("VmHWM:"))
+        return round(int(kib) / KIB_PER_MB, 1)
     return round(resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / KIB_PER_MB, 1)
 
 

@@ -88,7 +88,7 @@ class LidarModel:
         unit = (cones.axis / cones.dist[:, None]) @ rot  # in the sensor frame
         pairs = grid_pairs(unit, cones.cos_half, self.elevations, p.columns)
         pairs = pairs[0], cones.body[pairs[1]]
-        hits = self.scene.cast(origin, self.dirs @ rot.T, p.max_range_m, pairs)
+        hits = self.scene.cast(origin, self.dirs @ rot.T, p.max_range_m, pairs, normals=False)
         distance = hits.range.astype(np.float64)
         noise = self.rng.normal(0.0, p.range_noise_sigma_m, distance.shape)
         if self.noise:

@@ -75,8 +75,11 @@ class WaveCaster:
         self.scratch = Scratch()
         self.last_plan = ""  # what the last cast did (benchmarks, tests)
 
-    def cast(self, o: F64, d: F64, max_range: float, near: Nearest, time_s: float) -> None:
-        """Give the rays that meet the water before anything else the water's hit."""
+    def cast(
+        self, o: F64, d: F64, max_range: float, near: Nearest, time_s: float, *, normals: bool
+    ) -> None:
+        """Give the rays that meet the water before anything else the water's hit (and its
+        normal, or the calm one where `normals` is False, on the grid)."""
         limit = np.minimum(near.rng, max_range)
         spec = self.spec
         if spec is None:
@@ -98,7 +101,7 @@ class WaveCaster:
             if grid.zmax + spec.eps <= band and grid.zmin - spec.eps >= -band:
                 break
             band = self.amplitude  # the surface left the guessed band: plan with the bound
-        far = cast_on_grid(grid, rays, near, band, max_range)
+        far = cast_on_grid(grid, rays, near, (band, max_range), normals=normals)
         self.last_plan = f"grid {grid.nu} x {grid.nv}, {far.size} rays exact"
         self._exact(near, o, d, limit, far, time_s)
 

@@ -268,15 +268,17 @@ def grid_pass(
     reach: Reach,
     near: tuple[F64, NDArray[np.float32], NDArray[np.uint8], NDArray[np.int32], int],
     far: NDArray[np.bool_],
+    normals: bool,
 ) -> None:
     """Every downward ray (origins o: (1, 3) shared or (n, 3), directions d: (n, 3)) meets
     the interpolant at its first crossing in the band top..bottom (`reach` = top, bottom,
     max range), if that is nearer than its hit so far: near = (range, normal, class,
     instance, the water's class) updated in place. Rays whose band segment leaves the grid
-    are flagged in `far` (the exact march's). surface: the node table, its shape, the
-    steepest rise per cell along u and v (a ray descending faster crosses it once) and
-    the block maxima. A steep ray's Newton starts at the height of the last steep hit:
-    neighbouring rays hit at about the same height, and 99% settle in one step."""
+    are flagged in `far` (the exact march's). normals: the surface's at each hit, else
+    the calm one (up). surface: the node table, its shape, the steepest rise per cell
+    along u and v (a ray descending faster crosses it once) and the block maxima. A steep
+    ray's Newton starts at the height of the last steep hit: neighbouring rays hit at
+    about the same height, and 99% settle in one step."""
     flat, (nu, nv), rise, blocks = surface
     rng, normal, cls, inst, water = near
     row, cells = 3 * nv, (nu - 1, nv - 1)
@@ -298,7 +300,10 @@ def grid_pass(
             t, i, j = _walk_blocks(flat, row, cells, blocks, ray, span[0], span[1])
         if t < rng[r]:
             rng[r], cls[r], inst[r] = t, water, 0
-            _normal(frame, _gradient(flat, row, (i, j), ray, t), normal, r)
+            if normals:
+                _normal(frame, _gradient(flat, row, (i, j), ray, t), normal, r)
+            else:
+                normal[r, 0], normal[r, 1], normal[r, 2] = 0.0, 0.0, 1.0
 
 
 def warm_up() -> None:
@@ -311,5 +316,5 @@ def warm_up() -> None:
     flat = np.zeros(48, np.float32)
     top = block_tops(flat, (4, 4), 4)
     surface = flat, (4, 4), surface_bounds(flat, (4, 4))[2:], (top, top.shape, 4)
-    grid_pass(surface, frame, rays, (0.5, -0.5, 9.0), (*near, np.zeros(1, np.int32), 1), far)
+    grid_pass(surface, frame, rays, (0.5, -0.5, 9.0), (*near, np.zeros(1, np.int32), 1), far, True)
     band_ends((rays[0], rays[1], np.ones(1)), frame[:6], 0.5, 1, np.empty(1))

@@ -54,11 +54,13 @@ def _plain(a: F64) -> F64:
 
 
 def cast_on_grid(
-    grid: WaveGrid, rays: CastRays, near: Nearest, band: float, max_range: float
+    grid: WaveGrid, rays: CastRays, near: Nearest, reach: tuple[float, float], *, normals: bool
 ) -> Idx:
-    """Every downward ray of `rays` against the grid, nearer hits merged into `near`;
-    returns the rays that leave the grid (for the exact march). The planned band holds
-    every covered ray's segment; the surface is within both it and the grid's extremes."""
+    """Every downward ray of `rays` against the grid, nearer hits merged into `near` (with
+    the surface's normals, or the calm one); returns the rays that leave the grid (for the
+    exact march). reach: the planned band, which holds every covered ray's segment (the
+    surface is within both it and the grid's extremes), and the cast's range."""
+    band, max_range = reach
     spec = grid.spec
     top, bottom = min(grid.zmax + spec.eps, band), max(grid.zmin - spec.eps, -band)
     frame = np.concatenate([rays.frame, [grid.u0, grid.v0, 1.0 / grid.hu, 1.0 / grid.hv]])
@@ -66,7 +68,7 @@ def cast_on_grid(
     near_ = (near.rng, near.normal, near.cls, near.inst, CLASS_WATER)
     cast = (rays.o, rays.d)
     surface = (grid.flat, (grid.nu, grid.nv), grid.rise, grid.blocks)
-    grid_pass(surface, frame, cast, (top, bottom, max_range), near_, far)
+    grid_pass(surface, frame, cast, (top, bottom, max_range), near_, far, normals)
     return np.flatnonzero(far)
 
 

@@ -168,3 +168,14 @@ def test_casts_are_deterministic() -> None:
             strict=True,
         ):
             assert a.tobytes() == b.tobytes()
+
+
+def test_a_cast_without_normals_has_the_same_hits_and_the_calm_normal() -> None:
+    """A LiDAR ignores normals: sparing the wave surface's changes no range and no class."""
+    d, o = _fan(6000, 10), np.array([1.0, -1.0, 1.8])
+    full = _scene(MEDIUM, 5.5).cast(o, d, 120.0)
+    bare = _scene(MEDIUM, 5.5).cast(o, d, 120.0, normals=False)
+    assert np.array_equal(full.range, bare.range) and np.array_equal(full.cls, bare.cls)
+    gridded = (bare.cls == CLASS_WATER) & (bare.normal[:, 2] == 1.0)
+    assert gridded.sum() > 3000 and not np.array_equal(full.normal, bare.normal)
+    assert np.all(bare.normal[gridded, :2] == 0.0)

@@ -43,7 +43,7 @@ def _cast(grid: WaveGrid, d: np.ndarray, max_range: float) -> tuple[_Near, np.nd
     near = _Near(d.shape[0])
     o = np.broadcast_to(ORIGIN, d.shape)
     rays = CastRays.of(o, d, np.full(d.shape[0], max_range), grid.spec.rot)
-    far = cast_on_grid(grid, rays, near, 10.0, max_range)
+    far = cast_on_grid(grid, rays, near, (10.0, max_range), normals=True)
     return near, far
 
 
@@ -137,7 +137,7 @@ def test_casts_use_the_kernels_warm_up_compiled() -> None:
     _cast(grid, d, 60.0)  # a shared origin, a read-only broadcast view
     own = np.broadcast_to(ORIGIN + np.array([0.5, 0.0, 0.0]), d.shape)
     rays = CastRays.of(own.copy(), d, np.full(50, 60.0), grid.spec.rot)
-    cast_on_grid(grid, rays, _Near(50), 10.0, 60.0)
+    cast_on_grid(grid, rays, _Near(50), (10.0, 60.0), normals=True)
     for kernel in (wk.grid_pass, wk.band_ends, wk.block_tops, wk.surface_bounds):
         assert len(kernel.signatures) == 1, kernel
 
@@ -148,5 +148,6 @@ def test_calls_with_nearer_hits_keep_them() -> None:
     near = _Near(d.shape[0])
     near.rng[:] = 0.5  # something nearer than the water on every ray
     o = np.broadcast_to(ORIGIN, d.shape)
-    cast_on_grid(grid, CastRays.of(o, d, near.rng.copy(), grid.spec.rot), near, 10.0, 60.0)
+    rays = CastRays.of(o, d, near.rng.copy(), grid.spec.rot)
+    cast_on_grid(grid, rays, near, (10.0, 60.0), normals=True)
     assert (near.rng == 0.5).all() and (near.cls == 0).all()
