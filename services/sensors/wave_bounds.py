@@ -1,23 +1,56 @@
 """Compiled helpers of a cast's plan and grid: where the rays meet the band, the grid's
-bounds. One pass over the arrays each, where NumPy took several (~0.15 ms a LiDAR scan)."""
+bounds. One pass over the arrays each, where NumPy took several (~0.15 ms a LiDAR scan).
+
+And how the sensors' kernels are compiled. numba (llvmlite's compiler: ~110 MB resident) is
+loaded by the first sea with waves, not by every sensors process: a function is marked
+`@compiled` here and compiled, with the rest of its module, by `jit_marked` when its
+module's loader (`bounds()`, wave_kernel's `kernel()`) is first called; calls between marked
+functions reach the compiled ones because the module's own names are rebound. Every kernel
+is cached on disk (a process loads one in ~0.1 s instead of compiling it for ~4 s), runs
+without the GIL, and with NumPy's error model (x / 0 is inf, as the code expects, with no
+check on every division); small helpers are inlined.
+"""
 
 from __future__ import annotations
 
+import functools
 import math
+from collections.abc import Callable
+from dataclasses import dataclass
+from typing import Any, TypeVar
 
-import numba
 import numpy as np
 from numpy.typing import NDArray
 
 Nodes = NDArray[np.float32]
 F64 = NDArray[np.float64]
 Pair = tuple[int, int]
+Fn = TypeVar("Fn", bound=Callable[..., Any])
 NODE = 3  # floats a node of the grid: height, d/du, d/dv
-# How every kernel of the sensors is compiled: cached on disk (a process loads one in ~0.1 s
-# instead of compiling it for ~2 s), without the GIL, and with NumPy's error model (x / 0 is
-# inf, as the code expects, without a check on every division). Small helpers are inlined.
-compiled = numba.njit(cache=True, nogil=True, error_model="numpy")
-compiled_inline = numba.njit(cache=True, nogil=True, error_model="numpy", inline="always")
+OPTIONS = "numba_options"  # where a marked function keeps how it is to be compiled
+
+
+def compiled(fn: Fn) -> Fn:
+    """Mark a kernel for `jit_marked`."""
+    setattr(fn, OPTIONS, {})
+    return fn
+
+
+def compiled_inline(fn: Fn) -> Fn:
+    """Mark a small helper, inlined into its callers."""
+    setattr(fn, OPTIONS, {"inline": "always"})
+    return fn
+
+
+def jit_marked(namespace: dict[str, Any]) -> None:
+    """Compile the marked functions of a module in place (its globals()): idempotent."""
+    import numba  # ≈110 MB: only a process that meets waves pays it
+
+    for name, fn in list(namespace.items()):
+        options = getattr(fn, OPTIONS, None)
+        if options is not None and not isinstance(fn, numba.core.dispatcher.Dispatcher):
+            jit = numba.njit(cache=True, nogil=True, error_model="numpy", **options)
+            namespace[name] = jit(fn)
 
 
 Box = tuple[float, float, float, float]  # u_lo, v_lo, u_hi, v_hi
@@ -98,3 +131,20 @@ def block_tops(flat: Nodes, shape: Pair, size: int) -> NDArray[np.float32]:
                     high = max(high, flat[i * row + j * NODE])
             top[bi, bj] = high
     return top
+
+
+@dataclass(frozen=True)
+class Bounds:
+    """This module's compiled entry points."""
+
+    band_ends: Callable[..., tuple[int, Box]]
+    surface_bounds: Callable[[Nodes, Pair], tuple[float, float, float, float]]
+    block_tops: Callable[[Nodes, Pair, int], NDArray[np.float32]]
+
+
+@functools.cache
+def bounds() -> Bounds:
+    """The compiled helpers (numba loaded and the kernels compiled or read from the cache at
+    the first call)."""
+    jit_marked(globals())
+    return Bounds(band_ends, surface_bounds, block_tops)

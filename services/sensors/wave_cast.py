@@ -23,7 +23,7 @@ from numpy.typing import NDArray
 from catabot.world.waves import WaveField
 from services.sensors.common import Nearest, rows_of
 from services.sensors.water import wave_hits
-from services.sensors.wave_bounds import band_ends
+from services.sensors.wave_bounds import bounds
 from services.sensors.wave_grid import GridSpec, Scratch, WaveGrid, grid_spec
 from services.sensors.wave_kernel import warm_up
 from services.sensors.wave_pass import CastRays, cast_on_grid, merge
@@ -141,7 +141,7 @@ def _footprint(rays: CastRays, band: float, scratch: Scratch) -> _Footprint | No
     n = rays.d.shape[0]
     step = max(1, n // SAMPLE)
     radius = scratch.get("plan_radius", (n // step + 1,), np.float64)
-    m, box = band_ends((rays.o, rays.d, rays.limit), rays.frame, band, step, radius)
+    m, box = bounds().band_ends((rays.o, rays.d, rays.limit), rays.frame, band, step, radius)
     if m == 0:
         return None
     lo, hi = np.array(box[:2]), np.array(box[2:])

@@ -29,7 +29,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from catabot.world.waves import WaveField
-from services.sensors.wave_bounds import block_tops, surface_bounds
+from services.sensors.wave_bounds import bounds
 
 F32 = NDArray[np.float32]
 F64 = NDArray[np.float64]
@@ -124,10 +124,11 @@ class WaveGrid:
         self.nu = math.ceil((hi[0] - lo[0]) / spec.hu) + 3
         self.nv = math.ceil((hi[1] - lo[1]) / spec.hv) + 3
         self.flat = self._nodes(waves, time_s, scratch)
-        low, high, rise_u, rise_v = surface_bounds(self.flat, (self.nu, self.nv))
+        helpers = bounds()
+        low, high, rise_u, rise_v = helpers.surface_bounds(self.flat, (self.nu, self.nv))
         self.zmin, self.zmax = float(low), float(high)
         self.rise = (float(rise_u), float(rise_v))  # steepest rise per cell along u, v
-        top = block_tops(self.flat, (self.nu, self.nv), BLOCK_CELLS)
+        top = helpers.block_tops(self.flat, (self.nu, self.nv), BLOCK_CELLS)
         self.blocks = (top, top.shape, BLOCK_CELLS)
 
     @property

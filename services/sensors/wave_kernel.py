@@ -23,7 +23,9 @@ heights and gradients lie on two short runs of memory.
 
 from __future__ import annotations
 
+import functools
 import math
+from collections.abc import Callable
 
 import numpy as np
 from numpy.typing import NDArray
@@ -33,11 +35,10 @@ from services.sensors.wave_bounds import (
     NODE,
     Nodes,
     Pair,
-    band_ends,
-    block_tops,
+    bounds,
     compiled,
     compiled_inline,
-    surface_bounds,
+    jit_marked,
 )
 
 Ray = tuple[float, float, float, float, float, float, float]  # fu, fv, bu, bv, oz, dz, 1 / dz
@@ -306,15 +307,24 @@ def grid_pass(
                 normal[r, 0], normal[r, 1], normal[r, 2] = 0.0, 0.0, 1.0
 
 
+@functools.cache
+def kernel() -> Callable[..., None]:
+    """grid_pass, compiled (numba loaded and the module's kernels compiled or read from the
+    cache at the first call)."""
+    jit_marked(globals())
+    return grid_pass
+
+
 def warm_up() -> None:
-    """Compile (or load from numba's cache) before a cast needs it: the first call in a
-    process otherwise pays it inside a tick."""
+    """Load numba and every wave kernel, compiled or from the cache, and run each once on
+    the argument types the casts use: a sea with waves (WaveCaster) calls this as it is set,
+    so no tick pays it."""
     frame = np.array([0.0, 0.0, 1.0, 0.0, 0.0, 1.0, 0.0, 0.0, 1.0, 1.0])  # cells of 1 m
     rays = np.array([[1.5, 1.5, 1.0]]), np.array([[0.1, 0.1, -1.0]])
     near = np.full(1, np.inf), np.zeros((1, 3), np.float32), np.zeros(1, np.uint8)
-    far = np.zeros(1, bool)
-    flat = np.zeros(48, np.float32)
-    top = block_tops(flat, (4, 4), 4)
-    surface = flat, (4, 4), surface_bounds(flat, (4, 4))[2:], (top, top.shape, 4)
-    grid_pass(surface, frame, rays, (0.5, -0.5, 9.0), (*near, np.zeros(1, np.int32), 1), far, True)
-    band_ends((rays[0], rays[1], np.ones(1)), frame[:6], 0.5, 1, np.empty(1))
+    flat, helpers = np.zeros(48, np.float32), bounds()
+    top = helpers.block_tops(flat, (4, 4), 4)
+    surface = flat, (4, 4), helpers.surface_bounds(flat, (4, 4))[2:], (top, top.shape, 4)
+    near_ = (*near, np.zeros(1, np.int32), 1)
+    kernel()(surface, frame, rays, (0.5, -0.5, 9.0), near_, np.zeros(1, bool), True)
+    helpers.band_ends((rays[0], rays[1], np.ones(1)), frame[:6], 0.5, 1, np.empty(1))

@@ -16,7 +16,7 @@ from numpy.typing import NDArray
 from catabot.bus.messages import CLASS_WATER
 from services.sensors.common import Nearest
 from services.sensors.wave_grid import WaveGrid
-from services.sensors.wave_kernel import grid_pass
+from services.sensors.wave_kernel import kernel
 
 F32 = NDArray[np.float32]
 F64 = NDArray[np.float64]
@@ -68,7 +68,7 @@ def cast_on_grid(
     near_ = (near.rng, near.normal, near.cls, near.inst, CLASS_WATER)
     cast = (rays.o, rays.d)
     surface = (grid.flat, (grid.nu, grid.nv), grid.rise, grid.blocks)
-    grid_pass(surface, frame, cast, (top, bottom, max_range), near_, far, normals)
+    kernel()(surface, frame, cast, (top, bottom, max_range), near_, far, normals)
     return np.flatnonzero(far)
 
 

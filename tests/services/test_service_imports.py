@@ -12,7 +12,7 @@ import pytest
 
 from tests.paths import REPO
 
-HEAVY = ("open3d", "dartpy", "rerun", "matplotlib", "pandas", "PIL", "tifffile", "rosbags")
+HEAVY = ("open3d", "dartpy", "rerun", "matplotlib", "pandas", "PIL", "tifffile", "rosbags", "numba")
 USES = {  # what each service needs of HEAVY
     "physics": {"dartpy"},
     "traffic": set(),

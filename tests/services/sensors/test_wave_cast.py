@@ -3,6 +3,9 @@ the exact march where the grid does not pay, deterministic."""
 
 from __future__ import annotations
 
+import subprocess
+import sys
+
 import numpy as np
 import pytest
 
@@ -11,6 +14,7 @@ from catabot.config.waves import WaveConfig
 from catabot.world.waves import WaveField
 from services.sensors.scene import Body, Scene
 from services.sensors.water import wave_hits
+from tests.paths import REPO
 
 MEDIUM = WaveField(WaveConfig(preset="medium"), 1)
 HARBOUR = WaveField(WaveConfig(significant_height_m=0.3, peak_period_s=4.0, direction_rad=1.2), 3)
@@ -179,3 +183,23 @@ def test_a_cast_without_normals_has_the_same_hits_and_the_calm_normal() -> None:
     gridded = (bare.cls == CLASS_WATER) & (bare.normal[:, 2] == 1.0)
     assert gridded.sum() > 3000 and not np.array_equal(full.normal, bare.normal)
     assert np.all(bare.normal[gridded, :2] == 0.0)
+
+
+def test_only_a_sea_with_waves_loads_the_compiler() -> None:
+    """numba (≈110 MB resident) is loaded by the first wavy sea, not by calm-water casts."""
+    code = (
+        "import sys, numpy as np\n"
+        "from catabot.config.waves import WaveConfig\n"
+        "from catabot.world.waves import WaveField\n"
+        "from services.sensors.scene import Scene\n"
+        "d = np.array([[0.3, 0.0, -1.0]]); o = np.array([0.0, 0.0, 2.0])\n"
+        "for config in (WaveConfig(), WaveConfig(preset='medium')):\n"
+        "    scene = Scene(terrain=None, waves=WaveField(config, 1), bodies=[])\n"
+        "    scene.update({}, 1.0)\n"
+        "    scene.cast(o, d, 50.0)\n"
+        "    print('numba' in sys.modules)\n"
+    )
+    out = subprocess.run(
+        [sys.executable, "-c", code], cwd=REPO, capture_output=True, text=True, check=True
+    )
+    assert out.stdout.split() == ["False", "True"]
