@@ -88,6 +88,11 @@ class _Expansions:
 
     def __call__(self, x: Array, y: Array, time_s: float) -> Array:
         del time_s  # the expansion is of this step's surface
-        dx = (x - self._x0).astype(np.float32)
-        dy = (y - self._y0).astype(np.float32)
-        return np.broadcast_to(horner(self._coef, self._row, dx, dy), dx.shape).astype(np.float64)
+        # float64 differences rounded to float32 as they are written: the same bits as
+        # (x - x0).astype(np.float32), without the float64 temporary
+        dx = np.subtract(x, self._x0, out=np.empty(x.shape, np.float32), casting="same_kind")
+        dy = np.subtract(y, self._y0, out=np.empty(y.shape, np.float32), casting="same_kind")
+        eta = horner(self._coef, self._row, dx, dy)
+        out = np.empty(dx.shape)
+        out[...] = eta  # broadcast (an order-0 sea) and widened in one pass
+        return out
