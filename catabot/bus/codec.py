@@ -10,6 +10,7 @@ payload is refused with a message naming what is wrong instead of failing later.
 from __future__ import annotations
 
 import dataclasses
+import functools
 import math
 from typing import Any, TypeVar
 
@@ -36,10 +37,16 @@ def _array_to_ext(arr: np.ndarray) -> msgpack.ExtType:
     dtype = arr.dtype.newbyteorder("<") if arr.dtype.byteorder == ">" else arr.dtype
     if dtype.str not in ALLOWED_DTYPES:
         raise CodecError(f"arrays of dtype {arr.dtype} cannot be sent; use one of numeric/bool")
-    shape = list(arr.shape)  # before ascontiguousarray, which turns 0-d into 1-d
+    shape = arr.shape  # before ascontiguousarray, which turns 0-d into 1-d
     arr = np.ascontiguousarray(arr, dtype=dtype)
-    header = msgpack.packb([dtype.str, shape])
-    return msgpack.ExtType(ARRAY_EXT, bytes([len(header)]) + header + arr.tobytes())
+    return msgpack.ExtType(ARRAY_EXT, _header(dtype.str, shape) + arr.tobytes())
+
+
+@functools.lru_cache(maxsize=256)
+def _header(dtype: str, shape: tuple[int, ...]) -> bytes:
+    """An array extension's length-prefixed header: the same few shapes every tick."""
+    header = msgpack.packb([dtype, list(shape)])
+    return bytes([len(header)]) + header
 
 
 def _ext_to_array(code: int, data: bytes) -> Any:
@@ -47,17 +54,25 @@ def _ext_to_array(code: int, data: bytes) -> Any:
         raise CodecError(f"unknown msgpack extension type {code}")
     try:
         hlen = data[0]
-        dtype_str, shape = msgpack.unpackb(data[1 : 1 + hlen])
-        if dtype_str not in ALLOWED_DTYPES:
-            raise CodecError(f"array dtype {dtype_str!r} is not allowed")
-        if not isinstance(shape, list) or not all(type(n) is int and n >= 0 for n in shape):
-            raise CodecError(f"malformed array extension: shape {shape!r}")
-        arr = np.frombuffer(data, dtype=np.dtype(dtype_str), offset=1 + hlen)
+        dtype, shape = _parsed_header(data[1 : 1 + hlen])
+        arr = np.frombuffer(data, dtype=dtype, offset=1 + hlen)
         return arr.reshape(shape)
     except CodecError:
         raise
     except Exception as exc:
         raise CodecError(f"malformed array extension: {exc}") from None
+
+
+@functools.lru_cache(maxsize=256)
+def _parsed_header(header: bytes) -> tuple[np.dtype, tuple[int, ...]]:
+    """An array extension's dtype and shape, checked; the same few headers arrive every tick
+    (a refused one raises, and is not kept)."""
+    dtype_str, shape = msgpack.unpackb(header)
+    if dtype_str not in ALLOWED_DTYPES:
+        raise CodecError(f"array dtype {dtype_str!r} is not allowed")
+    if not isinstance(shape, list) or not all(type(n) is int and n >= 0 for n in shape):
+        raise CodecError(f"malformed array extension: shape {shape!r}")
+    return np.dtype(dtype_str), tuple(shape)
 
 
 def _default(obj: Any) -> Any:

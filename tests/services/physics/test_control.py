@@ -8,6 +8,7 @@ import pytest
 from catabot.bus.messages import ThrustCmd, TwistBatch, TwistCmd
 from catabot.config.vessel import load_vessel_model
 from services.physics.commands import CommandBook, Order
+from services.physics.control import TwistController, TwistControllerBank
 from services.physics.world import PhysicsWorld
 from tests.services.physics.helpers import vessels
 
@@ -76,3 +77,20 @@ def test_orders_gathers_every_vessel_in_world_rows() -> None:
         row = book.row[vid]
         assert order.thrust == thrust.get(row)
         assert order.twist == (tuple(target[rows.tolist().index(row)]) if row in rows else None)
+
+
+def test_the_bank_matches_each_vessels_own_controller_as_the_controlled_set_changes() -> None:
+    """The bank keeps its rows' constants between ticks: a different set of rows (a boat
+    handed to a stack, one back) must give what each boat's own controller gives."""
+    names = ["catabot", "wamv", "monohull"]
+    models = [load_vessel_model(names[i % 3]) for i in range(9)]
+    bank = TwistControllerBank(models, dt_s=0.01)
+    own = [TwistController(m, dt_s=0.01) for m in models]
+    rng = np.random.default_rng(5)
+    for rows in ([0, 1, 2, 3, 4, 5, 6, 7, 8], [0, 1, 2, 3, 4, 5, 6, 7, 8], [1, 4, 7], [2, 8]):
+        idx = np.array(rows)
+        target, measured = rng.uniform(-1, 3, (idx.size, 2)), rng.uniform(-1, 2, (idx.size, 2))
+        out = bank.command(idx, target, measured)
+        for k, row in enumerate(rows):
+            one = own[row].command(tuple(target[k]), tuple(measured[k]))
+            assert np.allclose(out[k, : one.size], one, rtol=1e-12, atol=1e-12), (rows, row)
