@@ -76,11 +76,11 @@ class BatchFormatter:
 
     def _vessels_only(self, batch: BodyStates) -> Block:
         thin = self.thin
-        table = np.concatenate(batch.arrays(), axis=1)[thin.rows]
+        table = thin.table(batch)
         lines = self.vessel_line(batch.stamp_ns, batch.tick, table)
         return Block(
             VesselState, batch.stamp_ns, thin.streams, lines, thin.topics, types.ODOMETRY,
-            thin.odometry_groups(batch), tf=thin.tf(batch),
+            thin.odometry_groups(batch.stamp_ns, table), tf=thin.tf(batch),
         )  # fmt: skip
 
     def twists(self, batch: TwistBatch) -> Block:
