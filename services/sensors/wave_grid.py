@@ -29,7 +29,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from catabot.world.waves import WaveField
-from services.sensors.wave_bounds import bounds
+from services.sensors.wave_bounds import NODE, bounds
 
 F32 = NDArray[np.float32]
 F64 = NDArray[np.float64]
@@ -51,15 +51,6 @@ class GridSpec:
     eps: float  # proven |bilinear - eta| bound at these sizes (m)
     curvature: F64  # (2, 2) sum a k k^T in the world frame: |d2 eta/ds2| <= d^T S d along d
     grad_err: tuple[float, float]  # bounds on the error of the interpolated d eta/du, d eta/dv
-
-    @property
-    def curvature_uv(self) -> F64:
-        """The curvature tensor in the grid frame (diagonal: its principal axes)."""
-        return self.rot @ self.curvature @ self.rot.T
-
-    @property
-    def node_area(self) -> float:
-        return self.hu * self.hv
 
 
 def grid_spec(waves: WaveField, eps: float = EPS_M) -> GridSpec | None:
@@ -105,9 +96,9 @@ class Scratch:
 
 class WaveGrid:
     """The surface's nodes over the box lo..hi (grid frame, metres from `anchor`) at one
-    instant, with the bounds a ray search needs: extremes, steepest rises, block maxima at
-    each block of cells. Positions are in cell units, f = (uv - uv0) / (hu, hv); node (i, j) is
-    flat[3 (i nv + j)], its d/du and d/dv the next two."""
+    instant, with the bounds a ray search needs: extremes, steepest rises and each block's
+    highest node. Positions are in cell units, f = (uv - uv0) / (hu, hv); node (i, j) is
+    flat[NODE (i nv + j)], its d/du and d/dv the next two."""
 
     def __init__(
         self,
@@ -119,12 +110,12 @@ class WaveGrid:
         scratch: Scratch,
     ) -> None:
         lo, hi = box
-        self.spec, self.anchor, self.scratch = spec, anchor, scratch
+        self.spec, self.anchor = spec, anchor
         self.hu, self.hv = spec.hu, spec.hv
         # nodes on the lattice of the cell sizes about the anchor, a cell of margin beyond
         # the box: a sensor's next cast then has the same v-nodes, and `_across` is kept
-        self.i0, self.j0 = math.floor(lo[0] / spec.hu) - 1, math.floor(lo[1] / spec.hv) - 1
-        self.u0, self.v0 = self.i0 * spec.hu, self.j0 * spec.hv
+        self.j0 = math.floor(lo[1] / spec.hv) - 1
+        self.u0, self.v0 = (math.floor(lo[0] / spec.hu) - 1) * spec.hu, self.j0 * spec.hv
         self.nu = math.ceil((hi[0] - self.u0) / spec.hu) + 2
         self.nv = math.ceil((hi[1] - self.v0) / spec.hv) + 2
         self.flat = self._nodes(waves, time_s, scratch)
@@ -134,10 +125,6 @@ class WaveGrid:
         self.rise = (float(rise_u), float(rise_v))  # steepest rise per cell along u, v
         top = helpers.block_tops(self.flat, (self.nu, self.nv), BLOCK_CELLS)
         self.blocks = (top, top.shape, BLOCK_CELLS)
-
-    @property
-    def nodes(self) -> int:
-        return self.nu * self.nv
 
     def _nodes(self, waves: WaveField, time_s: float, scratch: Scratch) -> F32:
         """Height, d/du and d/dv of every node, flat, node after node (row i: the nv nodes of
@@ -153,12 +140,12 @@ class WaveGrid:
         cos_a, sin_a = _trig(np.outer(self.u0 + spec.hu * np.arange(self.nu), spec.k_u) + shift)
         left = scratch.get("grid_left", (self.nu, 2 * m))
         left[:, :m], left[:, m:] = cos_a, sin_a
-        out = scratch.get("grid_nodes", (self.nu, 3 * self.nv))
+        out = scratch.get("grid_nodes", (self.nu, NODE * self.nv))
         np.matmul(left, self._across(waves, scratch), out=out)
         return out.ravel()
 
     def _across(self, waves: WaveField, scratch: Scratch) -> F32:
-        """The (2M, 3 nv) right factor: B = k_v v holds neither the time nor the anchor, so a
+        """The (2M, NODE nv) right factor: B = k_v v holds neither the time nor the anchor, so a
         grid with the same v-nodes as the last one reuses it (a LiDAR's scans: ~0.04 ms)."""
         key = (self.j0, self.nv)
         if scratch.across is not None and scratch.across[0] == key:
@@ -166,7 +153,7 @@ class WaveGrid:
         spec, m = self.spec, waves.amplitudes_m.size
         cos_b, sin_b = _trig(np.outer(self.v0 + spec.hv * np.arange(self.nv), spec.k_v))
         a = waves.amplitudes_m.astype(np.float32)
-        right = np.empty((2 * m, self.nv, 3), np.float32)
+        right = np.empty((2 * m, self.nv, NODE), np.float32)
         right[:m, :, 0], right[m:, :, 0] = (a * cos_b).T, (-a * sin_b).T  # cos(A + B)
         for field, k_axis in ((1, spec.k_u), (2, spec.k_v)):  # d/du: -k_u sin(A + B)
             ak = (a * k_axis).astype(np.float32)

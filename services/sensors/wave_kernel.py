@@ -17,7 +17,7 @@ first root of the interpolant, not a proven approximation of it; the interpolant
 the grid's eps of the sea, so no crossing of the sea before it dips deeper than eps.
 
 Positions are in cell units, f = f0 + t b (t in metres along the ray), heights in metres;
-node (i, j) is flat[i * row + 3 j] (row = 3 nv), its d/du and d/dv the next two: a cell's
+node (i, j) is flat[i * row + NODE j] (row = NODE nv), its d/du and d/dv the next two: a cell's
 heights and gradients lie on two short runs of memory.
 """
 
@@ -282,7 +282,7 @@ def grid_pass(
     about the same height, and 99% settle in one step."""
     flat, (nu, nv), rise, blocks = surface
     rng, normal, cls, inst, water = near
-    row, cells = 3 * nv, (nu - 1, nv - 1)
+    row, cells = NODE * nv, (nu - 1, nv - 1)
     cast = (frame, rays[0], rays[1])
     z = 0.0  # the height of the last steep hit: a neighbouring ray's is near it
     for r in range(rays[1].shape[0]):

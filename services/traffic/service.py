@@ -113,12 +113,12 @@ def _keep_clear(
     """How the boats `ids` keep clear (services/traffic/avoid.py), what of at the start, and
     those bodies' rows in `BodyStates`."""
     radius = {b.model_ref: footprint_m(b.model) for b in world.bodies}
-    own = np.array([radius[world.body(vid).model_ref] for vid in ids])
+    own_r = np.array([radius[world.body(vid).model_ref] for vid in ids])
     buoys = world.buoys if avoid.buoys else ()
     anchors = np.array([(b.pose.x_m, b.pose.y_m) for b in buoys]).reshape(-1, 2)
     buoy_r = max((radius[b.model_ref] for b in buoys), default=0.0)
-    pass_m = own + buoy_r + avoid.clearance_m if buoys else np.zeros(len(ids))
-    clear = KeepClear(anchors, pass_m, own + avoid.clearance_m, avoid.lookahead_s)
+    pass_m = own_r + buoy_r + avoid.clearance_m if buoys else np.zeros(len(ids))
+    clear = KeepClear(anchors, pass_m, own_r + avoid.clearance_m, avoid.lookahead_s)
     wanted = {"buoy": avoid.buoys, "boat": avoid.boats}
     bodies = [b for b in world.bodies if wanted.get(b.kind, avoid.vessels)]
     rows = np.array([b.row for b in bodies], dtype=np.intp)
@@ -127,8 +127,8 @@ def _keep_clear(
     where = {b.id: k for k, b in enumerate(bodies)}
     xy = np.array([(b.pose.x_m, b.pose.y_m) for b in bodies])
     r = np.array([radius[b.model_ref] for b in bodies])
-    own = np.array([where.get(vid, -1) for vid in ids], np.intp)
-    return clear, Obstacles(xy, r, own), rows
+    itself = np.array([where.get(vid, -1) for vid in ids], np.intp)  # a boat's own obstacle
+    return clear, Obstacles(xy, r, itself), rows
 
 
 def build(ctx: ServiceContext) -> Built:
