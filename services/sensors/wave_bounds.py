@@ -42,10 +42,22 @@ def compiled_inline(fn: Fn) -> Fn:
     return fn
 
 
+def compiled_parallel(fn: Fn) -> Fn:
+    """Mark a kernel whose `prange` loops run on every core."""
+    setattr(fn, OPTIONS, {"parallel": True})
+    return fn
+
+
+prange = range  # numba.prange once jit_marked has run
+
+
 def jit_marked(namespace: dict[str, Any]) -> None:
     """Compile the marked functions of a module in place (its globals()): idempotent."""
     import numba  # ≈110 MB: only a process that meets waves pays it
 
+    numba.config.THREADING_LAYER = "workqueue"  # type: ignore[attr-defined]  # OpenMP's spin
+    if "prange" in namespace:
+        namespace["prange"] = numba.prange
     for name, fn in list(namespace.items()):
         options = getattr(fn, OPTIONS, None)
         if options is not None and not isinstance(fn, numba.core.dispatcher.Dispatcher):

@@ -16,9 +16,9 @@ other cell the quadratic gives the first crossing there, if any. The hit is ther
 first root of the interpolant, not a proven approximation of it; the interpolant is within
 the grid's eps of the sea, so no crossing of the sea before it dips deeper than eps.
 
-Positions are in cell units, f = f0 + t b (t in metres along the ray), heights in metres;
-node (i, j) is flat[i * row + NODE j] (row = NODE nv), its d/du and d/dv the next two: a cell's
-heights and gradients lie on two short runs of memory.
+Positions in cell units, f = f0 + t b (t in metres along the ray), heights in metres; node
+(i, j) is flat[i * row + NODE j] (row = NODE nv), its d/du, d/dv the next two: a cell's
+heights and gradients lie on two short runs of memory. The rays run on every core.
 """
 
 from __future__ import annotations
@@ -38,7 +38,9 @@ from services.sensors.wave_bounds import (
     bounds,
     compiled,
     compiled_inline,
+    compiled_parallel,
     jit_marked,
+    prange,
 )
 
 Ray = tuple[float, float, float, float, float, float, float]  # fu, fv, bu, bv, oz, dz, 1 / dz
@@ -49,7 +51,11 @@ STEEP_STEPS = 48  # a cap: Newton in a bracket takes 1-2, bisection would need ~
 Span = tuple[float, float]  # lo, hi: metres along a ray
 Reach = tuple[float, float, float]  # the band's top and bottom, the cast's range
 Cast = tuple[F64, F64, F64]  # frame, origins, directions
+Surface = tuple[Nodes, Pair, tuple[float, float], Level]
+Near = tuple[F64, NDArray[np.float32], NDArray[np.uint8], NDArray[np.int32], int]
 ROOT_M = 1e-6  # |f| at which a steep ray's Newton ends between cells
+CHUNK = 1024  # rays a thread takes at once
+LANES = 16  # more than the cores of most machines
 GROWTH = 1e-9  # a quadratic root this far outside its interval still counts (rounding)
 
 
@@ -261,31 +267,46 @@ def _setup(cast: Cast, r: int, reach: Reach, limit: float) -> tuple[Ray, Span]:
     return ray, span
 
 
-@compiled
+@compiled_parallel
 def grid_pass(
-    surface: tuple[Nodes, Pair, tuple[float, float], Level],
-    frame: F64,
-    rays: tuple[F64, F64],
-    reach: Reach,
-    near: tuple[F64, NDArray[np.float32], NDArray[np.uint8], NDArray[np.int32], int],
-    far: NDArray[np.bool_],
-    normals: bool,
-) -> None:
+    surface: Surface, frame: F64, rays: tuple[F64, F64], reach: Reach, near: Near,
+    far: NDArray[np.bool_], normals: bool,
+) -> None:  # fmt: skip
     """Every downward ray (origins o: (1, 3) shared or (n, 3), directions d: (n, 3)) meets
     the interpolant at its first crossing in the band top..bottom (`reach` = top, bottom,
     max range), if that is nearer than its hit so far: near = (range, normal, class,
     instance, the water's class) updated in place. Rays whose band segment leaves the grid
     are flagged in `far` (the exact march's). normals: the surface's at each hit, else
     the calm one (up). surface: the node table, its shape, the steepest rise per cell
-    along u and v (a ray descending faster crosses it once) and the block maxima. A steep
-    ray's Newton starts at the height of the last steep hit: neighbouring rays hit at
-    about the same height, and 99% settle in one step."""
-    flat, (nu, nv), rise, blocks = surface
+    along u and v (a ray descending faster crosses it once) and the block maxima.
+    Chunks of CHUNK rays run on every core, dealt to LANES lanes in turn (the rows near
+    the horizon cost the most); they are fixed whatever the number of threads, so the
+    hits are too. A parallel loop captures arrays and scalars only: the tuples are taken
+    apart here and put together in each chunk."""
+    flat, (nu, nv), (rise_u, rise_v), (tops, (bu, bv), size) = surface
+    (o, d), (top, bottom, max_range) = rays, reach
     rng, normal, cls, inst, water = near
+    n = d.shape[0]
+    for lane in prange(LANES):
+        for c in range(lane, (n + CHUNK - 1) // CHUNK, LANES):
+            part = (c * CHUNK, min(n, c * CHUNK + CHUNK))
+            surface_ = (flat, (nu, nv), (rise_u, rise_v), (tops, (bu, bv), size))
+            near_ = (rng, normal, cls, inst, water)
+            _chunk(surface_, frame, (o, d), (top, bottom, max_range), near_, far, normals, part)
+
+
+@compiled
+def _chunk(
+    surface: Surface, frame: F64, rays: tuple[F64, F64], reach: Reach, near: Near,
+    far: NDArray[np.bool_], normals: bool, part: Pair,
+) -> None:  # fmt: skip
+    """grid_pass for rays part[0]..part[1]. A steep ray's Newton starts at the last steep
+    hit's height: neighbouring rays hit at about the same height; 99% settle in 1 step."""
+    (flat, (nu, nv), rise, blocks), (rng, normal, cls, inst, water) = surface, near
     row, cells = NODE * nv, (nu - 1, nv - 1)
     cast = (frame, rays[0], rays[1])
-    z = 0.0  # the height of the last steep hit: a neighbouring ray's is near it
-    for r in range(rays[1].shape[0]):
+    z = 0.0  # the last steep hit's height
+    for r in range(part[0], part[1]):
         if not rays[1][r, 2] < -1e-12:
             continue
         ray, span = _setup(cast, r, reach, min(rng[r], reach[2]))
@@ -309,8 +330,7 @@ def grid_pass(
 
 @functools.cache
 def kernel() -> Callable[..., None]:
-    """grid_pass, compiled (numba loaded and the module's kernels compiled or read from the
-    cache at the first call)."""
+    """grid_pass, compiled (numba loaded, the kernels compiled or read from the cache)."""
     jit_marked(globals())
     return grid_pass
 
@@ -325,6 +345,6 @@ def warm_up() -> None:
     flat, helpers = np.zeros(48, np.float32), bounds()
     top = helpers.block_tops(flat, (4, 4), 4)
     surface = flat, (4, 4), helpers.surface_bounds(flat, (4, 4))[2:], (top, top.shape, 4)
-    near_ = (*near, np.zeros(1, np.int32), 1)
-    kernel()(surface, frame, rays, (0.5, -0.5, 9.0), near_, np.zeros(1, bool), True)
+    kernel()(surface, frame, rays, (0.5, -0.5, 9.0), (*near, np.zeros(1, np.int32), 1),
+             np.zeros(1, bool), True)  # fmt: skip
     helpers.band_ends((rays[0], rays[1], np.ones(1)), frame[:6], 0.5, 1, np.empty(1))

@@ -3,6 +3,7 @@ checked against a NumPy reference of the same surface sampled densely along each
 
 from __future__ import annotations
 
+import numba
 import numpy as np
 import pytest
 
@@ -159,3 +160,21 @@ def test_calls_with_nearer_hits_keep_them() -> None:
     rays = CastRays.of(o, d, near.rng.copy(), grid.spec.rot)
     cast_on_grid(grid, rays, near, (10.0, 60.0), normals=True)
     assert (near.rng == 0.5).all() and (near.cls == 0).all()
+
+
+def test_hits_do_not_depend_on_the_number_of_threads() -> None:
+    """The rays run on every core in fixed chunks: one thread or two, the same bytes, on a
+    cast of many chunks (each starts its Newton from its own first ray)."""
+    grid, d = _grid(), _fan(20 * wk.CHUNK + 17, 8, (0.3, 40.0))
+    threads = numba.get_num_threads()
+    try:
+        casts = []
+        for n in (1, threads):
+            numba.set_num_threads(n)
+            casts.append(_cast(grid, d, 60.0))
+    finally:
+        numba.set_num_threads(threads)
+    (one, far_one), (many, far_many) = casts
+    assert far_one.tobytes() == far_many.tobytes() and np.isfinite(one.rng).sum() > 1000
+    for a, b in ((one.rng, many.rng), (one.normal, many.normal), (one.cls, many.cls)):
+        assert a.tobytes() == b.tobytes()
