@@ -12,7 +12,7 @@ $(STAMP): pyproject.toml scripts/system-deps.sh
 	$(PY) -m pip install -q --upgrade pip
 	$(PY) -m pip install -q -e ".[dev]"
 	bash scripts/system-deps.sh
-	$(PY) -c "from services.sensors.wave_kernel import warm_up; warm_up()"  # numba's cache
+	$(PY) -c "from services.sensors.wave_pass import warm_up; warm_up()"  # numba's cache
 	touch $(STAMP)
 
 setup: $(STAMP)

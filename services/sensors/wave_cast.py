@@ -25,8 +25,7 @@ from services.sensors.common import Nearest, rows_of
 from services.sensors.water import wave_hits
 from services.sensors.wave_bounds import bounds
 from services.sensors.wave_grid import GridSpec, Scratch, WaveGrid, grid_spec
-from services.sensors.wave_kernel import warm_up
-from services.sensors.wave_pass import CastRays, cast_on_grid, merge
+from services.sensors.wave_pass import CastRays, cast_on_grid, merge, warm_up
 
 F64 = NDArray[np.float64]
 Idx = NDArray[np.intp]

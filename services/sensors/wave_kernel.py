@@ -1,9 +1,7 @@
 """First crossings of rays with the bilinear wave surface of a WaveGrid: one compiled loop.
 
-Why compiled: the NumPy version of this search (Newton steps, then a proof that the root is
-the first, then sampling of what the proof left unclear) cost ~1 000 NumPy calls a LiDAR
-scan and ~185 ns a camera ray; one loop over the rays does the same work in a few tens of
-ns a ray, and it can afford the exact answer instead of a proof with a tolerance.
+Why compiled: a NumPy search (Newton, then a proof that the root is the first) cost ~1 000
+NumPy calls a scan; a loop over the rays takes tens of ns a ray, and finds the exact root.
 
 Inside one cell the bilinear surface along a ray is a quadratic in t, so its crossings in
 the cell are solved exactly. A ray steeper than every slope of the interpolant along its
@@ -18,7 +16,7 @@ the grid's eps of the sea, so no crossing of the sea before it dips deeper than 
 
 Positions in cell units, f = f0 + t b (t in metres along the ray), heights in metres; node
 (i, j) is flat[i * row + NODE j] (row = NODE nv), its d/du, d/dv the next two: a cell's
-heights and gradients lie on two short runs of memory. The rays run on every core.
+heights and gradients lie on two short runs of memory. A large cast's rays run on every core.
 """
 
 from __future__ import annotations
@@ -35,7 +33,6 @@ from services.sensors.wave_bounds import (
     NODE,
     Nodes,
     Pair,
-    bounds,
     compiled,
     compiled_inline,
     compiled_parallel,
@@ -56,6 +53,7 @@ Near = tuple[F64, NDArray[np.float32], NDArray[np.uint8], NDArray[np.int32], int
 ROOT_M = 1e-6  # |f| at which a steep ray's Newton ends between cells
 CHUNK = 1024  # rays a thread takes at once
 LANES = 16  # more than the cores of most machines
+PARALLEL_RAYS = 65_536  # a smaller cast runs on one thread
 GROWTH = 1e-9  # a quadratic root this far outside its interval still counts (rounding)
 
 
@@ -328,23 +326,25 @@ def _chunk(
                 normal[r, 0], normal[r, 1], normal[r, 2] = 0.0, 0.0, 1.0
 
 
+@compiled
+def serial_pass(
+    surface: Surface, frame: F64, rays: tuple[F64, F64], reach: Reach, near: Near,
+    far: NDArray[np.bool_], normals: bool,
+) -> None:  # fmt: skip
+    """grid_pass on the calling thread, the same chunks one after another (the same hits):
+    for a cast too small to pay for waking the other threads (a LiDAR scan's 16 384 rays)."""
+    n = rays[1].shape[0]
+    for c in range((n + CHUNK - 1) // CHUNK):
+        part = (c * CHUNK, min(n, c * CHUNK + CHUNK))
+        _chunk(surface, frame, rays, reach, near, far, normals, part)
+
+
 @functools.cache
-def kernel() -> Callable[..., None]:
-    """grid_pass, compiled (numba loaded, the kernels compiled or read from the cache)."""
-    jit_marked(globals())
-    return grid_pass
+def _loaded() -> None:
+    jit_marked(globals())  # numba loaded, the kernels compiled or read from the cache
 
 
-def warm_up() -> None:
-    """Load numba and every wave kernel, compiled or from the cache, and run each once on
-    the argument types the casts use: a sea with waves (WaveCaster) calls this as it is set,
-    so no tick pays it."""
-    frame = np.array([0.0, 0.0, 1.0, 0.0, 0.0, 1.0, 0.0, 0.0, 1.0, 1.0])  # cells of 1 m
-    rays = np.array([[1.5, 1.5, 1.0]]), np.array([[0.1, 0.1, -1.0]])
-    near = np.full(1, np.inf), np.zeros((1, 3), np.float32), np.zeros(1, np.uint8)
-    flat, helpers = np.zeros(48, np.float32), bounds()
-    top = helpers.block_tops(flat, (4, 4), 4)
-    surface = flat, (4, 4), helpers.surface_bounds(flat, (4, 4))[2:], (top, top.shape, 4)
-    kernel()(surface, frame, rays, (0.5, -0.5, 9.0), (*near, np.zeros(1, np.int32), 1),
-             np.zeros(1, bool), True)  # fmt: skip
-    helpers.band_ends((rays[0], rays[1], np.ones(1)), frame[:6], 0.5, 1, np.empty(1))
+def kernel(rays: int) -> Callable[..., None]:
+    """The compiled pass for a cast of `rays` rays: on every core from PARALLEL_RAYS on."""
+    _loaded()
+    return grid_pass if rays >= PARALLEL_RAYS else serial_pass

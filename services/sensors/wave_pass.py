@@ -15,8 +15,9 @@ from numpy.typing import NDArray
 
 from catabot.bus.messages import CLASS_WATER
 from services.sensors.common import Nearest
+from services.sensors.wave_bounds import bounds
 from services.sensors.wave_grid import WaveGrid
-from services.sensors.wave_kernel import kernel
+from services.sensors.wave_kernel import PARALLEL_RAYS, kernel
 
 F32 = NDArray[np.float32]
 F64 = NDArray[np.float64]
@@ -68,7 +69,7 @@ def cast_on_grid(
     near_ = (near.rng, near.normal, near.cls, near.inst, CLASS_WATER)
     cast = (rays.o, rays.d)
     surface = (grid.flat, (grid.nu, grid.nv), grid.rise, grid.blocks)
-    kernel()(surface, frame, cast, (top, bottom, max_range), near_, far, normals)
+    kernel(rays.d.shape[0])(surface, frame, cast, (top, bottom, max_range), near_, far, normals)
     return np.flatnonzero(far)
 
 
@@ -86,3 +87,19 @@ def merge(near: Nearest, rows: Idx, t: F64, normal: F32 | F64) -> None:
     else:
         near.normal[rows] = normal32
     near.cls[rows], near.inst[rows] = CLASS_WATER, 0
+
+
+def warm_up() -> None:
+    """Load numba and every wave kernel, compiled or from the cache, and run each once on
+    the argument types the casts use: a sea with waves (WaveCaster) calls this as it is set,
+    so no tick pays it."""
+    frame = np.array([0.0, 0.0, 1.0, 0.0, 0.0, 1.0, 0.0, 0.0, 1.0, 1.0])  # cells of 1 m
+    rays = np.array([[1.5, 1.5, 1.0]]), np.array([[0.1, 0.1, -1.0]])
+    near = np.full(1, np.inf), np.zeros((1, 3), np.float32), np.zeros(1, np.uint8)
+    flat, helpers = np.zeros(48, np.float32), bounds()
+    top = helpers.block_tops(flat, (4, 4), 4)
+    surface = flat, (4, 4), helpers.surface_bounds(flat, (4, 4))[2:], (top, top.shape, 4)
+    for n in (1, PARALLEL_RAYS):  # the one-thread pass and the every-core one
+        kernel(n)(surface, frame, rays, (0.5, -0.5, 9.0), (*near, np.zeros(1, np.int32), 1),
+                  np.zeros(1, bool), True)  # fmt: skip
+    helpers.band_ends((rays[0], rays[1], np.ones(1)), frame[:6], 0.5, 1, np.empty(1))

@@ -9,6 +9,7 @@ from catabot.config.waves import WaveConfig
 from catabot.world.waves import WaveField
 from services.sensors import wave_kernel as wk
 from services.sensors.wave_grid import EPS_M, Scratch, WaveGrid, grid_spec
+from services.sensors.wave_pass import warm_up
 
 MEDIUM = WaveField(WaveConfig(preset="medium"), 1)
 SEAS = {
@@ -31,7 +32,7 @@ def _grid(waves: WaveField, anchor: tuple[float, float], time_s: float) -> WaveG
 def _interpolate(grid: WaveGrid, uv: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """Bilinear height and gradient at grid-frame points (2, n), through the kernel's own
     cell lookup and interpolation."""
-    wk.warm_up()  # the kernel's helpers, compiled
+    warm_up()  # the kernel's helpers, compiled
     f0 = (uv - [[grid.u0], [grid.v0]]) / [[grid.hu], [grid.hv]]
     cells, row = (grid.nu - 1, grid.nv - 1), 3 * grid.nv
     height, grad = np.empty(f0.shape[1]), np.empty((2, f0.shape[1]))

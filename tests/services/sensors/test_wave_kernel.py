@@ -12,7 +12,7 @@ from catabot.world.waves import WaveField
 from services.sensors import wave_kernel as wk
 from services.sensors.wave_bounds import bounds
 from services.sensors.wave_grid import Scratch, WaveGrid, grid_spec
-from services.sensors.wave_pass import CastRays, cast_on_grid
+from services.sensors.wave_pass import CastRays, cast_on_grid, warm_up
 
 MEDIUM = WaveField(WaveConfig(preset="medium"), 1)
 ORIGIN = np.array([4.0, -2.0, 1.2])
@@ -21,7 +21,7 @@ ORIGIN = np.array([4.0, -2.0, 1.2])
 @pytest.fixture(autouse=True)
 def _compiled() -> None:
     """The module's helpers are called straight from here: compiled first, as in a cast."""
-    wk.warm_up()
+    warm_up()
 
 
 class _Near:
@@ -140,14 +140,15 @@ def test_first_root_is_the_least_in_the_interval(
 def test_casts_use_the_kernels_warm_up_compiled() -> None:
     """A second compilation would cost seconds inside a tick: shared and own origins, read-only
     views included, reach the kernels as the one type warm_up compiles them for."""
-    wk.warm_up()
+    warm_up()
     grid, d = _grid(), _fan(50, 6, (1.0, 30.0))
     _cast(grid, d, 60.0)  # a shared origin, a read-only broadcast view
     own = np.broadcast_to(ORIGIN + np.array([0.5, 0.0, 0.0]), d.shape)
     rays = CastRays.of(own.copy(), d, np.full(50, 60.0), grid.spec.rot)
     cast_on_grid(grid, rays, _Near(50), (10.0, 60.0), normals=True)
     helpers = bounds()
-    for kernel in (wk.kernel(), helpers.band_ends, helpers.block_tops, helpers.surface_bounds):
+    kernels = (wk.kernel(1), wk.kernel(wk.PARALLEL_RAYS))
+    for kernel in (*kernels, helpers.band_ends, helpers.block_tops, helpers.surface_bounds):
         assert len(kernel.signatures) == 1, kernel  # type: ignore[attr-defined]
 
 
@@ -162,19 +163,22 @@ def test_calls_with_nearer_hits_keep_them() -> None:
     assert (near.rng == 0.5).all() and (near.cls == 0).all()
 
 
-def test_hits_do_not_depend_on_the_number_of_threads() -> None:
-    """The rays run on every core in fixed chunks: one thread or two, the same bytes, on a
-    cast of many chunks (each starts its Newton from its own first ray)."""
-    grid, d = _grid(), _fan(20 * wk.CHUNK + 17, 8, (0.3, 40.0))
-    threads = numba.get_num_threads()
+def test_hits_do_not_depend_on_the_number_of_threads(monkeypatch: pytest.MonkeyPatch) -> None:
+    """A large cast's rays run on every core in fixed chunks: one thread or all, or the
+    one-thread pass of a small cast, the same bytes (each chunk starts its Newton afresh)."""
+    grid, d = _grid(), _fan(wk.PARALLEL_RAYS + 17, 8, (0.3, 40.0))
+    threads, casts = numba.get_num_threads(), []
     try:
-        casts = []
         for n in (1, threads):
             numba.set_num_threads(n)
             casts.append(_cast(grid, d, 60.0))
     finally:
         numba.set_num_threads(threads)
-    (one, far_one), (many, far_many) = casts
-    assert far_one.tobytes() == far_many.tobytes() and np.isfinite(one.rng).sum() > 1000
-    for a, b in ((one.rng, many.rng), (one.normal, many.normal), (one.cls, many.cls)):
-        assert a.tobytes() == b.tobytes()
+    monkeypatch.setattr(wk, "PARALLEL_RAYS", 10**9)  # the same rays through the serial pass
+    casts.append(_cast(grid, d, 60.0))
+    first, far = casts[0]
+    assert np.isfinite(first.rng).sum() > 10_000
+    for near, far_ in casts[1:]:
+        assert far_.tobytes() == far.tobytes()
+        for a, b in ((first.rng, near.rng), (first.normal, near.normal), (first.cls, near.cls)):
+            assert a.tobytes() == b.tobytes()
