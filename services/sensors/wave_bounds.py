@@ -51,8 +51,9 @@ def compiled_parallel(fn: Fn) -> Fn:
 prange = range  # numba.prange once jit_marked has run
 
 
-def jit_marked(namespace: dict[str, Any]) -> None:
-    """Compile the marked functions of a module in place (its globals()): idempotent."""
+def jit_marked(namespace: dict[str, Any]) -> Any:
+    """Compile the marked functions of a module in place (its globals()): idempotent.
+    Returns numba."""
     import numba  # ≈110 MB: only a process that meets waves pays it
 
     numba.config.THREADING_LAYER = "workqueue"  # type: ignore[attr-defined]  # OpenMP's spin
@@ -63,6 +64,7 @@ def jit_marked(namespace: dict[str, Any]) -> None:
         if options is not None and not isinstance(fn, numba.core.dispatcher.Dispatcher):
             jit = numba.njit(cache=True, nogil=True, error_model="numpy", **options)
             namespace[name] = jit(fn)
+    return numba
 
 
 Box = tuple[float, float, float, float]  # u_lo, v_lo, u_hi, v_hi

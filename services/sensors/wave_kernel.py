@@ -1,22 +1,19 @@
 """First crossings of rays with the bilinear wave surface of a WaveGrid: one compiled loop.
 
-Why compiled: a NumPy search (Newton, then a proof that the root is the first) cost ~1 000
-NumPy calls a scan; a loop over the rays takes tens of ns a ray, and finds the exact root.
-
-Inside one cell the bilinear surface along a ray is a quadratic in t, so its crossings in
-the cell are solved exactly. A ray steeper than every slope of the interpolant along its
-direction crosses it once: Newton from the height of the previous steep ray's hit, each
-step the cell's quadratic, kept in a bracket (99% of a scan's or a frame's rays settle in
-one step). Any other ray walks the blocks of cells its band segment passes (a 2D DDA) from
-where it enters the band: a block, then a cell, whose highest node is below the ray where
-the ray leaves it is passed (the bilinear surface is no higher than its nodes); in any
-other cell the quadratic gives the first crossing there, if any. The hit is therefore the
-first root of the interpolant, not a proven approximation of it; the interpolant is within
-the grid's eps of the sea, so no crossing of the sea before it dips deeper than eps.
+Why compiled: a NumPy search cost ~1 000 calls a scan; a loop takes tens of ns a ray. In a
+cell the bilinear surface along a ray is a quadratic in t, solved exactly. A ray steeper
+than every slope of the interpolant along its direction crosses it once: Newton from the
+height of the previous steep ray's hit, each step the cell's quadratic, kept in a bracket
+(99% settle in one step). Any other ray walks the blocks of cells its band segment passes
+(a 2D DDA) from where it enters the band: a block, then a cell, whose highest node is below
+the ray where the ray leaves it is passed (the bilinear surface is no higher than its
+nodes); in any other cell the quadratic gives the first crossing there, if any. So the hit
+is the first root of the interpolant, which is within the grid's eps of the sea: no
+crossing of the sea before it dips deeper than eps. A large cast's rays use every core.
 
 Positions in cell units, f = f0 + t b (t in metres along the ray), heights in metres; node
 (i, j) is flat[i * row + NODE j] (row = NODE nv), its d/du, d/dv the next two: a cell's
-heights and gradients lie on two short runs of memory. A large cast's rays run on every core.
+heights and gradients lie on two short runs of memory.
 """
 
 from __future__ import annotations
@@ -24,6 +21,7 @@ from __future__ import annotations
 import functools
 import math
 from collections.abc import Callable
+from typing import Any
 
 import numpy as np
 from numpy.typing import NDArray
@@ -277,13 +275,11 @@ def grid_pass(
     are flagged in `far` (the exact march's). normals: the surface's at each hit, else
     the calm one (up). surface: the node table, its shape, the steepest rise per cell
     along u and v (a ray descending faster crosses it once) and the block maxima.
-    Chunks of CHUNK rays run on every core, dealt to LANES lanes in turn (the rows near
-    the horizon cost the most); they are fixed whatever the number of threads, so the
-    hits are too. A parallel loop captures arrays and scalars only: the tuples are taken
-    apart here and put together in each chunk."""
+    Fixed chunks of CHUNK rays (so the hits do not depend on the threads) run on every
+    core, dealt to LANES lanes in turn: the rows near the horizon cost the most. A parallel
+    loop captures no tuples: they are taken apart here, put together in each chunk."""
     flat, (nu, nv), (rise_u, rise_v), (tops, (bu, bv), size) = surface
-    (o, d), (top, bottom, max_range) = rays, reach
-    rng, normal, cls, inst, water = near
+    (o, d), (top, bottom, max_range), (rng, normal, cls, inst, water) = rays, reach, near
     n = d.shape[0]
     for lane in prange(LANES):
         for c in range(lane, (n + CHUNK - 1) // CHUNK, LANES):
@@ -331,8 +327,8 @@ def serial_pass(
     surface: Surface, frame: F64, rays: tuple[F64, F64], reach: Reach, near: Near,
     far: NDArray[np.bool_], normals: bool,
 ) -> None:  # fmt: skip
-    """grid_pass on the calling thread, the same chunks one after another (the same hits):
-    for a cast too small to pay for waking the other threads (a LiDAR scan's 16 384 rays)."""
+    """grid_pass's chunks one after another on the calling thread (the same hits): for a
+    cast too small to pay for waking other threads (a LiDAR scan's 16 384 rays)."""
     n = rays[1].shape[0]
     for c in range((n + CHUNK - 1) // CHUNK):
         part = (c * CHUNK, min(n, c * CHUNK + CHUNK))
@@ -340,11 +336,15 @@ def serial_pass(
 
 
 @functools.cache
-def _loaded() -> None:
-    jit_marked(globals())  # numba loaded, the kernels compiled or read from the cache
+def _numba() -> Any:
+    return jit_marked(globals())  # numba loaded, the kernels compiled or read from the cache
 
 
 def kernel(rays: int) -> Callable[..., None]:
-    """The compiled pass for a cast of `rays` rays: on every core from PARALLEL_RAYS on."""
-    _loaded()
-    return grid_pass if rays >= PARALLEL_RAYS else serial_pass
+    """The compiled pass for a cast of `rays` rays: on every core from PARALLEL_RAYS on, the
+    lanes dealt one at a time to whichever thread is free (not halves dealt at the start),
+    so a thread the machine holds back leaves its lanes to the others."""
+    if rays < PARALLEL_RAYS:
+        return _numba() and serial_pass
+    _numba().set_parallel_chunksize(1)  # the calling thread's setting, for its next loops
+    return grid_pass
