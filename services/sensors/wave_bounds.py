@@ -53,10 +53,11 @@ prange = range  # numba.prange once jit_marked has run
 
 def jit_marked(namespace: dict[str, Any]) -> Any:
     """Compile the marked functions of a module in place (its globals()): idempotent.
-    Returns numba."""
+    Returns numba. Parallel kernels run on numba's workqueue threads, which sleep when idle
+    (OpenMP's spin) and serve one calling thread at a time: a sensors process casts from one."""
     import numba  # ≈110 MB: only a process that meets waves pays it
 
-    numba.config.THREADING_LAYER = "workqueue"  # type: ignore[attr-defined]  # OpenMP's spin
+    numba.config.THREADING_LAYER = "workqueue"  # type: ignore[attr-defined]
     if "prange" in namespace:
         namespace["prange"] = numba.prange
     for name, fn in list(namespace.items()):

@@ -341,10 +341,10 @@ def _numba() -> Any:
 
 
 def kernel(rays: int) -> Callable[..., None]:
-    """The compiled pass for a cast of `rays` rays: on every core from PARALLEL_RAYS on, the
-    lanes dealt one at a time to whichever thread is free (not halves dealt at the start),
-    so a thread the machine holds back leaves its lanes to the others."""
+    """The compiled pass for `rays` rays; from PARALLEL_RAYS on, on every core, each lane to
+    the next free thread (a thread the machine holds back leaves its lanes to the others)."""
+    numba = _numba()  # first: it rebinds the passes to their compiled selves
     if rays < PARALLEL_RAYS:
-        return _numba() and serial_pass
-    _numba().set_parallel_chunksize(1)  # the calling thread's setting, for its next loops
+        return serial_pass
+    numba.set_parallel_chunksize(1)  # the calling thread's setting, for its next loops
     return grid_pass
