@@ -54,7 +54,7 @@ prange = range  # numba.prange once jit_marked has run
 def jit_marked(namespace: dict[str, Any]) -> Any:
     """Compile the marked functions of a module in place (its globals()): idempotent.
     Returns numba. Parallel kernels run on numba's workqueue threads, which sleep when idle
-    (OpenMP's spin) and serve one calling thread at a time: a sensors process casts from one."""
+    (OpenMP's spin) and serve one calling thread at a time (wave_pass takes turns)."""
     import numba  # ≈110 MB: only a process that meets waves pays it
 
     numba.config.THREADING_LAYER = "workqueue"  # type: ignore[attr-defined]

@@ -8,6 +8,7 @@ grid are returned for the exact march (services/sensors/water.py).
 
 from __future__ import annotations
 
+import threading
 from dataclasses import dataclass
 
 import numpy as np
@@ -22,6 +23,8 @@ from services.sensors.wave_kernel import PARALLEL_RAYS, kernel
 F32 = NDArray[np.float32]
 F64 = NDArray[np.float64]
 Idx = NDArray[np.intp]
+ONE_CALLER = threading.Lock()  # numba's workqueue pool aborts the process if two threads
+# launch parallel passes at once: a program casting from several threads takes turns
 ROW = np.dtype((np.void, 12))  # a float32 normal as one item: a 1D scatter is 2x a 2D one
 
 
@@ -69,7 +72,8 @@ def cast_on_grid(
     near_ = (near.rng, near.normal, near.cls, near.inst, CLASS_WATER)
     cast = (rays.o, rays.d)
     surface = (grid.flat, (grid.nu, grid.nv), grid.rise, grid.blocks)
-    kernel(rays.d.shape[0])(surface, frame, cast, (top, bottom, max_range), near_, far, normals)
+    with ONE_CALLER:
+        kernel(rays.d.shape[0])(surface, frame, cast, (top, bottom, max_range), near_, far, normals)
     return np.flatnonzero(far)
 
 

@@ -3,6 +3,8 @@ checked against a NumPy reference of the same surface sampled densely along each
 
 from __future__ import annotations
 
+from concurrent.futures import ThreadPoolExecutor
+
 import numba
 import numpy as np
 import pytest
@@ -182,3 +184,13 @@ def test_hits_do_not_depend_on_the_number_of_threads(monkeypatch: pytest.MonkeyP
         assert far_.tobytes() == far.tobytes()
         for a, b in ((first.rng, near.rng), (first.normal, near.normal), (first.cls, near.cls)):
             assert a.tobytes() == b.tobytes()
+
+
+def test_threads_casting_at_once_take_turns() -> None:
+    """numba's workqueue pool aborts the whole process when two threads launch parallel
+    passes at once; casts from several threads take turns and get the one-thread hits."""
+    grid, d = _grid(), _fan(wk.PARALLEL_RAYS + 1, 8, (0.3, 40.0))
+    alone = _cast(grid, d, 60.0)[0].rng
+    with ThreadPoolExecutor(max_workers=3) as pool:
+        casts = list(pool.map(lambda _: _cast(grid, d, 60.0)[0].rng, range(6)))
+    assert all(c.tobytes() == alone.tobytes() for c in casts)
