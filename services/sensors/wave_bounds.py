@@ -4,7 +4,7 @@ bounds. One pass over the arrays each, where NumPy took several (~0.15 ms a LiDA
 And how the sensors' kernels are compiled. numba (llvmlite's compiler: ~110 MB resident) is
 loaded by the first sea with waves, not by every sensors process: a function is marked
 `@compiled` here and compiled, with the rest of its module, by `jit_marked` when its
-module's loader (`bounds()`, wave_kernel's `kernel()`) is first called; calls between marked
+module's loader (`bounds()`, wave_kernel's `kernel(rays)`) is first called; calls between marked
 functions reach the compiled ones because the module's own names are rebound. Every kernel
 is cached on disk (a process loads one in ~0.1 s instead of compiling it for ~4 s), runs
 without the GIL, and with NumPy's error model (x / 0 is inf, as the code expects, with no

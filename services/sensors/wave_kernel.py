@@ -282,25 +282,24 @@ def grid_pass(
     (o, d), (top, bottom, max_range), (rng, normal, cls, inst, water) = rays, reach, near
     n = d.shape[0]
     for lane in prange(LANES):
-        for c in range(lane, (n + CHUNK - 1) // CHUNK, LANES):
-            part = (c * CHUNK, min(n, c * CHUNK + CHUNK))
+        for c in range(lane, -(-n // CHUNK), LANES):
             surface_ = (flat, (nu, nv), (rise_u, rise_v), (tops, (bu, bv), size))
             near_ = (rng, normal, cls, inst, water)
-            _chunk(surface_, frame, (o, d), (top, bottom, max_range), near_, far, normals, part)
+            _chunk(surface_, frame, (o, d), (top, bottom, max_range), near_, far, normals, c)
 
 
 @compiled
 def _chunk(
     surface: Surface, frame: F64, rays: tuple[F64, F64], reach: Reach, near: Near,
-    far: NDArray[np.bool_], normals: bool, part: Pair,
+    far: NDArray[np.bool_], normals: bool, c: int,
 ) -> None:  # fmt: skip
-    """grid_pass for rays part[0]..part[1]. A steep ray's Newton starts at the last steep
-    hit's height: neighbouring rays hit at about the same height; 99% settle in 1 step."""
+    """grid_pass for chunk c: its rays are fixed whatever the threads, so its hits are. A
+    steep ray's Newton starts at the last steep hit's height (99% settle in 1 step)."""
     (flat, (nu, nv), rise, blocks), (rng, normal, cls, inst, water) = surface, near
     row, cells = NODE * nv, (nu - 1, nv - 1)
     cast = (frame, rays[0], rays[1])
     z = 0.0  # the last steep hit's height
-    for r in range(part[0], part[1]):
+    for r in range(c * CHUNK, min(rays[1].shape[0], c * CHUNK + CHUNK)):
         if not rays[1][r, 2] < -1e-12:
             continue
         ray, span = _setup(cast, r, reach, min(rng[r], reach[2]))
@@ -329,10 +328,8 @@ def serial_pass(
 ) -> None:  # fmt: skip
     """grid_pass's chunks one after another on the calling thread (the same hits): for a
     cast too small to pay for waking other threads (a LiDAR scan's 16 384 rays)."""
-    n = rays[1].shape[0]
-    for c in range((n + CHUNK - 1) // CHUNK):
-        part = (c * CHUNK, min(n, c * CHUNK + CHUNK))
-        _chunk(surface, frame, rays, reach, near, far, normals, part)
+    for c in range(-(-rays[1].shape[0] // CHUNK)):
+        _chunk(surface, frame, rays, reach, near, far, normals, c)
 
 
 @functools.cache
