@@ -48,6 +48,14 @@ def compiled_parallel(fn: Fn) -> Fn:
     return fn
 
 
+def compiled_sum(fn: Fn) -> Fn:
+    """Mark a kernel whose float sums may be reordered, so its loop is vectorised: the same
+    result on every run of one machine, not the strict left-to-right sum. Not inlined: an
+    inlined body takes its caller's (strict) arithmetic."""
+    setattr(fn, OPTIONS, {"fastmath": {"reassoc", "contract"}})
+    return fn
+
+
 prange = range  # numba.prange once jit_marked has run
 
 

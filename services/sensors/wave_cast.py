@@ -31,10 +31,11 @@ F64 = NDArray[np.float64]
 Idx = NDArray[np.intp]
 BAND_SIGMAS = 4.5
 SAMPLE = 4096  # rays the plan looks at
-SMALL_CAST = 3072  # rays: fewer go to the exact march unplanned (measured crossover 2-4 k)
+SMALL_CAST = 2048  # rays: fewer go to the exact march unplanned (measured crossover ~2 k)
 MARGIN = 0.02  # of the sampled footprint, added around it
 MAX_NODES = 2_000_000  # 24 MB of node tables at most
 GRID_NS, GRID_FIXED_NS = 70.0, 200_000.0  # a gridded ray; the rest of a cast (measured)
+GRAZING = 1.4  # a camera's 729 rays beyond its grid: 0.55 us each (more Newton steps)
 SIZES = 0.7 ** np.arange(12)  # grid boxes tried, as fractions of the whole footprint
 
 
@@ -45,10 +46,10 @@ def node_ns(components: int) -> float:
 
 
 def exact_ns(components: int) -> float:
-    """One ray on the exact march: ~6 evaluations of a float32 cosine per component
-    (measured 0.76 us for 48 components, 8-32 k LiDAR-like rays; a gridded ray costs 0.07;
-    a camera's grazing rays beyond its grid, ~2 us)."""
-    return 6.0 * (20.0 + 2.5 * components)
+    """One ray in the band on the compiled exact march: ~10 evaluations of ~0.6 ns a
+    component (measured 0.37-0.41 us for 48 components, 1-16 k LiDAR-like rays, where a
+    gridded ray costs 0.07). A ray leaving a grid grazes the sea: GRAZING times that."""
+    return 10.0 * (10.0 + 0.6 * components)
 
 
 @dataclass(frozen=True)
@@ -68,7 +69,7 @@ class WaveCaster:
         self.waves = waves
         self.amplitude = float(np.sum(waves.amplitudes_m))
         self.spec: GridSpec | None = grid_spec(waves)
-        if self.spec is not None:
+        if not waves.is_calm:
             warm_up()  # the kernels load (or compile) now, not inside the first cast
         sigma = waves.config.significant_height_m / 4.0
         self.guess = min(self.amplitude, BAND_SIGMAS * sigma)
@@ -110,10 +111,10 @@ class WaveCaster:
     ) -> None:
         """The exact march for the rays `idx` (None: all)."""
         if idx is None:
-            merge(near, *wave_hits(self.waves, self.amplitude, o, d, limit, time_s))
+            merge(near, *wave_hits(self.waves, o, d, limit, time_s))
         elif idx.size:
             sub = rows_of(o, idx), np.take(d, idx, axis=0), np.take(limit, idx)
-            rows, t, normal = wave_hits(self.waves, self.amplitude, *sub, time_s)
+            rows, t, normal = wave_hits(self.waves, *sub, time_s)
             merge(near, np.take(idx, rows), t, normal)
 
     def _plan(self, rays: CastRays, band: float, spec: GridSpec) -> tuple[F64, F64] | None:
@@ -128,7 +129,7 @@ class WaveCaster:
         nodes = ((hi[:, 0] - lo[:, 0]) / spec.hu + 3.0) * ((hi[:, 1] - lo[:, 1]) / spec.hv + 3.0)
         inside = np.searchsorted(foot.radius, sizes, side="right") * (n / foot.radius.size)
         cost = GRID_FIXED_NS + node_ns(m) * nodes + GRID_NS * inside
-        cost += exact_ns(m) * (n - inside)
+        cost += GRAZING * exact_ns(m) * (n - inside)
         cost[nodes > MAX_NODES] = np.inf
         best = int(np.argmin(cost))
         if cost[best] >= exact_ns(m) * n:

@@ -19,6 +19,7 @@ from services.sensors.common import Nearest
 from services.sensors.wave_bounds import bounds
 from services.sensors.wave_grid import WaveGrid
 from services.sensors.wave_kernel import PARALLEL_RAYS, kernel
+from services.sensors.wave_march import marcher, sea_tables
 
 F32 = NDArray[np.float32]
 F64 = NDArray[np.float64]
@@ -107,3 +108,6 @@ def warm_up() -> None:
         kernel(n)(surface, frame, rays, (0.5, -0.5, 9.0), (*near, np.zeros(1, np.int32), 1),
                   np.zeros(1, bool), True)  # fmt: skip
     helpers.band_ends((rays[0], rays[1], np.ones(1)), frame[:6], 0.5, 1, np.empty(1))
+    one = np.ones(1)
+    sea = sea_tables(one, one * 0.0, one * 0.0, one * 0.1)
+    marcher()(sea, rays[0], rays[1], np.ones(1), np.empty(1), np.zeros((1, 3)))

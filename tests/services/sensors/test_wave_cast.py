@@ -119,14 +119,7 @@ def test_few_rays_take_the_exact_march_unchanged() -> None:
     o, d = np.array([1.0, 2.0, 3.0]), _fan(60, 6)
     hits = scene.cast(o, d, 250.0)
     assert scene._water.last_plan == "exact"
-    rows, t, normal = wave_hits(
-        MEDIUM,
-        float(MEDIUM.amplitudes_m.sum()),
-        np.broadcast_to(o, d.shape),
-        d,
-        np.full(60, 250.0),
-        5.0,
-    )
+    rows, t, normal = wave_hits(MEDIUM, np.broadcast_to(o, d.shape), d, np.full(60, 250.0), 5.0)
     assert np.array_equal(hits.range[rows], t.astype(np.float32))
     assert np.array_equal(hits.normal[rows], normal.astype(np.float32))
 
