@@ -2,9 +2,10 @@
 
 Jacobi stepping: at tick k every participant advances from t_k to t_(k+1) using only
 samples produced in ticks < k, publishes what it produced (tagged k), then acks k.
-A stream has a period in ticks and is produced at ticks k with k % period == 0; a
-consumer steps tick k only once the last due sample of each stream it reads has
-arrived. That rule, not message ordering, makes runs deterministic across routes.
+A stream has a period in ticks and is produced at ticks k with k % period == phase (0
+but for a decimated copy of another stream); a consumer steps tick k only once the last
+due sample of each stream it reads has arrived. That rule, not message ordering, makes
+runs deterministic across routes.
 A consumer may read a stream with a lag of L ticks (a sample tagged j reaches step k
 only when j < k - L): a fixed transport delay, the same on every run, that lets the
 consumer step up to L ticks ahead of the producer instead of waiting for it every tick.
@@ -39,6 +40,8 @@ class Policy(StrEnum):
 class Stream:
     """A key with one producer and a period in ticks; `period=None` is free-running.
     `lag`: this consumer's fixed delay in ticks on top of the one tick (clocked only).
+    `phase`: samples are tagged k with k % period == phase (the traffic's copy of the states,
+    tagged just before each guidance tick: streams.py).
     `stamp_ticks`: a sample tagged k is stamped (k + stamp_ticks) x dt (states: 1, the state
     at the end of the tick). `check`: raises ValueError for a sample whose content this
     world cannot take (rows of other bodies, a thrust for thrusters the vessel lacks), so a
@@ -51,19 +54,26 @@ class Stream:
     lag: int = 0
     stamp_ticks: int = 0
     check: Callable[[Any], None] | None = field(default=None, compare=False)
+    phase: int = 0
 
     def __post_init__(self) -> None:
         if self.lag < 0 or (self.lag and self.period is None):
             raise ValueError(
                 f"{self.key}: a lag must be >= 0, on a clocked stream (got {self.lag})"
             )
+        if self.phase and not (self.period is not None and 0 <= self.phase < self.period):
+            raise ValueError(f"{self.key}: phase {self.phase} outside 0..period-1")
+
+    def is_due(self, tick: int) -> bool:
+        """Whether a sample is tagged `tick` (clocked streams)."""
+        return self.period is not None and tick >= 0 and tick % self.period == self.phase
 
     def due_before(self, tick: int) -> int:
         """The last tick < `tick` - lag at which a sample is due; -1 if none is due yet."""
         tick -= self.lag
-        if self.period is None or tick <= 0:
+        if self.period is None or tick <= self.phase:
             return -1
-        return ((tick - 1) // self.period) * self.period
+        return ((tick - 1 - self.phase) // self.period) * self.period + self.phase
 
     def released_before(self, tick: int) -> int:
         """Samples tagged below this tick are handed to the step of `tick`."""

@@ -98,7 +98,7 @@ class Inbox:
             if tick != -1:
                 raise Rejected("tick of a free-running sample", f"tick {tick}, not -1")
             return
-        if tick < 0 or tick % stream.period or tick >= horizon or tick <= self.latest[stream.key]:
+        if not stream.is_due(tick) or tick >= horizon or tick <= self.latest[stream.key]:
             raise Rejected(
                 "tag out of the window",
                 f"tick {tick} (period {stream.period}, last {self.latest[stream.key]}, "

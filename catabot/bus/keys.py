@@ -86,6 +86,11 @@ class Keys:
         """Every body's state in one `BodyStates` per tick (what lockstep services read)."""
         return f"{self.prefix}/world/states"
 
+    def guidance_states(self) -> str:
+        """The same `BodyStates` only at the tick before each traffic guidance tick: what
+        the traffic service reads (it would otherwise receive ten batches to use one)."""
+        return f"{self.prefix}/world/states/guidance"
+
     def world_twists(self, shard: int | None = None) -> str:
         """Every traffic boat's twist set-point in one `TwistBatch` per tick (lockstep); with
         `traffic.shards`, each shard's block of boats on a key of its own."""

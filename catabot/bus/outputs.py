@@ -22,9 +22,13 @@ class Outputs:
         self._listeners: dict[str, Any] = {}
         self._watched: set[str] = set()
 
-    def publish(self, key: str, msg: Message) -> None:
-        """Publish an output; lockstep data is never dropped under congestion."""
-        self.put(self._publisher(key), codec.encode(msg))
+    def publish(self, key: str, msg: Message, *, also: Sequence[str] = ()) -> None:
+        """Publish an output; lockstep data is never dropped under congestion. `also`: more
+        keys that carry the same sample (encoded once)."""
+        payload = codec.encode(msg)
+        self.put(self._publisher(key), payload)
+        for other in also:
+            self.put(self._publisher(other), payload)
 
     def put(self, pub: zenoh.Publisher, payload: bytes) -> None:
         """A put that says which session sent it (receivers check it: identity.py)."""

@@ -35,7 +35,11 @@ KEYS: dict[str, tuple[Callable[[], str], str]] = {  # wire type -> key, who puts
     "end": (_K.end, "put by the conductor"),
     "settings_change": (_K.config_changes, "recorded only: changes travel inside `tick`"),
     "vessel_state": (lambda: _K.vessel_state("VESSEL"), "put by physics"),
-    "body_states": (_K.world_states, "put by physics"),
+    "body_states": (
+        _K.world_states,
+        "put by physics (the batch of the tick before each traffic guidance tick also on "
+        "`world/states/guidance`, what the traffic service reads)",
+    ),
     "thrust_cmd": (lambda: _K.cmd_thrust("VESSEL"), "put by you (a client or stack)"),
     "twist_cmd": (lambda: _K.cmd_twist("VESSEL"), "put by you (a client or stack)"),
     "twist_batch": (_K.world_twists, "put by the traffic service"),

@@ -34,7 +34,7 @@ from catabot.errors import CataBotError
 
 OWN = {  # keys each process may put besides its ack and its liveliness token
     CONDUCTOR: ["clock/tick", "clock/end"],
-    "physics": ["world/states", "vessel/*/state"],
+    "physics": ["world/states", "world/states/guidance", "vessel/*/state"],
     "sensors": ["sensor/**"],
     "traffic": ["world/cmd/twist"],
     "recorder": [],

@@ -37,20 +37,22 @@ class Streams:
     controls: tuple[Stream, ...]  # the commands of vessels' controllers (lockstep stacks)
     waypoints: tuple[Stream, ...]  # high-level commands from outside
     twists: tuple[Stream, ...]  # the traffic service's set-points, one per shard (or none)
+    guidance_states: Stream  # the states the traffic service reads (see `_guidance_states`)
 
     @classmethod
     def of(cls, world: World) -> Streams:
         keys, vessels = world.keys, world.vessels
         commands = [s for v in vessels for s in _commands(world, v)]
         owner = world.sensor_owners
+        states = Stream(
+            keys.world_states(),
+            BodyStates,
+            "physics",
+            stamp_ticks=1,  # the state at the end of the tick
+            check=checks.body_states(world.body_ids),
+        )
         return cls(
-            states=Stream(
-                keys.world_states(),
-                BodyStates,
-                "physics",
-                stamp_ticks=1,  # the state at the end of the tick
-                check=checks.body_states(world.body_ids),
-            ),
+            states=states,
             vessel_states=tuple(
                 Stream(keys.vessel_state(v.id), VesselState, "physics") for v in vessels
             ),
@@ -62,6 +64,7 @@ class Streams:
             controls=tuple(s for s in commands if s.period is not None),
             waypoints=tuple(_waypoints(world, v) for v in vessels),
             twists=_twist_batches(world),
+            guidance_states=_guidance_states(world, states),
         )
 
     def lockstep(self) -> list[Stream]:
@@ -109,6 +112,20 @@ def _twist_batches(world: World) -> tuple[Stream, ...]:
         Stream(_twist_key(world, i), TwistBatch, name, period, check=checks.twist_batch(ids))
         for i, (name, ids) in enumerate(blocks.items())
     )
+
+
+def _guidance_states(world: World, states: Stream) -> Stream:
+    """The states traffic guidance reads at tick k (a multiple of its period P) are those
+    tagged k - 1: physics also puts them, the same bytes, on their own key at ticks
+    k % P == P - 1, so the traffic service receives and decodes one batch a guidance period,
+    not one a tick (and waits for physics only at guidance ticks). With P = 1 it is the
+    states stream itself."""
+    if not world.traffic_blocks:
+        return states
+    period = guidance_period_ticks(world.scenario)
+    if period == 1:
+        return states
+    return replace(states, key=world.keys.guidance_states(), period=period, phase=period - 1)
 
 
 def _twist_key(world: World, shard: int) -> str:

@@ -52,6 +52,8 @@ class PhysicsService:
         self.streams += streams.twist_batches(lag=delay)
         self.body_ids = world.body_ids
         self.state_keys = [s.key for s in streams.vessel_states]
+        guidance = streams.guidance_states  # the traffic's copy of the states, when it has one
+        self.guidance = guidance if guidance.key != streams.states.key else None
         self.scenario, self.specs = world.scenario, live.keys_of(world.scenario)
         self.participant = ctx.participant(self.streams)
 
@@ -94,9 +96,9 @@ class PhysicsService:
         stamp = tick.stamp_ns + self.dt_ns
         v, b = self.world.state_arrays(), self.world.buoy_state_arrays()
         cols = [np.concatenate((getattr(v, f), getattr(b, f))) for f in FIELDS]
-        self.participant.publish(
-            self.keys.world_states(), BodyStates(tick.tick, stamp, self.body_ids, *cols)
-        )
+        also = [self.guidance.key] if self.guidance and self.guidance.is_due(tick.tick) else []
+        batch = BodyStates(tick.tick, stamp, self.body_ids, *cols)
+        self.participant.publish(self.keys.world_states(), batch, also=also)
         for i in self.participant.watched_among(self.state_keys):
             row = (tuple(getattr(v, f)[i].tolist()) for f in FIELDS)
             self.participant.publish(self.state_keys[i], VesselState(tick.tick, stamp, *row))

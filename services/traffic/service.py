@@ -48,20 +48,20 @@ class TrafficService:
         self.pos = np.array([(b.pose.x_m, b.pose.y_m) for b in boats], dtype=np.float64)
         self.yaw = np.array([b.pose.yaw_rad for b in boats], dtype=np.float64)
         self.vel = np.zeros((n, 2))
-        self.states_key = ctx.keys.world_states()
+        states = world.streams.guidance_states  # only the batches guidance reads
+        self.states_key = states.key
         self.boat_rows = np.array([world.body(vid).row for vid in self.ids], dtype=np.intp)
         waypoints = [s for s in world.streams.waypoints if ctx.keys.vessel_of(s.key) in self.row]
         (self.twists_key,) = [s.key for s in world.streams.twists if s.producer == ctx.name]
         self.period = guidance_period_ticks(ctx.scenario)
         self.traffic, self.specs = ctx.scenario.traffic, live.keys_of(ctx.scenario)
-        self.participant = ctx.participant([world.streams.states, *waypoints])
+        self.participant = ctx.participant([states, *waypoints])
 
     def step(self, tick: Tick, inputs: Inputs) -> None:
         guide = tick.tick % self.period == 0
         for key, msgs in inputs.items():
             if key == self.states_key:
-                if guide:  # the states of the ticks between are not needed
-                    self._take_states(msgs[-1])
+                self._take_states(msgs[-1])  # tagged k - 1: released at guidance ticks only
                 continue
             i = self.row[self.keys.vessel_of(key)]
             for msg in msgs:

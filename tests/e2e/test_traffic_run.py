@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import math
 import time
+from dataclasses import replace
 from pathlib import Path
 from typing import Any
 
@@ -16,8 +17,11 @@ from catabot.bus.messages import TwistCmd, WaypointsCmd
 from catabot.bus.session import Connection, free_port, open_session
 from catabot.config.load import load_scenario
 from catabot.config.scenario import ClockConfig
+from catabot.world import rotations
 from catabot.world.terrain import load_terrain
 from catabot.world.world import World
+from services.traffic.behaviours import Behaviours
+from services.traffic.service import _keep_clear
 from tests.paths import BAY
 
 CIRCLE_RATE = math.radians(15.0)  # 5 m/s on the default 19.1 m circle
@@ -144,3 +148,30 @@ def test_set_points_come_at_the_guidance_rate_and_are_held_between(tmp_path: Pat
     assert twists[:, 1].tolist() == list(range(0, 30, 5))  # the tick column
     speed = _states(run, "boat_000")[:, 9]  # linear_velocity_x
     assert (np.diff(speed[1:]) > 0).all(), speed
+
+
+def test_guidance_reads_the_states_of_the_tick_before_its_own(tmp_path: Path) -> None:
+    """The traffic service receives only its copy of the states (`world/states/guidance`,
+    one batch a guidance period): the set-point of guidance tick k is the boat's law applied
+    to the state recorded at tick k - 1 (DESIGN.md §4), bit for bit."""
+    data = _traffic("guidestate", 1, duration_s=0.6, recording={"mcap": False})
+    data["traffic"] |= {"behaviour_mix": {"circle": 1.0}, "guidance_hz": 20.0}
+    out = tmp_path / "o"
+    result = catabot("run", str(scenario_file(tmp_path, data)), "--out", str(out), "--quiet")
+    assert result.returncode == 0, result.stderr
+    run = only_run_dir(out)
+    world = World.resolve(load_scenario(run / "scenario.json"))
+    ids = world.traffic_blocks["traffic"]
+    clear, obstacles, rows = _keep_clear(world, ids, world.scenario.traffic.avoid)
+    law = Behaviours(world.traffic.boats, hold_gain=world.scenario.traffic.hold.gain, clear=clear)
+    states = _states(run, "boat_000")  # stamp, tick, position (3), orientation (4), velocity
+    twists = np.loadtxt(run / "vessel.boat_000.cmd.twist.csv", delimiter=",", skiprows=1)
+    assert twists[1:, 1].tolist() == list(range(5, 60, 5))
+    for _, tick, surge, rate in twists[1:]:
+        s = states[int(tick) - 1]
+        assert s[1] == tick - 1
+        assert obstacles is not None and rows.tolist() == [world.body("boat_000").row]
+        seen = replace(obstacles, xy=s[None, 2:4].copy())
+        yaw = rotations.yaw_of_quaternions(s[None, 5:9])
+        got = law.command(s[None, 2:4].copy(), yaw, s[None, 9:11].copy(), seen)
+        assert (float(got[0][0]), float(got[1][0])) == (surge, rate), tick

@@ -195,6 +195,28 @@ def test_a_lagged_stream_is_due_and_released_lag_ticks_later() -> None:
     assert [m.tick for m in inbox.release(9)[STATE]] == [2, 3, 4, 5]
 
 
+def test_a_phased_stream_is_due_the_tick_before_each_period() -> None:
+    """The traffic's copy of the states (period 10, phase 9): its step at a guidance tick k
+    waits for the batch tagged k - 1 and, between guidance ticks, for nothing new."""
+    s = Stream(STATE, VesselState, "physics", 10, phase=9)
+    due = [s.due_before(k) for k in (0, 9, 10, 11, 19, 20, 21, 30)]
+    assert due == [-1, -1, 9, 9, 9, 19, 19, 29]
+    assert [k for k in range(-1, 31) if s.is_due(k)] == [9, 19, 29]
+    inbox = Inbox([s], roster=Roster(ZIDS))
+    assert inbox.missing(10) == [STATE] and inbox.missing(9) == []
+    with pytest.raises(Rejected, match="tag out of the window"):
+        _add(inbox, STATE, _state(10))  # not a tick of its phase
+    _add(inbox, STATE, _state(9))
+    assert inbox.missing(20) == [STATE] and inbox.missing(19) == []
+    assert [m.tick for m in inbox.release(10)[STATE]] == [9]
+
+
+@pytest.mark.parametrize("phase, period", [(-1, 10), (10, 10), (1, None)])
+def test_a_phase_lies_within_a_clocked_period(phase: int, period: int | None) -> None:
+    with pytest.raises(ValueError, match="phase"):
+        Stream(STATE, VesselState, "physics", period, phase=phase)
+
+
 @pytest.mark.parametrize("lag, period", [(-1, 1), (2, None)])
 def test_a_lag_must_be_non_negative_and_on_a_clocked_stream(lag: int, period: int | None) -> None:
     with pytest.raises(ValueError, match="lag"):
