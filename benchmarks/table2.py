@@ -124,8 +124,15 @@ def option(args: list[str], flag: str, default: list[int]) -> list[int]:
     return [int(x) for x in args[args.index(flag) + 1].split(",")]
 
 
+FLAGS = ("--columns", "--boats", "--rounds")
+USAGE = __doc__.split("Usage: ")[1].strip() if __doc__ else ""
+
+
 def main(argv: list[str] | None = None) -> None:
     args = sys.argv[1:] if argv is None else argv
+    unknown = [a for a in args if a.startswith("-") and a not in FLAGS]
+    if unknown:  # -h included: a typo must not start a 20-minute benchmark
+        sys.exit(f"{' '.join(unknown)}: not an option\nusage: {USAGE}")
     numbers = [a for a in args if a.replace(".", "", 1).isdigit()]
     seconds = float(numbers[0]) if numbers and args.index(numbers[0]) == 0 else 60.0
     missing = sorted({"lidar", "radar", "camera"} - set(SENSOR_TYPES))
