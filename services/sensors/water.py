@@ -30,11 +30,14 @@ than their cosines: a radar tick ~0.6 ms, a camera's 729 far rays 1.3-1.6 ms).
 
 from __future__ import annotations
 
+import functools
+
 import numpy as np
 from numpy.typing import NDArray
 
 from catabot.world.waves import WaveField
-from services.sensors.wave_march import marcher, sea_tables
+from services.sensors.wave_bounds import origins, plain
+from services.sensors.wave_march import Sea, marcher, sea_tables
 
 F64 = NDArray[np.float64]
 
@@ -59,15 +62,13 @@ def wave_hits(
     """The rays that meet the wave surface before `limit`, their distances and the
     surface's unit normals there (world frame): the compiled march (wave_march.py)."""
     shift = waves.phases_rad - waves.frequencies_radps * time_s
-    sea = sea_tables(waves.wavenumbers_radpm, waves.directions_rad, shift, waves.amplitudes_m)
     t, normal = np.empty(d.shape[0]), np.zeros((d.shape[0], 3))
-    own = o[:1] if o.strides[0] == 0 else o  # a shared origin: one row
-    marcher()(sea, _plain(own), _plain(d), _plain(limit), t, normal)
+    marcher()(_sea(waves), shift, origins(o), plain(d), plain(limit), t, normal)
     rows = np.flatnonzero(t < np.inf)
     return rows, np.take(t, rows), np.take(normal, rows, axis=0)
 
 
-def _plain(a: F64) -> F64:
-    """Contiguous, writable float64 (a copy only where needed): the one array type the
-    kernel is compiled for."""
-    return np.require(a, np.float64, ["C", "W"])
+@functools.lru_cache(maxsize=8)  # a scene's sea, and the next one a run-time setting sets
+def _sea(waves: WaveField) -> Sea:
+    """The march's tables of a sea, built once for it, not at every cast."""
+    return sea_tables(waves.wavenumbers_radpm, waves.directions_rad, waves.amplitudes_m)

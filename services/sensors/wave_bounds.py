@@ -59,6 +59,18 @@ def compiled_sum(fn: Fn) -> Fn:
 prange = range  # numba.prange once jit_marked has run
 
 
+def plain(a: F64) -> F64:
+    """Contiguous, writable float64 (a copy only where needed): the one array type the
+    kernels are compiled for (a read-only view, a shared origin's, would compile again)."""
+    return np.require(a, np.float64, ["C", "W"])
+
+
+def origins(o: F64) -> F64:
+    """The rays' origins as the kernels take them: (1, 3) for a shared origin (a broadcast
+    view, stride 0), else (n, 3); plain."""
+    return plain(o[:1] if o.strides[0] == 0 else o)
+
+
 def jit_marked(namespace: dict[str, Any]) -> Any:
     """Compile the marked functions of a module in place (its globals()): idempotent.
     Returns numba. Parallel kernels run on numba's workqueue threads, which sleep when idle

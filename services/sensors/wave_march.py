@@ -28,7 +28,7 @@ from services.sensors.wave_bounds import F64, compiled, compiled_inline, compile
 
 F32 = NDArray[np.float32]
 R32 = np.float32  # one float32 number: the sums stay in float32, as NumPy's did
-Sea = tuple[F64, F64, F32, F32, F32, float, float]  # see sea_tables
+Sea = tuple[F64, F32, F32, F32, float, float]  # see sea_tables
 Bracket = tuple[float, float, float, float]  # a, f(a), b, f(b)
 MARCH_SAMPLES = 8
 REFINE_STEPS = 16  # a cap: Newton in a bracket takes 2-6
@@ -44,16 +44,16 @@ COS = tuple(np.float32((-1) ** n / math.factorial(2 * n)) for n in range(10))
 SIN = tuple(np.float32((-1) ** n / math.factorial(2 * n + 1)) for n in range(10))
 
 
-def sea_tables(k: F64, theta: F64, shift: F64, amplitudes: F64) -> Sea:
-    """What the kernel reads of a sea at one instant: the wave vectors (2, M) in float64
-    (phases at the origins) and float32 (phase rates), the phases at the origin of the map
-    (phi - omega T), the amplitudes, their slopes a k (2, M), the sum of the amplitudes
-    (the band) and of a k (the steepest possible surface)."""
+def sea_tables(k: F64, theta: F64, amplitudes: F64) -> Sea:
+    """What the kernel reads of a sea, whatever the instant: the wave vectors (2, M) in
+    float64 (phases at the origins) and float32 (phase rates), the amplitudes, their slopes
+    a k (2, M), the sum of the amplitudes (the band) and of a k (the steepest surface). The
+    instant comes with each call: the phases at the map's origin, phi - omega T."""
     kxy = np.stack([k * np.cos(theta), k * np.sin(theta)])
     slopes = (amplitudes * kxy).astype(np.float32)
     amplitude, steepest = float(np.sum(amplitudes)), float(np.sum(amplitudes * k))
     k32, a32 = kxy.astype(np.float32), amplitudes.astype(np.float32)
-    return kxy, shift, k32, a32, slopes, amplitude, steepest
+    return kxy, k32, a32, slopes, amplitude, steepest
 
 
 @compiled_inline
@@ -116,6 +116,12 @@ def _slope(phase0: F32, rate: F32, slopes: F32, t: float) -> tuple[float, float]
 
 
 @compiled_inline
+def _gap(tables: Tables, ray: Ray, t: float) -> float:
+    """f = z - eta at t along the ray: positive above the water."""
+    return ray[0] + t * ray[1] - _eta(*tables, t)
+
+
+@compiled_inline
 def _phases(kxy: F64, shift: F64, x: float, y: float, out: F32) -> None:
     """Each component's phase at (x, y), reduced to within half a turn before float32."""
     for m in range(out.shape[0]):
@@ -143,10 +149,13 @@ def _band(oz: float, dz: float, limit: float, amplitude: float) -> tuple[float, 
 
 
 @compiled
-def march_pass(sea: Sea, o: F64, d: F64, limit: F64, t_out: F64, normal_out: F64) -> None:
+def march_pass(
+    sea: Sea, shift: F64, o: F64, d: F64, limit: F64, t_out: F64, normal_out: F64
+) -> None:
     """Each ray's first crossing before `limit` into t_out (inf: none) and the surface's
-    upward unit normal there into normal_out. Origins o: (1, 3) shared or (n, 3)."""
-    kxy, shift, k32, amp, slopes, amplitude, steepest = sea
+    upward unit normal there into normal_out, the phases at the map's origin being `shift`.
+    Origins o: (1, 3) shared or (n, 3)."""
+    kxy, k32, amp, slopes, amplitude, steepest = sea
     phase0, rate = np.empty(amp.shape[0], np.float32), np.empty(amp.shape[0], np.float32)
     shared = o.shape[0] == 1
     if shared:
@@ -188,7 +197,7 @@ def _crossing(tables: Tables, ray: Ray, span: tuple[float, float], limited: bool
     bracket = (t0, fa, t1, oz + t1 * dz)
     if -dz > steep * (1.0 + 1e-6):  # steeper than the surface: one crossing at most
         if limited:
-            fb = bracket[3] - _eta(*tables, t1)
+            fb = _gap(tables, ray, t1)
             if fb > 0.0:
                 return math.inf
             bracket = (t0, fa, t1, fb)
@@ -204,11 +213,11 @@ def _crossing(tables: Tables, ray: Ray, span: tuple[float, float], limited: bool
 def _march(tables: Tables, ray: Ray, bracket: Bracket) -> Bracket:
     """MARCH_SAMPLES samples from t0 to t1 up to the first under the surface: (the last
     above, its f, the first under, its f); f(b) > 0 where none is."""
-    (oz, dz, _), (a, fa, t1, _) = ray, bracket
+    a, fa, t1, _ = bracket
     t0, step = a, (t1 - a) / MARCH_SAMPLES
     for k in range(1, MARCH_SAMPLES + 1):
         t = t0 + k * step
-        f = oz + t * dz - _eta(*tables, t)
+        f = _gap(tables, ray, t)
         if f <= 0.0:
             return a, fa, t, f
         a, fa = t, f
@@ -222,7 +231,7 @@ def _narrow(tables: Tables, ray: Ray, bracket: Bracket) -> Bracket:
     sign gives. The far end gets the value f would have if the surface were flat there."""
     (oz, dz, steep), (a, fa, b, fb) = ray, bracket
     t = min(max(-oz / dz, a), b)
-    f = oz + t * dz - _eta(*tables, t)
+    f = _gap(tables, ray, t)
     reach = abs(f) / (-dz - steep)
     if f > 0.0:
         far = min(t + reach, b)

@@ -16,7 +16,7 @@ from numpy.typing import NDArray
 
 from catabot.bus.messages import CLASS_WATER
 from services.sensors.common import Nearest
-from services.sensors.wave_bounds import bounds
+from services.sensors.wave_bounds import bounds, origins, plain
 from services.sensors.wave_grid import WaveGrid
 from services.sensors.wave_kernel import PARALLEL_RAYS, kernel
 from services.sensors.wave_march import marcher, sea_tables
@@ -43,19 +43,13 @@ class CastRays:
 
     @classmethod
     def of(cls, o: F64, d: F64, limit: F64, rot: F64) -> CastRays:
-        own = _plain(o[:1] if o.strides[0] == 0 else o)
-        return cls(own, _plain(d), limit, rot, own[:, :2].mean(axis=0))
+        own = origins(o)
+        return cls(own, plain(d), limit, rot, own[:, :2].mean(axis=0))
 
     @property
     def frame(self) -> F64:
         """anchor (2), then rot (2 x 2, row-major): what the passes place rays with."""
         return np.concatenate([self.anchor, self.rot.ravel()])
-
-
-def _plain(a: F64) -> F64:
-    """Contiguous, writable float64 (a copy only where needed): the one array type the
-    kernels are compiled for (a read-only view, a shared origin's, would compile again)."""
-    return np.require(a, np.float64, ["C", "W"])
 
 
 def cast_on_grid(
@@ -109,5 +103,5 @@ def warm_up() -> None:
                   np.zeros(1, bool), True)  # fmt: skip
     helpers.band_ends((rays[0], rays[1], np.ones(1)), frame[:6], 0.5, 1, np.empty(1))
     one = np.ones(1)
-    sea = sea_tables(one, one * 0.0, one * 0.0, one * 0.1)
-    marcher()(sea, rays[0], rays[1], np.ones(1), np.empty(1), np.zeros((1, 3)))
+    sea = sea_tables(one, one * 0.0, one * 0.1)
+    marcher()(sea, one * 0.0, rays[0], rays[1], np.ones(1), np.empty(1), np.zeros((1, 3)))

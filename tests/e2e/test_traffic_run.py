@@ -167,10 +167,10 @@ def test_guidance_reads_the_states_of_the_tick_before_its_own(tmp_path: Path) ->
     states = _states(run, "boat_000")  # stamp, tick, position (3), orientation (4), velocity
     twists = np.loadtxt(run / "vessel.boat_000.cmd.twist.csv", delimiter=",", skiprows=1)
     assert twists[1:, 1].tolist() == list(range(5, 60, 5))
+    assert obstacles is not None and rows.tolist() == [world.body("boat_000").row]
     for _, tick, surge, rate in twists[1:]:
         s = states[int(tick) - 1]
         assert s[1] == tick - 1
-        assert obstacles is not None and rows.tolist() == [world.body("boat_000").row]
         seen = replace(obstacles, xy=s[None, 2:4].copy())
         yaw = rotations.yaw_of_quaternions(s[None, 5:9])
         got = law.command(s[None, 2:4].copy(), yaw, s[None, 9:11].copy(), seen)
