@@ -9,7 +9,8 @@ height of the previous steep ray's hit, each step the cell's quadratic, kept in 
 the ray where the ray leaves it is passed (the bilinear surface is no higher than its
 nodes); in any other cell the quadratic gives the first crossing there, if any. So the hit
 is the first root of the interpolant, which is within the grid's eps of the sea: no
-crossing of the sea before it dips deeper than eps. A large cast's rays use every core.
+crossing of the sea before it dips deeper than eps. A large cast's chunks of rays run on
+every core (services/sensors/wave_pass.py).
 
 Positions in cell units, f = f0 + t b (t in metres along the ray), heights in metres; node
 (i, j) is flat[i * row + NODE j] (row = NODE nv), its d/du, d/dv the next two: a cell's
@@ -21,7 +22,6 @@ from __future__ import annotations
 import functools
 import math
 from collections.abc import Callable
-from typing import Any
 
 import numpy as np
 from numpy.typing import NDArray
@@ -31,11 +31,9 @@ from services.sensors.wave_bounds import (
     NODE,
     Nodes,
     Pair,
-    compiled,
+    compiled_fused,
     compiled_inline,
-    compiled_parallel,
     jit_marked,
-    prange,
 )
 
 Ray = tuple[float, float, float, float, float, float, float]  # fu, fv, bu, bv, oz, dz, 1 / dz
@@ -49,9 +47,7 @@ Cast = tuple[F64, F64, F64]  # frame, origins, directions
 Surface = tuple[Nodes, Pair, tuple[float, float], Level]
 Near = tuple[F64, NDArray[np.float32], NDArray[np.uint8], NDArray[np.int32], int]
 ROOT_M = 1e-6  # |f| at which a steep ray's Newton ends between cells
-CHUNK = 1024  # rays a thread takes at once
-LANES = 16  # more than the cores of most machines
-PARALLEL_RAYS = 65_536  # a smaller cast runs on one thread
+CHUNK = 1024  # rays whose hits one thread finds in turn
 GROWTH = 1e-9  # a quadratic root this far outside its interval still counts (rounding)
 
 
@@ -141,7 +137,7 @@ def _scaled(ray: Ray, size: int) -> Ray:
     return ray[0] * k, ray[1] * k, ray[2] * k, ray[3] * k, ray[4], ray[5], ray[6]
 
 
-@compiled
+@compiled_fused
 def _walk(flat: Nodes, row: int, cells: Pair, ray: Ray, lo: float, hi: float) -> Hit:
     """The first crossing in [lo, hi] of a ray walked cell by cell (inf: none): a cell whose
     highest corner is below the ray where it leaves the cell is passed."""
@@ -160,7 +156,7 @@ def _walk(flat: Nodes, row: int, cells: Pair, ray: Ray, lo: float, hi: float) ->
     return math.inf, 0, 0
 
 
-@compiled
+@compiled_fused
 def _walk_blocks(
     flat: Nodes, row: int, cells: Pair, level: Level, ray: Ray, lo: float, hi: float
 ) -> Hit:
@@ -180,7 +176,7 @@ def _walk_blocks(
     return math.inf, 0, 0
 
 
-@compiled
+@compiled_fused
 def _steep(flat: Nodes, row: int, cells: Pair, ray: Ray, span: Span, z: float) -> Hit:
     """The one crossing in [lo, hi] = `span` of a ray steeper than the surface (f
     decreasing): Newton from where the ray is at height z, each step the cell's quadratic,
@@ -254,7 +250,7 @@ def _normal(frame: F64, grad: tuple[float, float], out: NDArray[np.float32], r: 
     out[r, 0], out[r, 1], out[r, 2] = -gx * scale, -gy * scale, scale
 
 
-@compiled
+@compiled_fused
 def _setup(cast: Cast, r: int, reach: Reach, limit: float) -> tuple[Ray, Span]:
     """Ray r in cell units and its segment in the band (lo >= hi: none)."""
     frame, o, d = cast
@@ -263,37 +259,12 @@ def _setup(cast: Cast, r: int, reach: Reach, limit: float) -> tuple[Ray, Span]:
     return ray, span
 
 
-@compiled_parallel
-def grid_pass(
-    surface: Surface, frame: F64, rays: tuple[F64, F64], reach: Reach, near: Near,
-    far: NDArray[np.bool_], normals: bool,
-) -> None:  # fmt: skip
-    """Every downward ray (origins o: (1, 3) shared or (n, 3), directions d: (n, 3)) meets
-    the interpolant at its first crossing in the band top..bottom (`reach` = top, bottom,
-    max range), if that is nearer than its hit so far: near = (range, normal, class,
-    instance, the water's class) updated in place. Rays whose band segment leaves the grid
-    are flagged in `far` (the exact march's). normals: the surface's at each hit, else
-    the calm one (up). surface: the node table, its shape, the steepest rise per cell
-    along u and v (a ray descending faster crosses it once) and the block maxima.
-    Fixed chunks of CHUNK rays (so the hits do not depend on the threads) run on every
-    core, dealt to LANES lanes in turn: the rows near the horizon cost the most. A parallel
-    loop captures no tuples: they are taken apart here, put together in each chunk."""
-    flat, (nu, nv), (rise_u, rise_v), (tops, (bu, bv), size) = surface
-    (o, d), (top, bottom, max_range), (rng, normal, cls, inst, water) = rays, reach, near
-    n = d.shape[0]
-    for lane in prange(LANES):
-        for c in range(lane, -(-n // CHUNK), LANES):
-            surface_ = (flat, (nu, nv), (rise_u, rise_v), (tops, (bu, bv), size))
-            near_ = (rng, normal, cls, inst, water)
-            _chunk(surface_, frame, (o, d), (top, bottom, max_range), near_, far, normals, c)
-
-
-@compiled
+@compiled_fused
 def _chunk(
     surface: Surface, frame: F64, rays: tuple[F64, F64], reach: Reach, near: Near,
     far: NDArray[np.bool_], normals: bool, c: int,
 ) -> None:  # fmt: skip
-    """grid_pass for chunk c: its rays are fixed whatever the threads, so its hits are. A
+    """chunk_pass for chunk c: its rays are fixed whatever the threads, so its hits are. A
     steep ray's Newton starts at the last steep hit's height (99% settle in 1 step)."""
     (flat, (nu, nv), rise, blocks), (rng, normal, cls, inst, water) = surface, near
     row, cells = NODE * nv, (nu - 1, nv - 1)
@@ -321,27 +292,27 @@ def _chunk(
                 normal[r, 0], normal[r, 1], normal[r, 2] = 0.0, 0.0, 1.0
 
 
-@compiled
-def serial_pass(
+@compiled_fused
+def chunk_pass(
     surface: Surface, frame: F64, rays: tuple[F64, F64], reach: Reach, near: Near,
-    far: NDArray[np.bool_], normals: bool,
+    far: NDArray[np.bool_], normals: bool, chunks: Pair,
 ) -> None:  # fmt: skip
-    """grid_pass's chunks one after another on the calling thread (the same hits): for a
-    cast too small to pay for waking other threads (a LiDAR scan's 16 384 rays)."""
-    for c in range(-(-rays[1].shape[0] // CHUNK)):
+    """Every downward ray of chunks first..last-1 (`chunks`; origins o: (1, 3) shared or
+    (n, 3), directions d: (n, 3)) meets the interpolant at its first crossing in the band
+    top..bottom (`reach` = top, bottom, max range), if that is nearer than its hit so far:
+    near = (range, normal, class, instance, the water's class) updated in place. Rays whose
+    band segment leaves the grid are flagged in `far` (the exact march's). normals: the
+    surface's at each hit, else the calm one (up). surface: the node table, its shape, the
+    steepest rise per cell along u and v (a ray descending faster crosses it once) and the
+    block maxima. A chunk's rays are fixed, so its hits are whichever thread runs it
+    (wave_pass.py deals the chunks of a large cast to every core)."""
+    for c in range(chunks[0], chunks[1]):
         _chunk(surface, frame, rays, reach, near, far, normals, c)
 
 
 @functools.cache
-def _numba() -> Any:
-    return jit_marked(globals())  # numba loaded, the kernels compiled or read from the cache
-
-
-def kernel(rays: int) -> Callable[..., None]:
-    """The compiled pass for `rays` rays; from PARALLEL_RAYS on, on every core, each lane to
-    the next free thread (a thread the machine holds back leaves its lanes to the others)."""
-    numba = _numba()  # first: it rebinds the passes to their compiled selves
-    if rays < PARALLEL_RAYS:
-        return serial_pass
-    numba.set_parallel_chunksize(1)  # the calling thread's setting, for its next loops
-    return grid_pass
+def chunks() -> Callable[..., None]:
+    """The compiled `chunk_pass` (numba loaded, the module's kernels compiled or read from
+    the cache, on the first call)."""
+    jit_marked(globals())  # rebinds the module's kernels to their compiled selves
+    return globals()["chunk_pass"]

@@ -3,58 +3,22 @@ checked against a NumPy reference of the same surface sampled densely along each
 
 from __future__ import annotations
 
-from concurrent.futures import ThreadPoolExecutor
+from typing import Any
 
-import numba
 import numpy as np
 import pytest
 
-from catabot.config.waves import WaveConfig
-from catabot.world.waves import WaveField
 from services.sensors import wave_kernel as wk
 from services.sensors.wave_bounds import bounds
-from services.sensors.wave_grid import Scratch, WaveGrid, grid_spec
+from services.sensors.wave_grid import WaveGrid
 from services.sensors.wave_pass import CastRays, cast_on_grid, warm_up
-
-MEDIUM = WaveField(WaveConfig(preset="medium"), 1)
-ORIGIN = np.array([4.0, -2.0, 1.2])
+from tests.services.sensors.wave_helpers import ORIGIN, Near, cast, fan, wave_grid
 
 
 @pytest.fixture(autouse=True)
 def _compiled() -> None:
     """The module's helpers are called straight from here: compiled first, as in a cast."""
     warm_up()
-
-
-class _Near:
-    def __init__(self, n: int) -> None:
-        self.rng = np.full(n, np.inf)
-        self.normal = np.zeros((n, 3), np.float32)
-        self.cls = np.zeros(n, np.uint8)
-        self.inst = np.zeros(n, np.int32)
-
-
-def _grid(time_s: float = 3.5) -> WaveGrid:
-    spec = grid_spec(MEDIUM)
-    assert spec is not None
-    box = (np.array([-70.0, -70.0]), np.array([70.0, 70.0]))
-    return WaveGrid(spec, MEDIUM, time_s, ORIGIN[:2].copy(), box, Scratch())
-
-
-def _fan(n: int, seed: int, elevations_deg: tuple[float, float]) -> np.ndarray:
-    rng = np.random.default_rng(seed)
-    lo, hi = np.log(elevations_deg[0]), np.log(elevations_deg[1])
-    el = -np.radians(np.exp(rng.uniform(lo, hi, n)))
-    az = rng.uniform(0.0, 2.0 * np.pi, n)
-    return np.stack([np.cos(el) * np.cos(az), np.cos(el) * np.sin(az), np.sin(el)], axis=1)
-
-
-def _cast(grid: WaveGrid, d: np.ndarray, max_range: float) -> tuple[_Near, np.ndarray]:
-    near = _Near(d.shape[0])
-    o = np.broadcast_to(ORIGIN, d.shape)
-    rays = CastRays.of(o, d, np.full(d.shape[0], max_range), grid.spec.rot)
-    far = cast_on_grid(grid, rays, near, (10.0, max_range), normals=True)
-    return near, far
 
 
 def _interpolant(grid: WaveGrid, xy: np.ndarray) -> np.ndarray:
@@ -83,9 +47,9 @@ def _gap(grid: WaveGrid, d: np.ndarray, t: np.ndarray) -> np.ndarray:
 def test_hits_are_the_first_roots_of_the_interpolant(
     elevations: tuple[float, float], hits: int
 ) -> None:
-    grid = _grid()
-    d = _fan(400, 1, elevations)
-    near, far = _cast(grid, d, 60.0)
+    grid = wave_grid()
+    d = fan(400, 1, elevations)
+    near, far = cast(grid, d, 60.0)
     assert far.size == 0
     hit = np.flatnonzero(np.isfinite(near.rng))
     assert hit.size >= hits  # the shallowest grazing rays reach the sea beyond 60 m
@@ -97,20 +61,20 @@ def test_hits_are_the_first_roots_of_the_interpolant(
 
 
 def test_normals_are_unit_and_upward() -> None:
-    near, _ = _cast(_grid(), _fan(500, 2, (1.0, 60.0)), 60.0)
+    near, _ = cast(wave_grid(), fan(500, 2, (1.0, 60.0)), 60.0)
     hit = np.isfinite(near.rng)
     assert np.allclose(np.linalg.norm(near.normal[hit], axis=1), 1.0, atol=1e-6)
     assert (near.normal[hit, 2] > 0.9).all()
 
 
 def test_a_steep_ray_gets_the_same_root_from_newton_and_from_the_walk() -> None:
-    grid = _grid()
+    grid = wave_grid()
     cells, row = (grid.nu - 1, grid.nv - 1), 3 * grid.nv
     frame = np.concatenate(
         [ORIGIN[:2], grid.spec.rot.ravel(), [grid.u0, grid.v0, 1 / grid.hu, 1 / grid.hv]]
     )
     top = grid.zmax + grid.spec.eps
-    for d in _fan(200, 3, (8.0, 80.0)):
+    for d in fan(200, 3, (8.0, 80.0)):
         ray = wk._in_cells(frame, ORIGIN, d)
         assert -ray[5] > abs(ray[2]) * grid.rise[0] + abs(ray[3]) * grid.rise[1]
         span = ((top - ORIGIN[2]) / d[2], (grid.zmin - 0.1 - ORIGIN[2]) / d[2])
@@ -120,8 +84,8 @@ def test_a_steep_ray_gets_the_same_root_from_newton_and_from_the_walk() -> None:
 
 
 def test_rays_leaving_the_grid_are_left_to_the_exact_march() -> None:
-    d = _fan(300, 4, (0.05, 0.2))  # reaching the water hundreds of metres out
-    near, far = _cast(_grid(), d, 1000.0)
+    d = fan(300, 4, (0.05, 0.2))  # reaching the water hundreds of metres out
+    near, far = cast(wave_grid(), d, 1000.0)
     assert far.size > 250 and np.isinf(near.rng[far]).all()
 
 
@@ -143,54 +107,23 @@ def test_casts_use_the_kernels_warm_up_compiled() -> None:
     """A second compilation would cost seconds inside a tick: shared and own origins, read-only
     views included, reach the kernels as the one type warm_up compiles them for."""
     warm_up()
-    grid, d = _grid(), _fan(50, 6, (1.0, 30.0))
-    _cast(grid, d, 60.0)  # a shared origin, a read-only broadcast view
+    grid, d = wave_grid(), fan(50, 6, (1.0, 30.0))
+    cast(grid, d, 60.0)  # a shared origin, a read-only broadcast view
     own = np.broadcast_to(ORIGIN + np.array([0.5, 0.0, 0.0]), d.shape)
     rays = CastRays.of(own.copy(), d, np.full(50, 60.0), grid.spec.rot)
-    cast_on_grid(grid, rays, _Near(50), (10.0, 60.0), normals=True)
+    cast_on_grid(grid, rays, Near(50), (10.0, 60.0), normals=True)
     helpers = bounds()
-    kernels = (wk.kernel(1), wk.kernel(wk.PARALLEL_RAYS))
-    for kernel in (*kernels, helpers.band_ends, helpers.block_tops, helpers.surface_bounds):
-        assert len(kernel.signatures) == 1, kernel  # type: ignore[attr-defined]
+    kernels: list[Any] = [wk.chunks(), helpers.band_ends, helpers.block_tops]
+    for kernel in (*kernels, helpers.surface_bounds):
+        assert len(kernel.signatures) == 1, kernel
 
 
 def test_calls_with_nearer_hits_keep_them() -> None:
-    grid = _grid()
-    d = _fan(100, 5, (5.0, 30.0))
-    near = _Near(d.shape[0])
+    grid = wave_grid()
+    d = fan(100, 5, (5.0, 30.0))
+    near = Near(d.shape[0])
     near.rng[:] = 0.5  # something nearer than the water on every ray
     o = np.broadcast_to(ORIGIN, d.shape)
     rays = CastRays.of(o, d, near.rng.copy(), grid.spec.rot)
     cast_on_grid(grid, rays, near, (10.0, 60.0), normals=True)
     assert (near.rng == 0.5).all() and (near.cls == 0).all()
-
-
-def test_hits_do_not_depend_on_the_number_of_threads(monkeypatch: pytest.MonkeyPatch) -> None:
-    """A large cast's rays run on every core in fixed chunks: one thread or all, or the
-    one-thread pass of a small cast, the same bytes (each chunk starts its Newton afresh)."""
-    grid, d = _grid(), _fan(wk.PARALLEL_RAYS + 17, 8, (0.3, 40.0))
-    threads, casts = numba.get_num_threads(), []
-    try:
-        for n in (1, threads):
-            numba.set_num_threads(n)
-            casts.append(_cast(grid, d, 60.0))
-    finally:
-        numba.set_num_threads(threads)
-    monkeypatch.setattr(wk, "PARALLEL_RAYS", 10**9)  # the same rays through the serial pass
-    casts.append(_cast(grid, d, 60.0))
-    first, far = casts[0]
-    assert np.isfinite(first.rng).sum() > 10_000
-    for near, far_ in casts[1:]:
-        assert far_.tobytes() == far.tobytes()
-        for a, b in ((first.rng, near.rng), (first.normal, near.normal), (first.cls, near.cls)):
-            assert a.tobytes() == b.tobytes()
-
-
-def test_threads_casting_at_once_take_turns() -> None:
-    """numba's workqueue pool aborts the whole process when two threads launch parallel
-    passes at once; casts from several threads take turns and get the one-thread hits."""
-    grid, d = _grid(), _fan(wk.PARALLEL_RAYS + 1, 8, (0.3, 40.0))
-    alone = _cast(grid, d, 60.0)[0].rng
-    with ThreadPoolExecutor(max_workers=3) as pool:
-        casts = list(pool.map(lambda _: _cast(grid, d, 60.0)[0].rng, range(6)))
-    assert all(c.tobytes() == alone.tobytes() for c in casts)
