@@ -70,10 +70,10 @@ def origins(o: F64) -> F64:
     return plain(o[:1] if o.strides[0] == 0 else o)
 
 
-def jit_marked(namespace: dict[str, Any]) -> Any:
-    """Compile the marked functions of a module in place (its globals()): idempotent.
-    Returns numba. No kernel is numba-parallel: wave_pass deals a large cast's chunks to
-    threads of its own, each as it comes free."""
+def jit_marked(namespace: dict[str, Any]) -> None:
+    """Compile the marked functions of a module in place (its globals()): idempotent. No
+    kernel is numba-parallel: wave_pass deals a large cast's chunks to threads of its own,
+    each as it comes free."""
     import numba  # ≈110 MB: only a process that meets waves pays it
 
     for name, fn in list(namespace.items()):
@@ -81,7 +81,6 @@ def jit_marked(namespace: dict[str, Any]) -> Any:
         if options is not None and not isinstance(fn, numba.core.dispatcher.Dispatcher):
             jit = numba.njit(cache=True, nogil=True, error_model="numpy", **options)
             namespace[name] = jit(fn)
-    return numba
 
 
 Box = tuple[float, float, float, float]  # u_lo, v_lo, u_hi, v_hi

@@ -30,6 +30,8 @@ F32 = NDArray[np.float32]
 R32 = np.float32  # one float32 number: the sums stay in float32, as NumPy's did
 Sea = tuple[F64, F32, F32, F32, float, float]  # see sea_tables
 Bracket = tuple[float, float, float, float]  # a, f(a), b, f(b)
+Tables = tuple[F32, F32, F32]  # a ray's phases at t = 0, phase rates, the amplitudes
+Ray = tuple[float, float, float]  # oz, dz, the steepest surface's rise along the ray
 MARCH_SAMPLES = 8
 REFINE_STEPS = 16  # a cap: Newton in a bracket takes 2-6
 TOLERANCE_M = 5e-4  # vertical distance to the surface at which a ray is done: within 1 mm
@@ -179,10 +181,6 @@ def march_pass(
             normal_out[r, 0], normal_out[r, 1], normal_out[r, 2] = gx * scale, gy * scale, scale
 
 
-Tables = tuple[F32, F32, F32]  # a ray's phases at t = 0, phase rates, the amplitudes
-Ray = tuple[float, float, float]  # oz, dz, the steepest surface's rise along the ray
-
-
 @compiled
 def _crossing(tables: Tables, ray: Ray, span: tuple[float, float], limited: bool) -> float:
     """The first root of f = z - eta in [t0, t1] = span (inf: none). Known signs are not
@@ -263,11 +261,8 @@ def _refine(tables: Tables, ray: Ray, bracket: Bracket) -> float:
 
 
 @functools.cache
-def _numba() -> Any:
-    return jit_marked(globals())  # numba loaded, the kernels compiled or read from the cache
-
-
 def marcher() -> Any:
-    """The compiled march_pass (numba loaded at the first call)."""
-    _numba()
-    return march_pass
+    """The compiled march_pass (numba loaded, the module's kernels compiled or read from the
+    cache, at the first call)."""
+    jit_marked(globals())  # rebinds the module's kernels to their compiled selves
+    return globals()["march_pass"]

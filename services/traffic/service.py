@@ -42,7 +42,7 @@ class TrafficService:
         self.row = {vid: i for i, vid in enumerate(self.ids)}
         self.keys = ctx.keys
         avoid = ctx.scenario.traffic.avoid
-        clear, self.obstacles, self.obstacle_rows = _keep_clear(world, self.ids, avoid)
+        clear, self.obstacles, self.obstacle_rows = keep_clear(world, self.ids, avoid)
         self.behaviours = Behaviours(boats, hold_gain=ctx.scenario.traffic.hold.gain, clear=clear)
         n = len(boats)
         self.pos = np.array([(b.pose.x_m, b.pose.y_m) for b in boats], dtype=np.float64)
@@ -107,7 +107,7 @@ class TrafficService:
         self.behaviours.set_path(i, points, msg.speed, loop=msg.mode == "loop", tol=msg.tolerance)
 
 
-def _keep_clear(
+def keep_clear(
     world: World, ids: tuple[str, ...], avoid: AvoidParams
 ) -> tuple[KeepClear, Obstacles | None, NDArray[np.intp]]:
     """How the boats `ids` keep clear (services/traffic/avoid.py), what of at the start, and

@@ -21,7 +21,7 @@ from catabot.world import rotations
 from catabot.world.terrain import load_terrain
 from catabot.world.world import World
 from services.traffic.behaviours import Behaviours
-from services.traffic.service import _keep_clear
+from services.traffic.service import keep_clear
 from tests.paths import BAY
 
 CIRCLE_RATE = math.radians(15.0)  # 5 m/s on the default 19.1 m circle
@@ -162,7 +162,7 @@ def test_guidance_reads_the_states_of_the_tick_before_its_own(tmp_path: Path) ->
     run = only_run_dir(out)
     world = World.resolve(load_scenario(run / "scenario.json"))
     ids = world.traffic_blocks["traffic"]
-    clear, obstacles, rows = _keep_clear(world, ids, world.scenario.traffic.avoid)
+    clear, obstacles, rows = keep_clear(world, ids, world.scenario.traffic.avoid)
     law = Behaviours(world.traffic.boats, hold_gain=world.scenario.traffic.hold.gain, clear=clear)
     states = _states(run, "boat_000")  # stamp, tick, position (3), orientation (4), velocity
     twists = np.loadtxt(run / "vessel.boat_000.cmd.twist.csv", delimiter=",", skiprows=1)
