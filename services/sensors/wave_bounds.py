@@ -4,11 +4,11 @@ bounds. One pass over the arrays each, where NumPy took several (~0.15 ms a LiDA
 And how the sensors' kernels are compiled. numba (llvmlite's compiler: ~110 MB resident) is
 loaded by the first sea with waves, not by every sensors process: a function is marked
 `@compiled` here and compiled, with the rest of its module, by `jit_marked` when its
-module's loader (`bounds()`, wave_kernel's `chunks()`) is first called; calls between marked
-functions reach the compiled ones because the module's own names are rebound. Every kernel
-is cached on disk (a process loads one in ~0.1 s instead of compiling it for ~4 s), runs
-without the GIL, and with NumPy's error model (x / 0 is inf, as the code expects, with no
-check on every division); small helpers are inlined.
+module's loader (`bounds()`, wave_kernel's `chunks()`, wave_march's `marcher()`) is first
+called; calls between marked functions reach the compiled ones because the module's own
+names are rebound. Every kernel is cached on disk (a process loads one in ~0.1 s instead
+of compiling it for ~4 s), runs without the GIL, and with NumPy's error model (x / 0 is inf,
+as the code expects, with no check on every division); small helpers are inlined.
 """
 
 from __future__ import annotations
@@ -70,10 +70,10 @@ def origins(o: F64) -> F64:
     return plain(o[:1] if o.strides[0] == 0 else o)
 
 
-def jit_marked(namespace: dict[str, Any]) -> None:
-    """Compile the marked functions of a module in place (its globals()): idempotent. No
-    kernel is numba-parallel: wave_pass deals a large cast's chunks to threads of its own,
-    each as it comes free."""
+def jit_marked(namespace: dict[str, Any]) -> dict[str, Any]:
+    """Compile the marked functions of a module in place (its globals(), returned, its
+    kernels now their compiled selves): idempotent. No kernel is numba-parallel: wave_pass
+    deals a large cast's chunks to threads of its own, each as it comes free."""
     import numba  # ≈110 MB: only a process that meets waves pays it
 
     for name, fn in list(namespace.items()):
@@ -81,6 +81,7 @@ def jit_marked(namespace: dict[str, Any]) -> None:
         if options is not None and not isinstance(fn, numba.core.dispatcher.Dispatcher):
             jit = numba.njit(cache=True, nogil=True, error_model="numpy", **options)
             namespace[name] = jit(fn)
+    return namespace
 
 
 Box = tuple[float, float, float, float]  # u_lo, v_lo, u_hi, v_hi

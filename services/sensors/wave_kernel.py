@@ -314,5 +314,4 @@ def chunk_pass(
 def chunks() -> Callable[..., None]:
     """The compiled `chunk_pass` (numba loaded, the module's kernels compiled or read from
     the cache, on the first call)."""
-    jit_marked(globals())  # rebinds the module's kernels to their compiled selves
-    return globals()["chunk_pass"]
+    return jit_marked(globals())["chunk_pass"]

@@ -264,5 +264,4 @@ def _refine(tables: Tables, ray: Ray, bracket: Bracket) -> float:
 def marcher() -> Any:
     """The compiled march_pass (numba loaded, the module's kernels compiled or read from the
     cache, at the first call)."""
-    jit_marked(globals())  # rebinds the module's kernels to their compiled selves
-    return globals()["march_pass"]
+    return jit_marked(globals())["march_pass"]

@@ -16,12 +16,17 @@ from services.sensors.wave_pass import PARALLEL_RAYS, run_chunks
 from tests.services.sensors.wave_helpers import cast, fan, wave_grid
 
 
-def _spans(rays: int, pause_s: float = 0.0) -> list[tuple[str, tuple[int, int]]]:
+def _spans(
+    rays: int, pause_s: float = 0.0, *, helpers_only: bool = False
+) -> list[tuple[str, tuple[int, int]]]:
+    """Which thread ran which span, each run pausing `pause_s` (on the helpers only)."""
     seen: list[tuple[str, tuple[int, int]]] = []
+    caller = threading.current_thread().name
 
     def run(span: tuple[int, int]) -> None:
         seen.append((threading.current_thread().name, span))
-        time.sleep(pause_s)
+        if not helpers_only or threading.current_thread().name != caller:
+            time.sleep(pause_s)
 
     run_chunks(run, rays)
     return seen
@@ -54,16 +59,9 @@ def test_a_thread_held_back_leaves_its_batches_to_the_others(
     """A core the machine takes away for a while: its thread does one batch, the caller the
     rest (numba's fixed halves would have waited for it)."""
     caller = threading.current_thread().name
-
-    def run(span: tuple[int, int]) -> None:
-        seen.append((threading.current_thread().name, span))
-        if threading.current_thread().name != caller:
-            time.sleep(0.5)
-
-    seen: list[tuple[str, tuple[int, int]]] = []
     with ThreadPoolExecutor(1) as pool:
         monkeypatch.setattr(wave_pass, "_helpers", lambda: (pool, 1))
-        run_chunks(run, PARALLEL_RAYS * 2)
+        seen = _spans(PARALLEL_RAYS * 2, 0.5, helpers_only=True)
     helped = [span for name, span in seen if name != caller]
     assert len(helped) == 1 and _covered(seen) == list(range(2 * PARALLEL_RAYS // CHUNK))
 
