@@ -30,7 +30,18 @@ def metrics_lines(run_dir: Path) -> list[str]:
     if len(lines) > MAX_LINES:  # a fleet of scenario vessels: the file has them all
         more = len(lines) - MAX_LINES + 1
         lines[MAX_LINES - 1 :] = [f"  ... {more} more in {run_dir / 'metrics.json'}"]
-    return lines
+    return lines + _traffic(record)
+
+
+def _traffic(record: dict[str, Any]) -> list[str]:
+    """The traffic's own collisions, in a run that has traffic (boats without the scenario
+    vessels' figures) or where any happened."""
+    hits = record.get("traffic_collisions")
+    vessels = record["vessels"].values()
+    boats = any(isinstance(m, dict) and "nearest_vessel" not in m for m in vessels)
+    if not isinstance(hits, list) or not (boats or hits):
+        return []
+    return [f"  traffic: {len(hits)} collisions among its boats and buoys"]
 
 
 def _parts(m: dict[str, Any]) -> list[str]:

@@ -92,6 +92,13 @@ def yaw_of_quaternions(q: Array) -> Array:
     return np.arctan2(2 * (w * z + x * y), 1 - 2 * (y * y + z * z))
 
 
+def turn_xy(xy: Array, yaw: Array) -> Array:
+    """Horizontal vectors (N, 2) turned by headings (N,): body-frame x, y in map axes (a
+    boat's velocity over ground from its surge and sway)."""
+    c, s = np.cos(yaw), np.sin(yaw)
+    return np.column_stack((c * xy[:, 0] - s * xy[:, 1], s * xy[:, 0] + c * xy[:, 1]))
+
+
 def yaw_of_matrix(rot: Array) -> float:
     """ENU heading of a body-to-map rotation matrix."""
     return math.atan2(float(rot[1, 0]), float(rot[0, 0]))

@@ -7,7 +7,8 @@ everything else: the nearest vessel, buoy and shore it came to (centre to centre
 the nearest land pixel), its goal and route (`tasks.py`), its thrust impulse, and episodes
 (`episodes.py`): encounters (another vessel within `recording.encounter_radius_m`, with the
 closest point of approach), collisions (plan-view hull boxes within `CONTACT_M`, the
-physics collision shapes; other vessels and buoys) and groundings (`seabed.py`).
+physics collision shapes; other vessels and buoys) and groundings (`seabed.py`). The
+traffic's own collisions, boat with boat or buoy, are `fleet_contacts.py`'s.
 
 Cost: arrays of (scenario vessels x bodies) per tick, no loop over bodies (DESIGN.md §8).
 Written with `repr` floats and sorted keys so two runs of one seed give the same bytes.
@@ -21,10 +22,12 @@ import numpy as np
 
 from catabot.bus.clock import NS_PER_S
 from catabot.bus.messages import BodyStates, Message
+from catabot.config.rates import traffic_record_period
 from catabot.world.hulls import CONTACT_M, box_gaps, footprints
 from catabot.world.rotations import yaw_of_quaternions
 from catabot.world.world import World
 from services.recorder.episodes import Episodes
+from services.recorder.fleet_contacts import FleetContacts
 from services.recorder.metrics_json import write_metrics
 from services.recorder.seabed import Seabed
 from services.recorder.tasks import Goals, Routes, Thrust, rowdot
@@ -52,6 +55,10 @@ class Metrics:
         self.encounters = Episodes((s, n), gap_ns=0)
         self.collisions = Episodes((s, total), gap_ns=gap)
         self.groundings = Episodes((s,), gap_ns=gap)
+        period = traffic_record_period(world.scenario)
+        self.fleet = FleetContacts(
+            self.offset, self.half, self.reach, first=s, period=period, gap_ns=gap
+        )
         self.radius = world.scenario.recording.encounter_radius_m
         self.pair_ok = np.ones((s, total), dtype=bool)  # each pair once, never a body itself
         self.pair_ok[:, :s] = np.triu(np.ones((s, s), dtype=bool), k=1)
@@ -80,6 +87,7 @@ class Metrics:
         if not np.isfinite(everything).all():  # a diverged body: no figure can use it
             self.skipped += 1
             return
+        self.fleet.add(batch)
         pos = everything[:n]
         if self.last is not None:
             step = pos - self.last

@@ -54,6 +54,9 @@ def record(m: Metrics) -> dict[str, Any]:
             {"bodies": [ids[e.slot[0]], ids[e.slot[1]]], **_span(e)} for e in m.collisions.all()
         ],
         "groundings": [{"vessel": ids[e.slot[0]], **_span(e)} for e in m.groundings.all()],
+        "traffic_collisions": [
+            {"bodies": [ids[e.slot[0]], ids[e.slot[1]]], **_span(e)} for e in m.fleet.all()
+        ],
     }
 
 

@@ -11,14 +11,16 @@ scenario's vessels only with `traffic.avoid.vessels`), each a footprint circle:
 - Rounding: a waypoint with a buoy on it (a mark) is aimed at `pass_m` to the right of the
   line of sight, so the boat leaves the mark to port about that far off; it counts as
   reached within the tolerance plus `pass_m` of the mark.
-- Corridor: an obstacle ahead of a boat on the arc it is turning on, within lookahead_s at
-  its speed and closer to that track than both footprints plus the clearance, turns it at
-  its full rate away from the side the obstacle bears on now: to starboard unless it lies
-  well to starboard (a third of the corridor). The nearest one decides; first, one closer
-  than that anywhere but astern (a boat turning at low speed, two boats alongside), which
-  it simply turns away from, backing off while it lies under the bow. The boat's own law
-  resumes when the corridor is clear. The marks on a boat's own path are left to the first
-  rule.
+- Corridor: a buoy ahead of a boat on the arc it is turning on, within lookahead_s at its
+  speed and closer to that track than both footprints plus the clearance, turns it at its
+  full rate away from the side the buoy bears on now: to starboard unless it lies well to
+  starboard (a third of the corridor). The nearest one decides; first, anything closer than
+  that anywhere but astern (a boat turning at low speed, two boats alongside), buoy or
+  boat, which it simply turns away from, backing off while it lies under the bow. The
+  boat's own law resumes when the corridor is clear. The marks on a boat's own path are
+  left to the first rule. Boats under way ahead are not corridor obstacles: reacting to
+  where another boat is now, both boats of a pair turned, each to the side the other bore
+  on, and still met; colregs.py gives such meetings to one of the two.
 """
 
 from __future__ import annotations
@@ -51,6 +53,13 @@ class Obstacles:
     xy: Array  # (M, 2)
     radius: Array  # (M,)
     own: Rows  # (N,): each boat's own row among them, -1 when it is not one
+    velocity: Array  # (M, 2) over ground, map frame
+    under_way: NDArray[np.bool_]  # (M,): boats and vessels, whose meetings colregs.py rules
+
+    @classmethod
+    def fixed(cls, xy: Array, radius: Array, own: Rows) -> Obstacles:
+        """Obstacles that do not move and are not boats (buoys, marks)."""
+        return cls(xy, radius, own, np.zeros_like(xy), np.zeros(len(xy), dtype=bool))
 
 
 def marks_on(path: Array, anchors: Array) -> NDArray[np.bool_]:
@@ -82,8 +91,8 @@ def corridor_turn(
     step = max(1, PAIRS // max(len(obstacles.xy), 1))
     for s in range(0, len(pos), step):
         rows = np.arange(s, min(s + step, len(pos)))
-        boat, obs = _near_pairs(pos, reach + width + obstacles.radius.max(), obstacles, rows)
-        boat, obs = _others(boat, obs, obstacles, marks)
+        boat, obs = near_pairs(pos, reach + width + obstacles.radius.max(), obstacles, rows)
+        boat, obs = _others(boat, obs, (pos, width), obstacles, marks)
         threat = _threats(boat, obs, (pos, chi, curvature, reach, width), obstacles)
         boat, along, left, wide, bow = threat
         order = np.lexsort((along, boat))  # each boat's nearest threat first
@@ -94,12 +103,19 @@ def corridor_turn(
     return out, stop
 
 
-def _others(boat: Rows, obs: Rows, obstacles: Obstacles, marks: Array) -> tuple[Rows, Rows]:
-    """The pairs without a boat itself and the marks on its own path."""
+def _others(
+    boat: Rows, obs: Rows, boats: tuple[Array, Array], obstacles: Obstacles, marks: Array
+) -> tuple[Rows, Rows]:
+    """The pairs without a boat itself, the marks on its own path and the boats under way
+    that are not close (those are colregs.py's; `_threats` meets a close one here)."""
+    pos, width = boats
+    rel = obstacles.xy[obs] - pos[boat]
+    near = rel[:, 0] ** 2 + rel[:, 1] ** 2 < (width[boat] + obstacles.radius[obs]) ** 2
+    keep = (obs != obstacles.own[boat]) & (near | ~obstacles.under_way[obs])
+    boat, obs = boat[keep], obs[keep]
     gap = obstacles.xy[obs][:, None, :] - marks[boat]  # (pairs, K, 2); nan: no mark
     mark = np.any(gap[..., 0] ** 2 + gap[..., 1] ** 2 < MARK_M**2, axis=1)
-    keep = (obs != obstacles.own[boat]) & ~mark
-    return boat[keep], obs[keep]
+    return boat[~mark], obs[~mark]
 
 
 def _threats(
@@ -115,6 +131,7 @@ def _threats(
     along, off = _on_arc(ahead, left, curvature[boat])
     wide = width[boat] + obstacles.radius[obs]
     hit = (along > 0.0) & (along < reach[boat] + wide) & (np.abs(off) < wide)
+    hit &= ~obstacles.under_way[obs]  # boats meeting boats: colregs.py
     close = (ahead > -width[boat]) & (np.hypot(ahead, left) < wide)  # alongside too
     bow = close & (ahead > 0.0) & (np.abs(left) < width[boat] / 2.0)
     hit |= close
@@ -122,7 +139,7 @@ def _threats(
     return boat[hit], along[hit], left[hit], wide[hit], bow[hit]
 
 
-def _near_pairs(pos: Array, far: Array, obstacles: Obstacles, rows: Rows) -> tuple[Rows, Rows]:
+def near_pairs(pos: Array, far: Array, obstacles: Obstacles, rows: Rows) -> tuple[Rows, Rows]:
     """(boat, obstacle) pairs closer than `far` (N,) to each other."""
     xy = obstacles.xy.astype(np.float32)  # a coarse test: float32 halves the traffic
     dx = np.subtract.outer(pos[rows, 0].astype(np.float32), xy[:, 0])  # (n, M), contiguous

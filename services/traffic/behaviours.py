@@ -18,7 +18,15 @@ from numpy.typing import NDArray
 
 from catabot.config.traffic import TrafficConfig
 from catabot.world.traffic_plan import Boat
-from services.traffic.avoid import KeepClear, Obstacles, corridor_turn, mark_aim, marks_on
+from services.traffic.avoid import (
+    KeepClear,
+    Obstacles,
+    corridor_turn,
+    mark_aim,
+    marks_on,
+    near_pairs,
+)
+from services.traffic.colregs import OFFSETS, SPEEDS, choose
 
 Array = NDArray[np.float64]
 CIRCLE, WAYPOINTS, HOLD = 0, 1, 2
@@ -102,6 +110,7 @@ class Behaviours:
         self.hold_gain = hold_gain
         self.clear = clear or KeepClear(np.zeros((0, 2)), np.zeros(n), np.zeros(n), 0.0)
         self.marked = np.zeros((n, 1), dtype=bool)  # path points that carry a buoy
+        self._last_pick = np.zeros(n, dtype=np.intp)  # each boat's last choice (colregs.py)
         self.kind = np.array([KINDS[b.behaviour] for b in boats], dtype=np.int64)
         self.speed = np.array([b.speed_mps for b in boats], dtype=np.float64)
         self.centre = np.array([b.center for b in boats], dtype=np.float64).reshape(n, 2)
@@ -179,14 +188,15 @@ class Behaviours:
             if rows.size:
                 surge[rows], rate[rows] = law(rows, pos[rows], yaw[rows], chi[rows], sog[rows])
         if obstacles is not None and len(obstacles.xy):
-            surge, rate = self._keep_clear(pos, chi, sog, obstacles, (surge, rate))
+            surge, rate, turned = self._keep_clear(pos, chi, sog, obstacles, (surge, rate))
+            surge, rate = self._give_way(pos, chi, sog, obstacles, (surge, rate), turned)
         return surge, rate
 
     def _keep_clear(
         self, pos: Array, chi: Array, sog: Array, obstacles: Obstacles, order: tuple[Array, Array]
-    ) -> tuple[Array, Array]:
+    ) -> tuple[Array, Array, NDArray[np.bool_]]:
         """Full turn away from the nearest obstacle in a boat's corridor, backing off while it
-        is under the bow (holding boats stay put)."""
+        is under the bow (holding boats stay put); and which boats it turned."""
         surge, rate = order
         speed = np.maximum(np.maximum(sog, self.speed), 1.0)
         bend = rate / speed  # the arc the boat's own law has it on
@@ -195,7 +205,40 @@ class Behaviours:
         turn, stop = corridor_turn(pos, chi, bend, reach, self.clear.width, obstacles, marks)
         turn[self.kind == HOLD], stop[self.kind == HOLD] = 0.0, False
         surge = np.where(stop, -BACK_OFF_MPS, surge)
-        return surge, np.where(turn != 0.0, turn * MAX_YAW_RATE, rate)
+        return surge, np.where(turn != 0.0, turn * MAX_YAW_RATE, rate), turn != 0.0
+
+    def _give_way(
+        self,
+        pos: Array,
+        chi: Array,
+        sog: Array,
+        obstacles: Obstacles,
+        order: tuple[Array, Array],
+        turned: NDArray[np.bool_],
+    ) -> tuple[Array, Array]:
+        """Boats meeting boats: each takes the course change and speed that keeps clear at
+        least cost under the rules of the road (colregs.py), unless the corridor already
+        turns it (a buoy, a hull alongside)."""
+        surge, rate = order
+        horizon = self.clear.lookahead_s
+        moving = np.flatnonzero(obstacles.under_way)
+        fastest = float(np.hypot(*obstacles.velocity[moving].T).max(initial=0.0))
+        far = (np.maximum(sog, self.speed) + fastest) * horizon + self.clear.width
+        boat, obs = near_pairs(pos, far + obstacles.radius.max(), obstacles, np.arange(len(pos)))
+        keep = obstacles.under_way[obs] & (obs != obstacles.own[boat]) & (self.kind[boat] != HOLD)
+        vel = sog[:, None] * np.column_stack((np.cos(chi), np.sin(chi)))
+        other = (obstacles.xy, obstacles.velocity, obstacles.radius)
+        pick = choose(
+            (pos, vel, chi), self.clear.width, other, (boat[keep], obs[keep]),
+            horizon_s=horizon, last=self._last_pick,
+        )  # fmt: skip
+        offset, part = OFFSETS[pick], SPEEDS[pick]
+        self._last_pick = pick
+        act = pick != 0
+        steer = act & ~turned & (offset != 0.0)
+        surge = np.where(act & (surge > 0.0), surge * part, surge)
+        rate = np.where(steer, np.clip(YAW_GAIN * offset, -MAX_YAW_RATE, MAX_YAW_RATE), rate)
+        return surge, rate
 
     def _own_marks(self) -> Array:
         """(N, K, 2): the marks on each boat's path, nan where none (it rounds them)."""

@@ -85,8 +85,11 @@ class TrafficService:
         self.yaw = rotations.yaw_of_quaternions(batch.orientation[rows])
         self.vel = batch.linear_velocity[rows, :2].copy()
         if self.obstacles is not None:
-            xy = batch.position[self.obstacle_rows, :2].copy()
-            self.obstacles = replace(self.obstacles, xy=xy)
+            rows = self.obstacle_rows
+            xy = batch.position[rows, :2].copy()
+            yaw = rotations.yaw_of_quaternions(batch.orientation[rows])
+            velocity = rotations.turn_xy(batch.linear_velocity[rows, :2], yaw)
+            self.obstacles = replace(self.obstacles, xy=xy, velocity=velocity)
 
     def _take_setting(self, key: str, value: object) -> None:
         """A boat's behaviour changed at run time, from its pose at the last guidance tick."""
@@ -128,7 +131,8 @@ def keep_clear(
     xy = np.array([(b.pose.x_m, b.pose.y_m) for b in bodies])
     r = np.array([radius[b.model_ref] for b in bodies])
     itself = np.array([where.get(vid, -1) for vid in ids], np.intp)  # a boat's own obstacle
-    return clear, Obstacles(xy, r, itself), rows
+    under_way = np.array([b.kind != "buoy" for b in bodies])
+    return clear, Obstacles(xy, r, itself, np.zeros_like(xy), under_way), rows
 
 
 def build(ctx: ServiceContext) -> Built:

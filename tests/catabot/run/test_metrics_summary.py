@@ -50,3 +50,14 @@ def test_a_fleet_is_cut_short(tmp_path: Path) -> None:
     lines = metrics_lines(tmp_path)
     assert len(lines) == 8 and lines[6].startswith("  v06: goal reached")
     assert lines[7] == f"  ... 13 more in {tmp_path / 'metrics.json'}"
+
+
+def test_the_traffic_collisions_have_a_line_where_there_is_traffic(tmp_path: Path) -> None:
+    boat = {"distance_m": 3.0, "max_speed_mps": 1.0, "final_position_m": [0, 0, 0]}
+    hit = {"bodies": ["boat_0", "boat_1"], "start_s": 1.0, "end_s": 2.0}
+    record = {"vessels": {"ego": EGO, "boat_0": boat}, "traffic_collisions": [hit, hit]}
+    (tmp_path / "metrics.json").write_text(json.dumps(record))
+    assert metrics_lines(tmp_path)[-1] == "  traffic: 2 collisions among its boats and buoys"
+    alone = {"vessels": {"ego": EGO}, "traffic_collisions": []}
+    (tmp_path / "metrics.json").write_text(json.dumps(alone))
+    assert len(metrics_lines(tmp_path)) == 1  # no traffic: no line

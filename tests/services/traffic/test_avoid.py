@@ -23,7 +23,7 @@ NO_MARKS = np.full((1, 1, 2), np.nan)
 
 def turn_for(xy: tuple[float, float], *, own: int = -1, marks: np.ndarray = NO_MARKS) -> tuple:
     """One boat at the origin heading +x at 5 m/s (40 m ahead, 5 m wide), one obstacle."""
-    obstacles = Obstacles(np.array([xy], dtype=float), np.array([0.3]), np.array([own]))
+    obstacles = Obstacles.fixed(np.array([xy], dtype=float), np.array([0.3]), np.array([own]))
     zero, one = np.zeros(1), np.ones(1)
     turn, stop = corridor_turn(zeros2(), zero, zero, 40.0 * one, 5.0 * one, obstacles, marks)
     return float(turn[0]), bool(stop[0])
@@ -56,7 +56,7 @@ def test_one_alongside_or_under_the_bow_is_met_at_once() -> None:
 def test_the_corridor_follows_the_arc_the_boat_turns_on() -> None:
     along, off = _on_arc(np.array([10.0]), np.array([10.0]), np.array([0.1]))
     np.testing.assert_allclose([along[0], off[0]], [5.0 * np.pi, 0.0], atol=1e-9)  # on it
-    obstacles = Obstacles(np.array([[10.0, 10.0]]), np.array([0.3]), np.array([-1]))
+    obstacles = Obstacles.fixed(np.array([[10.0, 10.0]]), np.array([0.3]), np.array([-1]))
     zero, one = np.zeros(1), np.ones(1)
     bent = corridor_turn(zeros2(), zero, 0.1 * one, 40.0 * one, 5.0 * one, obstacles, NO_MARKS)
     straight = corridor_turn(zeros2(), zero, zero, 40.0 * one, 5.0 * one, obstacles, NO_MARKS)
@@ -98,7 +98,7 @@ def _voyage(*, avoid: bool, seconds: float = 70.0) -> tuple[float, np.ndarray, i
         s, b = world.state_arrays(), world.buoy_state_arrays()
         if k % 10 == 0:
             yaw = rotations.yaw_of_quaternions(s.orientation)
-            seen = Obstacles(b.position[:, :2], np.full(3, buoy_r), np.array([-1]))
+            seen = Obstacles.fixed(b.position[:, :2], np.full(3, buoy_r), np.array([-1]))
             surge, rate = guide.command(s.position[:, :2], yaw, s.linear_velocity,
                                         seen if avoid else None)  # fmt: skip
             set_point = np.stack([surge, rate], axis=1)
