@@ -102,7 +102,7 @@ def _within_reach(
     boat, obs = pairs
     rel = other[0][obs] - own[0][boat]
     wide = width[boat] + other[2][obs]
-    speeds = np.hypot(*own[1][boat].T) + np.hypot(*other[1][obs].T)
+    speeds = np.hypot(*own[1].T)[boat] + np.hypot(*other[1].T)[obs]
     near = np.hypot(rel[:, 0], rel[:, 1]) < wide + speeds * horizon_s
     return boat[near], obs[near], rel[near], wide[near]
 
@@ -129,7 +129,9 @@ def _costs(
     soon, clear2 = _cpa(rel[:, :1], rel[:, 1:], -mine_x, -mine_y, wide[:, None])
     hazard = (clear2 < 0.0) & (soon < horizon_s)
     pair = np.where(hazard, HAZARD * (1.0 - soon / horizon_s), 0.0)
-    pair += _rules(own, other, pairs, rel, soon_now=soon[:, 0], horizon_s=horizon_s, hazard=hazard)
+    now = np.flatnonzero(hazard[:, 0])  # the rules bind the pairs that are a hazard now
+    sub = (boat[now], obs[now])
+    pair[now] += _rules(own, other, sub, rel[now], soon_now=soon[now, 0], horizon_s=horizon_s)
     cost = np.zeros((len(pos), len(OFFSETS)))
     first = np.flatnonzero(np.diff(boat, prepend=-1))  # pairs come sorted by boat
     cost[boat[first]] = np.maximum.reduceat(pair, first, axis=0)
@@ -153,9 +155,8 @@ def _rules(
     *,
     soon_now: Array,
     horizon_s: float,
-    hazard: NDArray[np.bool_],
 ) -> Array:
-    """(P, K) costs of breaking the rules in each pair that is a hazard as things go now."""
+    """(P, K) costs of breaking the rules in pairs that are a hazard as things go now."""
     boat, obs = pairs
     chi = own[2]
     bearing = _wrap(np.arctan2(rel[:, 1], rel[:, 0]) - chi[boat])  # + to port
@@ -165,8 +166,8 @@ def _rules(
     from_starboard = (bearing < 0.0) & (bearing > -ABEAM_AFT)
     overtaking = (np.abs(seen_from_them) > ABEAM_AFT) & (np.abs(bearing) < np.pi - ABEAM_AFT)
     adrift = np.hypot(other[1][obs, 0], other[1][obs, 1]) < ADRIFT_MPS
-    gives = (head_on | from_starboard | overtaking | adrift) & hazard[:, 0]
-    stands = ~gives & hazard[:, 0] & (soon_now > URGENT * horizon_s)
+    gives = head_on | from_starboard | overtaking | adrift
+    stands = ~gives & (soon_now > URGENT * horizon_s)
     changed = (OFFSETS != 0.0) | (SPEEDS != 1.0)
     return np.asarray(
         WRONG_WAY * (gives[:, None] & (OFFSETS > 0.0)) + STAND_ON * (stands[:, None] & changed)
