@@ -54,12 +54,14 @@ class Obstacles:
     radius: Array  # (M,)
     own: Rows  # (N,): each boat's own row among them, -1 when it is not one
     velocity: Array  # (M, 2) over ground, map frame
+    turn_rate: Array  # (M,) rad/s, to port positive
     under_way: NDArray[np.bool_]  # (M,): boats and vessels, whose meetings colregs.py rules
 
     @classmethod
     def fixed(cls, xy: Array, radius: Array, own: Rows) -> Obstacles:
         """Obstacles that do not move and are not boats (buoys, marks)."""
-        return cls(xy, radius, own, np.zeros_like(xy), np.zeros(len(xy), dtype=bool))
+        still = np.zeros(len(xy))
+        return cls(xy, radius, own, np.zeros_like(xy), still, np.zeros(len(xy), dtype=bool))
 
 
 def marks_on(path: Array, anchors: Array) -> NDArray[np.bool_]:

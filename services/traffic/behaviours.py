@@ -27,6 +27,7 @@ from services.traffic.avoid import (
     near_pairs,
 )
 from services.traffic.colregs import OFFSETS, SPEEDS, choose
+from services.traffic.predict import Movers
 
 Array = NDArray[np.float64]
 CIRCLE, WAYPOINTS, HOLD = 0, 1, 2
@@ -227,9 +228,11 @@ class Behaviours:
         boat, obs = near_pairs(pos, far + obstacles.radius.max(), obstacles, np.arange(len(pos)))
         keep = obstacles.under_way[obs] & (obs != obstacles.own[boat]) & (self.kind[boat] != HOLD)
         vel = sog[:, None] * np.column_stack((np.cos(chi), np.sin(chi)))
-        other = (obstacles.xy, obstacles.velocity, obstacles.radius)
+        own = Movers(pos, vel, chi, rate)  # on the arc its own law turns it on
+        v = obstacles.velocity
+        other = Movers(obstacles.xy, v, np.arctan2(v[:, 1], v[:, 0]), obstacles.turn_rate)
         pick = choose(
-            (pos, vel, chi), self.clear.width, other, (boat[keep], obs[keep]),
+            own, self.clear.width, other, obstacles.radius, (boat[keep], obs[keep]),
             horizon_s=horizon, last=self._last_pick,
         )  # fmt: skip
         offset, part = OFFSETS[pick], SPEEDS[pick]

@@ -11,8 +11,10 @@ control behavior selection"), one step of it at every guidance tick, for all boa
   (SPEEDS); the first is the boat's own law unchanged (a boat whose law meets no hazard
   keeps it, so most boats weigh nothing);
 - each candidate against each other boat under way near it: the closest point of approach
-  (CPA) along straight tracks; a CPA closer than both footprints plus the clearance within
-  `horizon_s` is a hazard, costlier the sooner it comes;
+  (CPA), each boat on the arc it is turning on (predict.py: the own law's turn for the
+  first candidate, a held new course for the others, the other boat's turn rate now); a
+  CPA closer than both footprints plus the clearance within `horizon_s` is a hazard,
+  costlier the sooner it comes;
 - the rules of the road (COLREGs 13-17) as costs: a boat that gives way (the other is
   head-on, crosses from starboard, or is being overtaken by it) must not turn to port; one
   that stands on (the other crosses from its port side or overtakes it) pays STAND_ON for
@@ -23,19 +25,20 @@ control behavior selection"), one step of it at every guidance tick, for all boa
 The least total wins. Both boats of a pair read the same geometry, so their roles agree.
 
 Measured over three seeds of that cell (60 s each, plan-view hull boxes at 10 Hz): 90 pairs
-touched before, 42 now; some pair was touching in 28-47 % of the samples before, 19-28 %
-now. Tried and not kept, each worse over the same seeds: a strict stand-on (STAND_ON as
-high as the hazard: 78 pairs; circling boats are not the straight-line movers the rule
-assumes), holding a give-way until the range opens (75), candidates only at full speed (51),
-a longer or shorter horizon (64, 44), a wider hazard margin, and planning at 5 or 2 Hz
-(60, 69). What is left: boats on crossing circles at 5 m/s, whose turns outrun a
-straight-line CPA, touching at 1-3 m/s.
+touched before, 42 with straight-line CPAs, 9 with arcs (2-5 a seed, some of them within
+the first seconds, between boats placed close together); some pair was touching in 36-47 %
+of the samples before, 1-15 % now. Tried and not kept, with straight-line CPAs, each worse
+over the same seeds: a strict stand-on (STAND_ON as high as the hazard: 78 pairs against
+42), holding a give-way until the range opens (75), candidates only at full speed (51),
+a longer or shorter horizon (64, 44), and planning at 5 or 2 Hz (60, 69).
 """
 
 from __future__ import annotations
 
 import numpy as np
 from numpy.typing import NDArray
+
+from services.traffic.predict import F32, Movers, closest, paths, sample_times
 
 Array = NDArray[np.float64]
 Rows = NDArray[np.intp]
@@ -59,9 +62,10 @@ def _wrap(angle: Array) -> Array:
 
 
 def choose(
-    own: tuple[Array, Array, Array],
+    own: Movers,
     width: Array,
-    other: tuple[Array, Array, Array],
+    other: Movers,
+    radius: Array,
     pairs: tuple[Rows, Rows],
     *,
     horizon_s: float,
@@ -69,87 +73,86 @@ def choose(
 ) -> NDArray[np.intp]:
     """Each boat's candidate (an index into OFFSETS and SPEEDS; 0: its own law).
 
-    own: (positions (N, 2), velocities over ground (N, 2), courses (N,)); `width` (N,) its
-    footprint plus the clearance; other: (positions (M, 2), velocities (M, 2), radii (M,))
-    of the boats under way; pairs: (own row, other row) pairs near enough to matter, sorted
-    by own row, never a boat with itself; `last` (N,): each boat's last pick."""
-    n = len(width)
+    own: the boats choosing, their turn rates their own laws' (N rows); `width` (N,) each
+    one's footprint plus the clearance; other: the boats under way they meet (M rows,
+    turning as they are now), `radius` (M,) their footprints; pairs: (own row, other row)
+    pairs near enough to matter, sorted by own row, never a boat with itself; `last` (N,):
+    each boat's last pick."""
+    n, t = len(width), sample_times(horizon_s)
     pick = np.zeros(n, dtype=np.intp)
-    vel = own[1]
-    boat, obs, rel, wide = _within_reach(own, width, other, pairs, horizon_s)
-    closing = other[1][obs] - vel[boat]
-    soon, clear2 = _cpa(rel[:, 0], rel[:, 1], closing[:, 0], closing[:, 1], wide)
+    boat, obs, rel, wide = _within_reach(own, width, other, radius, pairs, horizon_s)
+    theirs, law = paths(other, t), paths(own, t)
+    theirs = (theirs[0][obs], theirs[1][obs])  # (P, T) each
+    law = (law[0][boat, None], law[1][boat, None])  # (P, 1, T) each
+    _, gap2 = closest(rel, theirs, law, t)
     busy = np.zeros(n, dtype=bool)
-    busy[boat[(clear2 < 0.0) & (soon < horizon_s)]] = True
+    busy[boat[gap2[:, 0] < wide * wide]] = True
     mine = busy[boat]
     if mine.any():
         rows = np.flatnonzero(busy)
-        cost = _costs(own, other, (boat[mine], obs[mine]), rel[mine], wide[mine], horizon_s)
+        paired = (boat[mine], obs[mine])
+        ways = (theirs[0][mine], theirs[1][mine]), (law[0][mine], law[1][mine])
+        cost = _costs(own, other, paired, (rel[mine], wide[mine]), ways, t)
         cost += SWITCH * (np.sign(OFFSETS)[None, :] * np.sign(OFFSETS[last])[:, None] < 0.0)
         pick[rows] = np.argmin(cost[rows], axis=1)
     return pick
 
 
 def _within_reach(
-    own: tuple[Array, Array, Array],
+    own: Movers,
     width: Array,
-    other: tuple[Array, Array, Array],
+    other: Movers,
+    radius: Array,
     pairs: tuple[Rows, Rows],
     horizon_s: float,
 ) -> tuple[Rows, Rows, Array, Array]:
     """The pairs that can meet within the horizon at their speeds (no candidate is faster
     than the boat goes now), with their offsets and both footprints plus the clearance."""
     boat, obs = pairs
-    rel = other[0][obs] - own[0][boat]
-    wide = width[boat] + other[2][obs]
-    speeds = np.hypot(*own[1].T)[boat] + np.hypot(*other[1].T)[obs]
+    rel = other.xy[obs] - own.xy[boat]
+    wide = width[boat] + radius[obs]
+    speeds = np.hypot(*own.velocity.T)[boat] + np.hypot(*other.velocity.T)[obs]
     near = np.hypot(rel[:, 0], rel[:, 1]) < wide + speeds * horizon_s
     return boat[near], obs[near], rel[near], wide[near]
 
 
 def _costs(
-    own: tuple[Array, Array, Array],
-    other: tuple[Array, Array, Array],
+    own: Movers,
+    other: Movers,
     pairs: tuple[Rows, Rows],
-    rel: Array,
-    wide: Array,
-    horizon_s: float,
+    apart: tuple[Array, Array],
+    ways: tuple[tuple[F32, F32], tuple[F32, F32]],
+    t: Array,
 ) -> Array:
     """(N, K): each candidate's cost for each boat (rows of boats without pairs: zero
-    hazard)."""
+    hazard). `apart`: each pair's offset and both footprints plus the clearance; `ways`:
+    the other boat's displacements and this one's on its own law's arc. A candidate that
+    changes course holds the new one; candidate 0 is the law."""
     boat, obs = pairs
-    pos, vel, chi = own
-    speed = np.hypot(vel[boat, 0], vel[boat, 1])[:, None]
-    c, s = np.cos(chi[boat])[:, None], np.sin(chi[boat])[:, None]
-    mine_x = speed * (c * _ALONG - s * _ACROSS)  # (P, K): each candidate's velocity
-    mine_y = speed * (s * _ALONG + c * _ACROSS)
-    theirs = other[1][obs]
-    mine_x -= theirs[:, :1]  # now minus the closing velocity
-    mine_y -= theirs[:, 1:]
-    soon, clear2 = _cpa(rel[:, :1], rel[:, 1:], -mine_x, -mine_y, wide[:, None])
-    hazard = (clear2 < 0.0) & (soon < horizon_s)
+    (rel, wide), (theirs, law) = apart, ways
+    speed = np.hypot(*own.velocity.T)[boat][:, None]
+    c, s = np.cos(own.course[boat])[:, None], np.sin(own.course[boat])[:, None]
+    vx = (speed * (c * _ALONG - s * _ACROSS)).astype(np.float32)  # (P, K): each course's
+    vy = (speed * (s * _ALONG + c * _ACROSS)).astype(np.float32)
+    t32 = t.astype(np.float32)
+    mine_x, mine_y = vx[..., None] * t32, vy[..., None] * t32  # (P, K, T)
+    mine_x[:, :1], mine_y[:, :1] = law
+    soon, gap2 = closest(rel, theirs, (mine_x, mine_y), t)
+    hazard = gap2 < (wide * wide)[:, None]
+    horizon_s = float(t[-1])
     pair = np.where(hazard, HAZARD * (1.0 - soon / horizon_s), 0.0)
     now = np.flatnonzero(hazard[:, 0])  # the rules bind the pairs that are a hazard now
     sub = (boat[now], obs[now])
     pair[now] += _rules(own, other, sub, rel[now], soon_now=soon[now, 0], horizon_s=horizon_s)
-    cost = np.zeros((len(pos), len(OFFSETS)))
+    cost = np.zeros((len(own.xy), len(OFFSETS)))
     first = np.flatnonzero(np.diff(boat, prepend=-1))  # pairs come sorted by boat
     cost[boat[first]] = np.maximum.reduceat(pair, first, axis=0)
     return cost + TURN * np.abs(OFFSETS) + SLOW * (1.0 - SPEEDS) + PORT * (OFFSETS > 0.0)
 
 
-def _cpa(rx: Array, ry: Array, cx: Array, cy: Array, wide: Array) -> tuple[Array, Array]:
-    """Time to the closest point of approach (s, >= 0) of an offset (rx, ry) closing at
-    (cx, cy), and the squared distance then less `wide` squared (< 0: closer than `wide`)."""
-    speed2 = np.maximum(cx * cx + cy * cy, 1e-9)
-    soon = np.maximum(-(rx * cx + ry * cy) / speed2, 0.0)
-    at_x, at_y = rx + cx * soon, ry + cy * soon
-    return soon, at_x * at_x + at_y * at_y - wide * wide
-
-
 def _rules(
-    own: tuple[Array, Array, Array],
-    other: tuple[Array, Array, Array],
+    own: Movers,
+    other: Movers,
     pairs: tuple[Rows, Rows],
     rel: Array,
     *,
@@ -158,14 +161,14 @@ def _rules(
 ) -> Array:
     """(P, K) costs of breaking the rules in pairs that are a hazard as things go now."""
     boat, obs = pairs
-    chi = own[2]
-    bearing = _wrap(np.arctan2(rel[:, 1], rel[:, 0]) - chi[boat])  # + to port
-    theirs = np.arctan2(other[1][obs, 1], other[1][obs, 0])
+    chi = own.course[boat]
+    bearing = _wrap(np.arctan2(rel[:, 1], rel[:, 0]) - chi)  # + to port
+    theirs = other.course[obs]
     seen_from_them = _wrap(np.arctan2(-rel[:, 1], -rel[:, 0]) - theirs)
-    head_on = (np.abs(bearing) < HEAD_ON) & (np.abs(_wrap(theirs - chi[boat] - np.pi)) < RECIPROCAL)
+    head_on = (np.abs(bearing) < HEAD_ON) & (np.abs(_wrap(theirs - chi - np.pi)) < RECIPROCAL)
     from_starboard = (bearing < 0.0) & (bearing > -ABEAM_AFT)
     overtaking = (np.abs(seen_from_them) > ABEAM_AFT) & (np.abs(bearing) < np.pi - ABEAM_AFT)
-    adrift = np.hypot(other[1][obs, 0], other[1][obs, 1]) < ADRIFT_MPS
+    adrift = np.hypot(*other.velocity[obs].T) < ADRIFT_MPS
     gives = head_on | from_starboard | overtaking | adrift
     stands = ~gives & (soon_now > URGENT * horizon_s)
     changed = (OFFSETS != 0.0) | (SPEEDS != 1.0)

@@ -89,7 +89,8 @@ class TrafficService:
             xy = batch.position[rows, :2].copy()
             yaw = rotations.yaw_of_quaternions(batch.orientation[rows])
             velocity = rotations.turn_xy(batch.linear_velocity[rows, :2], yaw)
-            self.obstacles = replace(self.obstacles, xy=xy, velocity=velocity)
+            turn = batch.angular_velocity[rows, 2].copy()  # body z: the yaw rate, near level
+            self.obstacles = replace(self.obstacles, xy=xy, velocity=velocity, turn_rate=turn)
 
     def _take_setting(self, key: str, value: object) -> None:
         """A boat's behaviour changed at run time, from its pose at the last guidance tick."""
@@ -132,7 +133,8 @@ def keep_clear(
     r = np.array([radius[b.model_ref] for b in bodies])
     itself = np.array([where.get(vid, -1) for vid in ids], np.intp)  # a boat's own obstacle
     under_way = np.array([b.kind != "buoy" for b in bodies])
-    return clear, Obstacles(xy, r, itself, np.zeros_like(xy), under_way), rows
+    still = np.zeros(len(bodies))
+    return clear, Obstacles(xy, r, itself, np.zeros_like(xy), still, under_way), rows
 
 
 def build(ctx: ServiceContext) -> Built:

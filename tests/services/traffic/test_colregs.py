@@ -18,22 +18,27 @@ from services.physics.world import PhysicsWorld
 from services.traffic.avoid import KeepClear, Obstacles
 from services.traffic.behaviours import Behaviours
 from services.traffic.colregs import OFFSETS, SPEEDS, choose
+from services.traffic.predict import Movers
 
 WIDTH, RADIUS = 4.5, 2.5  # a boat's footprint plus the clearance, the other's footprint
 
 
-def picks(boats: list[tuple[float, float, float, float]]) -> list[tuple[float, float]]:
+def picks(
+    boats: list[tuple[float, float, float, float]], turn: tuple[float, ...] = ()
+) -> list[tuple[float, float]]:
     """Each boat's (course change in degrees, part of its speed) for boats (x, y, course
-    in degrees, speed) meeting each other."""
+    in degrees, speed) meeting each other, each turning at its rate in `turn` (rad/s, to
+    port; none: straight on)."""
     xy = np.array([(x, y) for x, y, _, _ in boats], dtype=float)
     chi = np.radians([c for _, _, c, _ in boats])
     speed = np.array([v for _, _, _, v in boats], dtype=float)
     vel = speed[:, None] * np.column_stack((np.cos(chi), np.sin(chi)))
     n = len(boats)
+    movers = Movers(xy, vel, chi, np.array(turn or [0.0] * n))
     boat, other = (a.ravel() for a in np.meshgrid(np.arange(n), np.arange(n), indexing="ij"))
     pairs = (boat[boat != other], other[boat != other])
     pick = choose(
-        (xy, vel, chi), np.full(n, WIDTH), (xy, vel, np.full(n, RADIUS)), pairs,
+        movers, np.full(n, WIDTH), movers, np.full(n, RADIUS), pairs,
         horizon_s=8.0, last=np.zeros(n, dtype=np.intp),
     )  # fmt: skip
     return [(round(math.degrees(OFFSETS[k])), float(SPEEDS[k])) for k in pick]
@@ -73,6 +78,13 @@ def test_a_boat_adrift_ahead_is_given_way_to() -> None:
     assert mover != KEEPS_ON and adrift == KEEPS_ON
 
 
+def test_a_boat_whose_circle_runs_into_another_sees_it_coming() -> None:
+    circling = (0.0, 0.0, 0.0, 5.0)  # turning to port at 0.4 rad/s: a circle 25 m across
+    moored = (0.0, 25.0, 0.0, 0.0)  # at the top of that circle, 7.9 s away
+    assert picks([circling, moored], turn=(0.4, 0.0))[0] != KEEPS_ON
+    assert picks([circling, moored])[0] == KEEPS_ON  # straight on, it would pass 25 m off
+
+
 def test_boats_that_pass_clear_keep_their_own_law() -> None:
     assert picks([(0.0, 0.0, 0.0, 5.0), (60.0, 30.0, 180.0, 5.0)]) == [KEEPS_ON] * 2  # wide
     assert picks([(0.0, 0.0, 0.0, 5.0), (-30.0, 0.0, 180.0, 5.0)]) == [KEEPS_ON] * 2  # opening
@@ -101,12 +113,14 @@ def _meeting(starts: list[tuple[float, float, float]], *, rules: bool) -> float:
     guide, bank = Behaviours(boats, clear=clear), TwistControllerBank([model] * n, dt_s=DT)
     offset, half = footprints([model] * n)
     rows, set_point, least = np.arange(n), np.zeros((n, 2)), math.inf
+    under_way = np.ones(n, dtype=bool)
     for k in range(round(45.0 / DT)):
         s = world.state_arrays()
         yaw = rotations.yaw_of_quaternions(s.orientation)
         if k % 10 == 0:
             over_ground = rotations.turn_xy(s.linear_velocity[:, :2], yaw)
-            seen = Obstacles(s.position[:, :2], np.full(n, r), rows, over_ground, np.ones(n, bool))
+            turn = s.angular_velocity[:, 2]
+            seen = Obstacles(s.position[:, :2], np.full(n, r), rows, over_ground, turn, under_way)
             surge, rate = guide.command(s.position[:, :2], yaw, s.linear_velocity,
                                         seen if rules else None)  # fmt: skip
             set_point = np.stack([surge, rate], axis=1)
