@@ -25,12 +25,15 @@ control behavior selection"), one step of it at every guidance tick, for all boa
 The least total wins. Both boats of a pair read the same geometry, so their roles agree.
 
 Measured over three seeds of that cell (60 s each, plan-view hull boxes at 10 Hz): 90 pairs
-touched before, 42 with straight-line CPAs, 9 with arcs (2-5 a seed, some of them within
-the first seconds, between boats placed close together); some pair was touching in 36-47 %
-of the samples before, 1-15 % now. Tried and not kept, with straight-line CPAs, each worse
-over the same seeds: a strict stand-on (STAND_ON as high as the hazard: 78 pairs against
-42), holding a give-way until the range opens (75), candidates only at full speed (51),
-a longer or shorter horizon (64, 44), and planning at 5 or 2 Hz (60, 69).
+touched before, 42 with straight-line CPAs, 6 with arcs (3, 1 and 2 a seed, 4 of them in
+the first 4 s, between boats placed close together at rest); some pair was touching in
+36-47 % of the samples before, 2-7 % now. STAND_ON: with 5 the stand-on boat acted almost
+as soon as the giver (9 pairs), with 100 it held on into the meeting (33 pairs): circling
+boats are not the straight-line movers rule 17 has in mind, and a stand-on boat must be
+free to act once the hazard is about 5 s away. Tried and not kept, with straight-line CPAs,
+each worse over the same seeds: holding a give-way until the range opens (75 pairs
+against 42), candidates only at full speed (51), a longer or shorter horizon (64, 44), and
+planning at 5 or 2 Hz (60, 69).
 """
 
 from __future__ import annotations
@@ -53,7 +56,7 @@ RECIPROCAL = np.radians(30.0)  # ... on a course this close to the reverse of ou
 ABEAM_AFT = np.radians(112.5)  # 22.5 degrees abaft the beam: a stern light's arc ends
 URGENT = 0.35  # a stand-on boat may act when the hazard is nearer than this part of the horizon
 ADRIFT_MPS = 0.5  # a boat slower than this has no course to read: the other one gives way
-HAZARD, WRONG_WAY, STAND_ON = 100.0, 20.0, 5.0  # costs
+HAZARD, WRONG_WAY, STAND_ON = 100.0, 20.0, 30.0  # costs (a hazard's at its soonest)
 TURN, SLOW, PORT, SWITCH = 4.0, 3.0, 1.0, 5.0  # costs per radian / per part of speed / flat
 
 

@@ -4,7 +4,7 @@ Why: the rules of the road (colregs.py) first predicted straight tracks, as most
 avoidance does for ships. A circling traffic boat turns about 15 degrees a second, so a
 straight line misjudged most meetings within a few seconds: 42 pairs of boats still touched
 over three seeds of Table II's 100-boat cell (60 s each). Predicted along each boat's arc
-(its turn rate held), 9 pairs did. There is no closed form for the closest point of
+(its turn rate held), 6 pairs did. There is no closed form for the closest point of
 approach of two arcs, so the distance is sampled SAMPLES times over the horizon and the
 least sample refined by a parabola (`closest`).
 """
