@@ -228,13 +228,12 @@ class Behaviours:
         boat, obs = near_pairs(pos, far + obstacles.radius.max(), obstacles, np.arange(len(pos)))
         keep = obstacles.under_way[obs] & (obs != obstacles.own[boat]) & (self.kind[boat] != HOLD)
         vel = sog[:, None] * np.column_stack((np.cos(chi), np.sin(chi)))
-        own = Movers(pos, vel, chi, rate)  # on the arc its own law turns it on
+        own = Movers(pos, vel, chi, rate, self.clear.width)  # on its own law's arc
         v = obstacles.velocity
-        other = Movers(obstacles.xy, v, np.arctan2(v[:, 1], v[:, 0]), obstacles.turn_rate)
-        pick = choose(
-            own, self.clear.width, other, obstacles.radius, (boat[keep], obs[keep]),
-            horizon_s=horizon, last=self._last_pick,
-        )  # fmt: skip
+        course = np.arctan2(v[:, 1], v[:, 0])
+        other = Movers(obstacles.xy, v, course, obstacles.turn_rate, obstacles.radius)
+        pairs = (boat[keep], obs[keep])
+        pick = choose(own, other, pairs, horizon_s=horizon, last=self._last_pick)
         offset, part = OFFSETS[pick], SPEEDS[pick]
         self._last_pick = pick
         act = pick != 0

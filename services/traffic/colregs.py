@@ -66,9 +66,7 @@ def _wrap(angle: Array) -> Array:
 
 def choose(
     own: Movers,
-    width: Array,
     other: Movers,
-    radius: Array,
     pairs: tuple[Rows, Rows],
     *,
     horizon_s: float,
@@ -76,14 +74,13 @@ def choose(
 ) -> NDArray[np.intp]:
     """Each boat's candidate (an index into OFFSETS and SPEEDS; 0: its own law).
 
-    own: the boats choosing, their turn rates their own laws' (N rows); `width` (N,) each
-    one's footprint plus the clearance; other: the boats under way they meet (M rows,
-    turning as they are now), `radius` (M,) their footprints; pairs: (own row, other row)
-    pairs near enough to matter, sorted by own row, never a boat with itself; `last` (N,):
-    each boat's last pick."""
-    n, t = len(width), sample_times(horizon_s)
+    own: the boats choosing (N rows), their turn rates their own laws', their sizes their
+    footprints plus the clearance; other: the boats under way they meet (M rows, turning
+    as they are now); pairs: (own row, other row) pairs near enough to matter, sorted by
+    own row, never a boat with itself; `last` (N,): each boat's last pick."""
+    n, t = len(own.xy), sample_times(horizon_s)
     pick = np.zeros(n, dtype=np.intp)
-    boat, obs, rel, wide = _within_reach(own, width, other, radius, pairs, horizon_s)
+    boat, obs, rel, wide = _within_reach(own, other, pairs, horizon_s)
     theirs, law = paths(other, t), paths(own, t)
     theirs = (theirs[0][obs], theirs[1][obs])  # (P, T) each
     law = (law[0][boat, None], law[1][boat, None])  # (P, 1, T) each
@@ -102,18 +99,13 @@ def choose(
 
 
 def _within_reach(
-    own: Movers,
-    width: Array,
-    other: Movers,
-    radius: Array,
-    pairs: tuple[Rows, Rows],
-    horizon_s: float,
+    own: Movers, other: Movers, pairs: tuple[Rows, Rows], horizon_s: float
 ) -> tuple[Rows, Rows, Array, Array]:
     """The pairs that can meet within the horizon at their speeds (no candidate is faster
     than the boat goes now), with their offsets and both footprints plus the clearance."""
     boat, obs = pairs
     rel = other.xy[obs] - own.xy[boat]
-    wide = width[boat] + radius[obs]
+    wide = own.size[boat] + other.size[obs]
     speeds = np.hypot(*own.velocity.T)[boat] + np.hypot(*other.velocity.T)[obs]
     near = np.hypot(rel[:, 0], rel[:, 1]) < wide + speeds * horizon_s
     return boat[near], obs[near], rel[near], wide[near]

@@ -29,6 +29,7 @@ class Movers:
     velocity: Array  # (n, 2) m/s over ground
     course: Array  # (n,) rad, the heading when too slow to have a course
     turn: Array  # (n,) rad/s, to port positive: each is predicted to hold this rate
+    size: Array  # (n,) m: its footprint's radius, plus the clearance for a boat choosing
 
 
 def arc(rate: Array, t: Array) -> tuple[Array, Array]:

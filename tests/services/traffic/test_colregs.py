@@ -34,13 +34,11 @@ def picks(
     speed = np.array([v for _, _, _, v in boats], dtype=float)
     vel = speed[:, None] * np.column_stack((np.cos(chi), np.sin(chi)))
     n = len(boats)
-    movers = Movers(xy, vel, chi, np.array(turn or [0.0] * n))
+    rates = np.array(turn or [0.0] * n)
+    own, seen = (Movers(xy, vel, chi, rates, np.full(n, size)) for size in (WIDTH, RADIUS))
     boat, other = (a.ravel() for a in np.meshgrid(np.arange(n), np.arange(n), indexing="ij"))
     pairs = (boat[boat != other], other[boat != other])
-    pick = choose(
-        movers, np.full(n, WIDTH), movers, np.full(n, RADIUS), pairs,
-        horizon_s=8.0, last=np.zeros(n, dtype=np.intp),
-    )  # fmt: skip
+    pick = choose(own, seen, pairs, horizon_s=8.0, last=np.zeros(n, dtype=np.intp))
     return [(round(math.degrees(OFFSETS[k])), float(SPEEDS[k])) for k in pick]
 
 
