@@ -221,19 +221,13 @@ class Behaviours:
         least cost under the rules of the road (colregs.py), unless the corridor already
         turns it (a buoy, a hull alongside)."""
         surge, rate = order
-        horizon = self.clear.lookahead_s
-        moving = np.flatnonzero(obstacles.under_way)
-        fastest = float(np.hypot(*obstacles.velocity[moving].T).max(initial=0.0))
-        far = (np.maximum(sog, self.speed) + fastest) * horizon + self.clear.width
-        boat, obs = near_pairs(pos, far + obstacles.radius.max(), obstacles, np.arange(len(pos)))
-        keep = obstacles.under_way[obs] & (obs != obstacles.own[boat]) & (self.kind[boat] != HOLD)
         vel = sog[:, None] * np.column_stack((np.cos(chi), np.sin(chi)))
         own = Movers(pos, vel, chi, rate, self.clear.width)  # on its own law's arc
         v = obstacles.velocity
         course = np.arctan2(v[:, 1], v[:, 0])
         other = Movers(obstacles.xy, v, course, obstacles.turn_rate, obstacles.radius)
-        pairs = (boat[keep], obs[keep])
-        pick = choose(own, other, pairs, horizon_s=horizon, last=self._last_pick)
+        pairs = self._meetings(pos, sog, obstacles)
+        pick = choose(own, other, pairs, horizon_s=self.clear.lookahead_s, last=self._last_pick)
         offset, part = OFFSETS[pick], SPEEDS[pick]
         self._last_pick = pick
         act = pick != 0
@@ -241,6 +235,18 @@ class Behaviours:
         surge = np.where(act & (surge > 0.0), surge * part, surge)
         rate = np.where(steer, np.clip(YAW_GAIN * offset, -MAX_YAW_RATE, MAX_YAW_RATE), rate)
         return surge, rate
+
+    def _meetings(
+        self, pos: Array, sog: Array, obstacles: Obstacles
+    ) -> tuple[NDArray[np.intp], NDArray[np.intp]]:
+        """(boat, obstacle) pairs of boats under way that could meet within the lookahead,
+        never a boat with itself nor a holding boat (it stays put)."""
+        moving = np.flatnonzero(obstacles.under_way)
+        fastest = float(np.hypot(*obstacles.velocity[moving].T).max(initial=0.0))
+        far = (np.maximum(sog, self.speed) + fastest) * self.clear.lookahead_s + self.clear.width
+        boat, obs = near_pairs(pos, far + obstacles.radius.max(), obstacles, np.arange(len(pos)))
+        keep = obstacles.under_way[obs] & (obs != obstacles.own[boat]) & (self.kind[boat] != HOLD)
+        return boat[keep], obs[keep]
 
     def _own_marks(self) -> Array:
         """(N, K, 2): the marks on each boat's path, nan where none (it rounds them)."""
