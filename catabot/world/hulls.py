@@ -15,8 +15,10 @@ import numpy as np
 from numpy.typing import NDArray
 
 from catabot.config.vessel import Hull, VesselModel
+from catabot.world.rotations import turn_xy, yaw_of_quaternions
 
 Array = NDArray[np.float64]
+Rows = NDArray[np.intp]
 PROBE_SPACING_M = 0.5  # along and across each hull bottom
 CONTACT_M = 0.01  # hull boxes this close touch (physics resolves a contact within mm)
 
@@ -74,3 +76,18 @@ def box_gaps(
     reach += half[b, :1] * np.abs(axes @ np.stack([cb, sb], -1)[..., None])[..., 0]
     reach += half[b, 1:] * np.abs(axes @ np.stack([-sb, cb], -1)[..., None])[..., 0]
     return np.asarray((along - reach).max(axis=1))
+
+
+def boxes_touch(
+    xy: Array, quat: Array, boxes: tuple[Array, Array], a: Rows, b: Rows
+) -> NDArray[np.bool_]:
+    """Which body pairs (a[k], b[k]) touch: their plan-view boxes within CONTACT_M. Bodies
+    at `xy` (N, 2) turned by `quat` (N, 4), boxes (offset, half) as `footprints` gives them;
+    headings are worked out for the bodies of the pairs only."""
+    offset, half = boxes
+    rows = np.unique(np.concatenate([a, b]))
+    heading = np.zeros(len(xy))
+    heading[rows] = yaw_of_quaternions(quat[rows])
+    centre = np.array(xy, dtype=np.float64)
+    centre[rows] += turn_xy(offset[rows], heading[rows])
+    return np.asarray(box_gaps(centre, heading, half, a, b) <= CONTACT_M)

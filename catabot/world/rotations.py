@@ -92,6 +92,11 @@ def yaw_of_quaternions(q: Array) -> Array:
     return np.arctan2(2 * (w * z + x * y), 1 - 2 * (y * y + z * z))
 
 
+def wrap(angle: Array) -> Array:
+    """Angles (rad) into [-pi, pi): the signed difference between two headings."""
+    return np.asarray((angle + np.pi) % (2 * np.pi) - np.pi)
+
+
 def turn_xy(xy: Array, yaw: Array) -> Array:
     """Horizontal vectors (N, 2) turned by headings (N,): body-frame x, y in map axes (a
     boat's velocity over ground from its surge and sway)."""

@@ -16,8 +16,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from catabot.bus.messages import BodyStates
-from catabot.world import rotations
-from catabot.world.hulls import CONTACT_M, box_gaps
+from catabot.world.hulls import CONTACT_M, boxes_touch
 from services.recorder.episodes import Episode
 
 Array = NDArray[np.float64]
@@ -54,12 +53,7 @@ class FleetContacts:
         a, b = _near_pairs(xy, self.reach)
         if a.size == 0:
             return a, b
-        rows = np.unique(np.concatenate([a, b]))
-        heading = np.zeros(len(xy))
-        heading[rows] = rotations.yaw_of_quaternions(quat[rows])
-        centre = xy.copy()
-        centre[rows] += rotations.turn_xy(self.offset[rows], heading[rows])
-        hit = box_gaps(centre, heading, self.half, a, b) <= CONTACT_M
+        hit = boxes_touch(xy, quat, (self.offset, self.half), a, b)
         return a[hit], b[hit]
 
     def all(self) -> list[Episode]:

@@ -23,8 +23,7 @@ import numpy as np
 from catabot.bus.clock import NS_PER_S
 from catabot.bus.messages import BodyStates, Message
 from catabot.config.rates import traffic_record_period
-from catabot.world.hulls import CONTACT_M, box_gaps, footprints
-from catabot.world.rotations import yaw_of_quaternions
+from catabot.world.hulls import CONTACT_M, boxes_touch, footprints
 from catabot.world.world import World
 from services.recorder.episodes import Episodes
 from services.recorder.fleet_contacts import FleetContacts
@@ -123,15 +122,9 @@ class Metrics:
         if near.any():
             touching = np.zeros_like(near)
             a, b = np.nonzero(near)
-            quat = np.asarray(batch.orientation)
-            rows = np.unique(np.concatenate([a, b]))
-            heading = np.zeros(len(self.body_ids))
-            heading[rows] = yaw_of_quaternions(quat[rows])
-            c, h = np.cos(heading[rows]), np.sin(heading[rows])
-            centre = np.asarray(batch.position)[:, :2].copy()
-            ox, oy = self.offset[rows].T  # the box centre, body frame, turned to the world's
-            centre[rows] += np.stack([c * ox - h * oy, h * ox + c * oy], axis=1)
-            touching[a, b] = box_gaps(centre, heading, self.half, a, b) <= CONTACT_M
+            position = np.asarray(batch.position)[:, :2]
+            boxes = (self.offset, self.half)
+            touching[a, b] = boxes_touch(position, np.asarray(batch.orientation), boxes, a, b)
         self.collisions.update(touching, stamp)
 
     def write(self, path: Path) -> None:

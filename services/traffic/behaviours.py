@@ -17,6 +17,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from catabot.config.traffic import TrafficConfig
+from catabot.world.rotations import wrap
 from catabot.world.traffic_plan import Boat
 from services.traffic.avoid import (
     KeepClear,
@@ -41,10 +42,6 @@ CIRCLE_GAIN = 0.5
 HOLD_RADIUS_M = 3.0  # closer than this, hold the heading instead of turning to the point
 BACK_OFF_MPS = 1.0  # astern, while an obstacle is under the bow (avoid.py)
 PATROL_M = 100.0  # a boat set to waypoints with no path patrols this far ahead and back
-
-
-def wrap(angle: Array) -> Array:
-    return np.asarray((angle + np.pi) % (2 * np.pi) - np.pi)
 
 
 def course(yaw: Array, velocity_b: Array) -> Array:

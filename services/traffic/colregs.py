@@ -41,6 +41,7 @@ from __future__ import annotations
 import numpy as np
 from numpy.typing import NDArray
 
+from catabot.world.rotations import wrap
 from services.traffic.predict import F32, Movers, closest, paths, sample_times
 
 Array = NDArray[np.float64]
@@ -58,10 +59,6 @@ URGENT = 0.35  # a stand-on boat may act when the hazard is nearer than this par
 ADRIFT_MPS = 0.5  # a boat slower than this has no course to read: the other one gives way
 HAZARD, WRONG_WAY, STAND_ON = 100.0, 20.0, 30.0  # costs (a hazard's at its soonest)
 TURN, SLOW, PORT, SWITCH = 4.0, 3.0, 1.0, 5.0  # costs per radian / per part of speed / flat
-
-
-def _wrap(angle: Array) -> Array:
-    return np.asarray((angle + np.pi) % (2 * np.pi) - np.pi)
 
 
 def choose(
@@ -157,10 +154,10 @@ def _rules(
     """(P, K) costs of breaking the rules in pairs that are a hazard as things go now."""
     boat, obs = pairs
     chi = own.course[boat]
-    bearing = _wrap(np.arctan2(rel[:, 1], rel[:, 0]) - chi)  # + to port
+    bearing = wrap(np.arctan2(rel[:, 1], rel[:, 0]) - chi)  # + to port
     theirs = other.course[obs]
-    seen_from_them = _wrap(np.arctan2(-rel[:, 1], -rel[:, 0]) - theirs)
-    head_on = (np.abs(bearing) < HEAD_ON) & (np.abs(_wrap(theirs - chi - np.pi)) < RECIPROCAL)
+    seen_from_them = wrap(np.arctan2(-rel[:, 1], -rel[:, 0]) - theirs)
+    head_on = (np.abs(bearing) < HEAD_ON) & (np.abs(wrap(theirs - chi - np.pi)) < RECIPROCAL)
     from_starboard = (bearing < 0.0) & (bearing > -ABEAM_AFT)
     overtaking = (np.abs(seen_from_them) > ABEAM_AFT) & (np.abs(bearing) < np.pi - ABEAM_AFT)
     adrift = np.hypot(*other.velocity[obs].T) < ADRIFT_MPS
