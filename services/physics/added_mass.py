@@ -43,7 +43,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from catabot.config.vessel import VesselModel
-from catabot.world import rotations
+from services.physics import kernels
 from services.physics.hydro import Array
 
 
@@ -73,9 +73,6 @@ class AddedMass:
         augmented = self.m_rb + np.einsum("ni,ij->nij", self.diag, np.eye(6))
         self.inverse = np.linalg.inv(augmented) if len(chosen) else augmented
         self.gravity = float(gravity)
-        self._lhs = np.empty((5, len(chosen), 3))  # stacked cross-product operands
-        self._rhs = np.empty((5, len(chosen), 3))
-        self._lhs[3] = self.cog
 
     def take(self, rows: NDArray[np.intp]) -> AddedMass:
         """The same for bodies `rows` (sorted) alone, in that order (forces.py)."""
@@ -85,8 +82,6 @@ class AddedMass:
         sub.all_rows = sub.rows.size == sub.count
         for name in ("diag", "coriolis_diag", "mass", "cog", "m_rb", "inverse"):
             setattr(sub, name, getattr(self, name)[keep])
-        sub._lhs, sub._rhs = np.empty((5, keep.size, 3)), np.empty((5, keep.size, 3))
-        sub._lhs[3] = sub.cog
         return sub
 
     @property
@@ -108,39 +103,8 @@ class AddedMass:
         return out
 
     def _solve(self, z_b: Array, nu: Array, nu_c: Array, other: Array) -> Array:
-        """tau_A for the chosen rows; z_b is the world up axis in body coordinates.
-
-        Written out component by component (C_A) and with one stacked cross product for the
-        rigid-body terms: at ~100 vessels numpy's per-call overhead, not arithmetic, is the
-        cost, so fewer, larger operations win.
-        """
-        p = np.einsum("nij,nj->ni", self.m_rb, nu)  # rigid-body momenta [p1, p2]
-        v_r = nu[:, :3] - nu_c
-        u_r, v_rel, w_r = v_r[:, 0], v_r[:, 1], v_r[:, 2]
-        rate_p, rate_q, rate_r = nu[:, 3], nu[:, 4], nu[:, 5]
-        a1, a2, a6 = self.coriolis_diag[:, 0], self.coriolis_diag[:, 1], self.coriolis_diag[:, 5]
-        m1, m2, m6 = a1 * u_r, a2 * v_rel, a6 * rate_r  # added-mass momenta (manoeuvring)
-        coriolis_a = np.stack(
-            [
-                -rate_r * m2,
-                rate_r * m1,
-                rate_p * m2 - rate_q * m1,
-                rate_q * m6 - w_r * m2,
-                w_r * m1 - rate_p * m6,
-                u_r * m2 - v_rel * m1,
-            ],
-            axis=1,
-        )
-        lhs, rhs = self._lhs, self._rhs  # pairs: w x p1, v x p1, w x p2, r_g x z_b, w x nu_c
-        lhs[0], lhs[1], lhs[2], lhs[4] = nu[:, 3:], nu[:, :3], nu[:, 3:], nu[:, 3:]
-        rhs[0], rhs[1], rhs[2], rhs[3], rhs[4] = p[:, :3], p[:, :3], p[:, 3:], z_b, nu_c
-        c = rotations.cross(lhs, rhs)
-        turning = self.diag[:, :3] * c[4]  # A_lin (w x nu_c): the current turning with the hull
-        weight = -self.gravity * self.mass
-        total = other - coriolis_a
-        total[:, :3] += weight * z_b - c[0] - turning
-        total[:, 3:] += weight * c[3] - c[1] - c[2]
-        nu_dot = np.einsum("nij,nj->ni", self.inverse, total)
-        tau = -self.diag * nu_dot - coriolis_a
-        tau[:, :3] -= turning
-        return tau
+        """tau_A for the chosen rows (kernels.added_mass); z_b is the world up axis in body
+        coordinates."""
+        tables = (self.m_rb, self.inverse, self.diag, self.coriolis_diag, self.mass, self.cog)
+        z_b, nu, nu_c, other = (np.ascontiguousarray(a) for a in (z_b, nu, nu_c, other))
+        return kernels.added_mass(tables, z_b, nu, nu_c, other, self.gravity)

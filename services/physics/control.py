@@ -20,6 +20,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from catabot.config.vessel import VesselModel
+from services.physics import kernels
 
 Array = NDArray[np.float64]
 
@@ -77,7 +78,7 @@ def _largest_scale(base: Array, step: Array, lo: Array, hi: Array) -> float:
 
 
 class TwistControllerBank:
-    """The same law as TwistController for many vessels at once (one NumPy pass per tick):
+    """The same law as TwistController for many vessels at once (one compiled loop a tick):
     with 100 traffic boats a controller call per boat would cost more than the physics."""
 
     def __init__(self, models: list[VesselModel], *, dt_s: float) -> None:
@@ -93,51 +94,13 @@ class TwistControllerBank:
             self.pinv[i, :t], self.fwd[i, :t], self.rev[i, :t] = c.pinv, c.fwd, c.rev
         self.dt_s, self.kp, self.ki = dt_s, single[0].kp, single[0].ki
         self.integral = np.zeros((len(single), 2))
-        self._rows = np.empty(0, np.intp)
-        self._of_rows: tuple[Array, ...] = ()
 
     def command(self, rows: NDArray[np.intp], target: Array, measured: Array) -> Array:
-        """Normalised commands (len(rows), width) for vessels `rows`; padding columns are 0."""
-        error = target - measured
-        damp, inertia, pinv, lo, hi = self._constants(rows)
-        feed = damp[:, :, 0] * target + damp[:, :, 1] * target * np.abs(target)
-        trial = _clip(self.integral[rows] + error * self.dt_s, -5.0, 5.0)
-        wrench = feed + inertia * (self.kp * error + self.ki * trial)
-        yaw_part = pinv[:, :, 1] * wrench[:, 1:2]
-        s_yaw = _largest_scales(np.zeros_like(yaw_part), yaw_part, lo, hi)
-        yaw_part = s_yaw[:, None] * yaw_part
-        surge_part = pinv[:, :, 0] * wrench[:, 0:1]
-        s_surge = _largest_scales(yaw_part, surge_part, lo, hi)
-        forces = yaw_part + s_surge[:, None] * surge_part
-        free = (s_yaw >= 1.0) & (s_surge >= 1.0)
-        self.integral[rows[free]] = trial[free]
-        limit = np.where(forces >= 0, hi, -lo)
-        return _clip(forces / np.maximum(limit, 1e-9), -1.0, 1.0)
-
-    def _constants(self, rows: NDArray[np.intp]) -> tuple[Array, ...]:
-        """The vessels' own constants, gathered again only when the controlled set changes
-        (the same boats under velocity control tick after tick: ~15 us a tick for 100)."""
-        if not np.array_equal(rows, self._rows):
-            self._rows = rows.copy()
-            self._of_rows = (
-                self.damp[rows],
-                self.inertia[rows],
-                self.pinv[rows],
-                -self.rev[rows],
-                self.fwd[rows],
-            )
-        return self._of_rows
-
-
-def _largest_scales(base: Array, step: Array, lo: Array, hi: Array) -> Array:
-    """Row-wise `_largest_scale`. No division meets a zero (the step is 1 there, its bound
-    inf), so no error state to set."""
-    room = np.where(step > 0, hi - base, np.where(step < 0, lo - base, np.inf))
-    moving = step != 0
-    bounds = np.where(moving, room / np.where(moving, step, 1.0), np.inf)
-    return _clip(np.min(bounds, axis=1, initial=1.0), 0.0, 1.0)
-
-
-def _clip(a: Array, lo: float, hi: float) -> Array:
-    """np.clip's values (NaN kept) for floats, without its Python wrapper's cost."""
-    return np.minimum(np.maximum(a, lo), hi)
+        """Normalised commands (len(rows), width) for vessels `rows`; padding columns are 0
+        (kernels.twist_commands: the law above, one compiled loop over the rows)."""
+        tables = (self.damp, self.inertia, self.pinv, self.rev, self.fwd)
+        gains = (float(self.dt_s), float(self.kp), float(self.ki))
+        setpoints = (np.ascontiguousarray(target, dtype=np.float64),
+                     np.ascontiguousarray(measured, dtype=np.float64))  # fmt: skip
+        rows = np.ascontiguousarray(rows, dtype=np.intp)
+        return kernels.twist_commands(tables, gains, self.integral, rows, setpoints)

@@ -14,7 +14,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from catabot.config.vessel import Hull, Thruster, VesselModel
-from catabot.world import rotations
+from services.physics import kernels
 
 Array = NDArray[np.float64]
 WaterHeight = Callable[[Array, Array, float], Array]
@@ -35,12 +35,13 @@ def water_height(x: Array, y: Array, time_s: float = 0.0) -> Array:
 
 
 class Columns:
-    """Vertical buoyancy columns of every vessel, padded to (N, C), plus scratch buffers.
+    """Vertical buoyancy columns of every vessel, padded to (N, C).
 
     bottom_m: column bottom points in the body frame, stored (N, 3, C) so that one batched
-    matmul moves them all; height_m: extent along body z; area_m2: horizontal cross-section
-    (0 for padding). The scratch buffers are reused every step: fresh arrays of this size cost
-    more in page faults than the arithmetic itself. Not thread-safe, by design (one world).
+    matmul moves them all (to sample a wavy surface under them); height_m: extent along body
+    z; area_m2: horizontal cross-section (0 for padding). The buffers are reused every step:
+    fresh arrays of this size cost more in page faults than the arithmetic itself. Not
+    thread-safe, by design (one world).
     """
 
     def __init__(self, bottom_m: Array, height_m: Array, area_m2: Array) -> None:
@@ -48,9 +49,8 @@ class Columns:
         self.height_m = np.ascontiguousarray(height_m, dtype=np.float64)
         self.area_m2 = np.ascontiguousarray(area_m2, dtype=np.float64)
         self.volume_m3 = self.height_m * self.area_m2
-        n, c = self.height_m.shape
-        self._world = np.empty((n, 3, c))
-        self._scratch = np.empty((3, n, c))
+        self.calm = np.zeros_like(self.height_m)  # the water height at every column, calm
+        self._world = np.empty(self.bottom_m.shape)
 
     def take(self, rows: NDArray[np.intp]) -> Columns:
         """The columns of vessels `rows`, with buffers of their own."""
@@ -117,34 +117,20 @@ def buoyancy_wrench(
     (world +z) and acts at the centroid of the submerged part: the total is rho*g times the
     submerged volume (Archimedes, exact for boxes) and tilt gives a restoring moment.
     """
-    bottom_w = np.matmul(rot, cols.bottom_m, out=cols._world)  # (N, 3, C), world frame
-    bottom_w += pos[:, :, None]
-    cos_tilt = rot[:, 2, 2:3]  # world z of the body z axis, (N, 1)
-    rise, frac, work = cols._scratch  # (N, C) buffers, overwritten below
-    np.multiply(cols.height_m, cos_tilt, out=rise)  # signed world-vertical extent
-    np.minimum(rise, 0.0, out=frac)
-    frac += bottom_w[:, 2]  # z of the lower end
-    eta = surface(bottom_w[:, 0], bottom_w[:, 1], time_s)
-    np.subtract(eta, frac, out=frac)
-    np.abs(rise, out=work)
-    np.maximum(work, 1e-12, out=work)
-    frac /= work
-    np.clip(frac, 0.0, 1.0, out=frac)  # submerged fraction of each column
-    force = np.multiply(cols.volume_m3, frac, out=work)
-    force *= density * gravity  # (N, C), newtons
-    # Centroid of the submerged part along body z, from the bottom (or the top when capsized).
-    along = np.multiply(frac, cols.height_m, out=rise)
-    along *= 0.5
-    inverted = np.flatnonzero(cos_tilt[:, 0] < 0.0)
-    if inverted.size:
-        along[inverted] = cols.height_m[inverted] - along[inverted]
-    first_moment = np.matmul(cols.bottom_m, force[:, :, None])[:, :, 0]
-    first_moment[:, 2] += np.einsum("nc,nc->n", force, along)
-    up_body = rot[:, 2, :]  # world +z expressed in the body frame
-    total = force.sum(axis=1)
-    return np.concatenate(
-        [total[:, None] * up_body, rotations.cross(first_moment, up_body)], axis=1
-    )
+    if surface is water_height:  # calm water: nothing to sample
+        eta = cols.calm
+    else:
+        bottom_w = np.matmul(rot, cols.bottom_m, out=cols._world)  # (N, 3, C), world frame
+        bottom_w += pos[:, :, None]
+        eta = np.empty_like(cols.height_m)
+        eta[...] = surface(bottom_w[:, 0], bottom_w[:, 1], time_s)
+    tables = (cols.bottom_m, cols.height_m, cols.volume_m3)
+    return kernels.buoyancy(_plain(rot), _plain(pos), tables, eta, density * gravity)
+
+
+def _plain(a: Array) -> Array:
+    """C-contiguous float64, the one array type the kernels are compiled for."""
+    return np.ascontiguousarray(a, dtype=np.float64)
 
 
 # --- damping ----------------------------------------------------------------------------

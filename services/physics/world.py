@@ -28,6 +28,7 @@ from catabot.world import rotations
 from catabot.world.environment import CurrentField, WindField
 from catabot.world.terrain import Terrain
 from catabot.world.waves import WaveField
+from services.physics import kernels
 from services.physics.diverged import check_finite, check_state
 from services.physics.fleet import Fleet, buoy_bodies
 from services.physics.forces import AwakeTables, BodyMotion, Fluid, ForceTables, body_wrench, spread
@@ -126,6 +127,7 @@ class PhysicsWorld:
         self._read_state()
         self._acc_w = np.zeros((len(models), 6))
         self._last_loads: dict[str, Array] = {}  # this step's loads by kind, for `diverged`
+        kernels.warm_up()  # the compiled force laws load now, not inside the first step
 
     # --- public API -----------------------------------------------------------------
 

@@ -14,7 +14,7 @@ from tests.paths import REPO
 
 HEAVY = ("open3d", "dartpy", "rerun", "matplotlib", "pandas", "PIL", "tifffile", "rosbags", "numba")
 USES = {  # what each service needs of HEAVY
-    "physics": {"dartpy"},
+    "physics": {"dartpy", "numba"},  # numba: the compiled force laws (kernels.py)
     "traffic": set(),
     "sensors": set(),
     "recorder": {"PIL", "rosbags"},  # dataset PNGs; the ROS 2 types of run.mcap

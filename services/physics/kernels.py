@@ -1,0 +1,199 @@
+"""The force model's per-body loops, compiled (numba): buoyancy columns, added mass, the
+velocity controllers.
+
+Why: written as NumPy array passes these were ≈60 calls a step, each a full pass over an
+(N, C) or (N, 6) temporary; with 100 boats that was ≈0.3 ms of the physics step, most of the
+cost a boat adds (benchmarks.table2). One loop per body keeps every value in registers.
+Each kernel does the arithmetic of the NumPy form it replaced, in the same order within a
+row; sums over a body's columns run left to right (NumPy summed pairwise), so results agree
+to rounding, not bit for bit. Comparisons are written so that a NaN stays NaN (as np.clip
+and np.maximum keep it): a diverging body is still named by physics' finite checks.
+Compiled on first use and cached on disk (`make setup` compiles them, see `warm_up`).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from typing import Any, TypeVar, cast
+
+import numba
+import numpy as np
+from numpy.typing import NDArray
+
+Array = NDArray[np.float64]
+F = TypeVar("F", bound=Callable[..., Any])
+
+
+def jit(fn: F) -> F:
+    """Compiled, cached on disk, the GIL released, NumPy's floating-point errors (inf, NaN
+    rather than an exception): typed for mypy as the Python function it compiles."""
+    return cast(F, numba.njit(cache=True, nogil=True, error_model="numpy")(fn))
+
+
+@jit
+def _clamp(x: float, lo: float, hi: float) -> float:
+    """np.clip for one value: NaN stays NaN."""
+    if x < lo:
+        return lo
+    if x > hi:
+        return hi
+    return x
+
+
+@jit
+def buoyancy(
+    rot: Array, pos: Array, columns: tuple[Array, Array, Array], eta: Array, rho_g: float
+) -> Array:
+    """Body-frame buoyancy wrench (N, 6) of every body's columns: hydro.buoyancy_wrench's
+    law. columns: bottoms (N, 3, C) in the body frame, heights and volumes (N, C); eta (N, C)
+    the water height at each column."""
+    bottom, height, volume = columns
+    n, c_max = height.shape
+    out = np.empty((n, 6))
+    for i in range(n):
+        r20, r21, cos_tilt, z0 = rot[i, 2, 0], rot[i, 2, 1], rot[i, 2, 2], pos[i, 2]
+        total, m0, m1, m2 = 0.0, 0.0, 0.0, 0.0
+        for c in range(c_max):
+            bx, by, bz, h = bottom[i, 0, c], bottom[i, 1, c], bottom[i, 2, c], height[i, c]
+            rise = h * cos_tilt  # signed world-vertical extent
+            low = (0.0 if rise > 0.0 else rise) + (r20 * bx + r21 * by + cos_tilt * bz + z0)
+            span = abs(rise)
+            frac = _clamp((eta[i, c] - low) / (1e-12 if span < 1e-12 else span), 0.0, 1.0)
+            force = volume[i, c] * frac * rho_g
+            along = frac * h * 0.5  # submerged centroid along body z, from the lower end
+            if cos_tilt < 0.0:
+                along = h - along
+            total += force
+            m0 += bx * force
+            m1 += by * force
+            m2 += bz * force + force * along
+        u0, u1, u2 = r20, r21, cos_tilt  # world +z in the body frame
+        out[i, 0], out[i, 1], out[i, 2] = total * u0, total * u1, total * u2
+        out[i, 3], out[i, 4], out[i, 5] = m1 * u2 - m2 * u1, m2 * u0 - m0 * u2, m0 * u1 - m1 * u0
+    return out
+
+
+@jit
+def _cross_into(out: Array, a: Array, b: Array) -> None:
+    out[0] = a[1] * b[2] - a[2] * b[1]
+    out[1] = a[2] * b[0] - a[0] * b[2]
+    out[2] = a[0] * b[1] - a[1] * b[0]
+
+
+@jit
+def _matvec_into(out: Array, m: Array, x: Array) -> None:
+    """out = m @ x for a small square m, summed left to right (numba's @ needs scipy)."""
+    for r in range(m.shape[0]):
+        acc = 0.0
+        for k in range(m.shape[1]):
+            acc += m[r, k] * x[k]
+        out[r] = acc
+
+
+@jit
+def added_mass(
+    tables: tuple[Array, Array, Array, Array, Array, Array],
+    z_b: Array,
+    nu: Array,
+    nu_c: Array,
+    other: Array,
+    gravity: float,
+) -> Array:
+    """tau_A (N, 6) per row: added_mass.AddedMass's solve (its docstring has the model).
+    tables: M_RB (N, 6, 6), the augmented inverse (N, 6, 6), diag A (N, 6), its manoeuvring
+    part (N, 6), mass (N, 1), COG (N, 3)."""
+    m_rb, inverse, diag, coriolis_diag, mass, cog = tables
+    out = np.empty((len(nu), 6))
+    p, total, nu_dot = np.empty(6), np.empty(6), np.empty(6)
+    c = np.empty((5, 3))  # w x p1, v x p1, w x p2, r_g x z_b, w x nu_c
+    for i in range(len(nu)):
+        w, v = nu[i, 3:], nu[i, :3]
+        _matvec_into(p, m_rb[i], nu[i])  # rigid-body momenta [p1, p2]
+        u_r, v_r, w_r = v[0] - nu_c[i, 0], v[1] - nu_c[i, 1], v[2] - nu_c[i, 2]
+        a1, a2, a6 = coriolis_diag[i, 0], coriolis_diag[i, 1], coriolis_diag[i, 5]
+        m1, m2, m6 = a1 * u_r, a2 * v_r, a6 * w[2]  # added-mass momenta (manoeuvring)
+        ca = (-w[2] * m2, w[2] * m1, w[0] * m2 - w[1] * m1,
+              w[1] * m6 - w_r * m2, w_r * m1 - w[0] * m6, u_r * m2 - v_r * m1)  # fmt: skip
+        _cross_into(c[0], w, p[:3])
+        _cross_into(c[1], v, p[:3])
+        _cross_into(c[2], w, p[3:])
+        _cross_into(c[3], cog[i], z_b[i])
+        _cross_into(c[4], w, nu_c[i])
+        weight = -gravity * mass[i, 0]
+        for k in range(3):
+            turning = diag[i, k] * c[4, k]  # A_lin (w x nu_c): the current turning with the hull
+            total[k] = other[i, k] - ca[k] + (weight * z_b[i, k] - c[0, k] - turning)
+            total[3 + k] = other[i, 3 + k] - ca[3 + k] + (weight * c[3, k] - c[1, k] - c[2, k])
+        _matvec_into(nu_dot, inverse[i], total)
+        for k in range(6):
+            out[i, k] = -diag[i, k] * nu_dot[k] - ca[k]
+        for k in range(3):
+            out[i, k] -= diag[i, k] * c[4, k]
+    return out
+
+
+@jit
+def _largest_scale(base: Array, step: Array, rev: Array, fwd: Array) -> float:
+    """Largest s in [0, 1] with -rev <= base + s * step <= fwd for every thruster (base
+    inside)."""
+    s = 1.0
+    for t in range(len(step)):
+        if step[t] > 0.0:
+            s = min(s, (fwd[t] - base[t]) / step[t])
+        elif step[t] < 0.0:
+            s = min(s, (-rev[t] - base[t]) / step[t])
+    return _clamp(s, 0.0, 1.0)
+
+
+@jit
+def twist_commands(
+    tables: tuple[Array, Array, Array, Array, Array],
+    gains: tuple[float, float, float],
+    integral: Array,
+    rows: NDArray[np.intp],
+    setpoints: tuple[Array, Array],
+) -> Array:
+    """Normalised thruster commands (len(rows), T) for vessels `rows`: control.TwistController's
+    law (feed-forward, PI with conditional integration, yaw-first allocation). tables: damping
+    (N, 2, 2), inertia (N, 2), allocation pseudo-inverse (N, T, 2), reverse and forward limits
+    (N, T); gains: dt, kp, ki; `integral` (N, 2) is updated in place."""
+    damp, inertia, pinv, rev, fwd = tables
+    dt, kp, ki = gains
+    target, measured = setpoints
+    out = np.zeros((len(rows), pinv.shape[1]))
+    trial, wrench = np.empty(2), np.empty(2)
+    zero, yaw, surge = np.zeros(pinv.shape[1]), np.empty(pinv.shape[1]), np.empty(pinv.shape[1])
+    for k in range(len(rows)):
+        i = rows[k]
+        for a in range(2):
+            goal, error = target[k, a], target[k, a] - measured[k, a]
+            feed = damp[i, a, 0] * goal + damp[i, a, 1] * goal * abs(goal)
+            trial[a] = _clamp(integral[i, a] + error * dt, -5.0, 5.0)
+            wrench[a] = feed + inertia[i, a] * (kp * error + ki * trial[a])
+        for t in range(len(yaw)):
+            yaw[t], surge[t] = pinv[i, t, 1] * wrench[1], pinv[i, t, 0] * wrench[0]
+        s_yaw = _largest_scale(zero, yaw, rev[i], fwd[i])
+        yaw *= s_yaw
+        s_surge = _largest_scale(yaw, surge, rev[i], fwd[i])
+        if s_yaw >= 1.0 and s_surge >= 1.0:
+            integral[i] = trial
+        for t in range(len(yaw)):
+            force = yaw[t] + s_surge * surge[t]
+            limit = fwd[i, t] if force >= 0.0 else rev[i, t]
+            out[k, t] = _clamp(force / max(limit, 1e-9), -1.0, 1.0)
+    return out
+
+
+def warm_up() -> None:
+    """Load every kernel (compiled, or from the disk cache) on the argument types physics
+    passes, so that no step pays it: PhysicsWorld calls this as it is built, and `make setup`
+    and the Dockerfile fill the cache."""
+    rot, zeros = np.eye(3)[None], np.zeros((1, 6))
+    buoyancy(rot, np.zeros((1, 3)), (np.zeros((1, 3, 1)), np.ones((1, 1)), np.ones((1, 1))),
+             np.zeros((1, 1)), 1.0)  # fmt: skip
+    tables = (np.eye(6)[None], np.eye(6)[None], zeros, zeros, np.ones((1, 1)), np.zeros((1, 3)))
+    added_mass(tables, np.zeros((1, 3)), zeros, np.zeros((1, 3)), zeros, 9.81)
+    one = np.ones((1, 1))
+    controller = (np.zeros((1, 2, 2)), np.ones((1, 2)), np.zeros((1, 1, 2)), one, one)
+    rows, setpoints = np.zeros(1, np.intp), (np.zeros((1, 2)), np.zeros((1, 2)))
+    twist_commands(controller, (0.01, 2.0, 0.5), np.zeros((1, 2)), rows, setpoints)
