@@ -31,6 +31,7 @@ from catabot.world.placement import CLEARANCE_M, footprint_m, keel_depth_m
 from catabot.world.terrain import Terrain
 
 TRIES = 2000
+START_ROOM_M = 10.0  # more water between a drawn start and every vessel's: see README § traffic
 PATH_DRAWS = 5000  # random paths per boat before the plan is refused
 MAX_BUOY_COVER = 0.05
 
@@ -148,8 +149,9 @@ class Planner:
             x, y = self._point(self.cfg.region)
             x, y = over.x_m if over.x_m is not None else x, over.y_m if over.y_m is not None else y
             yaw = over.yaw_rad if over.yaw_rad is not None else self.rng.uniform(-math.pi, math.pi)
-            if not self._free(x, y, radius, draft):
-                if over.x_m is not None and over.y_m is not None:
+            fixed = over.x_m is not None and over.y_m is not None  # the user's spot: as given
+            if not self._free(x, y, radius, draft, room=0.0 if fixed else START_ROOM_M):
+                if fixed:
                     raise ScenarioError(f"traffic.boats: boat {index} at ({x}, {y}) is not free")
                 continue
             boat = self._behave(index, model, Pose(x_m=x, y_m=y, yaw_rad=yaw), behaviour, over)
@@ -193,10 +195,11 @@ class Planner:
             return w / 2, h / 2
         return 0.0, 0.0
 
-    def _free(self, x: float, y: float, radius: float, draft: float) -> bool:
-        """Clear of every vessel and buoy placed so far, and in water deep enough for the hull."""
+    def _free(self, x: float, y: float, radius: float, draft: float, *, room: float) -> bool:
+        """Clear of every vessel (by `room` more) and buoy placed so far, and in water deep
+        enough for the hull."""
         here = np.array([(x, y)])
-        if not (self.placed.clear_of(here, radius) and self.marks.clear_of(here, radius)):
+        if not (self.placed.clear_of(here, radius + room) and self.marks.clear_of(here, radius)):
             return False
         if self.terrain is None:
             return True

@@ -26,8 +26,9 @@ The least total wins. Both boats of a pair read the same geometry, so their role
 
 Measured over three seeds of that cell (60 s each, plan-view hull boxes at 10 Hz): 90 pairs
 touched before, 42 with straight-line CPAs, 6 with arcs (3, 1 and 2 a seed, 4 of them in
-the first 4 s, between boats placed close together at rest); some pair was touching in
-36-47 % of the samples before, 2-7 % now. STAND_ON: with 5 the stand-on boat acted almost
+the first 4 s, between boats placed close together at rest), 1 with starts 10 m further
+apart (traffic_plan.START_ROOM_M); some pair was touching in 36-47 % of the samples before,
+0-1 % now. STAND_ON: with 5 the stand-on boat acted almost
 as soon as the giver (9 pairs), with 100 it held on into the meeting (33 pairs): circling
 boats are not the straight-line movers rule 17 has in mind, and a stand-on boat must be
 free to act once the hazard is about 5 s away. Tried and not kept, with straight-line CPAs,

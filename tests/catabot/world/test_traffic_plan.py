@@ -1,4 +1,5 @@
-"""The traffic plan keeps moored buoys clear: of every start and of every circling track."""
+"""The traffic plan keeps moored buoys clear of every start and of every circling track, and
+keeps room between the boats' starts."""
 
 from __future__ import annotations
 
@@ -6,8 +7,8 @@ import numpy as np
 
 from catabot.config.load import parse_scenario
 from catabot.config.vessel import load_vessel_model
-from catabot.world.placement import footprint_m
-from catabot.world.traffic_plan import TrafficPlan
+from catabot.world.placement import CLEARANCE_M, footprint_m
+from catabot.world.traffic_plan import START_ROOM_M, TrafficPlan
 from catabot.world.world import World
 
 HULL = footprint_m(load_vessel_model("monohull"))
@@ -47,3 +48,18 @@ def test_buoys_never_overlap_even_where_every_path_shares_its_points() -> None:
     plan = _plan(6, behaviour_mix={"waypoints": 1.0}, waypoints={"points": points})
     assert [(b.x_m, b.y_m) for b in plan.buoys] == [tuple(p) for p in points]
     assert all(b.path == tuple(map(tuple, points)) for b in plan.boats)
+
+
+def test_boats_start_with_room_between_them_and_an_explicit_start_as_given() -> None:
+    """Placed one footprint and half a metre apart, boats at rest touched within their first
+    seconds of getting under way (4 of 6 touching pairs over three seeds of Table II's
+    100-boat cell); a start the user gives is taken as given."""
+    near = {"index": 1, "x_m": 100.0, "y_m": 2 * HULL + 1.0, "model": "monohull"}
+    first = {"index": 0, "x_m": 100.0, "y_m": 0.0, "model": "monohull"}
+    plan = _plan(120, models=[{"model": "monohull"}], boats=[first, near])
+    starts = np.array([(b.pose.x_m, b.pose.y_m) for b in plan.boats])
+    gap = np.hypot(*(starts[:, None] - starts[None]).transpose(2, 0, 1))
+    np.fill_diagonal(gap, np.inf)
+    gap[0, 1] = gap[1, 0] = np.inf  # the two the user placed
+    assert gap.min() >= 2 * HULL + 10.0 + CLEARANCE_M == 2 * HULL + START_ROOM_M + CLEARANCE_M
+    assert np.hypot(*(starts[0] - starts[1])) == 2 * HULL + 1.0
