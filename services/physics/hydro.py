@@ -173,7 +173,7 @@ class ThrusterBank:
                 if th.time_constant_s > 0:
                     self.alpha[i, k] = -np.expm1(-dt_s / th.time_constant_s)
         self.command = np.zeros((n, t_max))
-        self._padding = np.arange(t_max)[None, :] >= np.array(self.count)[:, None]  # (N, T)
+        self._count = np.array(self.count, dtype=np.intp)
         self.force_n = np.zeros((n, t_max))
         # Wrench per newton of each thruster, so that a step needs one contraction, no cross.
         moment_arm = np.cross(self.position_m, self.direction)
@@ -184,12 +184,12 @@ class ThrusterBank:
         self.command[index, : self.count[index]] = command
 
     def set_commands(self, rows: NDArray[np.intp], commands: Array) -> None:
-        """Commands for vessels `rows` at once; columns past a vessel's thrusters are zeroed."""
-        width = min(commands.shape[1], self.command.shape[1])
-        block = np.zeros((len(rows), self.command.shape[1]))
-        block[:, :width] = commands[:, :width]
-        block[self._padding[rows]] = 0.0
-        self.command[rows] = block
+        """Commands (len(rows), >= 1) for vessels `rows` at once, clamped to [-1, 1];
+        columns past a vessel's thrusters are zeroed. ValueError, and nothing stored, when a
+        value a vessel uses is not finite."""
+        bad = kernels.store_commands(self.command, self._count, rows, commands)
+        if bad >= 0:
+            raise ValueError(f"thrust commands: a value for row {int(rows[bad])} is not finite")
 
     def advance(self) -> None:
         """Move each delivered force one time step towards its commanded force."""

@@ -184,6 +184,41 @@ def twist_commands(
     return out
 
 
+@jit
+def surge_and_yaw_rate(rot: Array, vel_w: Array, rows: NDArray[np.intp]) -> Array:
+    """(len(rows), 2): body-frame surge u (body x . linear velocity) and yaw rate r (body z .
+    angular velocity) of bodies `rows`; vel_w (N, 6) is [angular, linear], world frame."""
+    out = np.empty((len(rows), 2))
+    for k in range(len(rows)):
+        i = rows[k]
+        out[k, 0] = (
+            rot[i, 0, 0] * vel_w[i, 3] + rot[i, 1, 0] * vel_w[i, 4] + rot[i, 2, 0] * vel_w[i, 5]
+        )
+        out[k, 1] = (
+            rot[i, 0, 2] * vel_w[i, 0] + rot[i, 1, 2] * vel_w[i, 1] + rot[i, 2, 2] * vel_w[i, 2]
+        )
+    return out
+
+
+@jit
+def store_commands(
+    table: Array, count: NDArray[np.intp], rows: NDArray[np.intp], commands: Array
+) -> int:
+    """Commands (len(rows), >= 1) for vessels `rows` into the thruster table (N, T), each
+    clamped to [-1, 1], columns past a vessel's `count` thrusters zero; nothing is stored
+    if a value a vessel uses is not finite: returns that row's index, else -1."""
+    width = min(commands.shape[1], table.shape[1])
+    for k in range(len(rows)):
+        for t in range(min(width, count[rows[k]])):
+            if not np.isfinite(commands[k, t]):
+                return k
+    for k in range(len(rows)):
+        i = rows[k]
+        for t in range(table.shape[1]):
+            table[i, t] = _clamp(commands[k, t], -1.0, 1.0) if t < min(width, count[i]) else 0.0
+    return -1
+
+
 def warm_up() -> None:
     """Load every kernel (compiled, or from the disk cache) on the argument types physics
     passes, so that no step pays it: PhysicsWorld calls this as it is built, and `make setup`
@@ -197,3 +232,5 @@ def warm_up() -> None:
     controller = (np.zeros((1, 2, 2)), np.ones((1, 2)), np.zeros((1, 1, 2)), one, one)
     rows, setpoints = np.zeros(1, np.intp), (np.zeros((1, 2)), np.zeros((1, 2)))
     twist_commands(controller, (0.01, 2.0, 0.5), np.zeros((1, 2)), rows, setpoints)
+    surge_and_yaw_rate(rot, np.zeros((1, 6)), rows)
+    store_commands(np.zeros((1, 2)), np.ones(1, np.intp), rows, np.zeros((1, 2)))

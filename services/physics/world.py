@@ -196,12 +196,11 @@ class PhysicsWorld:
         """Commands for many vessels at once (a controller's output): rows index `vessel_ids`,
         commands (len(rows), >= thrusters) normalised, padding columns ignored; non-finite
         rows are refused (logged by the caller's ValueError), the others clamped to [-1, 1]."""
-        commands = np.asarray(commands, dtype=np.float64)
-        if commands.ndim != 2 or len(commands) != len(rows) or np.any(rows >= self._n_vessels):
+        commands = np.ascontiguousarray(commands, dtype=np.float64)
+        rows = np.ascontiguousarray(rows, dtype=np.intp)
+        if commands.ndim != 2 or len(commands) != len(rows) or _outside(rows, self._n_vessels):
             raise ValueError(f"thrust commands of shape {commands.shape} for rows {rows}")
-        if not np.isfinite(commands).all():
-            raise ValueError("thrust commands: a value is not finite")
-        self._thrusters.set_commands(rows, np.clip(commands, -1.0, 1.0))
+        self._thrusters.set_commands(rows, commands)
 
     def place(self, rows: NDArray[np.intp], pose: Array, velocity_w: Array) -> None:
         """Start bodies `rows` off rest: `pose` (k, 6) rotation vector and position in `map`,
@@ -261,10 +260,7 @@ class PhysicsWorld:
     def surge_and_yaw_rate(self, rows: NDArray[np.intp]) -> Array:
         """(len(rows), 2): body-frame surge speed u and yaw rate r, what the velocity
         controllers measure (two dot products, not the whole body-frame state)."""
-        rot, vel = self._rot[rows], self._vel_w[rows]
-        u = np.einsum("ni,ni->n", rot[:, :, 0], vel[:, 3:])
-        r = np.einsum("ni,ni->n", rot[:, :, 2], vel[:, :3])
-        return np.stack((u, r), axis=1)
+        return kernels.surge_and_yaw_rate(self._rot, self._vel_w, np.ascontiguousarray(rows))
 
     def states(self) -> dict[str, VesselKinematics]:
         """Every vessel's state keyed by vessel id."""
@@ -319,3 +315,8 @@ class PhysicsWorld:
         """Loads that do not change in time: no waves and no gusts (sleep.py)."""
         wind = self._loads.wind
         return self._sea.calm and (wind is None or not np.any(wind.gust_std))
+
+
+def _outside(rows: NDArray[np.intp], n: int) -> bool:
+    """A row that is not a vessel's (the min and max of a few rows: no temporaries)."""
+    return bool(rows.size) and (int(rows.min()) < 0 or int(rows.max()) >= n)

@@ -85,6 +85,31 @@ def test_a_stepping_world_reaches_each_kernel_as_the_one_type_warm_up_compiled(
         target = np.array([[1.5, 0.1], [2.0, -0.2]])
         world.set_thrusts(rows, bank.command(rows, target, world.surge_and_yaw_rate(rows)))
         world.step()
-    compiled: list[Any] = [kernels.buoyancy, kernels.added_mass, kernels.twist_commands]
+    compiled: list[Any] = [kernels.buoyancy, kernels.added_mass, kernels.twist_commands,
+                           kernels.surge_and_yaw_rate, kernels.store_commands]  # fmt: skip
     for kernel in compiled:
         assert len(kernel.signatures) == 1, kernel
+
+
+def test_surge_and_yaw_rate_are_the_body_frame_states_components() -> None:
+    starts = [(f"v{i}", m, (12.0 * i, 0.0, 0.0, 0.7 * i)) for i, m in enumerate(MODELS[:3])]
+    world = PhysicsWorld(starts, dt_s=0.01)
+    world.set_thrusts(np.arange(3), np.array([[1.0, 0.2], [0.6, -0.4], [1.0, 0.2]]))
+    for _ in range(200):
+        world.step()
+    state, rows = world.state_arrays(), np.array([2, 0])
+    measured = world.surge_and_yaw_rate(rows)
+    assert measured[:, 0] == pytest.approx(state.linear_velocity[rows, 0], rel=1e-12)
+    assert measured[:, 1] == pytest.approx(state.angular_velocity[rows, 2], rel=1e-12)
+    assert np.abs(measured).min() > 1e-3  # moving and turning
+
+
+def test_thrust_commands_clamped_padded_and_refused_whole() -> None:
+    world = PhysicsWorld([("cb", MODELS[0], (0, 0, 0, 0)), ("m", MODELS[2], (20, 0, 0, 0))],
+                         dt_s=0.01)  # fmt: skip
+    table = world._thrusters.command  # 2 thrusters each: padding only in the commands here
+    world.set_thrusts(np.array([1, 0]), np.array([[2.0, -0.5, 9.0], [-3.0, 0.25, np.nan]]))
+    assert table.tolist() == [[-1.0, 0.25], [1.0, -0.5]]  # the extra column never read
+    with pytest.raises(ValueError, match="row 0 is not finite"):
+        world.set_thrusts(np.array([1, 0]), np.array([[0.5, 0.5], [np.inf, 0.0]]))
+    assert table.tolist() == [[-1.0, 0.25], [1.0, -0.5]]  # nothing stored
