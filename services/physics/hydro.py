@@ -9,6 +9,7 @@ and the hot path needs no Python loop over vessels. Wrenches are 6-vectors in Fo
 from __future__ import annotations
 
 from collections.abc import Callable, Sequence
+from typing import Protocol, runtime_checkable
 
 import numpy as np
 from numpy.typing import NDArray
@@ -18,6 +19,16 @@ from services.physics import kernels
 
 Array = NDArray[np.float64]
 WaterHeight = Callable[[Array, Array, float], Array]
+
+
+@runtime_checkable
+class ColumnSurface(Protocol):
+    """A WaterHeight that also gives eta at body-frame columns (N, 3, C) of bodies turned
+    by rot (N, 3, 3), placed where it was sampled: no world-frame copy of the columns."""
+
+    def __call__(self, x: Array, y: Array, time_s: float) -> Array: ...
+
+    def at_columns(self, rot: Array, bottom_m: Array) -> Array: ...
 
 
 def water_height(x: Array, y: Array, time_s: float = 0.0) -> Array:
@@ -119,6 +130,8 @@ def buoyancy_wrench(
     """
     if surface is water_height:  # calm water: nothing to sample
         eta = cols.calm
+    elif isinstance(surface, ColumnSurface):  # a surface that evaluates columns itself
+        eta = surface.at_columns(_plain(rot), cols.bottom_m)
     else:
         bottom_w = np.matmul(rot, cols.bottom_m, out=cols._world)  # (N, 3, C), world frame
         bottom_w += pos[:, :, None]

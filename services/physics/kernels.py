@@ -185,6 +185,38 @@ def twist_commands(
 
 
 @jit
+def expansion_heights(rot: Array, bottom: Array, coef: NDArray[np.float32]) -> Array:
+    """eta (N, C) at every body's columns from one Taylor expansion about each body's origin:
+    surface.horner's polynomial in float32, of the columns' offsets from the origin (bottom
+    (N, 3, C), body frame, turned by rot). coef (N, n + 1, n + 1): c[p, q] of dx^p dy^q (zero
+    where p + q > n). Each Horner step runs across a body's columns at once: one column at a
+    time, its chain of dependent multiply-adds took 7x longer (73 vs 10 us for 101 bodies)."""
+    n_bodies, _, c_max = bottom.shape
+    order = coef.shape[1] - 1
+    out = np.empty((n_bodies, c_max))
+    dx, dy = np.empty(c_max, np.float32), np.empty(c_max, np.float32)
+    eta, inner = np.empty(c_max, np.float32), np.empty(c_max, np.float32)
+    for i in range(n_bodies):
+        r, c = rot[i], coef[i]
+        for k in range(c_max):
+            bx, by, bz = bottom[i, 0, k], bottom[i, 1, k], bottom[i, 2, k]
+            dx[k] = r[0, 0] * bx + r[0, 1] * by + r[0, 2] * bz
+            dy[k] = r[1, 0] * bx + r[1, 1] * by + r[1, 2] * bz
+        eta[:] = 0.0
+        for p in range(order, -1, -1):
+            inner[:] = 0.0
+            for q in range(order - p, -1, -1):
+                term = c[p, q]
+                for k in range(c_max):
+                    inner[k] = inner[k] * dy[k] + term
+            for k in range(c_max):
+                eta[k] = eta[k] * dx[k] + inner[k]
+        for k in range(c_max):
+            out[i, k] = eta[k]
+    return out
+
+
+@jit
 def surge_and_yaw_rate(rot: Array, vel_w: Array, rows: NDArray[np.intp]) -> Array:
     """(len(rows), 2): body-frame surge u (body x . linear velocity) and yaw rate r (body z .
     angular velocity) of bodies `rows`; vel_w (N, 6) is [angular, linear], world frame."""
@@ -233,4 +265,5 @@ def warm_up() -> None:
     rows, setpoints = np.zeros(1, np.intp), (np.zeros((1, 2)), np.zeros((1, 2)))
     twist_commands(controller, (0.01, 2.0, 0.5), np.zeros((1, 2)), rows, setpoints)
     surge_and_yaw_rate(rot, np.zeros((1, 6)), rows)
+    expansion_heights(rot, np.zeros((1, 3, 1)), np.zeros((1, 4, 4), np.float32))
     store_commands(np.zeros((1, 2)), np.ones(1, np.intp), rows, np.zeros((1, 2)))

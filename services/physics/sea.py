@@ -12,9 +12,11 @@ from collections.abc import Sequence
 from dataclasses import dataclass
 
 import numpy as np
+from numpy.typing import NDArray
 
 from catabot.config.vessel import VesselModel
 from catabot.world.waves import WaveField
+from services.physics import kernels
 from services.physics.hydro import Array, WaterHeight, water_height
 from services.physics.surface import F32, PatchLayout, Rows, choose_order, expansion, horner
 
@@ -47,6 +49,7 @@ class SeaSampler:
         self._order = choose_order(self._waves, self._radius_m)
         if self._order is not None:
             self._row, self._weights = expansion(self._waves, self._order)
+            self._pq = _monomials(self._row)
         else:
             self._surface = self._patches.surface(self._waves)
 
@@ -76,15 +79,28 @@ class SeaSampler:
         coef = cos @ self._weights[0]
         coef += sin @ self._weights[1]  # (N, T): before `orbital` scales cos and sin
         velocity = waves.orbital(cos, sin, pos[:, 2])
-        return SeaSample(velocity, _Expansions(coef.T[:, :, None], self._row, pos))
+        return SeaSample(velocity, _Expansions(coef, self._row, self._pq, pos))
 
 
 class _Expansions:
-    """eta(x, y) at the (N, C) columns from each vessel's expansion about its origin."""
+    """eta(x, y) at the (N, C) columns from each vessel's expansion about its origin;
+    `at_columns` is the same, compiled, for the buoyancy columns themselves (hydro.py)."""
 
-    def __init__(self, coef: F32, row: Rows, pos: Array) -> None:
-        self._coef, self._row = coef, row
+    def __init__(
+        self, coef: F32, row: Rows, pq: tuple[NDArray[np.intp], NDArray[np.intp]], pos: Array
+    ) -> None:
+        """coef (N, T): each vessel's Taylor coefficients, in `row`'s order; pq: the (p, q)
+        of each (`_monomials`)."""
+        self._coef, self._row = coef.T[:, :, None], row
         self._x0, self._y0 = pos[:, 0:1], pos[:, 1:2]
+        p, q = pq
+        self._grid = np.zeros((len(coef), p.max() + 1, p.max() + 1), np.float32)
+        self._grid[:, p, q] = coef  # row's order is _monomials'
+
+    def at_columns(self, rot: Array, bottom_m: Array) -> Array:
+        """eta at columns `bottom_m` (N, 3, C, body frame) of the bodies (turned by `rot`)
+        about whose origins it was expanded."""
+        return kernels.expansion_heights(rot, bottom_m, self._grid)
 
     def __call__(self, x: Array, y: Array, time_s: float) -> Array:
         del time_s  # the expansion is of this step's surface
@@ -96,3 +112,9 @@ class _Expansions:
         out = np.empty(dx.shape)
         out[...] = eta  # broadcast (an order-0 sea) and widened in one pass
         return out
+
+
+def _monomials(row: Rows) -> tuple[NDArray[np.intp], NDArray[np.intp]]:
+    """(p, q) of each coefficient of `row`, in its order."""
+    pq = sorted(row, key=row.__getitem__)
+    return np.array([p for p, _ in pq]), np.array([q for _, q in pq])

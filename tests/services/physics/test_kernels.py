@@ -86,7 +86,8 @@ def test_a_stepping_world_reaches_each_kernel_as_the_one_type_warm_up_compiled(
         world.set_thrusts(rows, bank.command(rows, target, world.surge_and_yaw_rate(rows)))
         world.step()
     compiled: list[Any] = [kernels.buoyancy, kernels.added_mass, kernels.twist_commands,
-                           kernels.surge_and_yaw_rate, kernels.store_commands]  # fmt: skip
+                           kernels.surge_and_yaw_rate, kernels.store_commands,
+                           kernels.expansion_heights]  # fmt: skip
     for kernel in compiled:
         assert len(kernel.signatures) == 1, kernel
 

@@ -12,7 +12,7 @@ from catabot.config.vessel import VesselModel, load_vessel_model
 from catabot.config.waves import WaveConfig
 from catabot.world import rotations
 from catabot.world.waves import WaveField
-from services.physics.hydro import build_columns, water_height
+from services.physics.hydro import ColumnSurface, build_columns, water_height
 from services.physics.sea import SeaSampler
 from services.physics.surface import TOLERANCE_M, choose_order
 
@@ -111,3 +111,27 @@ def test_the_order_is_the_least_whose_remainder_bound_holds() -> None:
     assert order is not None
     bound = [a * (k * r) ** (n + 1) / math.factorial(n + 1) for n in range(order + 1)]
     assert bound[order] <= TOLERANCE_M < bound[order - 1]
+
+
+@pytest.mark.parametrize("sea", [MEDIUM, WaveConfig(preset="heavy")])
+def test_the_compiled_column_heights_are_within_the_tolerance_too(sea: WaveConfig) -> None:
+    """What buoyancy reads (kernels.expansion_heights: the columns turned and evaluated in one
+    pass) is the same expansion as the array form above, within float32 rounding."""
+    waves, vessels = WaveField(sea, 4), fleet("catabot", "monohull", "wamv", "buoy") * 10
+    cols = build_columns(vessels)
+    rng = np.random.default_rng(11)
+    rotvec = rng.normal(0.0, 0.15, (len(vessels), 3))
+    rotvec[:, 2] = rng.uniform(-math.pi, math.pi, len(vessels))
+    pos = np.column_stack([rng.uniform(-3000, 3000, (len(vessels), 2)), rng.normal(0, 0.3, 40)])
+    rot = rotations.matrices(rotations.from_rotvec(rotvec))
+    world = np.matmul(rot, cols.bottom_m) + pos[:, :, None]
+    sampler = SeaSampler(vessels, cols.bottom_m.transpose(0, 2, 1))
+    sampler.use(waves)
+    surface = sampler.sample(pos, 321.0).surface
+    assert isinstance(surface, ColumnSurface)
+    got = surface.at_columns(rot, cols.bottom_m)
+    real = cols.area_m2 > 0
+    exact = waves.height(world[:, 0], world[:, 1], 321.0)
+    assert np.abs(got - exact)[real].max() <= TOLERANCE_M + 1e-6
+    arrays = surface(world[:, 0], world[:, 1], 321.0)
+    assert np.abs(got - arrays)[real].max() <= 1e-5  # float32 rounding of metres of offset
