@@ -1,4 +1,5 @@
-"""Hydrostatic and hydrodynamic forces for all vessels at once, vectorised with NumPy.
+"""Hydrostatic and hydrodynamic forces for all vessels at once: NumPy over the vessels, the
+per-column and per-thruster loops compiled (kernels.py).
 
 Every per-vessel quantity is stored padded to a common width: columns as (N, C) arrays,
 thrusters as (N, T). Padding entries have zero area / zero force, so they contribute nothing
@@ -146,6 +147,10 @@ def _plain(a: Array) -> Array:
     return np.ascontiguousarray(a, dtype=np.float64)
 
 
+def _plain_rows(rows: NDArray[np.intp]) -> NDArray[np.intp]:
+    return np.ascontiguousarray(rows, dtype=np.intp)
+
+
 # --- damping ----------------------------------------------------------------------------
 
 
@@ -200,6 +205,7 @@ class ThrusterBank:
         """Commands (len(rows), >= 1) for vessels `rows` at once, clamped to [-1, 1];
         columns past a vessel's thrusters are zeroed. ValueError, and nothing stored, when a
         value a vessel uses is not finite."""
+        rows, commands = _plain_rows(rows), _plain(commands)
         bad = kernels.store_commands(self.command, self._count, rows, commands)
         if bad >= 0:
             raise ValueError(f"thrust commands: a value for row {int(rows[bad])} is not finite")

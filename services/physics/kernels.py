@@ -1,9 +1,11 @@
 """The force model's per-body loops, compiled (numba): buoyancy columns, added mass, the
-velocity controllers.
+velocity controllers and their measurement, the thrust table, and in waves the surface's
+expansions at the columns.
 
 Why: written as NumPy array passes these were ≈60 calls a step, each a full pass over an
-(N, C) or (N, 6) temporary; with 100 boats that was ≈0.3 ms of the physics step, most of the
-cost a boat adds (benchmarks.table2). One loop per body keeps every value in registers.
+(N, C) or (N, 6) temporary. In Table II's 100-boat cell the physics service's CPU a tick fell
+from 1.11-1.15 to 0.89-0.90 ms, and with the ego alone from 0.43-0.49 to 0.34-0.36 ms
+(README, Performance). One loop per body keeps every value in registers.
 Each kernel does the arithmetic of the NumPy form it replaced, in the same order within a
 row; sums over a body's columns run left to right (NumPy summed pairwise), so results agree
 to rounding, not bit for bit. Comparisons are written so that a NaN stays NaN (as np.clip
