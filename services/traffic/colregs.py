@@ -79,6 +79,8 @@ def choose(
     n, t = len(own.xy), sample_times(horizon_s)
     pick = np.zeros(n, dtype=np.intp)
     boat, obs, rel, wide = _within_reach(own, other, pairs, horizon_s)
+    if boat.size == 0:  # nobody near enough to meet: every boat keeps its law
+        return pick
     theirs, law = paths(other, t), paths(own, t)
     theirs = (theirs[0][obs], theirs[1][obs])  # (P, T) each
     law = (law[0][boat, None], law[1][boat, None])  # (P, 1, T) each
