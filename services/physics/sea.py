@@ -18,7 +18,15 @@ from catabot.config.vessel import VesselModel
 from catabot.world.waves import WaveField
 from services.physics import kernels
 from services.physics.hydro import Array, WaterHeight, water_height
-from services.physics.surface import F32, PatchLayout, Rows, choose_order, expansion, horner
+from services.physics.surface import (
+    F32,
+    PatchLayout,
+    Rows,
+    choose_order,
+    expansion,
+    exponents,
+    horner,
+)
 
 
 @dataclass(frozen=True)
@@ -49,7 +57,7 @@ class SeaSampler:
         self._order = choose_order(self._waves, self._radius_m)
         if self._order is not None:
             self._row, self._weights = expansion(self._waves, self._order)
-            self._pq = _monomials(self._row)
+            self._pq = exponents(self._order)
         else:
             self._surface = self._patches.surface(self._waves)
 
@@ -90,12 +98,12 @@ class _Expansions:
         self, coef: F32, row: Rows, pq: tuple[NDArray[np.intp], NDArray[np.intp]], pos: Array
     ) -> None:
         """coef (N, T): each vessel's Taylor coefficients, in `row`'s order; pq: the (p, q)
-        of each (`_monomials`)."""
+        of each (`surface.exponents`)."""
         self._coef, self._row = coef.T[:, :, None], row
         self._x0, self._y0 = pos[:, 0:1], pos[:, 1:2]
         p, q = pq
         self._grid = np.zeros((len(coef), p.max() + 1, p.max() + 1), np.float32)
-        self._grid[:, p, q] = coef  # row's order is _monomials'
+        self._grid[:, p, q] = coef  # row's order is exponents'
 
     def at_columns(self, rot: Array, bottom_m: Array) -> Array:
         """eta at columns `bottom_m` (N, 3, C, body frame) of the bodies (turned by `rot`)
@@ -103,6 +111,8 @@ class _Expansions:
         return kernels.expansion_heights(rot, bottom_m, self._grid)
 
     def __call__(self, x: Array, y: Array, time_s: float) -> Array:
+        """eta at world points: the array form of `at_columns`, for a caller that has world
+        points (the WaterHeight contract; tests hold the two within float32 rounding)."""
         del time_s  # the expansion is of this step's surface
         # float64 differences rounded to float32 as they are written: the same bits as
         # (x - x0).astype(np.float32), without the float64 temporary
@@ -112,9 +122,3 @@ class _Expansions:
         out = np.empty(dx.shape)
         out[...] = eta  # broadcast (an order-0 sea) and widened in one pass
         return out
-
-
-def _monomials(row: Rows) -> tuple[NDArray[np.intp], NDArray[np.intp]]:
-    """(p, q) of each coefficient of `row`, in its order."""
-    pq = sorted(row, key=row.__getitem__)
-    return np.array([p for p, _ in pq]), np.array([q for _, q in pq])

@@ -118,7 +118,7 @@ def horner(coef: NDArray[np.float32], row: Rows, dx: F32, dy: F32) -> F32:
 def expansion(waves: WaveField, order: int) -> tuple[Rows, tuple[F32, F32]]:
     """The monomials' rows and the (M, T) matrices that turn a centre's cosines and sines
     into its Taylor coefficients."""
-    p, q = _exponents(order)
+    p, q = exponents(order)
     row = {(int(i), int(j)): t for t, (i, j) in enumerate(zip(p, q, strict=True))}
     on_cos, on_sin = np.split(_coefficient_matrix(waves, p, q).astype(np.float32), 2)
     return row, (on_cos, on_sin)
@@ -133,8 +133,9 @@ def choose_order(waves: WaveField, radius_m: float) -> int | None:
     return None
 
 
-def _exponents(order: int) -> tuple[NDArray[np.intp], NDArray[np.intp]]:
-    """(p, q) of every monomial dx^p dy^q with p + q <= order."""
+def exponents(order: int) -> tuple[NDArray[np.intp], NDArray[np.intp]]:
+    """(p, q) of every monomial dx^p dy^q with p + q <= order, in the order of `expansion`'s
+    rows (its coefficients' columns)."""
     pq = [(p, s - p) for s in range(order + 1) for p in range(s + 1)]
     return np.array([p for p, _ in pq]), np.array([q for _, q in pq])
 

@@ -196,8 +196,7 @@ class PhysicsWorld:
         """Commands for many vessels at once (a controller's output): rows index `vessel_ids`,
         commands (len(rows), >= thrusters) normalised, padding columns ignored; non-finite
         rows are refused (logged by the caller's ValueError), the others clamped to [-1, 1]."""
-        commands = np.ascontiguousarray(commands, dtype=np.float64)
-        rows = np.ascontiguousarray(rows, dtype=np.intp)
+        commands, rows = np.asarray(commands, dtype=np.float64), np.asarray(rows)
         if commands.ndim != 2 or len(commands) != len(rows) or _outside(rows, self._n_vessels):
             raise ValueError(f"thrust commands of shape {commands.shape} for rows {rows}")
         self._thrusters.set_commands(rows, commands)
