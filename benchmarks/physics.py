@@ -105,13 +105,18 @@ def resting_buoys_cost(buoys: int) -> tuple[float, int]:
 
 
 def bare_dart_cost(n: int) -> float:
-    """The reference: the same bodies (and buoy) in DART alone."""
+    """The reference: the same bodies (and buoy) in DART alone, under way (2 m/s, turning
+    at 0.2 rad/s). Why moving: DART recomputes a body's articulated inertia only when its
+    pose changed, so bodies at rest stepped 3x cheaper (101 vessels 0.04 against 0.14 ms)
+    than any floating fleet can."""
     models = fleet_of(n)
     fleet = Fleet([*models, ("b0", load_vessel_model("buoy"), (-20.0, -20.0, 0.0, 0.0))])
     world = dart.simulation.World()
     world.setGravity([0.0, 0.0, 0.0])
     world.setTimeStep(0.01)
     fleet.add_to(world)
+    for skel in fleet.skeletons:  # per tree: [angular, linear] (fleet.py)
+        skel.setVelocities(np.tile([0.0, 0.0, 0.2, 2.0, 0.0, 0.0], skel.getNumDofs() // 6))
     return timed(lambda: (world.step(), fleet.positions(), fleet.velocities()))
 
 

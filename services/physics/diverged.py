@@ -33,6 +33,8 @@ def check_state(
     ids: Sequence[str], pos: Array, vel: Array, loads: Mapping[str, Array], time_s: float
 ) -> None:
     """After DART steps: finite loads may still throw a body out of the numbers."""
+    if np.isfinite(pos).all() and np.isfinite(vel).all():
+        return
     ok = np.isfinite(pos).all(axis=1) & np.isfinite(vel).all(axis=1)
     if not ok.all():
         raise diverged(ids, np.asarray(~ok), loads, time_s, "its state")

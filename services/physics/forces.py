@@ -17,6 +17,7 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import NDArray
 
+from services.physics import kernels
 from services.physics.hydro import Array, Columns, buoyancy_wrench, damping_wrench
 from services.physics.loads import EnvironmentLoads
 from services.physics.sea import SeaSampler
@@ -91,20 +92,13 @@ def body_wrench(
     """Each load's body-frame wrench (N, 6), Fossen order, about the origin, and their sum
     under "total": buoyancy, damping against the water, thrust, then wind, moorings and
     added mass (which needs every other load)."""
-    rot_t = motion.rot.transpose(0, 2, 1)
-    nu = np.concatenate(
-        [
-            np.einsum("nij,nj->ni", rot_t, motion.vel_w[:, 3:]),
-            np.einsum("nij,nj->ni", rot_t, motion.vel_w[:, :3]),
-        ],
-        axis=1,
-    )
+    nu = kernels.body_twist(motion.rot, motion.vel_w)
     current_w = tables.loads.current_world(motion.pos)
     water = sea.sample(motion.pos, time_s)
     water_w = current_w  # plus the waves' orbital velocity at each body origin:
     if water.velocity_w is not None:  # damping acts on motion relative to the water
         water_w = water_w + water.velocity_w
-    current_b = np.einsum("nij,nj->ni", rot_t, water_w)
+    current_b = kernels.to_body(motion.rot, np.ascontiguousarray(water_w))
     loads = {
         "buoyancy": buoyancy_wrench(
             tables.columns,

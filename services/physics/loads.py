@@ -21,6 +21,7 @@ from numpy.typing import NDArray
 
 from catabot.config.vessel import VesselModel
 from catabot.world.environment import CurrentField, WindField
+from services.physics import kernels
 from services.physics.added_mass import AddedMass
 from services.physics.hydro import Array
 from services.physics.wind import wind_gains, wind_wrench
@@ -95,7 +96,7 @@ class EnvironmentLoads:
         if self.moored.size:
             total = total + self._mooring(rot, pos)
         if self.added_mass.active:
-            current_b = np.einsum("nji,nj->ni", rot, current_w)  # R^T v_c
+            current_b = kernels.to_body(rot, current_w)  # R^T v_c
             total = total + self.added_mass.wrench(rot, nu, current_b, total)
         return total
 

@@ -24,7 +24,6 @@ import numpy as np
 from numpy.typing import NDArray
 
 from catabot.config.vessel import VesselModel
-from catabot.world import rotations
 from catabot.world.environment import CurrentField, WindField
 from catabot.world.terrain import Terrain
 from catabot.world.waves import WaveField
@@ -213,11 +212,7 @@ class PhysicsWorld:
         `PhysicsDiverged` names the body and the load when a state stops being finite."""
         self._sleep.wake_near(self._pos, self._vel_w)  # first: one woken now gets its forces
         self._thrusters.advance()
-        wrench_b = self._body_wrench()
-        # Body-frame [F, M] about the origin -> DART's world-frame [M, F] generalized forces.
-        force_w = np.einsum("nij,nj->ni", self._rot, wrench_b[:, :3])
-        moment_w = np.einsum("nij,nj->ni", self._rot, wrench_b[:, 3:])
-        generalized = np.concatenate([moment_w, force_w], axis=1)
+        generalized = kernels.to_generalized(self._rot, self._body_wrench())
         if self._ground is not None:
             contact = self._ground.generalized_forces(
                 self._rot, self._pos, self._vel_w, generalized
@@ -293,8 +288,7 @@ class PhysicsWorld:
         q = self._fleet.positions()
         self._vel_w = self._fleet.velocities()
         self._pos = q[:, 3:]
-        self._quat = rotations.from_rotvec(q[:, :3])
-        self._rot = rotations.matrices(self._quat)
+        self._quat, self._rot = kernels.poses(q)
 
     def _body_wrench(self) -> Array:
         """Every load on the awake bodies (forces.py), body frame; zero rows for the rest."""

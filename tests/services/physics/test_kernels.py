@@ -87,7 +87,8 @@ def test_a_stepping_world_reaches_each_kernel_as_the_one_type_warm_up_compiled(
         world.step()
     compiled: list[Any] = [kernels.buoyancy, kernels.added_mass, kernels.twist_commands,
                            kernels.surge_and_yaw_rate, kernels.store_commands,
-                           kernels.expansion_heights]  # fmt: skip
+                           kernels.expansion_heights, kernels.poses, kernels.to_generalized,
+                           kernels.body_twist, kernels.to_body]  # fmt: skip
     for kernel in compiled:
         assert len(kernel.signatures) == 1, kernel
 
@@ -114,3 +115,28 @@ def test_thrust_commands_clamped_padded_and_refused_whole() -> None:
     with pytest.raises(ValueError, match="row 0 is not finite"):
         world.set_thrusts(np.array([1, 0]), np.array([[0.5, 0.5], [np.inf, 0.0]]))
     assert table.tolist() == [[-1.0, 0.25], [1.0, -0.5]]  # nothing stored
+
+
+def test_poses_are_the_rotation_rules_bit_for_bit() -> None:
+    """The compiled pose read is rotations.from_rotvec and rotations.matrices (one rule)."""
+    q = np.random.default_rng(4).normal(size=(50, 6)) * [2.0, 2.0, 2.0, 100.0, 100.0, 1.0]
+    q[0, :3], q[1, :3] = 0.0, 1e-8  # the small-angle series
+    quat, rot = kernels.poses(q)
+    assert np.array_equal(quat, rotations.from_rotvec(q[:, :3]))
+    assert np.array_equal(rot, rotations.matrices(quat))
+    nan = kernels.poses(np.full((1, 6), np.nan))
+    assert np.isnan(nan[0]).all() and np.isnan(nan[1]).all()
+
+
+def test_frame_turns_match_the_matrix_products() -> None:
+    rot, _ = poses(40, 5)
+    rng = np.random.default_rng(6)
+    wrench, vel = rng.normal(size=(40, 6)) * 1e3, rng.normal(size=(40, 6))
+    generalized = kernels.to_generalized(rot, wrench)  # [R M, R F]
+    assert generalized[:, :3] == pytest.approx(np.einsum("nij,nj->ni", rot, wrench[:, 3:]))
+    assert generalized[:, 3:] == pytest.approx(np.einsum("nij,nj->ni", rot, wrench[:, :3]))
+    nu, rot_t = kernels.body_twist(rot, vel), rot.transpose(0, 2, 1)  # [R^T v, R^T w]
+    assert np.array_equal(nu[:, :3], np.einsum("nij,nj->ni", rot_t, vel[:, 3:]))
+    assert np.array_equal(nu[:, 3:], np.einsum("nij,nj->ni", rot_t, vel[:, :3]))
+    forces = np.ascontiguousarray(wrench[:, :3])
+    assert np.array_equal(kernels.to_body(rot, forces), np.einsum("nij,nj->ni", rot_t, forces))
