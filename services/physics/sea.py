@@ -56,8 +56,8 @@ class SeaSampler:
             return
         self._order = choose_order(self._waves, self._radius_m)
         if self._order is not None:
-            self._row, self._weights = expansion(self._waves, self._order)
-            self._pq = exponents(self._order)
+            self._row, self._pq = expansion(self._waves, self._order)[0], exponents(self._order)
+            self._to_grid = _grid_weights(self._waves, self._order)
         else:
             self._surface = self._patches.surface(self._waves)
 
@@ -83,11 +83,14 @@ class SeaSampler:
             velocity = waves.velocity(pos[:, 0], pos[:, 1], pos[:, 2], time_s)
             return SeaSample(velocity, self._surface)
         phase = waves.phases(pos[:, 0], pos[:, 1], time_s)
-        cos, sin = np.cos(phase), np.sin(phase)
-        coef = cos @ self._weights[0]
-        coef += sin @ self._weights[1]  # (N, T): before `orbital` scales cos and sin
+        m = phase.shape[1]
+        trig = np.empty((len(phase), 2 * m), np.float32)  # [cos | sin]: one matmul below
+        cos, sin = np.cos(phase, out=trig[:, :m]), np.sin(phase, out=trig[:, m:])
+        grid = trig @ self._to_grid  # before `orbital` scales cos and sin
         velocity = waves.orbital(cos, sin, pos[:, 2])
-        return SeaSample(velocity, _Expansions(coef, self._row, self._pq, pos))
+        order = self._order
+        grid = grid.reshape(len(phase), order + 1, order + 1)
+        return SeaSample(velocity, _Expansions(grid, self._row, self._pq, pos))
 
 
 class _Expansions:
@@ -95,15 +98,13 @@ class _Expansions:
     `at_columns` is the same, compiled, for the buoyancy columns themselves (hydro.py)."""
 
     def __init__(
-        self, coef: F32, row: Rows, pq: tuple[NDArray[np.intp], NDArray[np.intp]], pos: Array
+        self, grid: F32, row: Rows, pq: tuple[NDArray[np.intp], NDArray[np.intp]], pos: Array
     ) -> None:
-        """coef (N, T): each vessel's Taylor coefficients, in `row`'s order; pq: the (p, q)
-        of each (`surface.exponents`)."""
-        self._coef, self._row = coef.T[:, :, None], row
+        """grid (N, n + 1, n + 1): each vessel's Taylor coefficient of dx^p dy^q at [p, q]
+        (zero where p + q > n); row and pq: the monomials' rows (`surface.expansion`) and
+        their (p, q) (`surface.exponents`)."""
+        self._grid, self._row, self._pq = grid, row, pq
         self._x0, self._y0 = pos[:, 0:1], pos[:, 1:2]
-        p, q = pq
-        self._grid = np.zeros((len(coef), p.max() + 1, p.max() + 1), np.float32)
-        self._grid[:, p, q] = coef  # row's order is exponents'
 
     def at_columns(self, rot: Array, bottom_m: Array) -> Array:
         """eta at columns `bottom_m` (N, 3, C, body frame) of the bodies (turned by `rot`)
@@ -118,7 +119,19 @@ class _Expansions:
         # (x - x0).astype(np.float32), without the float64 temporary
         dx = np.subtract(x, self._x0, out=np.empty(x.shape, np.float32), casting="same_kind")
         dy = np.subtract(y, self._y0, out=np.empty(y.shape, np.float32), casting="same_kind")
-        eta = horner(self._coef, self._row, dx, dy)
+        p, q = self._pq
+        eta = horner(self._grid[:, p, q].T[:, :, None], self._row, dx, dy)
         out = np.empty(dx.shape)
         out[...] = eta  # broadcast (an order-0 sea) and widened in one pass
         return out
+
+
+def _grid_weights(waves: WaveField, order: int) -> F32:
+    """(2M, (n + 1)^2) float32: a vessel's [cos | sin] of the phases at its origin times
+    this is its coefficient grid, flattened (`surface.expansion`'s matrices, their columns
+    moved to [p, q]): one matmul a step, nothing scattered."""
+    _, (on_cos, on_sin) = expansion(waves, order)
+    p, q = exponents(order)
+    out = np.zeros((2 * on_cos.shape[0], (order + 1) ** 2), np.float32)
+    out[:, p * (order + 1) + q] = np.concatenate([on_cos, on_sin])
+    return out
