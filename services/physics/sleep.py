@@ -9,7 +9,7 @@ sleeping (Bullet, PhysX).
 
 The unit is a fleet skeleton (fleet.py: GROUP trees), because DART skips a whole skeleton:
 one of buoys only falls asleep when every member has been still for REST_STEPS steps, the
-sea is steady and no moving body is near; it is made immobile and not collidable, its
+sea is steady and no moving body is near; it leaves the DART world (fleet.py), its
 velocities zeroed, and the force model leaves its rows out (forces.py). It wakes at the
 start of a step (before that step's forces) in which a moving body comes within
 WAKE_MARGIN_M (plus what that body covers in WAKE_LOOKAHEAD_S) of a member's bounding

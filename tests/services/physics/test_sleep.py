@@ -42,6 +42,7 @@ def test_buoys_on_calm_water_fall_asleep_at_their_equilibrium(catabot: VesselMod
     run(world, 4.5)
     asleep = world.asleep
     assert not asleep[0] and asleep[1:].all()  # the vessel never sleeps
+    assert world._world.getNumSkeletons() == 1  # the buoys' skeleton left DART's world
     before = world.buoy_state_arrays()
     run(world, 1.0)
     after = world.buoy_state_arrays()
@@ -74,6 +75,7 @@ def test_a_vessel_wakes_a_buoy_before_it_reaches_it_and_pushes_it(catabot: Vesse
         if gap < 1.0:
             break
     assert woke_at is not None and woke_at > 2.0  # awake well before any contact
+    assert world._world.getNumSkeletons() == 2  # back in DART's world to be hit
     run(world, 3.0)
     moved = np.hypot(*(world.buoy_state_arrays().position[0, :2] - anchor))
     assert moved > 0.05  # a real collision with a mobile buoy, not a wall
