@@ -288,24 +288,26 @@ def _turn_into(out: Array, k: int, rot: Array, i: int, v: Array, j: int, inverse
 
 
 @jit
+def halves_turned(rot: Array, six: Array, inverse: bool) -> Array:
+    """(N, 6) rows [R a, R b] (inverse: R^T) of rows [b, a]: the two frame changes of a
+    step, which also swap the halves (DART's [M, F] and [w, v] against Fossen's [F, M] and
+    [v, w])."""
+    out = np.empty((rot.shape[0], 6))
+    for i in range(rot.shape[0]):
+        _turn_into(out, 0, rot, i, six, 3, inverse)
+        _turn_into(out, 3, rot, i, six, 0, inverse)
+    return out
+
+
 def to_generalized(rot: Array, wrench_b: Array) -> Array:
     """Body-frame [F, M] (N, 6) about the origin -> DART's world-frame [M, F] generalized
     forces."""
-    out = np.empty((rot.shape[0], 6))
-    for i in range(rot.shape[0]):
-        _turn_into(out, 0, rot, i, wrench_b, 3, False)
-        _turn_into(out, 3, rot, i, wrench_b, 0, False)
-    return out
+    return halves_turned(rot, wrench_b, False)
 
 
-@jit
 def body_twist(rot: Array, vel_w: Array) -> Array:
     """World-frame [angular, linear] velocities (N, 6) -> body-frame nu = [v, w] (Fossen)."""
-    out = np.empty((rot.shape[0], 6))
-    for i in range(rot.shape[0]):
-        _turn_into(out, 0, rot, i, vel_w, 3, True)
-        _turn_into(out, 3, rot, i, vel_w, 0, True)
-    return out
+    return halves_turned(rot, vel_w, True)
 
 
 @jit
@@ -335,5 +337,5 @@ def warm_up() -> None:
     store_commands(np.zeros((1, 2)), np.ones(1, np.intp), rows, np.zeros((1, 2)))
     poses(zeros)
     to_generalized(rot, zeros)
-    body_twist(rot, zeros)
+    body_twist(rot, zeros)  # the same compiled kernel: one type, both flags
     to_body(rot, np.zeros((1, 3)))

@@ -87,8 +87,8 @@ def test_a_stepping_world_reaches_each_kernel_as_the_one_type_warm_up_compiled(
         world.step()
     compiled: list[Any] = [kernels.buoyancy, kernels.added_mass, kernels.twist_commands,
                            kernels.surge_and_yaw_rate, kernels.store_commands,
-                           kernels.expansion_heights, kernels.poses, kernels.to_generalized,
-                           kernels.body_twist, kernels.to_body]  # fmt: skip
+                           kernels.expansion_heights, kernels.poses, kernels.halves_turned,
+                           kernels.to_body]  # fmt: skip
     for kernel in compiled:
         assert len(kernel.signatures) == 1, kernel
 
