@@ -63,10 +63,9 @@ def setpoint_delay_ticks(scenario: Scenario) -> int:
     """The traffic set-points' lag L in physics (DESIGN.md §4): as set, or by default one
     guidance period less one tick. Why that default: a set-point computed at guidance tick k
     then takes effect at k + P, when the next is computed, so physics steps a whole period
-    without waiting for the traffic service (Table II's 100-boat cell +5 % real-time factor
-    against L = 0 at the median of seven interleaved pairs; across machines it hides a
-    network round trip a period), and a boat's autopilot answers its state of tick k - 1
-    after P + 1 ticks (110 ms at 10 Hz guidance and 100 Hz physics), as a real one does."""
+    without waiting for the traffic service (Table II's 100-boat cell ≈ +10 % real-time
+    factor against L = 0), and a boat's autopilot answers its state of tick k - 1 after
+    P + 1 ticks (110 ms at 10 Hz guidance and 100 Hz physics), as a real one does."""
     delay = scenario.traffic.setpoint_delay_ticks
     if delay is not None or not scenario.traffic.count:  # no traffic: no guidance rate to read
         return delay or 0
