@@ -59,19 +59,6 @@ def guidance_period_ticks(scenario: Scenario) -> int:
     return rate_in_ticks(scenario.traffic.guidance_hz, scenario.dt_ns, where="traffic.guidance_hz")
 
 
-def setpoint_delay_ticks(scenario: Scenario) -> int:
-    """The traffic set-points' lag L in physics (DESIGN.md §4): as set, or by default one
-    guidance period less one tick. Why that default: a set-point computed at guidance tick k
-    then takes effect at k + P, when the next is computed, so physics steps a whole period
-    without waiting for the traffic service (Table II's 100-boat cell ≈ +10 % real-time
-    factor against L = 0), and a boat's autopilot answers its state of tick k - 1 after
-    P + 1 ticks (110 ms at 10 Hz guidance and 100 Hz physics), as a real one does."""
-    delay = scenario.traffic.setpoint_delay_ticks
-    if delay is not None or not scenario.traffic.count:  # no traffic: no guidance rate to read
-        return delay or 0
-    return guidance_period_ticks(scenario) - 1
-
-
 def traffic_record_period(scenario: Scenario) -> int:
     """Ticks between two recorded states of the traffic and the buoys (1: every tick)."""
     rate = scenario.recording.traffic_rate_hz

@@ -138,13 +138,12 @@ class TrafficConfig(Strict):
         description="traffic processes, each guiding a contiguous block of the boats "
         "(catabot service traffic --shard I/N); the recording is the same for any number",
     )
-    setpoint_delay_ticks: int | None = Field(
-        None,
+    setpoint_delay_ticks: int = Field(
+        0,
         ge=0,
         le=1000,
         description="extra ticks before physics applies a boat's set-point (autopilot latency); "
-        "lets physics step ahead of the traffic service; 0 = the one-tick minimum; unset: one "
-        "guidance period less one tick, so each set-point takes effect at the next guidance tick",
+        "lets physics step ahead of the traffic service; 0 = the one-tick minimum",
     )
 
     @property

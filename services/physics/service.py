@@ -16,7 +16,6 @@ from catabot.bus.inbox import Inputs
 from catabot.bus.messages import BodyStates, Message, Tick, TwistBatch, VesselState
 from catabot.bus.settings import changes_of
 from catabot.config import live
-from catabot.config.rates import setpoint_delay_ticks
 from catabot.run.service import Built, ServiceContext, run_service
 from services.physics import settings
 from services.physics.commands import CommandBook
@@ -49,7 +48,7 @@ class PhysicsService:
         self.vessel_of = {s.key: ctx.keys.vessel_of(s.key) for s in self.streams}
         self.blocks = {s.key: ids for s, ids in zip(streams.twists, world.traffic_blocks.values(),
                                                       strict=True)}  # fmt: skip
-        delay = setpoint_delay_ticks(world.scenario)  # physics steps ahead of traffic
+        delay = world.scenario.traffic.setpoint_delay_ticks  # physics steps ahead of traffic
         self.streams += streams.twist_batches(lag=delay)
         self.body_ids = world.body_ids
         self.state_keys = [s.key for s in streams.vessel_states]

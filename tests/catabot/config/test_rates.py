@@ -9,7 +9,7 @@ import pytest
 
 from catabot.config.base import ScenarioError
 from catabot.config.load import parse_scenario
-from catabot.config.rates import guidance_period_ticks, setpoint_delay_ticks, traffic_record_period
+from catabot.config.rates import guidance_period_ticks, traffic_record_period
 
 
 def _base() -> dict[str, Any]:
@@ -86,18 +86,6 @@ def test_the_guidance_rate_sets_the_period_of_the_set_points() -> None:
     assert guidance_period_ticks(parse_scenario(data)) == 4
     data["traffic"] = {"count": 0, "guidance_hz": 30.0}  # no boats: nothing to refuse
     assert parse_scenario(data).traffic.guidance_hz == 30.0
-
-
-def test_set_points_take_effect_at_the_next_guidance_tick_unless_a_delay_is_set() -> None:
-    data = _base()
-    data["traffic"] = {"count": 2}  # 10 Hz guidance at 100 Hz physics: P = 10
-    assert setpoint_delay_ticks(parse_scenario(data)) == 9
-    data["traffic"] = {"count": 2, "guidance_hz": 100.0}  # every tick: no room for a lag
-    assert setpoint_delay_ticks(parse_scenario(data)) == 0
-    data["traffic"] = {"count": 2, "guidance_hz": 25.0, "setpoint_delay_ticks": 0}
-    assert setpoint_delay_ticks(parse_scenario(data)) == 0  # as set: the one-tick minimum
-    data["traffic"] = {"count": 0, "guidance_hz": 30.0}  # no boats: no rate read, no lag
-    assert setpoint_delay_ticks(parse_scenario(data)) == 0
 
 
 def test_the_traffic_recording_rate_sets_the_period_of_traffic_and_buoy_rows() -> None:
