@@ -232,3 +232,19 @@ def test_bad_field_arguments() -> None:
     field = WaveField(WaveConfig(preset="medium"), seed=3)
     with pytest.raises(WaveError, match="non-finite position or time"):
         field.height(np.nan, 0.0, 0.0)
+    xs = np.array([1.0, np.inf])  # arrays of one shape at one time: the unbroadcast path
+    with pytest.raises(WaveError, match="non-finite position or time"):
+        field.phases(xs, np.zeros(2), 2.0)
+    with pytest.raises(WaveError, match="non-finite position or time"):
+        field.phases(np.zeros(2), np.zeros(2), float("nan"))
+
+
+def test_both_ways_of_stacking_points_give_the_same_phases() -> None:
+    """Points of one shape at one time skip the broadcast (physics' every step): the same
+    phases as when the time is an array the points broadcast with."""
+    field = WaveField(WaveConfig(preset="medium"), seed=3)
+    x, y = np.linspace(-50.0, 900.0, 12).reshape(3, 4), np.linspace(7.0, -300.0, 12).reshape(3, 4)
+    fast = field.phases(x, y, 12.5)
+    broadcast = field.phases(x, y, np.full((3, 4), 12.5))
+    assert fast.shape == (12, field.amplitudes_m.size)
+    np.testing.assert_array_equal(fast, broadcast)
