@@ -56,8 +56,9 @@ class SeaSampler:
             return
         self._order = choose_order(self._waves, self._radius_m)
         if self._order is not None:
-            self._row, self._pq = expansion(self._waves, self._order)[0], exponents(self._order)
-            self._to_grid = _grid_weights(self._waves, self._order)
+            self._row, weights = expansion(self._waves, self._order)
+            self._pq = exponents(self._order)
+            self._to_grid = _grid_weights(weights, self._pq, self._order)
         else:
             self._surface = self._patches.surface(self._waves)
 
@@ -126,12 +127,13 @@ class _Expansions:
         return out
 
 
-def _grid_weights(waves: WaveField, order: int) -> F32:
+def _grid_weights(
+    weights: tuple[F32, F32], pq: tuple[NDArray[np.intp], NDArray[np.intp]], order: int
+) -> F32:
     """(2M, (n + 1)^2) float32: a vessel's [cos | sin] of the phases at its origin times
     this is its coefficient grid, flattened (`surface.expansion`'s matrices, their columns
     moved to [p, q]): one matmul a step, nothing scattered."""
-    _, (on_cos, on_sin) = expansion(waves, order)
-    p, q = exponents(order)
+    (on_cos, on_sin), (p, q) = weights, pq
     out = np.zeros((2 * on_cos.shape[0], (order + 1) ** 2), np.float32)
     out[:, p * (order + 1) + q] = np.concatenate([on_cos, on_sin])
     return out

@@ -254,7 +254,8 @@ class PhysicsWorld:
     def surge_and_yaw_rate(self, rows: NDArray[np.intp]) -> Array:
         """(len(rows), 2): body-frame surge speed u and yaw rate r, what the velocity
         controllers measure (two dot products, not the whole body-frame state)."""
-        return kernels.surge_and_yaw_rate(self._rot, self._vel_w, np.ascontiguousarray(rows))
+        rows = np.ascontiguousarray(rows, dtype=np.intp)  # the one type the kernel is built for
+        return kernels.surge_and_yaw_rate(self._rot, self._vel_w, rows)
 
     def states(self) -> dict[str, VesselKinematics]:
         """Every vessel's state keyed by vessel id."""

@@ -85,6 +85,7 @@ def test_a_stepping_world_reaches_each_kernel_as_the_one_type_warm_up_compiled(
         target = np.array([[1.5, 0.1], [2.0, -0.2]])
         world.set_thrusts(rows, bank.command(rows, target, world.surge_and_yaw_rate(rows)))
         world.step()
+    world.surge_and_yaw_rate(rows.astype(np.int32))  # a caller's narrower rows: no new type
     compiled: list[Any] = [kernels.buoyancy, kernels.added_mass, kernels.twist_commands,
                            kernels.surge_and_yaw_rate, kernels.store_commands,
                            kernels.expansion_heights, kernels.poses, kernels.halves_turned,
