@@ -85,6 +85,6 @@ def test_every_float_round_trips_exactly_and_specials_read_as_such() -> None:
     text = tabular.block_lines(0, 0, values.reshape(1, -1))[0].rstrip("\n").split(",")[2:]
     assert [float(t) for t in text] == values.tolist()
     assert all("." in t or "e" in t for t in text)  # a float's text, never an int's
-    assert tabular.fmt(1e-05) == "1e-05" and tabular.fmt(np.float64(1.0)) == "1.0"
+    assert tabular.fmt(1e-05) == "0.00001" and tabular.fmt(np.float64(1.0)) == "1.0"
     specials = tabular.block_lines(0, 0, np.array([[math.nan, math.inf, -math.inf]]))
     assert specials == ["0,0,nan,inf,-inf\n"]

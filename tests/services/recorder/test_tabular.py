@@ -75,7 +75,7 @@ def test_row_matches_columns_to_twelve_digits() -> None:
     cells = tabular.row(state)
     assert len(cells) == len(tabular.columns(VesselState))
     assert cells[:2] == ["700000000", "7"]
-    assert cells[-1] == "1e-05"
+    assert cells[-1] == "0.00001"
     assert float(cells[7]) == pytest.approx(state.orientation[2], rel=1e-11)  # 12 digits
 
 
@@ -95,11 +95,27 @@ def test_formatting_is_deterministic_for_numpy_and_specials() -> None:
 def test_floats_are_the_shortest_text_that_reads_back_exactly() -> None:
     assert tabular.fmt(1 / 3) == "0.3333333333333333"
     assert tabular.fmt(123456.789012345) == "123456.789012345"
-    assert tabular.fmt(1e-7) == "1e-07" and tabular.fmt(2.0) == "2.0"
+    assert tabular.fmt(1e-7) == "1e-7" and tabular.fmt(2.0) == "2.0"
+    assert tabular.fmt(1e16) == "1e+16" and tabular.fmt(1e15) == "1000000000000000.0"
+
+
+def test_float_text_has_as_few_digits_as_python_repr() -> None:
+    """Ryu's text and Python's repr are both the shortest that reads back: the same
+    significant digits, whatever the bits (random bit patterns cover subnormals too)."""
+    rng = np.random.default_rng(3)
+    values = rng.integers(0, 2**64, size=20_000, dtype=np.uint64).view(np.float64)
+    for value in values[np.isfinite(values)].tolist():
+        text = tabular.float_text(value)
+        assert float(text) == value and _digits(text) == _digits(repr(value))
+
+
+def _digits(text: str) -> str:
+    return text.split("e")[0].lstrip("-").replace(".", "").strip("0")
 
 
 def test_block_lines_equal_row_by_row_formatting() -> None:
-    table = np.array([[0.1, -2.5e-9], [float("nan"), 1e12]])
+    """Also where orjson has no text (non-finite numbers): only those rows differ."""
+    table = np.array([[0.1, -2.5e-9], [float("nan"), 1e12], [3.0, -float("inf")], [0.0, 1e300]])
     lines = tabular.block_lines(5, 2, table)
     assert lines == [
         "5,2," + ",".join(tabular.fmt(v) for v in row) + "\n" for row in table.tolist()
