@@ -73,9 +73,11 @@ def closest(
     gap_x = (near[:, :1] + theirs[0])[:, None, :] - mine[0]
     gap_y = (near[:, 1:] + theirs[1])[:, None, :] - mine[1]
     gap2 = gap_x * gap_x + gap_y * gap_y
-    k = np.clip(gap2.argmin(axis=-1), 1, len(t) - 2)[..., None]  # a sample with neighbours
-    before, at, after = (np.take_along_axis(gap2, k + d, axis=-1)[..., 0] for d in (-1, 0, 1))
+    k = np.clip(gap2.argmin(axis=-1), 1, len(t) - 2)  # a sample with neighbours
+    flat = gap2.reshape(-1)  # one gather a neighbour: take_along_axis built 3 index grids
+    where = np.arange(0, flat.size, len(t)).reshape(k.shape) + k
+    before, at, after = flat[where - 1], flat[where], flat[where + 1]
     bend = np.maximum(before - 2.0 * at + after, 1e-12)
     step = np.clip((before - after) / (2.0 * bend), -1.0, 1.0)  # the vertex, in samples
     least = np.maximum(at + 0.5 * (after - before) * step + 0.5 * bend * step * step, 0.0)
-    return (k[..., 0] + step) * (t[1] - t[0]), least
+    return (k + step) * (t[1] - t[0]), least
