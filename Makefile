@@ -10,6 +10,9 @@ $(STAMP): pyproject.toml scripts/system-deps.sh
 	@$(PYTHON) -c 'import sys; assert sys.version_info >= (3, 11), "CataBot needs Python >= 3.11"'
 	test -x $(PY) || $(PYTHON) -m venv $(VENV)
 	$(PY) -m pip install -q --upgrade pip
+	@# a venv made before open3d-cpu: the two share files, so the full build leaves first
+	if [ "$$(uname -sm)" = "Linux x86_64" ] && $(PY) -m pip show -q open3d 2>/dev/null; then \
+		$(PY) -m pip uninstall -q -y open3d; fi
 	$(PY) -m pip install -q -e ".[dev]"
 	bash scripts/system-deps.sh
 	$(PY) -c "from services.sensors.wave_pass import warm_up; warm_up()"  # numba's cache
