@@ -152,9 +152,9 @@ def _tails(table: np.ndarray) -> list[str]:
     """Each row's float cells and its line end, as `float_text` writes them: one orjson
     call for the whole (N, C) table, its text cut at the rows. Why: Python's repr, one
     `map(repr)` per row, was the cheapest exact way in Python, and for Table II's 101 rows of
-    19 numbers it cost 0.87 ms, orjson 0.04 ms (recorder 0.92 → 0.82 ms a tick with 100
-    boats). orjson writes a non-finite number as `null`, so a row holding one is written
-    number by number instead."""
+    19 numbers it cost 0.87 ms, orjson 0.04 ms (the recorder's CPU 0.86-0.90 → 0.74-0.77
+    ms a tick with 100 boats). orjson writes a non-finite number as `null`, so a row holding
+    one is written number by number instead."""
     if len(table) == 0:
         return []
     text = orjson.dumps(table, option=orjson.OPT_SERIALIZE_NUMPY).decode()
