@@ -113,17 +113,18 @@ def fmt(value: Any) -> str:
     if isinstance(value, int | np.integer):
         return str(int(value))
     if isinstance(value, float | np.floating):
-        return float_text(float(value))
+        return float_text(value)
     if isinstance(value, str):
         return value
     raise TypeError(f"cannot write a {type(value).__name__} to a CSV cell")
 
 
-def float_text(value: float) -> str:
+def float_text(value: float | np.floating[Any]) -> str:
     """The shortest text that parses back to `value`, with a point or an exponent (`%.12g`
     wrote 1.0 as `1`, which pandas typed int64, and lost the last digits); JSON has no
     text for the non-finite, so those are Python's (`nan`, `inf`, `-inf`)."""
-    return orjson.dumps(value).decode() if math.isfinite(value) else repr(value)
+    number = float(value)  # numpy scalars too: orjson takes a float and nothing else
+    return orjson.dumps(number).decode() if math.isfinite(number) else repr(number)
 
 
 def row(msg: Message) -> list[str]:

@@ -109,6 +109,12 @@ def test_float_text_has_as_few_digits_as_python_repr() -> None:
         assert float(text) == value and _digits(text) == _digits(repr(value))
 
 
+def test_float_text_takes_numpy_scalars_as_floats() -> None:
+    assert tabular.float_text(np.float64(0.1)) == "0.1"
+    assert tabular.float_text(np.float32(0.5)) == "0.5"
+    assert tabular.float_text(np.float64("nan")) == "nan"
+
+
 def _digits(text: str) -> str:
     return text.split("e")[0].lstrip("-").replace(".", "").strip("0")
 
