@@ -141,3 +141,10 @@ def test_remembered_lines_are_the_bytes_of_fresh_ones() -> None:
         table[tick] = rng.normal(size=19)  # one row moves, the others rest
         table[4, 3] = -table[4, 3]  # 0.0 <-> -0.0: equal values, different text
     assert lines(99, 9, table[:3]) == tabular.block_lines(99, 9, table[:3])  # fewer rows
+
+
+def test_block_lines_take_any_layout_of_the_table() -> None:
+    """orjson reads only C-contiguous float64: a column slice or an int table is made so."""
+    table = np.arange(12.0).reshape(3, 4) / 8.0
+    assert tabular.block_lines(1, 0, table[:, ::2]) == tabular.block_lines(1, 0, table[:, [0, 2]])
+    assert tabular.block_lines(1, 0, np.array([[1, 2]])) == ["1,0,1.0,2.0\n"]
