@@ -178,9 +178,13 @@ def row_key(boats: int, mix: dict[str, float]) -> str:
 
 
 def peak_memory(result: dict[str, Any]) -> str:
-    """Each process's peak RSS and the stack's sum (log/run.json's peak_rss_mb)."""
+    """Each process's peak RSS and the stack's sum (log/run.json's peak_rss_mb); then the
+    stack's proportional share and anonymous memory as the loops ended, which do not count a
+    shared library once per process nor depend on how the page cache holds it (usage.py)."""
     rss = result.get("peak_rss_mb") or {}
-    return ", ".join(f"{name} {mb:.0f}" for name, mb in rss.items()) or "n/a"
+    text = ", ".join(f"{name} {mb:.0f}" for name, mb in rss.items()) or "n/a"
+    pss, anon = (result.get(k, {}).get("total") for k in ("pss_mb", "anon_mb"))
+    return text + (f" (PSS {pss:.0f}, anonymous {anon:.0f})" if pss and anon else "")
 
 
 def keep_rtf(rtf: dict[str, list[float]], key: str, result: dict[str, Any]) -> None:

@@ -35,7 +35,7 @@ from catabot.config.scenario import Scenario, participants
 from catabot.errors import CataBotError
 from catabot.run.service import quiet_gc
 from catabot.run.settings_desk import SettingsDesk
-from catabot.run.usage import peak_rss_mb
+from catabot.run.usage import memory_mb
 from catabot.run.world_info import WorldInfoDesk
 
 log = logging.getLogger("catabot.bus.conductor")
@@ -135,7 +135,7 @@ def main(argv: list[str] | None = None) -> int:
     rejected = conductor.rejections.totals + desk.rejections.totals
     settings = [live.entry(c, scenario.dt_ns) for c in schedule.applied()]
     emit("result", **asdict(result), rejected=dict(rejected), settings=settings,
-         peak_rss_mb=peak_rss_mb())  # fmt: skip
+         **memory_mb())  # fmt: skip
     if result.error:
         log.error("run ended by a fault: %s", result.error)
     conductor.close()

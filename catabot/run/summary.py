@@ -17,7 +17,7 @@ from pathlib import Path
 from catabot.config.scenario import Scenario
 from catabot.run.metrics_summary import metrics_lines
 from catabot.run.service import EXIT_CLOCK
-from catabot.run.usage import peak_rss_mb, read_usage
+from catabot.run.usage import MEMORY, memory_mb, read_usage
 
 
 def describe_exit(code: int | None) -> str:
@@ -30,13 +30,25 @@ def describe_exit(code: int | None) -> str:
 
 def _memory(
     run_dir: Path, services: Mapping[str, object], result: Mapping[str, object]
+) -> dict[str, dict[str, float]]:
+    """Each memory figure (usage.MEMORY) of every process of the run and of the whole
+    stack, MiB: the launcher's own measured now, the conductor's from its result line."""
+    own = memory_mb()
+    return {field: _processes(run_dir, services, result, own, field) for field in MEMORY}
+
+
+def _processes(
+    run_dir: Path,
+    services: Mapping[str, object],
+    result: Mapping[str, object],
+    own: Mapping[str, float],
+    field: str,
 ) -> dict[str, float]:
-    """Peak resident memory of every process of the run and of the whole stack, MiB (the
-    launcher's own measured now, the conductor's from its result line)."""
-    out = {"launcher": peak_rss_mb()}
+    """A process that did not report `field` is left out (a crash; no smaps_rollup)."""
+    out = {"launcher": own[field]} if field in own else {}
     with contextlib.suppress(KeyError, TypeError, ValueError):  # a conductor that died: none
-        out["conductor"] = float(result["peak_rss_mb"])  # type: ignore[arg-type]
-    out |= read_usage(run_dir, services, "peak_rss_mb")
+        out["conductor"] = float(result[field])  # type: ignore[arg-type]
+    out |= read_usage(run_dir, services, field)
     return out | {"total": round(sum(out.values()), 1)}
 
 
@@ -96,7 +108,7 @@ def summarise(
         "reason": result.get("reason", ""),
         "services": dict(service_codes),
         "cpu_s": read_usage(run_dir, service_codes, "cpu_s"),
-        "peak_rss_mb": _memory(run_dir, service_codes, result),
+        **_memory(run_dir, service_codes, result),
         "rejected": _rejected(run_dir, service_codes, result),
     }
     try:

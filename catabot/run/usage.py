@@ -6,6 +6,15 @@ process (the Table II benchmark prints it). Peak resident memory is the kernel's
 mark, so it catches a spike a sampler would miss and costs nothing while the run goes: the
 process's own (VmHWM), not getrusage's ru_maxrss, which a process started by fork and exec
 inherits from its parent (`catabot run` launched from a 1 GB test session reported 1 GB).
+
+Resident memory counts every page of a shared library that the process has mapped, in each
+process that maps it, and how many pages a fault maps depends on the page cache: on Linux
+6.18 (ext4 with large folios) a library freshly written by pip is cached in large folios and a
+fault maps a whole one, so right after `make setup` llvmlite's library alone was 106 MiB
+resident in each process that imports numba, 36 MiB once the cache had been dropped and
+re-read. So each process also reports, as its loop ends, its proportional share (PSS: a
+shared page split between the processes that map it) and its anonymous memory (what it
+allocated itself: heaps, arrays, compiled code), which do not depend on that.
 """
 
 from __future__ import annotations
@@ -17,6 +26,7 @@ from collections.abc import Iterable
 from pathlib import Path
 
 KIB_PER_MB = 1024.0
+MEMORY = ("peak_rss_mb", "pss_mb", "anon_mb")  # run.json's memory tables, MiB
 
 
 def peak_rss_mb() -> float:
@@ -29,10 +39,28 @@ def peak_rss_mb() -> float:
     return round(resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / KIB_PER_MB, 1)
 
 
+def memory_mb() -> dict[str, float]:
+    """`MEMORY` of this process now, MiB: the peak always, PSS and anonymous memory where
+    the kernel reports them (/proc/self/smaps_rollup, Linux 4.14 on)."""
+    out = {"peak_rss_mb": peak_rss_mb()}
+    with contextlib.suppress(OSError, ValueError, KeyError, IndexError):
+        kib = dict(_kib_fields(Path("/proc/self/smaps_rollup").read_text()))
+        out |= {"pss_mb": kib["Pss"] / KIB_PER_MB, "anon_mb": kib["Anonymous"] / KIB_PER_MB}
+    return {k: round(v, 1) for k, v in out.items()}
+
+
+def _kib_fields(text: str) -> Iterable[tuple[str, int]]:
+    """`Name:   123 kB` lines as (name, 123)."""
+    for line in text.splitlines():
+        name, _, rest = line.partition(":")
+        if rest.strip().endswith("kB"):
+            yield name, int(rest.split()[0])
+
+
 def write_usage(name: str, run_dir: Path, cpu_s: float) -> None:
-    """CPU seconds of the stepping loop (every thread, start-up excluded) and peak memory."""
+    """CPU seconds of the stepping loop (every thread, start-up excluded) and memory."""
     (run_dir / "log").mkdir(parents=True, exist_ok=True)
-    record = {"cpu_s": round(cpu_s, 3), "peak_rss_mb": peak_rss_mb()}
+    record = {"cpu_s": round(cpu_s, 3), **memory_mb()}
     (run_dir / "log" / f"{name}.usage.json").write_text(json.dumps(record))
 
 

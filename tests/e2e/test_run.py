@@ -71,6 +71,9 @@ def test_default_run_writes_run_folder_and_floats_at_archimedes_draft(out: Path)
     processes = {"launcher", "conductor", *cpu}
     assert set(rss) == processes | {"total"} and all(20 < rss[p] < 1000 for p in processes)
     assert rss["total"] == pytest.approx(sum(rss[p] for p in processes), abs=0.1)
+    pss, anon = usage["pss_mb"], usage["anon_mb"]  # at the loop's end: at most the peak
+    assert set(pss) == set(anon) == set(rss)
+    assert all(0 < anon[p] < pss[p] <= rss[p] for p in processes)
 
 
 def column(

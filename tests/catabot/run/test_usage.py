@@ -8,7 +8,7 @@ import subprocess
 import sys
 from pathlib import Path
 
-from catabot.run.usage import peak_rss_mb, read_usage, write_usage
+from catabot.run.usage import _kib_fields, memory_mb, peak_rss_mb, read_usage, write_usage
 
 PARENT = """
 import json, resource, subprocess, sys
@@ -37,3 +37,27 @@ def test_usage_files_round_trip(tmp_path: Path) -> None:
     write_usage("physics", tmp_path, 1.25)
     assert read_usage(tmp_path, ["physics", "sensors"], "cpu_s") == {"physics": 1.25}
     assert 10.0 < read_usage(tmp_path, ["physics"], "peak_rss_mb")["physics"] <= peak_rss_mb()
+
+
+def test_proportional_and_anonymous_memory_count_a_shared_library_once() -> None:
+    """A big private allocation shows in all three figures; PSS and anonymous memory are
+    read as the process is now, so they do not exceed the peak."""
+    before = memory_mb()
+    block = bytearray(200 * 2**20)  # touched (zeroed) pages of this process's own
+    after = memory_mb()
+    assert set(after) == {"peak_rss_mb", "pss_mb", "anon_mb"}
+    assert after["anon_mb"] - before["anon_mb"] > 190.0
+    assert after["pss_mb"] - before["pss_mb"] > 190.0
+    assert after["anon_mb"] < after["pss_mb"] <= after["peak_rss_mb"]
+    del block
+
+
+def test_smaps_rollup_lines_are_read_by_name() -> None:
+    text = "55e0-7ffd ---p 00000000 00:00 0  [rollup]\nRss:  2048 kB\nPss_Anon:  12 kB\n"
+    assert dict(_kib_fields(text)) == {"Rss": 2048, "Pss_Anon": 12}
+
+
+def test_usage_files_keep_every_memory_figure(tmp_path: Path) -> None:
+    write_usage("sensors", tmp_path, 0.5)
+    for field in ("peak_rss_mb", "pss_mb", "anon_mb"):
+        assert read_usage(tmp_path, ["sensors"], field)["sensors"] > 1.0
