@@ -30,7 +30,9 @@ lint: setup
 	$(VENV)/bin/mypy
 
 test: lint
-	$(PY) -m pytest -q
+	@# two workers, each test module on one (its module fixtures built once): the end-to-end
+	@# runs wait on their clocks and leases much of the time, so two share the cores
+	$(PY) -m pytest -q -n 2 --dist loadscope
 
 bench: setup
 	$(PY) -m benchmarks

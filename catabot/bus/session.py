@@ -24,6 +24,7 @@ from catabot.errors import CataBotError
 MODES = ("peer", "client", "router")
 LEASE_MS = 1500
 LOOPBACK = "tcp/127.0.0.1:0"
+RETRY = "{period_init_ms: 250, period_max_ms: 1000, period_increase_factor: 2}"  # connect
 BLOCK = zenoh.CongestionControl.BLOCK  # lockstep data and clock messages are never dropped
 
 
@@ -79,6 +80,11 @@ def _embedded(mode: str) -> zenoh.Config:
     # 1.6-1.9 s after the cut across six hosts, tests/e2e/test_distributed.py).
     cfg.insert_json5("transport/link/tx/lease", str(LEASE_MS))
     cfg.insert_json5("transport/link/tx/keep_alive", "4")
+    # A program started before the one it connects to (a client before `catabot run`, a
+    # service before the conductor listens) tries again every 0.25 s, at most 1 s apart:
+    # Zenoh's default backs off to 4 s, and a short run could end before it joined
+    # (measured: 1.5 s late after a 5 s wait with the default, 0.3 s with this).
+    cfg.insert_json5("connect/retry", RETRY)
     return cfg
 
 

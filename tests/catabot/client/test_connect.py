@@ -137,3 +137,24 @@ def test_a_second_different_answer_for_the_world_is_refused(served: Served) -> N
             Client.connect([served.endpoint], timeout_s=10).close()
     finally:
         fake.undeclare()
+
+
+def test_a_session_opened_before_its_peer_listens_joins_within_a_second() -> None:
+    """The embedded config retries a refused connection every 0.25-1 s, not Zenoh's 1-4 s:
+    a client started before `catabot run` must not miss a short run."""
+    endpoint = f"tcp/127.0.0.1:{free_port()}"
+    early = open_session(Connection(connect=(endpoint,)))
+    try:
+        seen = early.declare_subscriber("catabot/retry/x", zenoh.handlers.RingChannel(1))
+        time.sleep(5.0)  # Zenoh's own back-off would be at 4 s by now
+        late = open_session(Connection(listen=(endpoint,)))
+        try:
+            started = time.monotonic()
+            while seen.try_recv() is None:
+                assert time.monotonic() - started < 1.5, "the early session never joined"
+                late.put("catabot/retry/x", b"1")
+                time.sleep(0.02)
+        finally:
+            late.close()
+    finally:
+        early.close()
