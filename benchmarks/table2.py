@@ -37,6 +37,7 @@ from typing import Any
 
 from catabot.config.load import parse_scenario
 from catabot.config.sensors import SENSOR_TYPES
+from catabot.run.usage import ANON, PEAK, PSS
 from catabot.world.world import World
 
 BOATS = (0, 5, 10, 20, 50, 100)
@@ -181,9 +182,9 @@ def peak_memory(result: dict[str, Any]) -> str:
     """Each process's peak RSS and the stack's sum (log/run.json's peak_rss_mb); then the
     stack's proportional share and anonymous memory as the loops ended, which do not count a
     shared library once per process nor depend on how the page cache holds it (usage.py)."""
-    rss = result.get("peak_rss_mb") or {}
+    rss = result.get(PEAK) or {}
     text = ", ".join(f"{name} {mb:.0f}" for name, mb in rss.items()) or "n/a"
-    pss, anon = (result.get(k, {}).get("total") for k in ("pss_mb", "anon_mb"))
+    pss, anon = (result.get(k, {}).get("total") for k in (PSS, ANON))
     return text + (f" (PSS {pss:.0f}, anonymous {anon:.0f})" if pss and anon else "")
 
 

@@ -26,7 +26,8 @@ from collections.abc import Iterable
 from pathlib import Path
 
 KIB_PER_MB = 1024.0
-MEMORY = ("peak_rss_mb", "pss_mb", "anon_mb")  # run.json's memory tables, MiB
+PEAK, PSS, ANON = "peak_rss_mb", "pss_mb", "anon_mb"  # run.json's memory tables, MiB
+MEMORY = (PEAK, PSS, ANON)
 
 
 def peak_rss_mb() -> float:
@@ -42,10 +43,10 @@ def peak_rss_mb() -> float:
 def memory_mb() -> dict[str, float]:
     """`MEMORY` of this process now, MiB: the peak always, PSS and anonymous memory where
     the kernel reports them (/proc/self/smaps_rollup, Linux 4.14 on)."""
-    out = {"peak_rss_mb": peak_rss_mb()}
+    out = {PEAK: peak_rss_mb()}
     with contextlib.suppress(OSError, ValueError, KeyError, IndexError):
         kib = dict(_kib_fields(Path("/proc/self/smaps_rollup").read_text()))
-        out |= {"pss_mb": kib["Pss"] / KIB_PER_MB, "anon_mb": kib["Anonymous"] / KIB_PER_MB}
+        out |= {PSS: kib["Pss"] / KIB_PER_MB, ANON: kib["Anonymous"] / KIB_PER_MB}
     return {k: round(v, 1) for k, v in out.items()}
 
 
