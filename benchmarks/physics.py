@@ -3,8 +3,12 @@
 A mixed fleet (catamarans and monohulls, both with added mass), a 50 x 50 current map on top
 of a uniform current, gusty wind with a circle and a polygon zone, a moored buoy; once on
 calm water and once with the "medium" sea state. Measures `PhysicsWorld.step()` plus reading
-every state back (`state_arrays()`), best of three repeats, in a process set up as every
-service is (one BLAS thread, the kept heap). Then Table II's waypoint row in physics alone:
+every state back (`state_arrays()`), in a process set up as every service is (one BLAS
+thread, the kept heap). A shared machine's speed drifts by tens of percent from one second
+to the next, so bare DART, calm and swell are timed in interleaved blocks (ROUNDS of them,
+each STEPS steps of each world in turn), and each figure is the median over rounds; the
+swell / calm ratio is the median of each round's own ratio, both worlds timed within the
+same second or two. Then Table II's waypoint row in physics alone:
 101 vessels at rest among 275 moored buoys once these sleep, against the vessels alone.
 
 Reference beside it: bare DART, the same bodies in the same skeletons (fleet.py) stepped by
@@ -15,8 +19,9 @@ any DART-based simulator of these bodies pays before hydrodynamics. Targets: 101
 
 from __future__ import annotations
 
+import statistics
 import time
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 
 import dartpy as dart
 import numpy as np
@@ -32,7 +37,8 @@ from services.physics.fleet import Fleet
 from services.physics.world import PhysicsWorld
 
 COUNTS = (1, 10, 50, 100, 101, 200)
-STEPS = 500
+STEPS = 300  # steps a block
+ROUNDS = 7  # blocks of each world, interleaved
 ZONES = [
     WindZone(shape="circle", center_m=(50, 50), radius_m=30, speed_mps=12, toward_rad=1.0),
     WindZone(
@@ -67,27 +73,39 @@ def world_of(n: int, *, waves: bool) -> PhysicsWorld:
     return world
 
 
-def timed(step: Callable[[], object]) -> float:
-    """Seconds a call, best of three runs of STEPS after 50 to warm up."""
+def warm(step: Callable[[], object]) -> Callable[[], object]:
     for _ in range(50):
         step()
-    best = float("inf")
-    for _ in range(3):
-        start = time.perf_counter()
-        for _ in range(STEPS):
-            step()
-        best = min(best, (time.perf_counter() - start) / STEPS)
-    return best
+    return step
 
 
-def step_cost(n: int, *, waves: bool) -> float:
+def block(step: Callable[[], object], steps: int = STEPS) -> float:
+    """Seconds a call over one block of `steps` calls."""
+    start = time.perf_counter()
+    for _ in range(steps):
+        step()
+    return (time.perf_counter() - start) / steps
+
+
+def interleaved(steps: Sequence[Callable[[], object]]) -> list[list[float]]:
+    """ROUNDS blocks of each of `steps` in turn: [round][which] seconds a call."""
+    warmed = [warm(step) for step in steps]
+    return [[block(step) for step in warmed] for _ in range(ROUNDS)]
+
+
+def stepper(n: int, *, waves: bool) -> Callable[[], object]:
     world = world_of(n, waves=waves)
-    return timed(lambda: (world.step(), world.state_arrays()))
+
+    def step() -> None:
+        world.step()
+        world.state_arrays()
+
+    return step
 
 
-def resting_buoys_cost(buoys: int) -> tuple[float, int]:
-    """101 vessels at rest among `buoys` moored buoys in a steady current and wind, after
-    the buoys fell asleep (services/physics/sleep.py); and how many sleep."""
+def resting_buoys(buoys: int) -> tuple[Callable[[], object], int]:
+    """A step of 101 vessels at rest among `buoys` moored buoys in a steady current and
+    wind, after the buoys fell asleep (services/physics/sleep.py); and how many sleep."""
     vessels = fleet_of(101)
     xy = np.random.default_rng(3).uniform(300.0, 900.0, (buoys, 2))
     world = PhysicsWorld(
@@ -99,12 +117,16 @@ def resting_buoys_cost(buoys: int) -> tuple[float, int]:
     )
     for _ in range(2500):  # the moorings' swing dies down in ~20 s
         world.step()
-    return timed(lambda: (world.step(), world.state_arrays(), world.buoy_state_arrays())), int(
-        world.asleep.sum()
-    )
+
+    def step() -> None:
+        world.step()
+        world.state_arrays()
+        world.buoy_state_arrays()
+
+    return step, int(world.asleep.sum())
 
 
-def bare_dart_cost(n: int) -> float:
+def bare_dart(n: int) -> Callable[[], object]:
     """The reference: the same bodies (and buoy) in DART alone, under way (2 m/s, turning
     at 0.2 rad/s). Why moving: DART recomputes a body's articulated inertia only when its
     pose changed, so bodies at rest stepped 3x cheaper (101 vessels 0.04 against 0.14 ms)
@@ -117,24 +139,33 @@ def bare_dart_cost(n: int) -> float:
     fleet.add_to(world)
     for skel in fleet.skeletons:  # per tree: [angular, linear] (fleet.py)
         skel.setVelocities(np.tile([0.0, 0.0, 0.2, 2.0, 0.0, 0.0], skel.getNumDofs() // 6))
-    return timed(lambda: (world.step(), fleet.positions(), fleet.velocities()))
+    return lambda: (world.step(), fleet.positions(), fleet.velocities())
+
+
+def row(n: int) -> str:
+    """One table row: the medians over interleaved rounds (see the module's docstring)."""
+    rounds = interleaved([bare_dart(n), stepper(n, waves=False), stepper(n, waves=True)])
+    bare, calm, swell = (statistics.median(r[i] for r in rounds) for i in range(3))
+    ratio = statistics.median(r[2] / r[1] for r in rounds)
+    return (f"| {n} | {bare * 1e3:.3f} | {calm * 1e3:.3f} | {1 / calm:.0f} | "
+            f"{swell * 1e3:.3f} | {1 / swell:.0f} | {ratio:.2f} |")  # fmt: skip
 
 
 def main() -> None:
     single_thread_blas()  # as every service does (catabot/run/service.py)
     keep_heap()
-    print("Physics step cost, every force on (dt 10 ms, one core), ms a step and steps/s")
+    print("Physics step cost, every force on (dt 10 ms, one core), ms a step and steps/s;")
+    print(f"medians over {ROUNDS} interleaved rounds of {STEPS} steps of each world")
     print("| vessels | bare DART | calm | steps/s | medium swell | steps/s | swell / calm |")
     print("|---:|---:|---:|---:|---:|---:|---:|")
     for n in COUNTS:
-        bare, calm, swell = bare_dart_cost(n), step_cost(n, waves=False), step_cost(n, waves=True)
-        print(f"| {n} | {bare * 1e3:.3f} | {calm * 1e3:.3f} | {1 / calm:.0f} | "
-              f"{swell * 1e3:.3f} | {1 / swell:.0f} | {swell / calm:.2f} |")  # fmt: skip
+        print(row(n), flush=True)
     print(f"swell: {world_of(1, waves=True).sea_method}")
-    alone, _ = resting_buoys_cost(0)
-    among, asleep = resting_buoys_cost(275)
-    print(f"101 vessels at rest: {alone * 1e3:.3f} ms a step; among 275 moored buoys, "
-          f"{asleep} asleep: {among * 1e3:.3f} ms (+{(among - alone) * 1e3:.3f} ms)")  # fmt: skip
+    (alone, _), (among, asleep) = resting_buoys(0), resting_buoys(275)
+    rounds = interleaved([alone, among])
+    ms_alone, ms_among = (1e3 * statistics.median(r[i] for r in rounds) for i in range(2))
+    print(f"101 vessels at rest: {ms_alone:.3f} ms a step; among 275 moored buoys, "
+          f"{asleep} asleep: {ms_among:.3f} ms (+{ms_among - ms_alone:.3f} ms)")  # fmt: skip
     print("targets: 101 vessels >= 1000 steps/s calm; swell / calm <= 1.25")
 
 

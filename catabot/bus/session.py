@@ -112,6 +112,55 @@ def check_endpoint(endpoint: str) -> str:
     return endpoint
 
 
+def check_listen(endpoint: str) -> None:
+    """A TCP endpoint this machine can listen on now: its host is one of this machine's
+    addresses and its port is free. Zenoh says so only once every process has started."""
+    host, port = _tcp(endpoint)
+    if host is None:
+        return
+    family, addr = _address(endpoint, host, port)
+    with socket.socket(family, socket.SOCK_STREAM) as probe:
+        probe.setsockopt(socket.SOL_SOCKET, socket.SO_REUSEADDR, 1)  # as a listener does
+        try:
+            probe.bind(addr)
+        except OSError as exc:
+            raise SessionError(f"cannot listen on {endpoint}: {exc.strerror or exc}") from None
+
+
+def check_router(endpoint: str) -> None:
+    """Something answers at a TCP endpoint to connect to: a client session fails at once
+    when nothing does, so every process would start only to fail."""
+    host, port = _tcp(endpoint)
+    if host is None:
+        return
+    family, addr = _address(endpoint, host, port)
+    with socket.socket(family, socket.SOCK_STREAM) as probe:
+        probe.settimeout(3.0)
+        try:
+            probe.connect(addr)
+        except OSError as exc:
+            raise SessionError(
+                f"nothing answers at {endpoint} ({exc.strerror or exc}): start a router there "
+                "first (catabot router --listen ENDPOINT)"
+            ) from None
+
+
+def _tcp(endpoint: str) -> tuple[str | None, int]:
+    """Host and port of a plain TCP endpoint; None for the others (TLS, UDP, QUIC, WS: a
+    bare socket probe would not speak their handshake)."""
+    m = _ENDPOINT.match(check_endpoint(endpoint))
+    assert m is not None, "check_endpoint matched it"
+    return (m.group(2).strip("[]") if m.group(1) == "tcp" else None), int(m.group(3))
+
+
+def _address(endpoint: str, host: str, port: int) -> tuple[socket.AddressFamily, tuple[str, int]]:
+    try:
+        family, _, _, _, addr = socket.getaddrinfo(host, port, type=socket.SOCK_STREAM)[0]
+    except socket.gaierror:
+        raise SessionError(f"zenoh endpoint {endpoint}: host {host!r} is not known") from None
+    return family, (str(addr[0]), int(addr[1]))
+
+
 def open_session(conn: Connection) -> zenoh.Session:
     try:
         return zenoh.open(conn.config())

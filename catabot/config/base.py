@@ -14,6 +14,7 @@ from pathlib import Path
 from typing import Annotated, Any, get_args
 
 from pydantic import AfterValidator, BaseModel, ConfigDict, Field, StrictInt, ValidationError
+from pydantic_core import PydanticCustomError
 
 from catabot.bus.keys import check_name
 from catabot.errors import CataBotError
@@ -101,7 +102,7 @@ def describe(err: Any, *, model: type[BaseModel], where: str = "") -> str:
     if kind == "missing":
         return f"{path}: required field missing"
     if kind == "extra_forbidden":
-        allowed = ", ".join(_allowed_fields(model, err["loc"][:-1]))
+        allowed = ctx.get("allowed") or ", ".join(_allowed_fields(model, err["loc"][:-1]))
         return f"{path}: unknown field (allowed: {allowed})"
     if kind == "literal_error":
         return f"{path}: must be one of {ctx.get('expected')}{shown}"
@@ -111,6 +112,10 @@ def describe(err: Any, *, model: type[BaseModel], where: str = "") -> str:
         return f"{path}: must be {_BOUNDS[kind]} {limit}{shown}"
     if kind in _TYPES:
         return f"{path}: must be {_TYPES[kind]}{shown}"
+    if kind in ("too_short", "too_long"):
+        most = "at least" if kind == "too_short" else "at most"
+        count = ctx.get("min_length" if kind == "too_short" else "max_length")
+        return f"{path}: needs {most} {count} item(s), got {ctx.get('actual_length')}"
     if kind == "finite_number":
         return f"{path}: must be a finite number{shown}"
     return f"{path}: {str(err['msg']).removeprefix('Value error, ')}{shown}"
@@ -120,6 +125,20 @@ def _short(value: Any) -> str:
     """A value as shown in a message: its repr, cut short (a 10,000-character name)."""
     text = repr(value)
     return text if len(text) <= 80 else text[:77] + "..."
+
+
+def naming_allowed(exc: ValidationError, *, model: type[BaseModel]) -> ValidationError:
+    """`exc` with each unknown field's allowed names found in `model` now: raised again
+    inside a field such as a sensor's free-form `params`, its errors are explained against
+    the scenario, where the walk to the field cannot see the model that refused it."""
+    errors: list[Any] = []
+    for err in exc.errors():
+        line = {k: err[k] for k in ("type", "loc", "input")} | {"ctx": err.get("ctx") or {}}
+        if err["type"] == "extra_forbidden":
+            allowed = {"allowed": ", ".join(_allowed_fields(model, err["loc"][:-1]))}
+            line["type"] = PydanticCustomError("extra_forbidden", "unknown field", allowed)
+        errors.append(line)
+    return ValidationError.from_exception_data(exc.title, errors)
 
 
 def _allowed_fields(model: type[BaseModel], loc: tuple[Any, ...]) -> list[str]:

@@ -8,6 +8,7 @@ original simulator's `SettingsConfig.json` format are mapped by `settings_config
 from __future__ import annotations
 
 import json
+import os
 from pathlib import Path
 from typing import Any
 
@@ -19,6 +20,7 @@ from catabot.config.scenario import Scenario
 from catabot.config.settings_config import is_settings_config, map_settings_config
 
 BUNDLED = Path(__file__).parents[1] / "data" / "scenarios"
+TERRAINS = BUNDLED.parent / "terrain"  # elevation images a scenario may name bare: "bay.png"
 
 
 def parse_scenario(data: Any, *, source: str = "<data>") -> Scenario:
@@ -39,6 +41,10 @@ def load_scenario(path: str | Path | None = None) -> Scenario:
         bundled = BUNDLED / f"{file.name}.json"
         if path is not None and "/" not in str(path) and bundled.is_file():
             file = bundled
+        elif file.is_dir():
+            inside = file / "scenario.json"  # a run folder: replaying it is the likely wish
+            hint = f"; a run folder's scenario is {inside}" if inside.is_file() else ""
+            raise ScenarioError(f"scenario file {str(file)!r} is a folder{hint}")
         else:
             raise ScenarioError(f"scenario file {str(file)!r} does not exist")
     data = read_json(file, what="scenario")
@@ -53,7 +59,7 @@ def absolute_paths(data: Any, base: Path) -> Any:
     if not isinstance(data, dict):
         return data
     data = json.loads(json.dumps(data))
-    _absolute(_node(data, "terrain"), "elevation_image", base)
+    _absolute(_node(data, "terrain"), "elevation_image", base, bundled=TERRAINS)
     _absolute(_node(data, "water", "current", "map"), "path", base)
     vessels = data.get("vessels")
     for vessel in vessels if isinstance(vessels, list) else []:
@@ -72,9 +78,17 @@ def _node(data: dict[str, Any], *path: str) -> dict[str, Any]:
     return data
 
 
-def _absolute(node: dict[str, Any], key: str, base: Path) -> None:
-    if isinstance(node.get(key), str):
-        node[key] = str(base / Path(node[key]).expanduser())
+def _absolute(node: dict[str, Any], key: str, base: Path, *, bundled: Path | None = None) -> None:
+    """node[key] relative to `base`, without `..` parts; a bare name that is not there but
+    is a bundled file (`bay.png`) names that one, so a bundled scenario copied elsewhere
+    still runs."""
+    if not isinstance(node.get(key), str):
+        return
+    path = Path(os.path.normpath(base / Path(node[key]).expanduser()))
+    named = Path(node[key]).name == node[key]
+    if bundled is not None and named and not path.exists() and (bundled / node[key]).is_file():
+        path = bundled / node[key]
+    node[key] = str(path)
 
 
 def _program(controller: dict[str, Any], base: Path) -> None:

@@ -11,6 +11,7 @@ from pydantic import (
     Field,
     StrictBool,
     StrictInt,
+    ValidationError,
     ValidationInfo,
     field_validator,
     model_validator,
@@ -26,6 +27,7 @@ from catabot.config.base import (
     Strict,
     VesselId,
     WorldName,
+    naming_allowed,
     unique,
 )
 from catabot.config.controller import ControllerConfig, check_programs
@@ -96,7 +98,12 @@ class SensorConfig(Strict):
     @classmethod
     def _params(cls, v: dict[str, Any], info: ValidationInfo) -> dict[str, Any]:
         kind = SENSOR_TYPES.get(info.data.get("type", ""))
-        return kind.params.model_validate(v).model_dump() if kind is not None else v
+        if kind is None:
+            return v
+        try:
+            return kind.params.model_validate(v).model_dump()
+        except ValidationError as exc:
+            raise naming_allowed(exc, model=kind.params) from None
 
     def typed_params(self) -> Any:
         """The parameters as the type's own model (every default filled in)."""

@@ -9,8 +9,25 @@ from __future__ import annotations
 
 import sys
 from collections.abc import Callable
+from pathlib import Path
 
 from catabot.errors import CataBotError
+
+
+class OutputPathError(CataBotError, ValueError):
+    """A file to write names a folder, or a folder that does not exist."""
+
+
+def output_file(path: str, *, flag: str) -> Path:
+    """`path` as a file this command may create; OutputPathError names the flag and why
+    not, before any work (rerun's writer and `Path.write_text` fail only at the end, deep
+    inside, after a replay or a schema has been built)."""
+    file = Path(path)
+    if file.is_dir():
+        raise OutputPathError(f"{flag} {path}: is a folder; give a file name")
+    if not file.parent.is_dir():
+        raise OutputPathError(f"{flag} {path}: folder {file.parent} does not exist")
+    return file
 
 
 def answered(prog: str, work: Callable[[], str | None]) -> int:

@@ -13,14 +13,13 @@ import threading
 from pathlib import Path
 
 from catabot.bus.session import Connection, SessionError, add_connection_args, open_session
-from catabot.config.load import json_schema, load_scenario
+from catabot.config.load import json_schema
 from catabot.errors import CataBotError
 from catabot.run import compose, conduct, launcher, secure, settings_cli
+from catabot.run.answer import answered, output_file
 from catabot.run.companions import VIEW_MODES
 from catabot.run.generate import add_arguments as add_generate_arguments
 from catabot.run.generate import generate
-from catabot.run.progress import PlanningProgress
-from catabot.world.world import World
 
 
 def _run(args: argparse.Namespace) -> int:
@@ -44,6 +43,15 @@ def _run(args: argparse.Namespace) -> int:
         view=args.view,
     )
     return launcher.run(opts)
+
+
+def _schema(output: str | None) -> str | None:
+    text = json.dumps(json_schema(), indent=2) + "\n"
+    if output is None:
+        sys.stdout.write(text)
+        return None
+    output_file(output, flag="--output").write_text(text)
+    return f"{output}: the scenario's JSON Schema"
 
 
 def _secure(args: argparse.Namespace) -> int:
@@ -117,17 +125,11 @@ def _router(args: argparse.Namespace) -> int:
 
 def _scenario(args: argparse.Namespace) -> int:
     if args.action == "schema":
-        text = json.dumps(json_schema(), indent=2) + "\n"
-        if args.output:
-            Path(args.output).write_text(text)
-        else:
-            sys.stdout.write(text)
-        return 0
+        return answered("scenario schema", lambda: _schema(args.output))
     if args.action == "generate":
         return generate(args)
     try:  # what `catabot run` checks before it starts anything, no less
-        world = World.resolve(load_scenario(args.file), progress=PlanningProgress())
-        _ = world.shapes  # every mesh file read, as `catabot run` does
+        world = launcher.prepare(launcher.RunOptions(scenario=args.file))
     except CataBotError as exc:
         print(f"catabot scenario validate: {exc}", file=sys.stderr)
         return 2

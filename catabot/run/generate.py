@@ -12,9 +12,10 @@ import sys
 from pathlib import Path
 from typing import Any
 
-from catabot.config.load import parse_scenario
+from catabot.config.load import absolute_paths, parse_scenario
 from catabot.config.traffic import BEHAVIOURS
 from catabot.errors import CataBotError
+from catabot.run.answer import answered, output_file
 from catabot.world.world import World
 
 
@@ -48,9 +49,9 @@ def scenario_data(args: argparse.Namespace) -> dict[str, Any]:
         "vessels": [{"id": "ego", "model": "catabot"}],
         "traffic": {"count": args.boats, "behaviour_mix": parse_mix(args.mix)},
     }
-    if args.terrain:
-        data["terrain"] = {"elevation_image": str(Path(args.terrain).resolve())}
-    return data
+    if args.terrain:  # from the current directory, or a bundled one named bare
+        data["terrain"] = {"elevation_image": args.terrain}
+    return absolute_paths(data, Path.cwd())
 
 
 def add_arguments(p: argparse.ArgumentParser) -> None:
@@ -66,16 +67,16 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
 
 def generate(args: argparse.Namespace) -> int:
     """Write the scenario to args.output (stdout when none); 2 on a bad flag or scenario."""
-    try:
-        data = scenario_data(args)
-        World.resolve(parse_scenario(data, source="generate"))  # refuse now what cannot run
-    except CataBotError as exc:
-        print(f"catabot scenario generate: {exc}", file=sys.stderr)
-        return 2
+    return answered("scenario generate", lambda: _write(args))
+
+
+def _write(args: argparse.Namespace) -> str | None:
+    output = output_file(args.output, flag="--output") if args.output else None
+    data = scenario_data(args)
+    World.resolve(parse_scenario(data, source="generate"))  # refuse now what cannot run
     text = json.dumps(data, indent=2) + "\n"
-    if args.output:
-        Path(args.output).write_text(text)
-        print(f"{args.output}: {args.boats} boat(s), seed {args.seed}")
-    else:
+    if output is None:
         sys.stdout.write(text)
-    return 0
+        return None
+    output.write_text(text)
+    return f"{args.output}: {args.boats} boat(s), seed {args.seed}"

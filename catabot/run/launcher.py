@@ -15,7 +15,7 @@ from pathlib import Path
 from catabot.bus.clock import CONDUCTOR
 from catabot.bus.identity import Roster, new_zid
 from catabot.bus.scheduling import requested_policy
-from catabot.bus.session import check_endpoint, free_port
+from catabot.bus.session import check_listen, check_router, free_port
 from catabot.config.load import load_scenario, parse_scenario
 from catabot.config.scenario import Scenario
 from catabot.config.sensors import service_of
@@ -57,8 +57,10 @@ def prepare(opts: RunOptions) -> World:
     """Everything that can be refused is refused here, before any process starts: the world
     is resolved once (poses, traffic, models, terrain), as every service will resolve it."""
     requested_policy()  # a bad CATABOT_SCHED would stop every service
-    for endpoint in (*opts.connect, *([opts.listen] if opts.listen else [])):
-        check_endpoint(endpoint)
+    for endpoint in opts.connect:
+        check_router(endpoint)
+    if opts.listen and not opts.connect:  # the embedded mesh: the conductor listens there
+        check_listen(opts.listen)
     scenario = load_scenario(opts.scenario)
     data = scenario.model_dump()
     if opts.duration_s is not None:
@@ -137,17 +139,31 @@ def run(opts: RunOptions) -> int:
         except OSError as exc:
             print(f"catabot run: cannot make a run folder in {opts.out}: {exc.strerror}",
                   file=sys.stderr)  # fmt: skip
-            return 1
+            return 2
         cond_flags, svc_flags = _endpoints(opts)
         print(
             f"run folder: {run_dir}\nzenoh: clients connect to {svc_flags[1]} (world "
             f"{scenario.name!r}, keys catabot/{scenario.name}/...)",
             flush=True,
         )
+        _tell_external(world, opts, svc_flags[1])
         supervisor, viewer = _start(world, run_dir, opts, stops, (cond_flags, svc_flags))
         code = _watch(scenario, run_dir, supervisor, quiet=opts.quiet)
     _close_viewer(viewer)
     return code
+
+
+def _tell_external(world: World, opts: RunOptions, endpoint: str) -> None:
+    """The clock starts only once the participants started outside the run have joined:
+    say so, or the console shows a progress bar standing at zero until the start timeout."""
+    launched = {p.participant for p in programs.programs(world.scenario, opts.scenario)}
+    outside = [p for p in world.participants if p not in {*world.services, *launched}]
+    if outside:
+        print(
+            f"waiting for {', '.join(outside)} to join (started by you, connecting to "
+            f"{endpoint}); the run gives up after {world.scenario.clock.start_timeout_s:g} s",
+            flush=True,
+        )
 
 
 def _start(

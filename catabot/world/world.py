@@ -224,8 +224,9 @@ def _bodies(scenario: Scenario, plan: TrafficPlan) -> tuple[Body, ...]:
         return models[ref]
 
     rows: list[tuple[str, BodyKind, str, Pose, VesselConfig | None]] = []
-    for v in scenario.vessels:
+    for index, v in enumerate(scenario.vessels):
         assert v.pose is not None, "resolve_poses placed every vessel"
+        _check_script(v, model(v.model), where=f"vessels.{index}")
         rows.append((v.id, "vessel", v.model, v.pose, v))
     rows += [(b.id, "boat", b.model, b.pose, None) for b in plan.boats]
     buoys = [*scenario.buoys, *plan.buoys]
@@ -244,6 +245,18 @@ def _scenario_part(
     if config is None:
         return (), None, Velocity()
     return tuple(sorted(config.script, key=lambda s: s.t_s)), config.controller, config.velocity
+
+
+def _check_script(vessel: VesselConfig, model: VesselModel, *, where: str) -> None:
+    """A thrust step gives one value per thruster of the vessel's model: physics would
+    refuse any other at every tick and the vessel would drift unpowered."""
+    count = len(model.thrusters)
+    for k, step in enumerate(vessel.script):
+        if step.thrust is not None and len(step.thrust) != count:
+            raise ScenarioError(
+                f"{where}.script.{k}.thrust: {len(step.thrust)} value(s), but model "
+                f"{vessel.model!r} has {count} thruster(s) (one value each, in [-1, 1])"
+            )
 
 
 def _unique(ids: list[str]) -> None:

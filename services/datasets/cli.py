@@ -60,10 +60,16 @@ def main(argv: list[str] | None = None) -> int:
 
     def export() -> str:
         run = RecordedRun(args.run)
+        made = not out.exists()
         out.mkdir(parents=True, exist_ok=True)
-        summary = FORMATS[args.format](
-            run, out, val_fraction=args.val_fraction, block_s=args.split_block_s
-        )
+        try:
+            summary = FORMATS[args.format](
+                run, out, val_fraction=args.val_fraction, block_s=args.split_block_s
+            )
+        except Exception:
+            if made and not any(out.iterdir()):  # a refused export leaves no empty folder
+                out.rmdir()
+            raise
         return f"{args.format} dataset in {out}: {summary}"
 
     return answered("dataset export", export)

@@ -26,6 +26,7 @@ from catabot.bus.session import SessionError, add_connection_args, connection_fr
 from catabot.bus.session import open_session as open_zenoh
 from catabot.config.load import load_scenario
 from catabot.errors import CataBotError
+from catabot.run.answer import output_file
 from catabot.run.recorded import RecordedRun
 from catabot.world.world import World
 from services.viewer.blueprint import blueprint
@@ -120,6 +121,8 @@ def main(argv: list[str] | None = None) -> int:
     if not args.connect and args.source is None:
         parser().error("give a RUN_FOLDER to replay, or --connect ENDPOINT to attach to a run")
     try:
+        if args.save:
+            output_file(args.save, flag="--save")  # before the replay, not after it
         rec = _live(args) if args.connect else _replay(args)
     except (CataBotError, SessionError) as exc:
         print(f"catabot view: {exc}", file=sys.stderr)

@@ -1,0 +1,44 @@
+"""The endpoint probes `catabot run` makes before it starts anything (catabot/bus/session.py):
+Zenoh itself would fail only inside every process, after all of them had started."""
+
+from __future__ import annotations
+
+import socket
+
+import pytest
+
+from catabot.bus.session import SessionError, check_listen, check_router
+
+
+def test_a_free_loopback_port_can_be_listened_on() -> None:
+    with socket.socket() as s:
+        s.bind(("127.0.0.1", 0))
+        port = s.getsockname()[1]
+    check_listen(f"tcp/127.0.0.1:{port}")
+
+
+def test_an_address_of_another_machine_cannot_be_listened_on() -> None:
+    with pytest.raises(SessionError, match=r"on tcp/192\.0\.2\.1:7447: Cannot assign"):
+        check_listen("tcp/192.0.2.1:7447")
+
+
+def test_an_unknown_host_is_named() -> None:
+    for check in (check_listen, check_router):
+        with pytest.raises(SessionError, match=r"host 'no-such-host\.invalid' is not known"):
+            check("tcp/no-such-host.invalid:7447")
+
+
+def test_a_router_is_found_where_something_listens() -> None:
+    with socket.socket() as server:
+        server.bind(("127.0.0.1", 0))
+        server.listen()
+        check_router(f"tcp/127.0.0.1:{server.getsockname()[1]}")
+        with pytest.raises(SessionError, match="Address already in use"):
+            check_listen(f"tcp/127.0.0.1:{server.getsockname()[1]}")
+
+
+def test_other_protocols_are_left_to_zenoh_but_their_syntax_is_checked() -> None:
+    check_router("tls/127.0.0.1:1")  # a bare socket would not speak TLS: not probed
+    check_listen("udp/192.0.2.1:7447")
+    with pytest.raises(SessionError, match="use proto/host:port"):
+        check_router("garbage")

@@ -1,0 +1,65 @@
+"""Loading a scenario file (catabot/config/load.py): paths relative to the file, bundled
+elevation images by bare name, and the one-line answers for what is not a scenario file."""
+
+from __future__ import annotations
+
+import json
+import shutil
+from pathlib import Path
+
+import pytest
+
+from catabot.config.base import ScenarioError
+from catabot.config.load import BUNDLED, TERRAINS, load_scenario
+from tests.paths import BAY
+
+
+def test_a_copied_bundled_scenario_still_finds_its_terrain(tmp_path: Path) -> None:
+    copy = Path(shutil.copy(BUNDLED / "harbour.json", tmp_path))
+    assert load_scenario(copy).terrain is not None
+    assert load_scenario(copy).terrain.elevation_image == str(TERRAINS / "bay.png")  # type: ignore[union-attr]
+
+
+def test_an_image_beside_the_scenario_comes_before_the_bundled_one(tmp_path: Path) -> None:
+    shutil.copy(BAY, tmp_path / "bay.png")
+    path = tmp_path / "s.json"
+    terrain = {"elevation_image": "bay.png", "min_elevation_m": -15.0, "max_elevation_m": 25.0}
+    path.write_text(json.dumps({"name": "s", "terrain": terrain, "vessels": [{"id": "ego"}]}))
+    assert load_scenario(path).terrain.elevation_image == str(tmp_path / "bay.png")  # type: ignore[union-attr]
+
+
+def test_relative_paths_are_written_without_dot_dot(tmp_path: Path) -> None:
+    (tmp_path / "maps").mkdir()
+    shutil.copy(BAY, tmp_path / "maps" / "coast.png")
+    (tmp_path / "scenarios").mkdir()
+    path = tmp_path / "scenarios" / "s.json"
+    terrain = {"elevation_image": "../maps/coast.png", "min_elevation_m": -1.0}
+    path.write_text(json.dumps({"name": "s", "terrain": terrain, "vessels": [{"id": "ego"}]}))
+    image = load_scenario(path).terrain.elevation_image  # type: ignore[union-attr]
+    assert image == str(tmp_path / "maps" / "coast.png")
+
+
+def test_a_folder_is_not_a_scenario_file_and_a_run_folder_gets_a_hint(tmp_path: Path) -> None:
+    with pytest.raises(ScenarioError, match=r"is a folder$"):
+        load_scenario(tmp_path)
+    (tmp_path / "scenario.json").write_text("{}")
+    with pytest.raises(ScenarioError, match=r"a run folder.s scenario is .*/scenario\.json"):
+        load_scenario(tmp_path)
+
+
+def test_an_empty_list_says_how_many_items_it_needs(tmp_path: Path) -> None:
+    path = tmp_path / "s.json"
+    path.write_text(json.dumps({"name": "s", "vessels": []}))
+    with pytest.raises(ScenarioError, match=r"vessels: needs at least 1 item\(s\), got 0"):
+        load_scenario(path)
+
+
+def test_a_sensors_unknown_parameter_lists_that_types_parameters(tmp_path: Path) -> None:
+    imu = {"name": "imu", "type": "imu", "rate_hz": 100.0, "params": {"gyro_noise": 1.0}}
+    path = tmp_path / "s.json"
+    path.write_text(json.dumps({"name": "s", "vessels": [{"id": "ego", "sensors": [imu]}]}))
+    with pytest.raises(ScenarioError) as caught:
+        load_scenario(path)
+    message = str(caught.value)
+    assert "vessels.0.sensors.0.params.gyro_noise: unknown field" in message
+    assert "(allowed: gyro_sigma, accel_sigma" in message and "rate_hz" not in message

@@ -1,0 +1,117 @@
+"""What `catabot` refuses before anything starts, with one line naming why (exit 2): a
+script that does not fit its vessel's thrusters, a controller's missing program (validate
+says what run would), an output file in a folder that is not there, an endpoint nobody
+listens on or that cannot be listened on. And the line a run prints while it waits for a
+stack the user starts."""
+
+from __future__ import annotations
+
+import json
+import socket
+import subprocess
+import sys
+from pathlib import Path
+from typing import Any
+
+import pytest
+
+from catabot.run.cli import main
+
+
+def _scenario(folder: Path, **vessel: Any) -> str:
+    data = {"name": "refused", "duration_s": 1.0, "vessels": [{"id": "ego", **vessel}]}
+    path = folder / "refused.json"
+    path.write_text(json.dumps(data))
+    return str(path)
+
+
+def _both_refuse(path: str, out: Path, capsys: pytest.CaptureFixture[str]) -> str:
+    """validate and run both exit 2 with the same line, and run makes no run folder."""
+    errs = []
+    for argv in (["scenario", "validate", path], ["run", path, "--out", str(out)]):
+        assert main(argv) == 2
+        errs.append(capsys.readouterr().err.split(": ", 1)[1])
+    assert errs[0] == errs[1] and "Traceback" not in errs[0]
+    assert not out.exists()
+    return errs[0]
+
+
+def test_a_thrust_step_needs_one_value_per_thruster(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    script = [{"t_s": 0.0, "thrust": [0.5, 0.5]}, {"t_s": 2.0, "thrust": [0.5]}]
+    err = _both_refuse(_scenario(tmp_path, script=script), tmp_path / "runs", capsys)
+    assert "vessels.0.script.1.thrust: 1 value(s), but model 'catabot' has 2 thruster(s)" in err
+
+
+def test_validate_refuses_a_missing_program_as_run_does(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    controller = {"participant": "stack", "rate_hz": 10.0, "program": "nope.py"}
+    err = _both_refuse(_scenario(tmp_path, controller=controller), tmp_path / "runs", capsys)
+    assert "vessels.0.controller.program: 'nope.py' is not a file" in err
+
+
+@pytest.mark.parametrize(
+    ("argv", "why"),
+    [
+        (["scenario", "schema", "-o", "{missing}/s.json"], "folder {missing} does not exist"),
+        (["scenario", "schema", "-o", "{tmp}"], "is a folder; give a file name"),
+        (["scenario", "generate", "-o", "{missing}/g.json"], "folder {missing} does not exist"),
+    ],
+)
+def test_an_output_file_that_cannot_be_written_is_refused_first(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str], argv: list[str], why: str
+) -> None:
+    names = {"missing": str(tmp_path / "no" / "such"), "tmp": str(tmp_path)}
+    assert main([a.format(**names) for a in argv]) == 2
+    err = capsys.readouterr().err
+    assert why.format(**names) in err and "Traceback" not in err
+
+
+def test_the_schema_is_written_where_asked(tmp_path: Path) -> None:
+    assert main(["scenario", "schema", "-o", str(tmp_path / "s.json")]) == 0
+    assert json.loads((tmp_path / "s.json").read_text())["title"] == "CataBot scenario"
+
+
+def _closed_port() -> int:
+    with socket.socket() as s:
+        s.bind(("127.0.0.1", 0))
+        return int(s.getsockname()[1])
+
+
+def test_a_router_that_does_not_answer_is_refused_before_any_start(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    endpoint = f"tcp/127.0.0.1:{_closed_port()}"
+    assert main(["run", "--duration", "1", "--connect", endpoint, "--out", str(tmp_path)]) == 2
+    assert f"nothing answers at {endpoint}" in capsys.readouterr().err
+    assert not any(tmp_path.iterdir())
+
+
+def test_a_listen_port_in_use_is_refused_before_any_start(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    with socket.socket() as taken:
+        taken.bind(("127.0.0.1", 0))
+        taken.listen()
+        endpoint = f"tcp/127.0.0.1:{taken.getsockname()[1]}"
+        assert main(["run", "--duration", "1", "--listen", endpoint, "--out", str(tmp_path)]) == 2
+    assert f"cannot listen on {endpoint}: Address already in use" in capsys.readouterr().err
+    assert not any(tmp_path.iterdir())
+
+
+def test_a_run_says_it_waits_for_a_stack_started_outside_it(tmp_path: Path) -> None:
+    data = {
+        "name": "waits", "duration_s": 1.0, "clock": {"start_timeout_s": 1.0},
+        "vessels": [{"id": "ego", "controller": {"participant": "stack", "rate_hz": 10.0}}],
+    }  # fmt: skip
+    path = tmp_path / "waits.json"
+    path.write_text(json.dumps(data))
+    argv = ["run", str(path), "--quiet", "--out", str(tmp_path / "runs")]
+    done = subprocess.run(
+        [sys.executable, "-m", "catabot", *argv], capture_output=True, text=True, timeout=120
+    )
+    assert "waiting for stack to join (started by you, connecting to tcp/" in done.stdout
+    assert "the run gives up after 1 s" in done.stdout
+    assert done.returncode == 1 and "never joined within 1 s: stack" in done.stderr
