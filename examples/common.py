@@ -11,6 +11,7 @@ import zenoh
 from catabot.bus.keys import Keys
 from catabot.bus.session import add_connection_args, connection_from_args, open_session
 from catabot.client import ClientError
+from catabot.client.discover import find_world
 
 
 def parser(description: str | None) -> argparse.ArgumentParser:
@@ -33,9 +34,19 @@ def session(args: argparse.Namespace) -> zenoh.Session:
     return open_session(connection_from_args(args))
 
 
-def keys(args: argparse.Namespace) -> Keys:
-    """The keys of `--world` (the bundled `default` scenario when not given)."""
-    return Keys(args.world or "default")
+def keys(s: zenoh.Session, args: argparse.Namespace) -> Keys:
+    """The keys of `--world`, or of the one world running, once it answers (waiting up to
+    `--timeout`); ends the program naming the vessels if `--vessel` is not one of them."""
+    with clear_errors("catabot example"):
+        info = find_world(s, args.world, args.timeout, " ".join(args.connect) or "peer mesh")
+    bodies = [*info.vessels, *info.traffic]
+    if args.vessel not in bodies:
+        vessels, boats = ", ".join(info.vessels), len(info.traffic)
+        raise SystemExit(
+            f"world {info.name!r} has no vessel {args.vessel!r}; its vessels: {vessels} "
+            f"(and {boats} traffic boats)"
+        )
+    return Keys(info.name)
 
 
 @contextmanager

@@ -27,13 +27,12 @@ def main() -> None:
     p = parser(__doc__)
     p.add_argument("--thrust", type=float, nargs="+", required=True)
     p.add_argument("--repeat", type=int, default=10, help="send this many times, 0.1 s apart")
-    p.add_argument("--wait", type=float, default=10.0, help="seconds to wait for the simulation")
     args = p.parse_args()
-    at = keys(args)
     with session(args) as s:
+        at = keys(s, args)
         pub = s.declare_publisher(at.cmd_thrust(args.vessel))
         states = s.declare_subscriber(at.vessel_state(args.vessel), zenoh.handlers.RingChannel(1))
-        if not ticking(states, timeout_s=args.wait):  # then every service of the run is listening
+        if not ticking(states, timeout_s=args.timeout):  # then every service of the run listens
             raise SystemExit(f"no simulation subscribes to {pub.key_expr}: is it running?")
         states.undeclare()
         for _ in range(args.repeat):

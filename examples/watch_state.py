@@ -24,7 +24,7 @@ def main() -> None:
     args = p.parse_args()
     with session(args) as s:
         sub = s.declare_subscriber(
-            keys(args).vessel_state(args.vessel), zenoh.handlers.RingChannel(256)
+            keys(s, args).vessel_state(args.vessel), zenoh.handlers.RingChannel(256)
         )
         shown = 0
         for n, sample in enumerate(sub):

@@ -56,13 +56,16 @@ def twist_batch(boats: tuple[str, ...]) -> Check:
 
 
 def thrust(thrusters: int) -> Check:
-    """One finite value per thruster (values beyond -1..1 are clamped by physics)."""
+    """One finite value in [-1, 1] per thruster. Refused, not clamped: what is recorded is
+    what physics applied, as for a scenario's script and the ROS gateway's commands."""
 
     def check(msg: ThrustCmd) -> None:
         if len(msg.thrust) != thrusters:
             raise ValueError(f"{len(msg.thrust)} values for {thrusters} thrusters")
         if not finite(msg.thrust):
             raise ValueError(f"a thrust value is not finite: {msg.thrust}")
+        if not all(-1.0 <= v <= 1.0 for v in msg.thrust):
+            raise ValueError(f"thrust values are normalised, each in [-1, 1]: {msg.thrust}")
 
     return check
 

@@ -68,6 +68,7 @@ class Participant(Outputs):
         self._everyone = self.peers | {name}  # the peers a tick may name as dropped
         self.drain_s = drain_s
         self.next_tick = 0
+        self._acked = -1  # the last tick acked
         self._grant: Tick | None = None
         self._settings: dict[int, list[str]] = {}  # changes granted, by the tick they apply
         self._held_clock: list[Event] = []  # until the conductor's session is known
@@ -115,6 +116,8 @@ class Participant(Outputs):
             if end is not None:
                 return self._finish(end, on_end)
             self._step_ready(step)
+            if event[0] == "idle":
+                self._ack_waiting()
 
     def _take(self, event: Event) -> End | None:
         kind, key, payload, sender = event
@@ -135,8 +138,21 @@ class Participant(Outputs):
             step(self._tick_of(grant, k), self.inbox.release(k))
             self.next_tick = k + 1
             if (k + 1) % grant.ack_every == 0 or k == grant.tick:
-                self.put(self._ack, codec.encode(Ack(grant.run, k)))
+                self._ack_through(grant, k)
             self._waiting_since = time.monotonic()
+
+    def _ack_through(self, grant: Tick, k: int) -> None:
+        self.put(self._ack, codec.encode(Ack(grant.run, k)))
+        self._acked = k
+
+    def _ack_waiting(self) -> None:
+        """A second without events while ticks stepped since the last ack wait for inputs:
+        ack them now. Acks come every half window, so a participant that waits for a slow
+        one's data looked as late as it, and a missed deadline named whoever came first
+        (physics, for a stack that slept in its step)."""
+        grant, done = self._grant, self.next_tick - 1
+        if grant is not None and done > self._acked:
+            self._ack_through(grant, done)
 
     def _tick_of(self, grant: Tick, k: int) -> Tick:
         stamp = grant.stamp_ns - (grant.tick - k) * grant.dt_ns

@@ -52,8 +52,8 @@ EXAMPLES: tuple[tuple[Message, str], ...] = (
     (WaypointsCmd((0.0, 0.0, 40.0, 20.0), 1.5, 2.0, "loop"), "a two-point loop at 1.5 m/s"),
 )
 COMMAND_RULES = {
-    "thrust_cmd": "one finite value per thruster of the vessel's model, in its thruster order; "
-    "values beyond -1..1 are clamped",
+    "thrust_cmd": "one value in [-1, 1] per thruster of the vessel's model, in its thruster "
+    "order (a value out of range is refused, not clamped)",
     "twist_cmd": "finite values; the velocity controller clamps what the thrusters can do",
     "waypoints_cmd": "an even number (>= 2) of finite coordinates, `speed` and `tolerance` "
     '> 0, `mode` one of "loop", "back_and_forth", "release" (release: the rest is ignored)',

@@ -85,7 +85,10 @@ class Client:
     def vessel(self, vessel_id: str) -> Vessel:
         """A scenario vessel's handle; UnknownVessel (listing the ids) if there is none."""
         if vessel_id not in self._vessels:
-            self._vessels[vessel_id] = Vessel(self.watch, self._outputs, self._vessel(vessel_id))
+            info, timeout = self._vessel(vessel_id), self.timeout_s
+            self._vessels[vessel_id] = Vessel(
+                self.watch, self._outputs, info, ready_timeout_s=timeout
+            )
         return self._vessels[vessel_id]
 
     def _vessel(self, vessel_id: str) -> VesselInfo:

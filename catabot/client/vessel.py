@@ -39,9 +39,12 @@ class Sensor:
 
 
 class Vessel:
-    def __init__(self, watch: Watch, outputs: Outputs, info: VesselInfo) -> None:
+    def __init__(
+        self, watch: Watch, outputs: Outputs, info: VesselInfo, *, ready_timeout_s: float = 5.0
+    ) -> None:
         self.info, self.id = info, info.id
         self._watch, self._outputs = watch, outputs
+        self._ready_timeout_s = ready_timeout_s
         self._state: Latest | None = None
         self._sensors: dict[str, Sensor] = {}
 
@@ -70,7 +73,9 @@ class Vessel:
 
     def send(self, command: Command) -> None:
         """Send a Thrust, Twist or Waypoints now (free-running); CommandError if the vessel
-        cannot take it."""
+        cannot take it. Before the run's first tick it waits for it (up to the client's
+        timeout; NoData then): a command sent while the services were still subscribing
+        reached some of them only (the recorder wrote a thrust that physics never got)."""
         kind = kind_of(command)
         controller = self.info.controller
         if controller is not None and controller.command == kind:
@@ -79,5 +84,12 @@ class Vessel:
                 f"{controller.participant!r}: send it with act() after "
                 f"join({controller.participant!r}); a free {kind} on that key would be refused"
             )
+        if controller is not None:
+            raise CommandError(
+                f"vessel {self.id!r} is driven in lockstep by participant "
+                f"{controller.participant!r} ({controller.command}): a free {kind} would "
+                "change the run, and is refused"
+            )
         msg: Message = message(command, self.info)
+        self.state(self._ready_timeout_s)  # the run is going: every service hears it
         self._outputs.publish(self.info.command_keys[kind], msg)

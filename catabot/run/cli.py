@@ -188,8 +188,10 @@ def parser() -> argparse.ArgumentParser:
     sec.add_argument("--sensor-shards", type=int, default=1, metavar="N", help=shards)
     guides = "logins for N traffic processes (a scenario's traffic.shards)"
     sec.add_argument("--traffic-shards", type=int, default=1, metavar="N", help=guides)
-    svc = sub.add_parser("service", help="run one service (conductor, physics, ...) alone")
-    svc.add_argument("name")
+    svc = sub.add_parser(  # its --help is the service's own: `catabot service physics -h`
+        "service", help="run one service (conductor, physics, ...) alone", add_help=False
+    )
+    svc.add_argument("name", help="conductor, or a service: physics, sensors, traffic, ...")
     rtr = sub.add_parser("router", help="run a zenoh router for distributed runs")
     add_connection_args(rtr)
     scen = sub.add_parser("scenario", help="scenario tools")

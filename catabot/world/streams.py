@@ -94,13 +94,30 @@ def _commands(world: World, vessel: Body) -> list[Stream]:
             period = rate_in_ticks(c.rate_hz, world.scenario.dt_ns, where=key)
             out.append(Stream(key, message, c.participant, period, check=check))
         else:
-            out.append(Stream(key, message, EXTERNAL, None, check=check))
+            out.append(Stream(key, message, EXTERNAL, None, check=_free(vessel, check)))
     return out
 
 
 def _waypoints(world: World, vessel: Body) -> Stream:
     key = world.keys.cmd_waypoints(vessel.id)
-    return Stream(key, WaypointsCmd, EXTERNAL, None, check=checks.waypoints)
+    return Stream(key, WaypointsCmd, EXTERNAL, None, check=_free(vessel, checks.waypoints))
+
+
+def _free(vessel: Body, check: checks.Check) -> checks.Check:
+    """A free-running command's check; every free command is refused for a vessel driven
+    by a lockstep controller: whoever sent it would change a run that is to be reproducible
+    (the controller's own key is clocked: only its participant may produce it)."""
+    c = vessel.controller
+    if c is None:
+        return check
+
+    def refused(_msg: object) -> None:
+        raise ValueError(
+            f"vessel {vessel.id!r} is driven in lockstep by {c.participant!r} ({c.command} "
+            "commands): a free command would change the run"
+        )
+
+    return refused
 
 
 def _twist_batches(world: World) -> tuple[Stream, ...]:

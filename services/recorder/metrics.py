@@ -73,6 +73,7 @@ class Metrics:
         keys = world.keys
         self.command_keys = {keys.cmd_thrust(b.id): b.id for b in subjects}
         self.command_keys |= {keys.cmd_twist(b.id): b.id for b in subjects}
+        self.command_keys |= {keys.cmd_waypoints(b.id): b.id for b in subjects}
 
     def command(self, key: str, msg: Message) -> None:
         """A command the recorder received: the thrust in force from now on (`tasks.Thrust`)."""

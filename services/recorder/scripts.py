@@ -5,12 +5,15 @@ Physics applies a vessel's script step at the first tick at or after its `t_s`
 an external command of its kind uses (`vessel/<id>/cmd/thrust` or `.../cmd/twist`), so the
 CSV and `/<ns>/thrust` or `/<ns>/cmd_vel` in run.mcap hold every command a vessel was given,
 scripted or sent. Stamp: the tick's, as for an external command (the tick physics applies
-it at). Steps that fall on one tick: the last, the one physics follows.
+it at). Steps that fall on one tick: the last, the one physics follows. A vessel that a
+command from the bus has taken over no longer follows its script (physics' precedence:
+an outside thrust or twist until a `WaypointsCmd` hands it back, a lockstep controller's
+set-point from then on), so its later steps are not written as if it had obeyed them.
 """
 
 from __future__ import annotations
 
-from catabot.bus.messages import Message, ThrustCmd, TwistCmd
+from catabot.bus.messages import Message, ThrustCmd, TwistCmd, WaypointsCmd
 from catabot.config.scenario import ScriptStep
 from catabot.world.world import World
 
@@ -26,11 +29,32 @@ class ScriptedCommands:
                 tick = -(-t_ns // dt)  # the first tick at or after the step's time
                 self._due.setdefault(tick, {})[vessel.id] = step
         self._keys = world.keys
+        scripted = [v.id for v in world.vessels if v.script]
+        k = world.keys
+        self._vessel_of = {key(v): v for v in scripted for key in (k.cmd_thrust, k.cmd_twist)}
+        self._vessel_of |= {k.cmd_waypoints(v): v for v in scripted}
+        self._taken: set[str] = set()  # by an outside command, until handed back
+        self._steered: set[str] = set()  # by a lockstep controller's set-points, for good
+
+    def heard(self, key: str, msg: Message) -> None:
+        """A command physics received for a vessel (`key` its absolute key)."""
+        vessel = self._vessel_of.get(key)
+        if vessel is None:
+            return
+        if isinstance(msg, WaypointsCmd):
+            self._taken.discard(vessel)
+        elif isinstance(msg, TwistCmd) and msg.tick >= 0:
+            self._steered.add(vessel)
+        elif isinstance(msg, ThrustCmd | TwistCmd):
+            self._taken.add(vessel)
 
     def due(self, tick: int, stamp_ns: int) -> list[tuple[str, Message]]:
-        """(stream, command) of every step that takes effect at `tick`."""
+        """(stream, command) of every step that takes effect at `tick`, for the vessels that
+        still follow their script."""
         out: list[tuple[str, Message]] = []
         for vessel, step in self._due.get(tick, {}).items():
+            if vessel in self._taken or vessel in self._steered:
+                continue
             if step.thrust is not None:
                 key = self._keys.cmd_thrust(vessel)
                 out.append((key, ThrustCmd(tuple(step.thrust), tick=tick, stamp_ns=stamp_ns)))

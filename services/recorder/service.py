@@ -71,6 +71,7 @@ class Recorder:
                     self._write_block(stream, msg, self.batches.twists)
                 else:
                     self.metrics.command(key, msg)  # the thrust in force, for its impulse
+                    self.scripts.heard(key, msg)  # a script it overrides is not written
                     self._write(stream, _stamped(msg, tick))
         for change in changes_of(tick.settings):  # what took effect at this tick: an input
             record = SettingsChange(tick.tick, tick.stamp_ns, change.key, change.value)

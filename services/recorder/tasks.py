@@ -19,7 +19,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from catabot.bus.clock import NS_PER_S
-from catabot.bus.messages import Message, ThrustCmd, TwistCmd
+from catabot.bus.messages import Message, ThrustCmd, TwistCmd, WaypointsCmd
 from catabot.config.task import TaskConfig
 from catabot.world.world import Body
 
@@ -120,21 +120,28 @@ class Thrust:
         self.impulse = np.zeros(len(bodies))
         self.unknown_s = np.zeros(len(bodies))
         self.pending = 0  # ticks driven by the current forces, not yet added up
+        self.began = -1  # the stamp the last tick began at (a released vessel's script step)
         for i in range(len(bodies)):
             self._resolve(i, -1)
 
     def command(self, vessel: str, msg: Message) -> None:
-        """A `ThrustCmd` or `TwistCmd` the recorder received for a scenario vessel."""
+        """A `ThrustCmd` or `TwistCmd` the recorder received for a scenario vessel; a
+        `WaypointsCmd` hands an outside one's vessel back to its script, as in physics."""
         i = self.row.get(vessel)
-        if i is not None and isinstance(msg, ThrustCmd | TwistCmd):
-            self._settle()
+        if i is None or not isinstance(msg, ThrustCmd | TwistCmd | WaypointsCmd):
+            return
+        self._settle()
+        if isinstance(msg, WaypointsCmd):
+            if not (isinstance(self.bus.get(i), TwistCmd) and self.bus[i].tick >= 0):
+                self.bus.pop(i, None)  # a lockstep set-point stays, as physics keeps it
+        else:
             self.bus[i] = msg
-            self._resolve(i, -1)
+        self._resolve(i, self.began)
 
     def add(self, stamp_ns: int) -> None:
         """The state at `stamp_ns` ends the tick that began at stamp_ns - dt: the orders in
         force then drove it."""
-        began = stamp_ns - self.dt_ns
+        began = self.began = stamp_ns - self.dt_ns
         while self.next_event < len(self.events) and self.events[self.next_event] <= began:
             self.next_event += 1
             self._settle()

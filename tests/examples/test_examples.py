@@ -76,7 +76,11 @@ def test_every_example_has_a_main_and_is_checked_here() -> None:
 
 
 def test_watch_state_prints_the_vessel_moving(run: type[Run]) -> None:
-    sim = run("default", "--duration", "8", "--realtime", "2")
+    """Any world: the one running answers (a fixed `default` hung on the harbour's keys)."""
+    sim = run("harbour", "--duration", "8", "--realtime", "2")
+    wrong = example("watch_state.py", "--connect", sim.endpoint, "--vessel", "nope")
+    assert wrong.returncode != 0
+    assert "world 'harbour' has no vessel 'nope'; its vessels: ego, " in wrong.stderr
     shown = example("watch_state.py", "--connect", sim.endpoint, "--count", "5", "--every", "20")
     assert shown.returncode == 0, shown.stderr
     lines = [ln for ln in shown.stdout.splitlines() if ln.startswith("t=")]
@@ -97,9 +101,9 @@ def test_send_thrust_is_recorded_and_applied(run: type[Run]) -> None:
 
 def test_send_thrust_says_when_no_simulation_listens() -> None:
     lonely = f"tcp/127.0.0.1:{free_port()}"
-    sent = example("send_thrust.py", "--listen", lonely, "--thrust", "0.1", "0.1", "--wait", "2",
-                   timeout=30)  # fmt: skip
-    assert sent.returncode != 0 and "no simulation subscribes" in sent.stderr
+    sent = example("send_thrust.py", "--listen", lonely, "--thrust", "0.1", "0.1", "--timeout",
+                   "2", timeout=30)  # fmt: skip
+    assert sent.returncode != 0 and "no simulation of any world answered" in sent.stderr
 
 
 def test_lockstep_stack_reaches_its_goal_and_records_the_same_bytes_twice(

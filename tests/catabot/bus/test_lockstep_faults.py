@@ -52,6 +52,30 @@ def test_a_step_past_the_deadline_ends_the_run_naming_it(
     world.members["stuck"].join()
 
 
+def test_a_participant_waiting_for_a_late_ones_data_is_not_named(world: World) -> None:
+    """`cons` needs `slow`'s output of each tick before; `slow` sleeps in tick 13. Acks come
+    every half window, so `cons` had stepped 12 and 13 unacknowledged and looked as late as
+    `slow`: the deadline named it, the first in the list (as physics for a slow stack). A
+    second without events, it acks what it has stepped."""
+    release = threading.Event()
+    key = world.keys.vessel_state("ego")
+    names = ["cons", "slow"]
+    holder: dict[str, Participant] = {}
+
+    def slow(tick: Tick, _inputs: Inputs) -> None:
+        if tick.tick == 13:
+            release.wait(6.0)
+        holder["p"].publish(key, _state(tick.tick))
+
+    world.member("cons", inputs=[Stream(key, VesselState, "slow", 1)], peers=names)
+    holder["p"] = world.member("slow", slow, peers=names).participant
+    try:
+        result = world.run(names, 100, deadline_s=2.5, start_timeout_s=5.0, window_ticks=8)
+    finally:
+        release.set()
+    assert result.error == "participant 'slow' missed the 2.5 s deadline of tick 12"
+
+
 # -- (d) policy drop ----------------------------------------------------------------------
 
 

@@ -9,7 +9,8 @@ from catabot.bus.messages import ThrustCmd, TwistCmd, WaypointsCmd
 from catabot.client import CommandError, Thrust, Twist, Waypoints
 from catabot.client.commands import Command, kind_of, message
 from catabot.client.info import parse
-from tests.catabot.client.fixtures import answer
+from catabot.world.world import World
+from tests.catabot.client.fixtures import answer, scenario
 
 EGO = parse(answer(), "test").vessels["ego"]
 NAN, INF = float("nan"), float("inf")
@@ -31,6 +32,8 @@ def test_good_commands_become_their_messages() -> None:
         (Thrust([0.5]), "thrust command for vessel 'ego': 1 values for 2 thrusters"),
         (Thrust([0.5, 0.5, 0.5]), "3 values for 2 thrusters"),
         (Thrust([NAN, 0.0]), "a thrust value is not finite"),
+        (Thrust([5.0, -7.0]), r"normalised, each in \[-1, 1\]: \(5.0, -7.0\)"),
+        (Thrust([1.0, -1.0001]), r"each in \[-1, 1\]"),
         (Thrust(["fast", 0.0]), "could not convert string to float"),  # type: ignore[list-item]
         (Twist(INF, 0.0), "twist command for vessel 'ego': surge inf m/s"),
         (Twist(1.0, NAN), "not finite"),
@@ -48,3 +51,25 @@ def test_bad_commands_are_refused_in_the_stack(command: Command, why: str) -> No
 def test_something_else_is_no_command() -> None:
     with pytest.raises(CommandError, match="ThrustCmd is not a command: send Thrust, Twist"):
         kind_of(ThrustCmd((0.0, 0.0)))  # type: ignore[arg-type]
+
+
+def test_the_bus_refuses_every_free_command_for_a_vessel_a_controller_drives() -> None:
+    """Any client may publish, not only ours: the streams' own checks (what physics and the
+    recorder apply at the sample) refuse a free twist, thrust or path for a vessel whose
+    lockstep controller drives it, and nothing for a vessel without one."""
+    world = World.resolve(scenario())
+    checks = {s.key: s.check for s in [*world.streams.commands, *world.streams.waypoints]}
+    keys = world.keys
+    for key, msg in (
+        (keys.cmd_thrust("ego"), ThrustCmd((0.5, 0.5))),
+        (keys.cmd_waypoints("ego"), WaypointsCmd((1.0, 2.0), 1.0, 2.0, "loop")),
+    ):
+        check = checks[key]
+        assert check is not None
+        with pytest.raises(ValueError, match="'ego' is driven in lockstep by 'stack' \\(twist"):
+            check(msg)
+    other = checks[keys.cmd_thrust("other")]
+    assert other is not None
+    other(ThrustCmd((0.5, 0.5)))
+    with pytest.raises(ValueError, match="normalised"):
+        other(ThrustCmd((1.5, 0.5)))

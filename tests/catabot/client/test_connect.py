@@ -16,9 +16,11 @@ from catabot.client import (
     Client,
     ClientError,
     CommandError,
+    NoData,
     NotAParticipant,
     SeveralWorlds,
     SimulatorNotFound,
+    Thrust,
     TooLate,
     Twist,
     UnknownSensor,
@@ -116,6 +118,19 @@ def test_unknown_vessels_sensors_and_participants(served: Served) -> None:
             CommandError, match="twist is driven in lockstep by participant 'stack'"
         ):
             sim.vessel("ego").send(Twist(1.0, 0.0))
+        with pytest.raises(CommandError, match=r"'stack' \(twist\): a free thrust would change"):
+            sim.vessel("ego").send(Thrust([0.5, 0.5]))
+
+
+def test_a_free_command_waits_for_the_runs_first_tick(served: Served) -> None:
+    """Sent while the services were still subscribing, a command reached some only (the
+    recorder wrote a thrust that physics never applied): send waits for the vessel's first
+    state, up to the client's timeout. Here no physics runs: NoData, nothing sent."""
+    with Client.connect([served.endpoint], timeout_s=1.0) as sim:
+        started = time.monotonic()
+        with pytest.raises(NoData, match="no state of vessel 'other' within 1 s"):
+            sim.vessel("other").send(Thrust([0.5, 0.5]))
+        assert time.monotonic() - started >= 1.0
 
 
 def test_a_run_that_has_started_is_too_late_to_join(served: Served) -> None:

@@ -10,7 +10,7 @@ from typing import Any
 import numpy as np
 import pytest
 
-from catabot.bus.messages import BodyStates, ThrustCmd, TwistCmd
+from catabot.bus.messages import BodyStates, ThrustCmd, TwistCmd, WaypointsCmd
 from catabot.config.load import parse_scenario
 from catabot.world.world import World
 from services.recorder.metrics import Metrics
@@ -163,6 +163,22 @@ def test_thrust_impulse_of_script_and_bus_commands(tmp_path: Path) -> None:
     # 10 ticks at 0.5*36 + 1*28 = 46 N, 10 ticks at 72 N, then nothing; then 5 ticks unknown
     assert v0["thrust_impulse_Ns"] == pytest.approx(0.1 * 46 + 0.1 * 72)
     assert v0["thrust_unknown_s"] == pytest.approx(0.05)
+
+
+def test_a_path_hands_an_outside_commands_vessel_back_to_its_script(tmp_path: Path) -> None:
+    """As in physics: an outside thrust outranks the script until a WaypointsCmd."""
+    script = [{"t_s": 0.0, "thrust": [1.0, 1.0]}]
+    world = _world(vessels=[{"id": "v0", "script": script, "pose": {"x_m": 0.0, "y_m": 0.0}}])
+    metrics = Metrics(world)
+    for tick in range(30):
+        if tick == 10:
+            metrics.command(world.keys.cmd_thrust("v0"), ThrustCmd((0.0, 0.0)))
+        if tick == 20:
+            release = WaypointsCmd((), 1.0, 1.0, "release")
+            metrics.command(world.keys.cmd_waypoints("v0"), release)
+        metrics.add(_states(world, tick, [(0.0, 0.0)]))
+    v0 = _record(metrics, tmp_path)["vessels"]["v0"]
+    assert v0["thrust_impulse_Ns"] == pytest.approx(0.1 * 72 + 0.1 * 72)  # ticks 0-9, 20-29
 
 
 def test_same_states_same_bytes(tmp_path: Path) -> None:

@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from catabot.bus.messages import ThrustCmd, TwistCmd
+from catabot.bus.messages import ThrustCmd, TwistCmd, WaypointsCmd
 from catabot.config.load import parse_scenario
 from catabot.world.world import World
 from services.recorder.scripts import ScriptedCommands
@@ -23,3 +23,20 @@ def test_steps_land_on_the_first_tick_at_or_after_their_time() -> None:
     assert due[2] == [("vessel/ego/cmd/thrust", ThrustCmd((0.3, 0.3), 2, 20_000_000))]
     assert due[5] == [("vessel/ego/cmd/twist", TwistCmd(1.0, -0.5, 5, 50_000_000))]
     assert [k for k, d in due.items() if d] == [0, 2, 5]
+
+
+def test_a_vessel_taken_over_from_the_bus_is_not_written_as_following_its_script() -> None:
+    """Physics' precedence (services/physics/commands.py): an outside thrust or twist holds
+    the vessel until a WaypointsCmd hands it back; a lockstep set-point holds it for good."""
+    world = World.resolve(parse_scenario({"vessels": [{"id": "ego", "script": SCRIPT}]}))
+    scripts, keys = ScriptedCommands(world), world.keys
+    scripts.heard(keys.cmd_thrust("ego"), ThrustCmd((0.9, 0.9)))  # from outside: tick -1
+    assert scripts.due(2, 20_000_000) == []
+    scripts.heard(keys.cmd_waypoints("ego"), WaypointsCmd((), 1.0, 1.0, "release"))
+    assert scripts.due(2, 20_000_000) == [
+        ("vessel/ego/cmd/thrust", ThrustCmd((0.3, 0.3), 2, 20_000_000))
+    ]
+    scripts.heard(keys.cmd_twist("ego"), TwistCmd(1.0, 0.0, 3, 30_000_000))  # lockstep
+    scripts.heard(keys.cmd_waypoints("ego"), WaypointsCmd((), 1.0, 1.0, "release"))
+    assert scripts.due(5, 50_000_000) == []
+    scripts.heard(keys.cmd_thrust("other"), ThrustCmd((0.9, 0.9)))  # no such vessel: ignored
