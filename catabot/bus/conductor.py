@@ -28,6 +28,7 @@ from catabot.bus.rejections import Rejected, Rejections
 from catabot.bus.settings import Schedule
 
 log = logging.getLogger("catabot.bus.conductor")
+WAITING_NOTE_S = 5.0  # how often the log names who has not joined yet
 
 
 @dataclass(frozen=True)
@@ -147,11 +148,21 @@ class Conductor:
     def _await_members(self) -> None:
         expected = set(self.spec.participants)
         limit = time.monotonic() + self.spec.start_timeout_s
+        note = time.monotonic() + WAITING_NOTE_S
         while not expected <= self.members:
             if self._stop_reason:
                 return
-            if self._next_event(limit)[0] == "late":
-                raise ClockError(self._start_timeout(expected))
+            if self._next_event(min(limit, note))[0] == "late":
+                if time.monotonic() >= limit:
+                    raise ClockError(self._start_timeout(expected))
+                note = time.monotonic() + WAITING_NOTE_S
+                self._waiting_note(expected, limit)
+
+    def _waiting_note(self, expected: set[str], limit: float) -> None:
+        """Who the run still waits for: a conductor started by hand (one service per
+        machine) said nothing until the start timeout named them."""
+        missing = ", ".join(sorted(expected - self.members))
+        log.info("waiting for %s to join (%.0f s left)", missing, limit - time.monotonic())
 
     def _start_timeout(self, expected: set[str]) -> str:
         missing = ", ".join(sorted(expected - self.members))

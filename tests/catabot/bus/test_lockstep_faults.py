@@ -8,7 +8,7 @@ import time
 
 import pytest
 
-from catabot.bus import codec
+from catabot.bus import codec, conductor
 from catabot.bus.clock import Policy, Stream
 from catabot.bus.inbox import Inputs
 from catabot.bus.messages import Tick, VesselState
@@ -111,6 +111,19 @@ def test_policy_drop_goes_on_without_the_hanging_participant(world: World) -> No
 
 
 # -- (e) start timeout --------------------------------------------------------------------
+
+
+def test_the_conductor_says_who_it_waits_for(
+    world: World, monkeypatch: pytest.MonkeyPatch, caplog: pytest.LogCaptureFixture
+) -> None:
+    """Started by hand (a service per machine), it named them only at the timeout."""
+    monkeypatch.setattr(conductor, "WAITING_NOTE_S", 0.3)
+    world.member("here")
+    with caplog.at_level(logging.INFO, logger="catabot.bus.conductor"):
+        result = world.run(["here", "ghost"], 10, deadline_s=1.0, start_timeout_s=1.0)
+    assert "never joined" in result.error
+    notes = [r.getMessage() for r in caplog.records if "waiting for" in r.getMessage()]
+    assert notes and all(n.startswith("waiting for ghost to join (") for n in notes)
 
 
 def test_a_participant_that_never_joins_is_named(world: World) -> None:
