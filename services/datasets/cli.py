@@ -13,6 +13,7 @@ import sys
 from collections.abc import Callable
 from pathlib import Path
 
+from catabot.errors import CataBotError
 from catabot.run.answer import answered
 from catabot.run.recorded import RecordedRun
 from services.datasets import coco, kitti, yolo
@@ -42,23 +43,28 @@ def parser() -> argparse.ArgumentParser:
     return p
 
 
-def _check(args: argparse.Namespace, p: argparse.ArgumentParser) -> Path:
+class ExportOptionError(CataBotError, ValueError):
+    """An option the export cannot use; the message names it."""
+
+
+def _check(args: argparse.Namespace) -> Path:
+    """Options refused in one line, as every tool refuses (argparse's error printed the
+    parent command's usage first)."""
     if not 0.0 <= args.val_fraction <= 1.0:
-        p.error(f"--val-fraction must be in [0, 1] (got {args.val_fraction})")
+        raise ExportOptionError(f"--val-fraction must be in [0, 1] (got {args.val_fraction})")
     if args.split_block_s is not None and not args.split_block_s > 0:
-        p.error(f"--split-block-s must be > 0 (got {args.split_block_s})")
+        raise ExportOptionError(f"--split-block-s must be > 0 (got {args.split_block_s})")
     out = Path(args.output)
     if out.exists() and (not out.is_dir() or any(out.iterdir())):
-        p.error(f"--output {out} exists and is not an empty folder")
+        raise ExportOptionError(f"--output {out} exists and is not an empty folder")
     return out
 
 
 def main(argv: list[str] | None = None) -> int:
-    p = parser()
-    args = p.parse_args(argv)
-    out = _check(args, p)
+    args = parser().parse_args(argv)
 
     def export() -> str:
+        out = _check(args)
         run = RecordedRun(args.run)
         made = not out.exists()
         out.mkdir(parents=True, exist_ok=True)

@@ -68,7 +68,7 @@ def document(run: RecordedRun, frames: list[Frame], subset: str) -> dict[str, An
         })  # fmt: skip
         annos += frame_annotations(frame, image_id, len(annos) + 1)
     return {
-        "info": {"description": f"CataBot run {run.folder.name} ({subset})",
+        "info": {"description": f"CataBot world {run.world.scenario.name} ({subset})",
                  "version": "1", "contributor": "CataBot"},
         "licenses": [],
         "images": images,

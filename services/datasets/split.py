@@ -5,8 +5,10 @@ simulated time, not one by one: a frame-by-frame split would put almost the same
 both sets and make the validation score meaningless. A block is `block_s` long (default: 10 s,
 or a tenth of the frames' time span if that is shorter, so a short run still gives both
 sets). Each block draws u from its own generator, `seeding.rng(seed, "dataset/split/<block>")`
-(DESIGN.md §2), and goes to val when u < `val_fraction`; with two blocks or more neither set
-stays empty (the block with the smallest u goes to val, the largest to train).
+(DESIGN.md §2), and the round(`val_fraction` x blocks) blocks of least u go to val, so the
+share is the one asked for to within a block (each block going to val on its own draw, a
+run of ten blocks gave 40 % and 82 % for 0.2 and 0.5); with two blocks or more neither set
+stays empty.
 """
 
 from __future__ import annotations
@@ -33,11 +35,14 @@ def split(
     length = block_ns(stamps_ns, block_s)
     blocks = [int(s // length) for s in stamps_ns]
     draws = {b: float(seeding.rng(seed, f"dataset/split/{b}").random()) for b in set(blocks)}
-    val = {b for b, u in draws.items() if u < val_fraction}
-    if len(draws) >= 2:
-        ordered = sorted(draws, key=lambda b: (draws[b], b))
-        if not val and val_fraction > 0:
-            val = {ordered[0]}
-        if val == set(draws) and val_fraction < 1:
-            val.discard(ordered[-1])
+    ordered = sorted(draws, key=lambda b: (draws[b], b))
+    val = set(ordered[: _val_blocks(len(ordered), val_fraction)])
     return ["val" if b in val else "train" for b in blocks]
+
+
+def _val_blocks(n: int, fraction: float) -> int:
+    """How many of n blocks go to val: the share asked for, neither set empty when n >= 2."""
+    k = round(fraction * n)
+    if n >= 2 and 0.0 < fraction < 1.0:
+        k = min(max(k, 1), n - 1)
+    return k

@@ -44,7 +44,8 @@ def label_lines(frame: Frame) -> str:
 def data_yaml(out: Path, run: RecordedRun) -> str:
     names = "".join(f"  {i}: {name}\n" for i, name in enumerate(BOX_CLASSES))
     return (
-        f"# CataBot run {run.folder.name}: YOLO detection dataset (Ultralytics layout)\n"
+        f"# CataBot world {run.world.scenario.name}: YOLO detection dataset (Ultralytics "
+        "layout); path: this folder, absolute as Ultralytics wants it (edit it after a move)\n"
         f"path: {out.resolve()}\ntrain: images/train\nval: images/val\n"
         f"nc: {len(BOX_CLASSES)}\nnames:\n{names}"
     )

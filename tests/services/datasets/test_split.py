@@ -12,7 +12,7 @@ def test_the_same_seed_splits_the_same_way_and_another_may_not() -> None:
     first = split(stamps, seed=3, val_fraction=0.2)
     assert first == split(stamps, seed=3, val_fraction=0.2)
     assert any(split(stamps, seed=s, val_fraction=0.2) != first for s in (4, 5, 6))
-    assert 0.05 < first.count("val") / len(first) < 0.45
+    assert first.count("val") / len(first) == 2 / 12  # 12 blocks of 10 s: round(2.4)
 
 
 def test_frames_of_one_block_share_a_set() -> None:
@@ -34,3 +34,14 @@ def test_short_runs_get_blocks_of_a_tenth_of_their_span() -> None:
     assert block_ns([0, 2 * S], None) == S // 5
     assert block_ns([0, 600 * S], None) == 10 * S
     assert block_ns([0, 600 * S], 2.5) == 5 * S // 2
+
+
+def test_the_val_share_is_the_one_asked_for_to_within_a_block() -> None:
+    """Blocks went to val each on its own draw: 20 of 50 frames for 0.2, 41 of 50 for 0.5."""
+    stamps = [k * S // 5 for k in range(50)]  # 10 s at 5 Hz: ten blocks of 1 s
+    for fraction in (0.1, 0.2, 0.5, 0.8):
+        for seed in range(5):
+            subsets = split(stamps, seed=seed, val_fraction=fraction, block_s=1.0)
+            assert subsets.count("val") / len(stamps) == fraction, (fraction, seed)
+            blocks = split(stamps, seed=seed, val_fraction=fraction)  # 11 blocks of 0.98 s
+            assert abs(blocks.count("val") / len(stamps) - fraction) <= 0.1, (fraction, seed)
