@@ -27,6 +27,7 @@ from catabot.bus.messages import (
 
 Check = Callable[[Any], None]
 PATH_MODES = ("loop", "back_and_forth", "release")
+MAX_WAYPOINTS = 1000  # a path widens the traffic's path table for every boat (10^6 stalled it)
 
 
 def body_states(ids: tuple[str, ...]) -> Check:
@@ -84,5 +85,7 @@ def waypoints(msg: WaypointsCmd) -> None:
     pts = msg.points
     if len(pts) < 2 or len(pts) % 2 or not finite(pts):
         raise ValueError("points: need x0, y0, x1, ...: an even number of finite values")
+    if len(pts) > 2 * MAX_WAYPOINTS:
+        raise ValueError(f"{len(pts) // 2} waypoints: at most {MAX_WAYPOINTS} in one path")
     if not (finite((msg.speed, msg.tolerance)) and msg.speed > 0 and msg.tolerance > 0):
         raise ValueError(f"speed {msg.speed} and tolerance {msg.tolerance} must be > 0")

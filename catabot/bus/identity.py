@@ -5,10 +5,12 @@ clock message or a lockstep sample only from the session that owns its name: the
 for ticks and ends, a stream's producer for its samples, a participant for its acks.
 
 - Every CataBot publisher puts with Zenoh `source_info` (its session id and a sequence
-  number); `sender_of(sample)` reads it back. A Zenoh client sets its own source info, and
-  the Python API can only state its own session's id, so a client cannot pose as another
-  session without writing its own Zenoh client; the secure profile (router access control)
-  is what makes identities enforceable against such a client.
+  number); `sender_of(sample)` reads it back. This guards against a buggy client, not a
+  hostile one: a put states whatever source info its sender gives it (zenoh-python takes
+  any `SourceInfo`), and every sample a client receives shows the ids to copy. So on the
+  embedded mesh (loopback by default) a hostile local process can pose as any participant.
+  The secure profile is what makes identities enforceable: TLS, a login per process, and a
+  router whose access control lets each login put only its own keys.
 - Names are bound to zids by a `Roster`: given by `catabot run`, which picks a random zid
   for every process it starts (`--zid`, `--roster`), or learnt from liveliness tokens
   `live/<name>/<zid>` (first binding wins; a second token claiming a bound name is ignored;

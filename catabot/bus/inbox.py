@@ -27,6 +27,8 @@ from catabot.errors import CataBotError
 
 Inputs = Mapping[str, list[Message]]
 MAX_PENDING = 10_000  # samples held while their producer's session is not yet known
+MAX_PENDING_BYTES = 64 * 2**20  # and their bytes: 2,500 junk samples of 1 MB took 3.2 GB
+MAX_FREE_BYTES = 64 * 2**10  # a free-running command (a 1000-point path is 18 KB)
 OPEN = 2**62  # an off interval not closed yet
 
 
@@ -43,6 +45,7 @@ class Inbox:
         self.held: dict[str, list[Message]] = {key: [] for key in self.streams}
         self.dropped: set[str] = set()
         self.pending: list[tuple[str, bytes, str]] = []
+        self._pending_bytes = 0
         # Only clocked streams can be due (physics has ~300 free-running command keys with
         # 100 boats); only keys holding samples need a look at release.
         self._clocked = [s for s in self.streams.values() if s.period is not None]
@@ -60,6 +63,10 @@ class Inbox:
         stream = self.streams.get(key)
         if stream is None:
             raise Rejected("not a stream key", f"{key!r} (a wildcard or another vessel's key)")
+        if stream.period is None and len(payload) > MAX_FREE_BYTES:  # before decoding it
+            raise Rejected(
+                "too large", f"{len(payload)} bytes; a command: {MAX_FREE_BYTES} at most"
+            )
         if stream.period is not None and not self._from_producer(stream, key, payload, sender):
             return  # held until the producer's session is known
         msg = _decoded(payload, stream)
@@ -73,9 +80,11 @@ class Inbox:
     def _from_producer(self, stream: Stream, key: str, payload: bytes, sender: str) -> bool:
         producer = self.roster.zid(stream.producer)
         if producer is None:
-            if len(self.pending) >= MAX_PENDING:
+            full = self._pending_bytes + len(payload) > MAX_PENDING_BYTES
+            if full or len(self.pending) >= MAX_PENDING:
                 raise Rejected("producer unknown", f"{stream.producer} has no session yet")
             self.pending.append((key, payload, sender))
+            self._pending_bytes += len(payload)
             return False
         if sender != producer:
             raise Rejected(
@@ -86,6 +95,7 @@ class Inbox:
     def retry_pending(self, horizon: int) -> list[tuple[str, Rejected]]:
         """Samples held for a producer now known: added, or refused (returned with why)."""
         pending, self.pending, refused = self.pending, [], []
+        self._pending_bytes = 0
         for key, payload, sender in pending:
             try:
                 self.add(key, payload, sender=sender, horizon=horizon)

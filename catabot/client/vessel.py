@@ -12,7 +12,7 @@ from collections.abc import Callable
 from typing import Any
 
 from catabot.bus.clock import Stream
-from catabot.bus.messages import Message, VesselState
+from catabot.bus.messages import Message, VesselState, WaypointsCmd
 from catabot.bus.outputs import Outputs
 from catabot.client.commands import Command, kind_of, message
 from catabot.client.errors import CommandError
@@ -91,5 +91,11 @@ class Vessel:
                 "change the run, and is refused"
             )
         msg: Message = message(command, self.info)
+        if isinstance(msg, WaypointsCmd) and msg.mode != "release":
+            raise CommandError(
+                f"vessel {self.id!r} follows no path from the bus (traffic boats do): send "
+                "Thrust or Twist from your own guidance; Waypoints(mode='release') ends an "
+                "outside order"
+            )
         self.state(self._ready_timeout_s)  # the run is going: every service hears it
         self._outputs.publish(self.info.command_keys[kind], msg)

@@ -54,8 +54,10 @@ class SettingsDesk:
             _reply_err(query, "the settings desk failed on this query (see log/conductor.log)")
             return
         self.answered += 1
+        settings = zenoh.KeyExpr(key).intersects(zenoh.KeyExpr(self.keys.config("settings")))
+        where = self.keys.config("settings" if settings else "set")  # `catabot/**` asked too
         try:
-            query.reply(self.keys.config(key.rsplit("/", 1)[-1]), json.dumps(answer))
+            query.reply(where, json.dumps(answer))
         except zenoh.ZError as exc:  # the asker gave up; nothing to do
             log.warning("could not answer a settings query: %s", exc)
 

@@ -100,7 +100,24 @@ def _commands(world: World, vessel: Body) -> list[Stream]:
 
 def _waypoints(world: World, vessel: Body) -> Stream:
     key = world.keys.cmd_waypoints(vessel.id)
-    return Stream(key, WaypointsCmd, EXTERNAL, None, check=_free(vessel, checks.waypoints))
+    check = checks.waypoints if vessel.kind == "boat" else _release_only(vessel.id)
+    return Stream(key, WaypointsCmd, EXTERNAL, None, check=_free(vessel, check))
+
+
+def _release_only(vessel: str) -> checks.Check:
+    """A scenario vessel takes a release (it ends an outside thrust or twist) but no path:
+    physics follows paths for traffic boats only, and a path sent to the ego was accepted
+    and then silently had no effect."""
+
+    def check(msg: WaypointsCmd) -> None:
+        checks.waypoints(msg)
+        if msg.mode != "release":
+            raise ValueError(
+                f"{vessel!r} is a scenario vessel: it follows no path from the bus (traffic "
+                'boats do); mode "release" hands it back to its script'
+            )
+
+    return check
 
 
 def _free(vessel: Body, check: checks.Check) -> checks.Check:

@@ -16,7 +16,15 @@ from collections.abc import Callable
 from typing import Any
 
 from catabot.bus.inbox import Inputs
-from catabot.bus.messages import BodyStates, End, Message, SettingsChange, Tick, TwistBatch
+from catabot.bus.messages import (
+    BodyStates,
+    End,
+    Message,
+    SettingsChange,
+    Tick,
+    TwistBatch,
+    WaypointsCmd,
+)
 from catabot.bus.settings import changes_of
 from catabot.ros2.convert import Converter
 from catabot.run.service import Built, ServiceContext, run_service
@@ -45,7 +53,7 @@ class Recorder:
             else None
         )
         self.dataset = Dataset(ctx.run_dir / "dataset", world)
-        streams = [*world.streams.lockstep(), *world.streams.commands]
+        streams = [*world.streams.lockstep(), *world.streams.commands, *world.streams.waypoints]
         self.batches = BatchFormatter(convert)
         self.metrics = Metrics(world)
         self.scripts = ScriptedCommands(world)
@@ -95,7 +103,7 @@ class Recorder:
 
     def _write(self, stream: str, msg: Message) -> None:
         try:
-            if self.csv is not None:
+            if self.csv is not None and not isinstance(msg, WaypointsCmd):  # a path: no row
                 self.csv.write(stream, msg)
             if self.mcap is not None:
                 self.mcap.message(stream, msg)

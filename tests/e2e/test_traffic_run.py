@@ -20,6 +20,7 @@ from catabot.config.scenario import ClockConfig
 from catabot.world import rotations
 from catabot.world.terrain import load_terrain
 from catabot.world.world import World
+from services.recorder.mcap_read import read_mcap_messages
 from services.traffic.behaviours import Behaviours
 from services.traffic.service import keep_clear
 from tests.paths import BAY
@@ -86,6 +87,10 @@ def test_external_twist_takes_over_a_boat_and_release_restores_it(
     boat = World.resolve(load_scenario(run / "scenario.json")).traffic.boats[0]
     radius = np.hypot(*(states[-500:, 2:4] - boat.center).T)  # back on its circle
     assert np.abs(radius / boat.radius_m - 1).max() < 0.1, (radius.min(), radius.max())
+    paths = [m for m in read_mcap_messages(run / "run.extra.mcap") if "waypoints" in m.topic]
+    assert [(m.topic, m.decoded["mode"]) for m in paths] == [
+        ("/vessel/boat_000/cmd/waypoints", "release")
+    ]  # recorded like every command (it was not, and changed the boat's path)
 
 
 def test_a_hundred_boats_stay_afloat_in_the_bay(tmp_path: Path, out: Path) -> None:

@@ -5,6 +5,7 @@ from __future__ import annotations
 import pytest
 
 from catabot.bus import codec
+from catabot.bus import inbox as inbox_module
 from catabot.bus.clock import ClockError, Policy, Stream, period_in_ticks, ticks_for
 from catabot.bus.identity import Roster
 from catabot.bus.inbox import Inbox
@@ -267,3 +268,26 @@ def test_inbox_keys() -> None:
 
 
 # -- streams of a scenario ----------------------------------------------------------------
+
+
+def test_a_free_command_over_64_kib_is_refused_before_it_is_decoded() -> None:
+    """An 83 MB map of unknown keys took physics past its deadline decoding it."""
+    inbox = _inbox()
+    with pytest.raises(Rejected, match=r"too large.*70000 bytes; a command: 65536 at most"):
+        inbox.add(CMD, b"\x00" * 70_000)
+    assert inbox.release(0) == {}
+
+
+def test_samples_held_for_an_unknown_producer_are_bounded_in_bytes(
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    """Junk sent on a stack's key before it joined was held whole: 2,500 x 1 MB, 3.2 GB."""
+    monkeypatch.setattr(inbox_module, "MAX_PENDING_BYTES", 3_000_000)
+    inbox = Inbox([Stream(CMD, ThrustCmd, "stack", 10)], roster=Roster(ZIDS))
+    inbox.add(CMD, b"\x00" * 1_000_000, sender="x")
+    inbox.add(CMD, b"\x00" * 1_000_000, sender="x")
+    with pytest.raises(Rejected, match="producer unknown"):
+        inbox.add(CMD, b"\x00" * 1_500_000, sender="x")
+    assert len(inbox.pending) == 2
+    inbox.add(CMD, b"\x00" * 900_000, sender="x")  # what fits is still held
+    assert len(inbox.pending) == 3

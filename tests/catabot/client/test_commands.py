@@ -41,6 +41,7 @@ def test_good_commands_become_their_messages() -> None:
         (Waypoints([(1, 2)], speed=0), "speed 0.0 and tolerance 2.0 must be > 0"),
         (Waypoints([(1, NAN)]), "an even number of finite values"),
         (Waypoints([(1, 2)], mode="zigzag"), "mode 'zigzag' is not one of"),
+        (Waypoints([(k, 0) for k in range(1001)]), "1001 waypoints: at most 1000 in one path"),
     ],
 )
 def test_bad_commands_are_refused_in_the_stack(command: Command, why: str) -> None:
@@ -73,3 +74,18 @@ def test_the_bus_refuses_every_free_command_for_a_vessel_a_controller_drives() -
     other(ThrustCmd((0.5, 0.5)))
     with pytest.raises(ValueError, match="normalised"):
         other(ThrustCmd((1.5, 0.5)))
+
+
+def test_a_path_is_for_traffic_boats_a_scenario_vessel_takes_only_a_release() -> None:
+    """A path sent to the ego was accepted and then silently had no effect."""
+    world = World.resolve(scenario())
+    checks = {s.key: s.check for s in world.streams.waypoints}
+    path = WaypointsCmd((1.0, 2.0, 3.0, 4.0), 1.0, 2.0, "loop")
+    ego_free = checks[world.keys.cmd_waypoints("other")]
+    assert ego_free is not None
+    with pytest.raises(ValueError, match="'other' is a scenario vessel: it follows no path"):
+        ego_free(path)
+    ego_free(WaypointsCmd((), 1.0, 1.0, "release"))
+    boat = checks[world.keys.cmd_waypoints("boat_000")]
+    assert boat is not None
+    boat(path)

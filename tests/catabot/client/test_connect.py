@@ -25,6 +25,7 @@ from catabot.client import (
     Twist,
     UnknownSensor,
     UnknownVessel,
+    Waypoints,
 )
 from catabot.run.world_info import WorldInfoDesk, describe
 from catabot.world.world import World
@@ -127,6 +128,8 @@ def test_a_free_command_waits_for_the_runs_first_tick(served: Served) -> None:
     recorder wrote a thrust that physics never applied): send waits for the vessel's first
     state, up to the client's timeout. Here no physics runs: NoData, nothing sent."""
     with Client.connect([served.endpoint], timeout_s=1.0) as sim:
+        with pytest.raises(CommandError, match="'other' follows no path from the bus"):
+            sim.vessel("other").send(Waypoints([(1.0, 2.0)]))
         started = time.monotonic()
         with pytest.raises(NoData, match="no state of vessel 'other' within 1 s"):
             sim.vessel("other").send(Thrust([0.5, 0.5]))

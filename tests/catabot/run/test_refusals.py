@@ -7,6 +7,7 @@ stack the user starts."""
 from __future__ import annotations
 
 import json
+import re
 import socket
 import subprocess
 import sys
@@ -103,7 +104,7 @@ def test_a_listen_port_in_use_is_refused_before_any_start(
 
 def test_a_run_says_it_waits_for_a_stack_started_outside_it(tmp_path: Path) -> None:
     data = {
-        "name": "waits", "duration_s": 1.0, "clock": {"start_timeout_s": 1.0},
+        "name": "waits", "duration_s": 1.0, "clock": {"start_timeout_s": 4.0},
         "vessels": [{"id": "ego", "controller": {"participant": "stack", "rate_hz": 10.0}}],
     }  # fmt: skip
     path = tmp_path / "waits.json"
@@ -113,5 +114,6 @@ def test_a_run_says_it_waits_for_a_stack_started_outside_it(tmp_path: Path) -> N
         [sys.executable, "-m", "catabot", *argv], capture_output=True, text=True, timeout=120
     )
     assert "waiting for stack to join (started by you, connecting to tcp/" in done.stdout
-    assert "the run gives up after 1 s" in done.stdout
-    assert done.returncode == 1 and "never joined within 1 s: stack" in done.stderr
+    assert "the run gives up after 4 s" in done.stdout
+    assert done.returncode == 1  # under load a service may be late as well: named with it
+    assert re.search(r"never joined within 4 s: (\w+, )*stack\n", done.stderr), done.stderr

@@ -80,3 +80,14 @@ def test_refusals_change_nothing(
     assert not ok and why in error
     assert d.schedule.in_force() == [] and sum(d.rejections.totals.values()) == 1
     assert MAX_QUERY_BYTES < 100_000
+
+
+def test_a_wildcard_query_gets_the_settings_on_their_own_key(
+    desk: tuple[SettingsDesk, zenoh.Session],
+) -> None:
+    """`catabot/**` made the desk reply on `config/**`, which Zenoh refused: no answer."""
+    _, session = desk
+    replies = list(session.get("catabot/**", timeout=2.0))
+    assert len(replies) == 1 and replies[0].ok is not None
+    assert str(replies[0].ok.key_expr) == KEYS.config("settings")
+    assert json.loads(replies[0].ok.payload.to_bytes())["world"] == "desk"
