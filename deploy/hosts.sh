@@ -18,7 +18,11 @@ if [[ $# -gt 0 ]]; then
   fault=${1#--}; victim=$2; after=$3
 fi
 mkdir -p "$out"
-py=${PYTHON:-$(command -v python3)}
+repo_py="$(cd "$(dirname "$0")/.." && pwd)/.venv/bin/python"  # sudo's python3 has no catabot
+py=${PYTHON:-$([[ -x $repo_py ]] && echo "$repo_py" || command -v python3)}
+"$py" -c "import catabot" 2>/dev/null || {
+  echo "$0: $py cannot import catabot: run make setup, or give PYTHON=/path/to/venv/bin/python" >&2
+  exit 2; }
 tag=$$; sw=cbsw$tag; bridge=cbbr$tag
 # The services this scenario runs, as `catabot run` would start them (the world's participants
 # that are CataBot services; an external stack joins through the router like any client).

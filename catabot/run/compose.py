@@ -25,6 +25,7 @@ from typing import Any
 
 from catabot.bus.clock import CONDUCTOR
 from catabot.config.load import BUNDLED, load_scenario
+from catabot.config.ros import RosConfig
 from catabot.config.scenario import Scenario, participants, services
 from catabot.config.sensors import service_of
 from catabot.errors import CataBotError
@@ -38,7 +39,10 @@ REPO = Path(__file__).resolve().parents[2]  # in a checkout, deploy/Dockerfile i
 PORT = 7447
 START_S = 120  # a service's start period: at least the scenario's start timeout
 LINGER_S = 30  # the conductor's container ends once every participant has left (or after this)
-BRIDGE_IMAGE = "eclipse/zenoh-bridge-ros2dds:1.1.0"  # Zenoh 1.x, as our eclipse-zenoh
+# Zenoh 1.10, as our eclipse-zenoh; from 1.5.1 on it reads TRANSIENT_LOCAL history through
+# Zenoh's advanced subscriber, which the gateway's `/tf_static` and `/buoys` publishers serve
+# (1.1.0 asked a publication cache that is not there: a late tf2 node got no static frames).
+BRIDGE_IMAGE = "eclipse/zenoh-bridge-ros2dds:1.10.0"
 VIEWER_PORTS = (9090, 9876)  # the rerun web viewer and its data (gRPC) port
 Service = dict[str, Any]
 
@@ -152,13 +156,21 @@ def _viewer(p: Plan) -> Service:
     return {"profiles": ["viewer"], **svc}
 
 
-def _bridge(p: Plan, domain_id: int) -> Service:
+def _bridge(p: Plan, ros: RosConfig) -> Service:
+    """The bridge with the scenario's domain and namespace (the gateway's keys carry it)."""
+    namespace = ["-n", ros.bridge_namespace] if ros.bridge_namespace != "/" else []
     return {
         "image": BRIDGE_IMAGE,
         "profiles": ["ros2dds"],
         "network_mode": "host",  # DDS discovery is multicast on the host's network
-        "environment": {"ROS_DOMAIN_ID": f"${{ROS_DOMAIN_ID:-{domain_id}}}"},
-        "command": ["-m", "client", "-e", f"tcp/127.0.0.1:${{CATABOT_PORT:-{p.port}}}"],
+        "environment": {"ROS_DOMAIN_ID": f"${{ROS_DOMAIN_ID:-{ros.domain_id}}}"},
+        "command": [
+            "-m",
+            "client",
+            "-e",
+            f"tcp/127.0.0.1:${{CATABOT_PORT:-{p.port}}}",
+            *namespace,
+        ],
         "depends_on": {"router": {"condition": "service_healthy"}},
     }
 
@@ -183,8 +195,8 @@ def document(p: Plan) -> dict[str, Any]:
         command = ["service", program, *shard, "--scenario", p.source, "--run-dir", run_dir]
         svcs[name] = _process(p, name, command, [p.router, *token], runs=True)
     svcs["viewer"] = _viewer(p)
-    if s.ros is not None:
-        svcs["zenoh-bridge-ros2dds"] = _bridge(p, s.ros.domain_id)
+    if s.ros is not None and s.ros.mode != "rmw_zenoh":  # rmw_zenoh nodes read the keys as they are
+        svcs["zenoh-bridge-ros2dds"] = _bridge(p, s.ros)
     external = [n for n in stepping if n not in names]
     doc: dict[str, Any] = {
         "x-catabot": {

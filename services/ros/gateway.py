@@ -172,20 +172,34 @@ class Gateway:
         goes out whatever `ros.clock_hz`: the stack replies to it)."""
         return any(tick.tick % (c.stream.period or 1) == 0 for c in self.controls.values())
 
+    def clocked(self, tick: Tick) -> None:
+        """A lockstep tick: this tick's /clock, then the controlled vessels' commands, each
+        the stack's reply to that /clock. A reply that came before it was sent answers an
+        earlier one: dropped. (Taken at the next controller tick, a late reply to /clock 0
+        raced the reply to /clock 10, and two runs of one stack differed.)"""
+        takes = self.takes_commands(tick)
+        if takes and tick.tick == 0:
+            self._await_stack()  # before the first /clock: a stack to answer it
+        for cmd in self.inbound.take():
+            self._route(cmd)
+        for control in self.controls.values():
+            if takes and tick.tick % (control.stream.period or 1) == 0:
+                control.fresh = None
+        self.tick_clock(tick.tick, tick.stamp_ns, force=takes)
+        self.commands(tick)
+
     def commands(self, tick: Tick | None = None) -> None:
         """Route the commands received so far. At a tick where a vessel this gateway
-        controls takes a command, publish it clocked, waiting (tick > 0) for the ROS
-        stack's reply to this tick's /clock for up to `ros.reply_timeout_s`."""
+        controls takes a command, publish it clocked, waiting for the ROS stack's reply to
+        this tick's /clock for up to `ros.reply_timeout_s`."""
         for cmd in self.inbound.take():
             self._route(cmd)
         if tick is None:
             return
-        if tick.tick == 0 and self.controls:
-            self._await_stack()
         for vessel, control in self.controls.items():
             if tick.tick % (control.stream.period or 1):
                 continue
-            if tick.tick > 0 and control.fresh is None:
+            if control.fresh is None:
                 self._await(vessel, control, tick)
             msg = control.fresh or control.last
             control.last, control.fresh = msg, None

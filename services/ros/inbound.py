@@ -20,6 +20,7 @@ from dataclasses import dataclass
 
 import zenoh
 
+from catabot.bus.keys import ROOT
 from catabot.bus.messages import Message
 from catabot.config.ros import RosConfig
 from catabot.ros2.commands import CommandError, command
@@ -93,7 +94,10 @@ class Inbound:
         ]
 
     def _push(self, sample: zenoh.Sample) -> None:
-        self._samples.put((str(sample.key_expr), sample.payload.to_bytes()))
+        key = str(sample.key_expr)
+        if key.startswith(ROOT + "/"):  # `**/thrust` matches CataBot's own command keys too
+            return
+        self._samples.put((key, sample.payload.to_bytes()))
         self._on_sample()
 
     def take(self) -> list[Command]:

@@ -32,8 +32,7 @@ def build(ctx: ServiceContext) -> Built:
 
         def step(tick: Tick, received: Inputs) -> None:
             gateway.publish(received, clock_from_states=False)
-            gateway.tick_clock(tick.tick, tick.stamp_ns, force=gateway.takes_commands(tick))
-            gateway.commands(tick)
+            gateway.clocked(tick)
 
         return participant, step, _closer(gateway)
     wake = threading.Event()

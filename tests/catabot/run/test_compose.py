@@ -105,6 +105,19 @@ def test_a_ros_scenario_gets_the_gateway_and_the_bridge_profile(tmp_path: Path) 
     assert bridge["profiles"] == ["ros2dds"] and bridge["network_mode"] == "host"
     assert bridge["environment"] == {"ROS_DOMAIN_ID": "${ROS_DOMAIN_ID:-7}"}
     assert bridge["image"].startswith("eclipse/zenoh-bridge-ros2dds:1.")
+    assert "-n" not in bridge["command"]
+
+
+def test_the_bridge_takes_the_scenarios_namespace_and_rmw_zenoh_needs_none(
+    tmp_path: Path,
+) -> None:
+    """The gateway puts on `bot1/...`: a bridge without `-n /bot1` matched no topic."""
+    doc = generate(scenario_file(tmp_path, ros={"bridge_namespace": "/bot1"}), tmp_path / "a.yml")
+    assert doc["services"]["zenoh-bridge-ros2dds"]["command"][-2:] == ["-n", "/bot1"]
+    version = doc["services"]["zenoh-bridge-ros2dds"]["image"].rsplit(":", 1)[1]
+    assert tuple(map(int, version.split("."))) >= (1, 5, 1)  # reads advanced publishers' history
+    doc = generate(scenario_file(tmp_path, ros={"mode": "rmw_zenoh"}), tmp_path / "b.yml")
+    assert "zenoh-bridge-ros2dds" not in doc["services"] and "ros" in doc["services"]
 
 
 def test_a_lockstep_gateway_and_an_external_stack(tmp_path: Path) -> None:

@@ -93,6 +93,12 @@ def test_free_commands_go_to_the_bus_and_bad_ones_are_refused(
         junk = [r for r in caplog.records if "on /ego/cmd_vel" in r.getMessage()]
         assert len(junk) == 1 and "not little-endian CDR" in junk[0].getMessage()
         assert any("nobody/cmd_vel" in r.getMessage() for r in caplog.records)
+        caplog.clear()
+        with caplog.at_level(logging.WARNING, logger="ros.inbound"):
+            ros.put(world.keys.cmd_thrust("ego"), b"\x00")  # CataBot's own key, `**/thrust`
+            time.sleep(0.3)
+            gateway.commands()
+        assert not caplog.records  # not a ROS topic: nothing said, nothing queued
     finally:
         bus.undeclare()
         gateway.close()
