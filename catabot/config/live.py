@@ -112,6 +112,11 @@ def allowed_keys(scenario: Scenario, *, limit: int = 12) -> str:
 def check(scenario: Scenario, key: str, value: Any) -> str:
     """The canonical JSON text of `value` for `key`; SettingError naming what is allowed."""
     spec = spec_of(scenario, key)
+    if spec.kind in NUMBERS and _has_bool(value):  # pydantic's lax floats took true as 1.0
+        raise SettingError(
+            f"{key}: {_short(value)} is not allowed (a number, not true or false); "
+            f"allowed: {spec.allowed}"
+        )
     try:
         checked = _validated(scenario, spec, value)
     except ValidationError as exc:
@@ -139,6 +144,15 @@ def _validated(scenario: Scenario, spec: Spec, value: Any) -> Any:
     if kind in ("enabled", "output"):
         return CameraOutputs.model_validate({"color": value}).color  # a strict bool
     return _Behaviour.model_validate({"behaviour": value}).behaviour
+
+
+NUMBERS = ("rain", "wind.speed_mps", "wind.toward_rad", "current")  # kinds that take numbers
+
+
+def _has_bool(value: Any) -> bool:
+    return isinstance(value, bool) or (
+        isinstance(value, list) and any(isinstance(v, bool) for v in value)
+    )
 
 
 class _Behaviour(Strict):

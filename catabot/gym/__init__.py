@@ -17,20 +17,19 @@ from catabot.gym.options import EnvOptions, EnvOptionsError
 __all__ = ["ActionError", "CataBotEnv", "EnvOptions", "EnvOptionsError"]
 
 ENTRY_POINT = "catabot.gym.env:CataBotEnv"
-MAX_STEPS = 600  # 60 s at 10 Hz
+MAX_STEPS = 600  # 60 s at 10 Hz; the env truncates itself at `max_steps` (no TimeLimit:
+# registered with max_episode_steps, `gym.make(..., max_steps=700)` still ended at 600)
 
 if "CataBot/Navigate-v0" not in gymnasium.registry:
     gymnasium.register(
         "CataBot/Navigate-v0",
         entry_point=ENTRY_POINT,
-        max_episode_steps=MAX_STEPS,
         kwargs={"task": "navigate", "scenario": "navigate", "max_steps": MAX_STEPS},
     )
 if "CataBot/StationKeep-v0" not in gymnasium.registry:
     gymnasium.register(
         "CataBot/StationKeep-v0",
         entry_point=ENTRY_POINT,
-        max_episode_steps=MAX_STEPS,
         kwargs={
             "task": "station_keep",
             "scenario": "harbour",

@@ -73,7 +73,7 @@ def generate(args: argparse.Namespace) -> int:
 def _write(args: argparse.Namespace) -> str | None:
     output = output_file(args.output, flag="--output") if args.output else None
     data = scenario_data(args)
-    World.resolve(parse_scenario(data, source="generate"))  # refuse now what cannot run
+    World.resolve(parse_scenario(data, source="from the flags"))  # refuse what cannot run
     text = json.dumps(data, indent=2) + "\n"
     if output is None:
         sys.stdout.write(text)

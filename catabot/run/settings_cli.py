@@ -22,7 +22,12 @@ from PIL import Image
 from catabot.bus import codec
 from catabot.bus.keys import ROOT, Keys
 from catabot.bus.messages import CameraFrame
-from catabot.bus.session import add_connection_args, connection_from_args, open_session
+from catabot.bus.session import (
+    add_connection_args,
+    check_router,
+    connection_from_args,
+    open_session,
+)
 from catabot.config.live import parse_value
 from catabot.errors import CataBotError
 from catabot.run.answer import answered
@@ -64,7 +69,13 @@ def _json(data: bytes) -> Any:
 def _settings(session: zenoh.Session, world: str | None, timeout: float) -> dict[str, Any]:
     """The settings desk's answer, from `world` or the only simulation that answers."""
     selector = Keys(world).config("settings") if world else f"{ROOT}/*/config/settings"
-    answers = [a for _, a in _ask(session, selector, timeout) if isinstance(a, dict)]
+    limit = time.monotonic() + timeout
+    while True:  # asked again until --timeout: a run just starting has no desk yet
+        left = max(min(limit - time.monotonic(), 2.0), 0.1)
+        answers = [a for _, a in _ask(session, selector, left) if isinstance(a, dict)]
+        if answers or time.monotonic() >= limit:
+            break
+        time.sleep(0.2)
     worlds = sorted({str(a.get("world")) for a in answers})
     if not answers:
         where = f"world {world!r}" if world else "any world"
@@ -79,7 +90,10 @@ def _settings(session: zenoh.Session, world: str | None, timeout: float) -> dict
 
 
 def _session(args: argparse.Namespace) -> zenoh.Session:
-    session = open_session(connection_from_args(args))
+    conn = connection_from_args(args)
+    for endpoint in conn.connect:  # one line, not Zenoh's error from deep inside
+        check_router(endpoint)
+    session = open_session(conn)
     time.sleep(0.3)  # peers meet before the first query (a router answers at once)
     return session
 

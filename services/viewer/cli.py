@@ -19,10 +19,17 @@ import signal
 import sys
 import time
 from pathlib import Path
+from typing import Any
+from urllib.parse import quote
 
 import rerun as rr
 
-from catabot.bus.session import SessionError, add_connection_args, connection_from_args
+from catabot.bus.session import (
+    SessionError,
+    add_connection_args,
+    connection_from_args,
+    free_port,
+)
 from catabot.bus.session import open_session as open_zenoh
 from catabot.config.load import load_scenario
 from catabot.errors import CataBotError
@@ -58,12 +65,27 @@ def recording(world: World, args: argparse.Namespace, *, live: bool) -> rr.Recor
     if args.save:
         rec.save(args.save, default_blueprint=layout)
     elif args.web:
-        grpc = rec.serve_grpc(grpc_port=args.grpc_port or None, default_blueprint=layout)
-        rr.serve_web_viewer(web_port=args.web_port or None, open_browser=False, connect_to=grpc)
-        print(f"rerun web viewer: http://127.0.0.1:{args.web_port or 9090}/?url={grpc}", flush=True)
+        print(f"rerun web viewer: {_serve_web(rec, layout, args)}", flush=True)
     else:
         rec.spawn(default_blueprint=layout)
     return rec
+
+
+def _serve_web(rec: rr.RecordingStream, layout: Any, args: argparse.Namespace) -> str:
+    """Serve the recording and the web viewer on the asked ports, or on free ones (rerun's
+    defaults, 9090 and 9876, clashed with a second viewer: a traceback); the page's URL,
+    its `url` parameter escaped (a bare `+` reads as a space)."""
+    web, grpc_port = args.web_port or free_port(), args.grpc_port or free_port()
+    try:
+        grpc = rec.serve_grpc(grpc_port=grpc_port, default_blueprint=layout)
+        rr.serve_web_viewer(web_port=web, open_browser=False, connect_to=grpc)
+    except RuntimeError as exc:  # rerun's "Failed to create server: Address already in use"
+        raise ViewerPortError(f"--web-port {web} / --grpc-port {grpc_port}: {exc}") from None
+    return f"http://127.0.0.1:{web}/?url={quote(grpc, safe=':/')}"
+
+
+class ViewerPortError(CataBotError, OSError):
+    """The web viewer could not serve on its ports."""
 
 
 def _world(args: argparse.Namespace) -> World:

@@ -8,6 +8,7 @@ run.rrd and export/<format>/ after the lockstep; the other tools are run on its 
 from __future__ import annotations
 
 import json
+import socket
 from collections import Counter
 from pathlib import Path
 from typing import Any
@@ -171,6 +172,8 @@ def test_plot_writes_figures_and_a_report(run: Path, tmp_path: Path) -> None:
         (("dataset", "export", "{run}", "-f", "yolo", "-o", "{run}"), "is not an empty folder"),
         (("dataset", "export", "{nocam}", "-f", "coco", "-o", "{tmp}/o"), "no labelled camera"),
         (("view", "{tmp}"), "not a run folder"),
+        (("view", "{run}", "--save", "{tmp}/no/x.rrd"), "does not exist"),
+        (("view", "{run}", "--web", "--no-hold", "--web-port", "{taken}"), "Address already"),
     ],
 )
 def test_refusals_exit_2_with_one_clear_line(
@@ -183,7 +186,11 @@ def test_refusals_exit_2_with_one_clear_line(
                                          if s["type"] != "camera"]  # fmt: skip
     scenario["recording"]["export"] = []
     (nocam / "scenario.json").write_text(json.dumps(scenario))
-    filled = [a.format(tmp=tmp_path, run=run, nocam=nocam) for a in args]
-    result = catabot(*filled)
+    with socket.socket() as taken:  # a port in use: a second web viewer met rerun's 9090
+        taken.bind(("0.0.0.0", 0))
+        taken.listen()
+        port = taken.getsockname()[1]
+        filled = [a.format(tmp=tmp_path, run=run, nocam=nocam, taken=port) for a in args]
+        result = catabot(*filled)
     assert result.returncode == 2, result.stdout + result.stderr
     assert message in result.stderr and "Traceback" not in result.stderr

@@ -67,6 +67,9 @@ def test_values_are_checked_and_made_canonical(key: str, value: Any, text: str) 
         ("sensor.ego.1.lidar.enabled", "yes", "true or false"),
         ("sensor.ego.1.lidar.enabled", 1, "true or false"),
         ("traffic.boat_000.behaviour", "dance", "'circle', 'waypoints', 'hold'"),
+        ("rain", True, "a number, not true or false"),  # pydantic's lax float took it as 1.0
+        ("wind.speed_mps", False, "a number, not true or false"),
+        ("current", [True, False], "a number, not true or false"),
     ],
 )
 def test_bad_values_name_what_is_allowed(key: str, value: Any, allowed: str) -> None:

@@ -126,3 +126,13 @@ def test_a_run_that_fails_mid_episode_is_a_clear_error_and_reset_recovers(env: g
         env.step(FORWARD)
     obs, _ = env.reset(seed=4)
     assert env.observation_space.contains(obs)
+
+
+def test_max_steps_above_the_default_is_not_cut_by_a_time_limit() -> None:
+    """Registered with max_episode_steps=600, a TimeLimit ended max_steps=700 at 600."""
+    env = gym.make("CataBot/Navigate-v0", max_steps=700)
+    try:
+        assert env.spec is not None and env.spec.max_episode_steps is None
+        assert env.unwrapped.options.max_steps == 700  # type: ignore[attr-defined]
+    finally:
+        env.close()
