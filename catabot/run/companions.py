@@ -11,8 +11,10 @@ started by module name: the library never imports a service.
 
 from __future__ import annotations
 
+import signal
 import subprocess
 import sys
+import threading
 import time
 from dataclasses import dataclass
 from pathlib import Path
@@ -27,6 +29,7 @@ DATASETS = "services.datasets"
 
 
 READY_S = 30.0  # the viewer's start-up (imports, a link to the conductor) before services start
+HOLD_SIGNALS = (signal.SIGTERM, signal.SIGHUP)  # besides Ctrl-C: end a held web viewer
 
 
 @dataclass
@@ -56,13 +59,20 @@ class Viewer:
             ended(self.proc, grace_s=5)
 
     def hold(self) -> None:
-        """Serve the web viewer until Ctrl-C (after the run, so it can still be looked at)."""
+        """Serve the web viewer until Ctrl-C, SIGTERM or SIGHUP (after the run, so it can
+        still be looked at). The viewer is in its own session, so a signal to the launcher
+        does not reach it: the launcher stops it (on SIGTERM it was left serving, orphaned)."""
         print(f"the web viewer stays at {self.url} until Ctrl-C", flush=True)
+        asked = threading.Event()
+        previous = {sig: signal.signal(sig, lambda *_: asked.set()) for sig in HOLD_SIGNALS}
         try:
-            while self.proc.poll() is None:
-                time.sleep(0.5)
+            while self.proc.poll() is None and not asked.wait(0.5):
+                pass
         except KeyboardInterrupt:
             pass
+        finally:
+            for sig, handler in previous.items():
+                signal.signal(sig, handler)
         self.stop(wait_s=0)
 
 
