@@ -12,9 +12,10 @@ formatted here in a few array-wide calls; the bytes are those of the per-message
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
+from numpy.typing import NDArray
 
 from catabot.bus.messages import (
     BodyStates,
@@ -45,6 +46,20 @@ class Block:
     groups: list[tuple[np.ndarray, np.ndarray]]
     tf: bytes | None = None
     family: tuple[str, ...] = ()  # topics whose channels are declared together, in order
+
+
+def without(block: Block, skip: NDArray[np.bool_]) -> Block:
+    """The block less the rows `skip` marks (CSV lines and ROS messages alike)."""
+    if not skip.any():
+        return block
+    keep = np.flatnonzero(~skip)
+    groups = [(rows[~skip[rows]], matrix[~skip[rows]]) for rows, matrix in block.groups]
+    return replace(
+        block,
+        streams=tuple(block.streams[i] for i in keep),
+        lines=[block.lines[i] for i in keep],
+        groups=[(rows, matrix) for rows, matrix in groups if len(rows)],
+    )
 
 
 class BatchFormatter:

@@ -8,10 +8,16 @@ scripted or sent. Stamp: the tick's, as for an external command (the tick physic
 it at). Steps that fall on one tick: the last, the one physics follows. A vessel that a
 command from the bus has taken over no longer follows its script (physics' precedence:
 an outside thrust or twist until a `WaypointsCmd` hands it back, a lockstep controller's
-set-point from then on), so its later steps are not written as if it had obeyed them.
+set-point from then on), so its later steps are not written as if it had obeyed them; nor
+are a traffic boat's set-points while an outside command holds it (`taken`).
 """
 
 from __future__ import annotations
+
+from collections.abc import Sequence
+
+import numpy as np
+from numpy.typing import NDArray
 
 from catabot.bus.messages import Message, ThrustCmd, TwistCmd, WaypointsCmd
 from catabot.config.scenario import ScriptStep
@@ -28,11 +34,10 @@ class ScriptedCommands:
             for step, t_ns in zip(vessel.script, vessel.script_ns, strict=True):
                 tick = -(-t_ns // dt)  # the first tick at or after the step's time
                 self._due.setdefault(tick, {})[vessel.id] = step
-        self._keys = world.keys
-        scripted = [v.id for v in world.vessels if v.script]
-        k = world.keys
-        self._vessel_of = {key(v): v for v in scripted for key in (k.cmd_thrust, k.cmd_twist)}
-        self._vessel_of |= {k.cmd_waypoints(v): v for v in scripted}
+        self._keys = k = world.keys
+        ids = [v.id for v in world.vessels]  # traffic boats too: their set-points yield alike
+        self._vessel_of = {key(v): v for v in ids for key in (k.cmd_thrust, k.cmd_twist)}
+        self._vessel_of |= {k.cmd_waypoints(v): v for v in ids}
         self._taken: set[str] = set()  # by an outside command, until handed back
         self._steered: set[str] = set()  # by a lockstep controller's set-points, for good
 
@@ -47,6 +52,12 @@ class ScriptedCommands:
             self._steered.add(vessel)
         elif isinstance(msg, ThrustCmd | TwistCmd):
             self._taken.add(vessel)
+
+    def taken(self, ids: Sequence[str]) -> NDArray[np.bool_]:
+        """Which of these traffic boats an outside command holds: physics does not follow
+        their set-points, so a batch's rows for them are not written (they were, every
+        guidance tick, while the boat obeyed the outside command)."""
+        return np.fromiter((b in self._taken for b in ids), dtype=bool, count=len(ids))
 
     def due(self, tick: int, stamp_ns: int) -> list[tuple[str, Message]]:
         """(stream, command) of every step that takes effect at `tick`, for the vessels that

@@ -28,7 +28,7 @@ from catabot.bus.messages import (
 from catabot.bus.settings import changes_of
 from catabot.ros2.convert import Converter
 from catabot.run.service import Built, ServiceContext, run_service
-from services.recorder.batches import BatchFormatter, Block
+from services.recorder.batches import BatchFormatter, Block, without
 from services.recorder.csv_sink import CsvSink, RecorderError
 from services.recorder.dataset import Dataset
 from services.recorder.mcap_recording import McapRecording
@@ -76,7 +76,7 @@ class Recorder:
                     if self._write_block(stream, msg, self.batches.states):
                         self.metrics.add(msg)  # only batches of this run's bodies
                 elif isinstance(msg, TwistBatch):
-                    self._write_block(stream, msg, self.batches.twists)
+                    self._write_block(stream, msg, self._twists)
                 else:
                     self.metrics.command(key, msg)  # the thrust in force, for its impulse
                     self.scripts.heard(key, msg)  # a script it overrides is not written
@@ -84,6 +84,10 @@ class Recorder:
         for change in changes_of(tick.settings):  # what took effect at this tick: an input
             record = SettingsChange(tick.tick, tick.stamp_ns, change.key, change.value)
             self._write(self.changes_stream, record)
+
+    def _twists(self, batch: TwistBatch) -> Block:
+        """The set-points of the boats that follow them (not those an outside command holds)."""
+        return without(self.batches.twists(batch), self.scripts.taken(batch.ids))
 
     def _write_block(self, stream: str, msg: Any, formatter: Callable[[Any], Block]) -> bool:
         """A batch as the per-vessel rows it stands for (`batches.py`); False if refused."""

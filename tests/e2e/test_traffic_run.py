@@ -91,6 +91,11 @@ def test_external_twist_takes_over_a_boat_and_release_restores_it(
     assert [(m.topic, m.decoded["mode"]) for m in paths] == [
         ("/vessel/boat_000/cmd/waypoints", "release")
     ]  # recorded like every command (it was not, and changed the boat's path)
+    twists = np.loadtxt(run / "vessel.boat_000.cmd.twist.csv", delimiter=",", skiprows=1)
+    held = twists[(twists[:, 0] >= twists[twists[:, 2] == 2.0, 0].min())
+                  & (twists[:, 0] < paths[0].log_time)]  # fmt: skip
+    assert len(held) and (held[:, 2:] == (2.0, 0.0)).all()  # no set-points it did not follow
+    assert (twists[twists[:, 0] > paths[0].log_time, 2] == 5.0).any()  # its set-points again
 
 
 def test_a_hundred_boats_stay_afloat_in_the_bay(tmp_path: Path, out: Path) -> None:

@@ -40,3 +40,12 @@ def test_a_vessel_taken_over_from_the_bus_is_not_written_as_following_its_script
     scripts.heard(keys.cmd_waypoints("ego"), WaypointsCmd((), 1.0, 1.0, "release"))
     assert scripts.due(5, 50_000_000) == []
     scripts.heard(keys.cmd_thrust("other"), ThrustCmd((0.9, 0.9)))  # no such vessel: ignored
+
+
+def test_a_boat_an_outside_command_holds_is_marked_until_a_path_or_release() -> None:
+    world = World.resolve(parse_scenario({"vessels": [{"id": "ego"}], "traffic": {"count": 3}}))
+    scripts, keys, boats = ScriptedCommands(world), world.keys, world.boat_ids
+    scripts.heard(keys.cmd_twist("boat_001"), TwistCmd(0.0, 0.0))  # tick -1: from outside
+    assert scripts.taken(boats).tolist() == [False, True, False]
+    scripts.heard(keys.cmd_waypoints("boat_001"), WaypointsCmd((), 1.0, 1.0, "release"))
+    assert not scripts.taken(boats).any()
