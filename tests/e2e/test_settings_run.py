@@ -77,7 +77,8 @@ def test_no_simulation_is_a_clear_error(tmp_path: Path) -> None:
     gone = f"tcp/127.0.0.1:{free_port()}"
     refused = catabot("set", "rain", "1", "-e", gone, "--mode", "client", "--timeout", "1")
     assert refused.returncode == 2 and "Traceback" not in refused.stderr
-    assert "cannot open zenoh" in refused.stderr
+    assert f"catabot set: nothing answers at {gone} (Connection refused)" in refused.stderr
+    assert refused.stderr.count("\n") == 1  # one line, not Zenoh's error from orchestrator.rs
     alone = catabot("get", "--world", "nobody", "--timeout", "1")
     assert alone.returncode == 2 and "Traceback" not in alone.stderr
     assert "no running simulation of world 'nobody' answered within 1 s" in alone.stderr
