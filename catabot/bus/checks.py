@@ -89,3 +89,33 @@ def waypoints(msg: WaypointsCmd) -> None:
         raise ValueError(f"{len(pts) // 2} waypoints: at most {MAX_WAYPOINTS} in one path")
     if not (finite((msg.speed, msg.tolerance)) and msg.speed > 0 and msg.tolerance > 0):
         raise ValueError(f"speed {msg.speed} and tolerance {msg.tolerance} must be > 0")
+
+
+def driven(vessel: str, participant: str, command: str, *, kind: str) -> Check:
+    """Every free `kind` command refused for a vessel a lockstep controller drives: whoever
+    sent it would change a run that is to be reproducible (the controller's own key is
+    clocked: only its participant may produce it)."""
+
+    def check(_msg: Any) -> None:
+        raise ValueError(
+            f"vessel {vessel!r} is driven in lockstep by {participant!r} ({command}): a free "
+            f"{kind} would change the run"
+        )
+
+    return check
+
+
+def release_only(vessel: str) -> Check:
+    """A scenario vessel takes a release (it ends an outside thrust or twist) but no path:
+    physics follows paths for traffic boats only, and a path sent to the ego was accepted
+    and then silently had no effect."""
+
+    def check(msg: WaypointsCmd) -> None:
+        waypoints(msg)
+        if msg.mode != "release":
+            raise ValueError(
+                f"{vessel!r} is a scenario vessel: it follows no path from the bus (traffic "
+                'boats do); mode "release" hands it back to its script'
+            )
+
+    return check

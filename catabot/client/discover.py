@@ -10,7 +10,8 @@ from __future__ import annotations
 
 import json
 import time
-from typing import Any
+from collections.abc import Callable, Sized
+from typing import Any, TypeVar
 
 import zenoh
 
@@ -19,6 +20,7 @@ from catabot.client.errors import ClientError, SeveralWorlds, SimulatorNotFound
 from catabot.client.info import WorldInfo, parse
 
 RETRY_S = 0.2
+A = TypeVar("A", bound=Sized)  # a batch of answers: empty when nobody answered
 
 
 def find_world(
@@ -27,20 +29,15 @@ def find_world(
     """The `WorldInfo` of `world` (or of the only world running); `where` names the
     endpoints in the error."""
     selector = Keys(world).world_info() if world else world_infos()
-    limit = time.monotonic() + timeout_s
-    while True:
-        answers = _ask(session, selector, max(min(limit - time.monotonic(), 2.0), 0.1))
-        if answers:
-            break
-        if time.monotonic() >= limit:
-            what = f"world {world!r}" if world else "any world"
-            raise SimulatorNotFound(
-                f"no simulation of {what} answered on {selector} within {timeout_s:g} s "
-                f"({where}); is `catabot run` running, and does it listen where this client "
-                "connects (`catabot run --listen tcp/127.0.0.1:7447`, then connect="
-                '["tcp/127.0.0.1:7447"] or --connect tcp/127.0.0.1:7447)?'
-            )
-        time.sleep(RETRY_S)
+    answers = until_answered(lambda left: _ask(session, selector, left), timeout_s)
+    if not answers:
+        what = f"world {world!r}" if world else "any world"
+        raise SimulatorNotFound(
+            f"no simulation of {what} answered on {selector} within {timeout_s:g} s "
+            f"({where}); is `catabot run` running, and does it listen where this client "
+            "connects (`catabot run --listen tcp/127.0.0.1:7447`, then connect="
+            '["tcp/127.0.0.1:7447"] or --connect tcp/127.0.0.1:7447)?'
+        )
     worlds = sorted(answers)
     if len(worlds) > 1:
         raise SeveralWorlds(
@@ -48,6 +45,17 @@ def find_world(
         )
     key, data = answers[worlds[0]]
     return parse(data, key)
+
+
+def until_answered(ask: Callable[[float], A], timeout_s: float) -> A:
+    """`ask(seconds)` again, each wait at most 2 s, until it answers something or
+    `timeout_s` is over (a run just starting has no queryable yet); its last answer."""
+    limit = time.monotonic() + timeout_s
+    while True:
+        answers = ask(max(min(limit - time.monotonic(), 2.0), 0.1))
+        if answers or time.monotonic() >= limit:
+            return answers
+        time.sleep(RETRY_S)
 
 
 def _ask(session: zenoh.Session, selector: str, timeout_s: float) -> dict[str, tuple[str, Any]]:

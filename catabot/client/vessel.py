@@ -11,6 +11,7 @@ from __future__ import annotations
 from collections.abc import Callable
 from typing import Any
 
+from catabot.bus import checks
 from catabot.bus.clock import Stream
 from catabot.bus.messages import Message, VesselState, WaypointsCmd
 from catabot.bus.outputs import Outputs
@@ -84,18 +85,24 @@ class Vessel:
                 f"{controller.participant!r}: send it with act() after "
                 f"join({controller.participant!r}); a free {kind} on that key would be refused"
             )
-        if controller is not None:
-            raise CommandError(
-                f"vessel {self.id!r} is driven in lockstep by participant "
-                f"{controller.participant!r} ({controller.command}): a free {kind} would "
-                "change the run, and is refused"
-            )
         msg: Message = message(command, self.info)
-        if isinstance(msg, WaypointsCmd) and msg.mode != "release":
-            raise CommandError(
+        # the bus's own rules for a free command (catabot/world/streams.py applies them)
+        if controller is not None:
+            _refused(
+                checks.driven(self.id, controller.participant, controller.command, kind=kind), msg
+            )
+        if isinstance(msg, WaypointsCmd):
+            _refused(checks.release_only(self.id), msg, instead=(
                 f"vessel {self.id!r} follows no path from the bus (traffic boats do): send "
                 "Thrust or Twist from your own guidance; Waypoints(mode='release') ends an "
-                "outside order"
-            )
+                "outside order"))  # fmt: skip
         self.state(self._ready_timeout_s)  # the run is going: every service hears it
         self._outputs.publish(self.info.command_keys[kind], msg)
+
+
+def _refused(check: checks.Check, msg: Message, *, instead: str | None = None) -> None:
+    """`check(msg)`, its refusal a CommandError (saying `instead`, when given)."""
+    try:
+        check(msg)
+    except ValueError as exc:
+        raise CommandError(instead or str(exc)) from None

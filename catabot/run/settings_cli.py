@@ -28,6 +28,7 @@ from catabot.bus.session import (
     connection_from_args,
     open_session,
 )
+from catabot.client.discover import until_answered
 from catabot.config.live import parse_value
 from catabot.errors import CataBotError
 from catabot.run.answer import answered
@@ -69,13 +70,10 @@ def _json(data: bytes) -> Any:
 def _settings(session: zenoh.Session, world: str | None, timeout: float) -> dict[str, Any]:
     """The settings desk's answer, from `world` or the only simulation that answers."""
     selector = Keys(world).config("settings") if world else f"{ROOT}/*/config/settings"
-    limit = time.monotonic() + timeout
-    while True:  # asked again until --timeout: a run just starting has no desk yet
-        left = max(min(limit - time.monotonic(), 2.0), 0.1)
-        answers = [a for _, a in _ask(session, selector, left) if isinstance(a, dict)]
-        if answers or time.monotonic() >= limit:
-            break
-        time.sleep(0.2)
+    answers = until_answered(
+        lambda left: [a for _, a in _ask(session, selector, left) if isinstance(a, dict)],
+        timeout,
+    )
     worlds = sorted({str(a.get("world")) for a in answers})
     if not answers:
         where = f"world {world!r}" if world else "any world"

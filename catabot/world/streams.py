@@ -94,47 +94,20 @@ def _commands(world: World, vessel: Body) -> list[Stream]:
             period = rate_in_ticks(c.rate_hz, world.scenario.dt_ns, where=key)
             out.append(Stream(key, message, c.participant, period, check=check))
         else:
-            out.append(Stream(key, message, EXTERNAL, None, check=_free(vessel, check)))
+            out.append(Stream(key, message, EXTERNAL, None, check=_free(vessel, check, kind)))
     return out
 
 
 def _waypoints(world: World, vessel: Body) -> Stream:
     key = world.keys.cmd_waypoints(vessel.id)
-    check = checks.waypoints if vessel.kind == "boat" else _release_only(vessel.id)
-    return Stream(key, WaypointsCmd, EXTERNAL, None, check=_free(vessel, check))
+    check = checks.waypoints if vessel.kind == "boat" else checks.release_only(vessel.id)
+    return Stream(key, WaypointsCmd, EXTERNAL, None, check=_free(vessel, check, "waypoints"))
 
 
-def _release_only(vessel: str) -> checks.Check:
-    """A scenario vessel takes a release (it ends an outside thrust or twist) but no path:
-    physics follows paths for traffic boats only, and a path sent to the ego was accepted
-    and then silently had no effect."""
-
-    def check(msg: WaypointsCmd) -> None:
-        checks.waypoints(msg)
-        if msg.mode != "release":
-            raise ValueError(
-                f"{vessel!r} is a scenario vessel: it follows no path from the bus (traffic "
-                'boats do); mode "release" hands it back to its script'
-            )
-
-    return check
-
-
-def _free(vessel: Body, check: checks.Check) -> checks.Check:
-    """A free-running command's check; every free command is refused for a vessel driven
-    by a lockstep controller: whoever sent it would change a run that is to be reproducible
-    (the controller's own key is clocked: only its participant may produce it)."""
+def _free(vessel: Body, check: checks.Check, kind: str) -> checks.Check:
+    """A free-running command's check, or `checks.driven` for a vessel a controller drives."""
     c = vessel.controller
-    if c is None:
-        return check
-
-    def refused(_msg: object) -> None:
-        raise ValueError(
-            f"vessel {vessel.id!r} is driven in lockstep by {c.participant!r} ({c.command} "
-            "commands): a free command would change the run"
-        )
-
-    return refused
+    return check if c is None else checks.driven(vessel.id, c.participant, c.command, kind=kind)
 
 
 def _twist_batches(world: World) -> tuple[Stream, ...]:
