@@ -13,8 +13,11 @@ import json
 import os
 import re
 import socket
+import time
+from collections.abc import Callable, Sized
 from dataclasses import dataclass
 from pathlib import Path
+from typing import TypeVar
 
 import zenoh
 
@@ -25,6 +28,8 @@ MODES = ("peer", "client", "router")
 LEASE_MS = 1500
 LOOPBACK = "tcp/127.0.0.1:0"
 RETRY = "{period_init_ms: 250, period_max_ms: 1000, period_increase_factor: 2}"  # connect
+ASK_AGAIN_S = 0.2  # between two queries nobody answered (until_answered)
+A = TypeVar("A", bound=Sized)  # a batch of answers: empty when nobody answered
 BLOCK = zenoh.CongestionControl.BLOCK  # lockstep data and clock messages are never dropped
 
 
@@ -159,6 +164,17 @@ def _address(endpoint: str, host: str, port: int) -> tuple[socket.AddressFamily,
     except socket.gaierror:
         raise SessionError(f"zenoh endpoint {endpoint}: host {host!r} is not known") from None
     return family, (str(addr[0]), int(addr[1]))
+
+
+def until_answered(ask: Callable[[float], A], timeout_s: float) -> A:
+    """`ask(seconds)` again, each wait at most 2 s, until it answers something or
+    `timeout_s` is over (a run just starting has no queryable yet); its last answer."""
+    limit = time.monotonic() + timeout_s
+    while True:
+        answers = ask(max(min(limit - time.monotonic(), 2.0), 0.1))
+        if answers or time.monotonic() >= limit:
+            return answers
+        time.sleep(ASK_AGAIN_S)
 
 
 def open_session(conn: Connection) -> zenoh.Session:

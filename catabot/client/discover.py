@@ -9,18 +9,14 @@ exactly one must answer, or the error lists them.
 from __future__ import annotations
 
 import json
-import time
-from collections.abc import Callable, Sized
-from typing import Any, TypeVar
+from typing import Any
 
 import zenoh
 
 from catabot.bus.keys import KeyNameError, Keys, world_infos
+from catabot.bus.session import until_answered
 from catabot.client.errors import ClientError, SeveralWorlds, SimulatorNotFound
 from catabot.client.info import WorldInfo, parse
-
-RETRY_S = 0.2
-A = TypeVar("A", bound=Sized)  # a batch of answers: empty when nobody answered
 
 
 def find_world(
@@ -45,17 +41,6 @@ def find_world(
         )
     key, data = answers[worlds[0]]
     return parse(data, key)
-
-
-def until_answered(ask: Callable[[float], A], timeout_s: float) -> A:
-    """`ask(seconds)` again, each wait at most 2 s, until it answers something or
-    `timeout_s` is over (a run just starting has no queryable yet); its last answer."""
-    limit = time.monotonic() + timeout_s
-    while True:
-        answers = ask(max(min(limit - time.monotonic(), 2.0), 0.1))
-        if answers or time.monotonic() >= limit:
-            return answers
-        time.sleep(RETRY_S)
 
 
 def _ask(session: zenoh.Session, selector: str, timeout_s: float) -> dict[str, tuple[str, Any]]:

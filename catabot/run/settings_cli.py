@@ -27,8 +27,8 @@ from catabot.bus.session import (
     check_router,
     connection_from_args,
     open_session,
+    until_answered,
 )
-from catabot.client.discover import until_answered
 from catabot.config.live import parse_value
 from catabot.errors import CataBotError
 from catabot.run.answer import answered
