@@ -9,11 +9,20 @@ errors into one line per problem naming the dotted field, the rule and the value
 from __future__ import annotations
 
 import json
-from functools import partial
+from functools import cache, partial
 from pathlib import Path
-from typing import Annotated, Any, get_args
+from types import UnionType
+from typing import Annotated, Any, Union, get_args, get_origin
 
-from pydantic import AfterValidator, BaseModel, ConfigDict, Field, StrictInt, ValidationError
+from pydantic import (
+    AfterValidator,
+    BaseModel,
+    ConfigDict,
+    Field,
+    StrictInt,
+    ValidationError,
+    model_validator,
+)
 from pydantic_core import PydanticCustomError
 
 from catabot.bus.keys import check_name
@@ -52,6 +61,46 @@ class ScenarioError(ConfigError):
 
 class Strict(BaseModel):
     model_config = ConfigDict(extra="forbid", frozen=True, allow_inf_nan=False)
+
+    @model_validator(mode="before")
+    @classmethod
+    def _no_bools_for_numbers(cls, data: Any) -> Any:
+        """pydantic's lax mode reads true as 1: `"rate_mm_h": true` would run in rain."""
+        for name, value in data.items() if isinstance(data, dict) else ():
+            kind = _number_kind(cls, name) if _has_bool(value) else None
+            if kind is not None:
+                many = isinstance(value, list | tuple)
+                a = f"a list of {kind}s" if many else f"a{'n' if kind[0] == 'i' else ''} {kind}"
+                raise FieldProblem(name, f"must be {a}, not true or false")
+        return data
+
+
+def _has_bool(value: Any) -> bool:
+    if isinstance(value, list | tuple):
+        return any(isinstance(v, bool) for v in value)
+    return isinstance(value, bool)
+
+
+@cache
+def _number_kind(model: type[BaseModel], field: str) -> str | None:
+    """'integer' or 'number' when a field takes only those (or lists of them), else None."""
+    if field not in model.model_fields:
+        return None
+    kinds = _leaves(model.model_fields[field].annotation)
+    if not kinds or not kinds <= {int, float}:
+        return None
+    return "integer" if kinds == {int} else "number"
+
+
+def _leaves(annotation: Any) -> set[Any]:
+    """The scalar types an annotation is made of (Annotated, unions, tuples, lists opened)."""
+    origin, args = get_origin(annotation), get_args(annotation)
+    if origin is Annotated:
+        return _leaves(args[0])
+    if origin in (Union, UnionType, tuple, list):
+        kinds = [a for a in args if a not in (type(None), Ellipsis)]
+        return set().union(*(_leaves(a) for a in kinds)) if kinds else {object}
+    return {annotation}
 
 
 class FieldProblem(ValueError):

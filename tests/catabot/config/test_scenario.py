@@ -286,3 +286,28 @@ def test_a_setpoint_delay_that_is_not_a_whole_number_of_ticks(delay: object) -> 
     data = _base()
     data["traffic"] = {"count": 2, "setpoint_delay_ticks": delay}
     assert "traffic.setpoint_delay_ticks:" in _error(data)
+
+
+@pytest.mark.parametrize(
+    ("path", "value", "message"),
+    [
+        (("duration_s",), True, "duration_s: must be a number, not true or false"),
+        (("vessels", 0, "pose"), {"x_m": False}, "pose.x_m: must be a number, not true"),
+        (("traffic",), {"count": True}, "traffic.count: must be an integer, not true"),
+        (("rain",), {"rate_mm_h": True}, "rain.rate_mm_h: must be a number"),
+        (("vessels", 0, "script", 0, "thrust"), [True, 0.5], "thrust: must be a list of numbers"),
+        (
+            ("vessels", 0, "sensors", 0, "params"),
+            {"gyro_sigma": True},
+            "sensors.0.params.gyro_sigma: must be a number, not true or false",
+        ),
+    ],
+)
+def test_true_or_false_is_not_a_number(path: tuple[Any, ...], value: Any, message: str) -> None:
+    """pydantic's lax mode took true as 1.0: a run in 1 mm/h rain nobody asked for."""
+    root = _base()
+    target: Any = root
+    for part in path[:-1]:
+        target = target[part]
+    target[path[-1]] = value
+    assert message in _error(root)

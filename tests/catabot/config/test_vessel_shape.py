@@ -140,3 +140,8 @@ def test_validate_accepts_a_custom_model_with_a_mesh(
     (tmp_path / "hull.obj").write_text("v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n")
     path = _scenario(tmp_path, _with_shape({"mesh": {"file": "hull.obj", "scale": 2.0}}))
     assert main(["scenario", "validate", path]) == 0, capsys.readouterr().err
+
+
+def test_a_model_file_refuses_true_for_a_number() -> None:
+    with pytest.raises(VesselModelError, match=r"'m\.json': mass_kg: must be a number, not true"):
+        parse_vessel_model({**CATABOT, "mass_kg": True}, source="m.json")

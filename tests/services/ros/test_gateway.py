@@ -129,6 +129,51 @@ def test_a_lockstep_controller_takes_the_reply_to_its_tick(sessions: Any) -> Non
         gateway.close()
 
 
+def _path(points: list[tuple[float, float]]) -> bytes:
+    t = ROSBAGS.types
+    header = t["std_msgs/msg/Header"](
+        stamp=t["builtin_interfaces/msg/Time"](sec=0, nanosec=0), frame_id="map"
+    )
+    poses = [
+        t["geometry_msgs/msg/PoseStamped"](
+            header=header,
+            pose=t["geometry_msgs/msg/Pose"](
+                position=t["geometry_msgs/msg/Point"](x=x, y=y, z=0.0),
+                orientation=t["geometry_msgs/msg/Quaternion"](x=0.0, y=0.0, z=0.0, w=1.0),
+            ),
+        )
+        for x, y in points
+    ]
+    msg = t["nav_msgs/msg/Path"](header=header, poses=poses)
+    return bytes(ROSBAGS.serialize_cdr(msg, "nav_msgs/msg/Path"))
+
+
+def test_commands_the_bus_would_refuse_are_refused_here(
+    sessions: Any, caplog: pytest.LogCaptureFixture
+) -> None:
+    ours, ros = sessions
+    data = scenario(mode="bridge")
+    data["vessels"][1]["controller"] = {"participant": "stack", "rate_hz": 10, "command": "thrust"}
+    world = World.resolve(parse_scenario(data))
+    got: list[str] = []
+    bus = ros.declare_subscriber("catabot/**", lambda s: got.append(str(s.key_expr)))
+    gateway = Gateway(world, world.scenario.ros, ours)  # type: ignore[arg-type]
+    try:
+        time.sleep(0.3)  # the wildcard subscribers reach the other session
+        with caplog.at_level(logging.WARNING, logger="ros.inbound"):
+            ros.put("ego/waypoints", _path([(5.0, 5.0)]))  # the ego follows no path
+            ros.put("other/cmd_vel", _twist(1.0))  # driven in lockstep by its thrust
+            ros.put("ego/waypoints", _path([]))  # a release: taken
+            assert _until(lambda: (gateway.commands(), bool(got))[1])
+        assert got == [world.keys.cmd_waypoints("ego")]
+        said = " ".join(r.getMessage() for r in caplog.records)
+        assert "on ego/waypoints: 'ego' is a scenario vessel" in said
+        assert "on other/cmd_vel: vessel 'other' is driven in lockstep by 'stack'" in said
+    finally:
+        bus.undeclare()
+        gateway.close()
+
+
 def test_complaints_come_once_a_second_per_topic(caplog: pytest.LogCaptureFixture) -> None:
     complain = Complaints(period_s=0.2)
     with caplog.at_level(logging.WARNING, logger="ros.inbound"):
