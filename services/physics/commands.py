@@ -5,9 +5,8 @@ from the bus replaces the scripted one from the next tick on and stays until ano
 arrives (the vessel keeps the last order it was given, as a real autopilot does).
 
 Traffic boats: the traffic service's set-points arrive in one lockstep `TwistBatch` per
-tick on `world/cmd/twist`. An external command (tick -1, twist or thrust) outranks them
-and holds the boat until a `WaypointsCmd` arrives for it (release, or a new path that
-the traffic service then steers): external > traffic set-point > script.
+tick on `world/cmd/twist`. Precedence, outside > lockstep set-point > script, is
+catabot/world/orders.py's; the set-points' values live here in arrays, whatever their count.
 """
 
 from __future__ import annotations
@@ -21,8 +20,9 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
-from catabot.bus.messages import Message, ThrustCmd, TwistBatch, TwistCmd, WaypointsCmd
+from catabot.bus.messages import Message, ThrustCmd, TwistBatch, TwistCmd
 from catabot.config.scenario import ScriptStep
+from catabot.world.orders import Orders
 from catabot.world.world import Body
 
 Array = NDArray[np.float64]
@@ -50,15 +50,16 @@ class CommandBook:
         self.scripts = {v.id: v.script for v in vessels}  # in time order
         self.times = {v.id: v.script_ns for v in vessels}
         self.scripted = [v.id for v in vessels if v.script]
-        self.external: dict[str, Order] = {}
+        self.book = Orders()  # who holds each vessel: outside commands, set-points
         self.set_point = np.zeros((len(self.ids), 2))  # (surge m/s, yaw rate rad/s)
         self.has_set_point = np.zeros(len(self.ids), dtype=bool)
         self._batch_rows: dict[tuple[str, ...], NDArray[np.intp]] = {}  # a traffic shard's
 
     def order(self, vessel: str, stamp_ns: int) -> Order:
         """One vessel's order now: external > lockstep set-point > script."""
-        if vessel in self.external:
-            return self.external[vessel]
+        held = self.book.held.get(vessel)
+        if held is not None:
+            return _from_command(held)
         i = self.row[vessel]
         if self.has_set_point[i]:
             surge, rate = self.set_point[i].tolist()
@@ -74,8 +75,8 @@ class CommandBook:
         for vid in self.scripted:
             if not follow[self.row[vid]]:
                 _place(self.order(vid, stamp_ns), self.row[vid], target, follow, thrust)
-        for vid, order in self.external.items():
-            _place(order, self.row[vid], target, follow, thrust)
+        for vid, held in self.book.held.items():
+            _place(_from_command(held), self.row[vid], target, follow, thrust)
         rows = np.flatnonzero(follow)
         return thrust, rows, target[rows]
 
@@ -102,15 +103,10 @@ class CommandBook:
         thruster, a finite twist: catabot/bus/checks.py). A lockstep twist (tick >= 0) is a
         set-point; an outside command (tick -1) takes the vessel over."""
         for msg in msgs:
-            if isinstance(msg, WaypointsCmd):
-                self.external.pop(vessel, None)  # handed back (to traffic or the script)
-            elif isinstance(msg, TwistCmd) and msg.tick >= 0:
+            self.book.heard(vessel, msg)
+            if isinstance(msg, TwistCmd) and msg.tick >= 0:
                 self.set_point[self.row[vessel]] = (msg.surge, msg.yaw_rate)
                 self.has_set_point[self.row[vessel]] = True
-            elif isinstance(msg, ThrustCmd):
-                self.external[vessel] = Order(thrust=msg.thrust)
-            elif isinstance(msg, TwistCmd):
-                self.external[vessel] = Order(twist=(msg.surge, msg.yaw_rate))
 
 
 def _place(
@@ -122,6 +118,12 @@ def _place(
         target[row] = order.twist
     elif order.thrust is not None:
         thrust[row] = order.thrust
+
+
+def _from_command(cmd: ThrustCmd | TwistCmd) -> Order:
+    if isinstance(cmd, ThrustCmd):
+        return Order(thrust=cmd.thrust)
+    return Order(twist=(cmd.surge, cmd.yaw_rate))
 
 
 def _from_step(step: ScriptStep) -> Order:

@@ -21,9 +21,10 @@ from pathlib import Path
 import numpy as np
 
 from catabot.bus.clock import NS_PER_S
-from catabot.bus.messages import BodyStates, Message
+from catabot.bus.messages import BodyStates
 from catabot.config.rates import traffic_record_period
 from catabot.world.hulls import CONTACT_M, boxes_touch, footprints
+from catabot.world.orders import Orders
 from catabot.world.world import World
 from services.recorder.episodes import Episodes
 from services.recorder.fleet_contacts import FleetContacts
@@ -35,7 +36,7 @@ EPISODE_GAP_S = 1.0  # a contact that stops for less than this is the same conta
 
 
 class Metrics:
-    def __init__(self, world: World) -> None:
+    def __init__(self, world: World, orders: Orders) -> None:
         self.ids = [v.id for v in world.vessels]  # the first rows of every batch
         self.body_ids = list(world.body_ids)
         subjects = world.bodies[: len(world.scenario.vessels)]
@@ -68,18 +69,12 @@ class Metrics:
         self.reach_sum = self.reach[:s, None] + self.reach[None, :] + CONTACT_M
         tasks = [v.task for v in world.scenario.vessels]
         self.goals, self.routes = Goals(tasks), Routes(tasks)
-        self.thrust = Thrust(subjects, world.scenario.dt_ns)
+        self.thrust = Thrust(subjects, world.scenario.dt_ns, orders)
         self.seabed = Seabed(world.terrain, subjects) if world.terrain is not None else None
-        keys = world.keys
-        self.command_keys = {keys.cmd_thrust(b.id): b.id for b in subjects}
-        self.command_keys |= {keys.cmd_twist(b.id): b.id for b in subjects}
-        self.command_keys |= {keys.cmd_waypoints(b.id): b.id for b in subjects}
 
-    def command(self, key: str, msg: Message) -> None:
-        """A command the recorder received: the thrust in force from now on (`tasks.Thrust`)."""
-        vessel = self.command_keys.get(key)
-        if vessel is not None:
-            self.thrust.command(vessel, msg)
+    def order_changed(self, vessel: str) -> None:
+        """The thrust in force from now on (`tasks.Thrust`)."""
+        self.thrust.changed(vessel)
 
     def add(self, batch: BodyStates) -> None:
         n, s, stamp = len(self.ids), self.subjects, batch.stamp_ns

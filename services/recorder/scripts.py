@@ -19,52 +19,38 @@ from collections.abc import Sequence
 import numpy as np
 from numpy.typing import NDArray
 
-from catabot.bus.messages import Message, ThrustCmd, TwistCmd, WaypointsCmd
+from catabot.bus.messages import Message, ThrustCmd, TwistCmd
 from catabot.config.scenario import ScriptStep
+from catabot.world.orders import Orders
 from catabot.world.world import World
 
 
 class ScriptedCommands:
     """Every vessel's script steps by the tick they take effect at."""
 
-    def __init__(self, world: World) -> None:
+    def __init__(self, world: World, orders: Orders) -> None:
         dt = world.scenario.dt_ns
         self._due: dict[int, dict[str, ScriptStep]] = {}
         for vessel in world.vessels:
             for step, t_ns in zip(vessel.script, vessel.script_ns, strict=True):
                 tick = -(-t_ns // dt)  # the first tick at or after the step's time
                 self._due.setdefault(tick, {})[vessel.id] = step
-        self._keys = k = world.keys
-        ids = [v.id for v in world.vessels]  # traffic boats too: their set-points yield alike
-        self._vessel_of = {key(v): v for v in ids for key in (k.cmd_thrust, k.cmd_twist)}
-        self._vessel_of |= {k.cmd_waypoints(v): v for v in ids}
-        self._taken: set[str] = set()  # by an outside command, until handed back
-        self._steered: set[str] = set()  # by a lockstep controller's set-points, for good
-
-    def heard(self, key: str, msg: Message) -> None:
-        """A command physics received for a vessel (`key` its absolute key)."""
-        vessel = self._vessel_of.get(key)
-        if vessel is None:
-            return
-        if isinstance(msg, WaypointsCmd):
-            self._taken.discard(vessel)
-        elif isinstance(msg, TwistCmd) and msg.tick >= 0:
-            self._steered.add(vessel)
-        elif isinstance(msg, ThrustCmd | TwistCmd):
-            self._taken.add(vessel)
+        self._keys = world.keys
+        self._orders = orders
 
     def taken(self, ids: Sequence[str]) -> NDArray[np.bool_]:
         """Which of these traffic boats an outside command holds: physics does not follow
         their set-points, so a batch's rows for them are not written (they were, every
         guidance tick, while the boat obeyed the outside command)."""
-        return np.fromiter((b in self._taken for b in ids), dtype=bool, count=len(ids))
+        held = self._orders.held
+        return np.fromiter((b in held for b in ids), dtype=bool, count=len(ids))
 
     def due(self, tick: int, stamp_ns: int) -> list[tuple[str, Message]]:
         """(stream, command) of every step that takes effect at `tick`, for the vessels that
         still follow their script."""
         out: list[tuple[str, Message]] = []
         for vessel, step in self._due.get(tick, {}).items():
-            if vessel in self._taken or vessel in self._steered:
+            if not self._orders.follows_script(vessel):
                 continue
             if step.thrust is not None:
                 key = self._keys.cmd_thrust(vessel)

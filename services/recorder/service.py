@@ -28,6 +28,7 @@ from catabot.bus.messages import (
 from catabot.bus.settings import changes_of
 from catabot.ros2.convert import Converter
 from catabot.run.service import Built, ServiceContext, run_service
+from catabot.world.orders import Orders
 from services.recorder.batches import BatchFormatter, Block, without
 from services.recorder.csv_sink import CsvSink, RecorderError
 from services.recorder.dataset import Dataset
@@ -55,8 +56,15 @@ class Recorder:
         self.dataset = Dataset(ctx.run_dir / "dataset", world)
         streams = [*world.streams.lockstep(), *world.streams.commands, *world.streams.waypoints]
         self.batches = BatchFormatter(convert)
-        self.metrics = Metrics(world)
-        self.scripts = ScriptedCommands(world)
+        self.orders = Orders()  # what physics follows, by its rule: what is written, metered
+        k = self.keys
+        self.commanded = {
+            key(v.id): v.id
+            for v in world.vessels
+            for key in (k.cmd_thrust, k.cmd_twist, k.cmd_waypoints)
+        }  # traffic boats too: their set-points yield alike
+        self.metrics = Metrics(world, self.orders)
+        self.scripts = ScriptedCommands(world, self.orders)
         self.run_dir = ctx.run_dir
         self._flushed_at = 0.0
         self.changes_stream = self.keys.relative(self.keys.config_changes())
@@ -78,12 +86,18 @@ class Recorder:
                 elif isinstance(msg, TwistBatch):
                     self._write_block(stream, msg, self._twists)
                 else:
-                    self.metrics.command(key, msg)  # the thrust in force, for its impulse
-                    self.scripts.heard(key, msg)  # a script it overrides is not written
+                    self._heard(key, msg)
                     self._write(stream, _stamped(msg, tick))
         for change in changes_of(tick.settings):  # what took effect at this tick: an input
             record = SettingsChange(tick.tick, tick.stamp_ns, change.key, change.value)
             self._write(self.changes_stream, record)
+
+    def _heard(self, key: str, msg: Message) -> None:
+        """A command for a vessel: the order physics follows from now on, so an overridden
+        script's steps are not written and the thrust metered is the one in force."""
+        vessel = self.commanded.get(key)
+        if vessel is not None and self.orders.heard(vessel, msg):
+            self.metrics.order_changed(vessel)
 
     def _twists(self, batch: TwistBatch) -> Block:
         """The set-points of the boats that follow them (not those an outside command holds)."""

@@ -19,8 +19,9 @@ import numpy as np
 from numpy.typing import NDArray
 
 from catabot.bus.clock import NS_PER_S
-from catabot.bus.messages import Message, ThrustCmd, TwistCmd, WaypointsCmd
+from catabot.bus.messages import ThrustCmd
 from catabot.config.task import TaskConfig
+from catabot.world.orders import Orders
 from catabot.world.world import Body
 
 Array = NDArray[np.float64]
@@ -101,20 +102,21 @@ class Routes:
 
 class Thrust:
     """The commanded thrust force of each scenario vessel (N, summed over its thrusters), and
-    its integral. Commands change rarely: the force is re-derived only when one arrives or a
-    script step begins, and the integral is added up then, so a tick costs a counter.
-    A command from the bus counts from the tick the recorder receives it (physics applies
-    it from the next: the impulse is exact to within a tick per command)."""
+    its integral. Commands change rarely: the force is re-derived only when the order in
+    force changes (`orders`, physics' rule) or a script step begins, and the integral is
+    added up then, so a tick costs a counter. A command from the bus counts from the tick
+    the recorder receives it (physics applies it from the next: the impulse is exact to
+    within a tick per command)."""
 
-    def __init__(self, bodies: Sequence[Body], dt_ns: int) -> None:
+    def __init__(self, bodies: Sequence[Body], dt_ns: int, orders: Orders) -> None:
         self.dt_s = dt_ns / NS_PER_S
         self.dt_ns = dt_ns
         self.bodies = list(bodies)
+        self.orders = orders
         self.row = {b.id: i for i, b in enumerate(bodies)}
         self.times = [b.script_ns for b in bodies]
         self.events = sorted({t for ts in self.times for t in ts})
         self.next_event = 0
-        self.bus: dict[int, ThrustCmd | TwistCmd] = {}  # an order from the bus outranks a script
         self.force = np.zeros(len(bodies))
         self.known = np.ones(len(bodies), dtype=bool)
         self.impulse = np.zeros(len(bodies))
@@ -124,19 +126,12 @@ class Thrust:
         for i in range(len(bodies)):
             self._resolve(i, -1)
 
-    def command(self, vessel: str, msg: Message) -> None:
-        """A `ThrustCmd` or `TwistCmd` the recorder received for a scenario vessel; a
-        `WaypointsCmd` hands an outside one's vessel back to its script, as in physics."""
+    def changed(self, vessel: str) -> None:
+        """The order in force for `vessel` changed (a command from the bus, or a release)."""
         i = self.row.get(vessel)
-        if i is None or not isinstance(msg, ThrustCmd | TwistCmd | WaypointsCmd):
-            return
-        self._settle()
-        if isinstance(msg, WaypointsCmd):
-            if not (isinstance(self.bus.get(i), TwistCmd) and self.bus[i].tick >= 0):
-                self.bus.pop(i, None)  # a lockstep set-point stays, as physics keeps it
-        else:
-            self.bus[i] = msg
-        self._resolve(i, self.began)
+        if i is not None:
+            self._settle()
+            self._resolve(i, self.began)
 
     def add(self, stamp_ns: int) -> None:
         """The state at `stamp_ns` ends the tick that began at stamp_ns - dt: the orders in
@@ -162,7 +157,7 @@ class Thrust:
             self.pending = 0
 
     def _resolve(self, i: int, began: int) -> None:
-        msg = self.bus.get(i)
+        msg = self.orders.in_force(self.bodies[i].id)
         if isinstance(msg, ThrustCmd):
             self.force[i], self.known[i] = self._newtons(i, msg.thrust), True
             return

@@ -12,6 +12,7 @@ import numpy as np
 from catabot.bus.messages import BodyStates
 from catabot.config.load import parse_scenario
 from catabot.world.hulls import CONTACT_M
+from catabot.world.orders import Orders
 from catabot.world.world import World
 from services.recorder.fleet_contacts import FleetContacts, _near_pairs
 from services.recorder.metrics import Metrics
@@ -83,7 +84,7 @@ def test_metrics_json_lists_the_traffic_collisions(tmp_path: Path) -> None:
     scenario = {"name": "f", "vessels": [{"id": "ego", "pose": {"x_m": 0.0, "y_m": 0.0}}],
                 "traffic": {"count": 2, "behaviour_mix": {"hold": 1.0}}}  # fmt: skip
     world = World.resolve(parse_scenario(scenario))
-    metrics = Metrics(world)
+    metrics = Metrics(world, Orders())
     xy = [(0.0, 0.0), (40.0, 40.0), (40.5, 40.0)]  # the two boats on top of each other
     metrics.add(_batch(0, xy, [0.0] * 3))
     metrics.write(tmp_path / "metrics.json")

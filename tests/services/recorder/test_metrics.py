@@ -10,8 +10,9 @@ from typing import Any
 import numpy as np
 import pytest
 
-from catabot.bus.messages import BodyStates, ThrustCmd, TwistCmd, WaypointsCmd
+from catabot.bus.messages import BodyStates, Message, ThrustCmd, TwistCmd, WaypointsCmd
 from catabot.config.load import parse_scenario
+from catabot.world.orders import Orders
 from catabot.world.world import World
 from services.recorder.metrics import Metrics
 
@@ -45,7 +46,7 @@ def _record(metrics: Metrics, tmp: Path) -> dict[str, Any]:
 
 def test_distance_speed_and_closest_approach(tmp_path: Path) -> None:
     world = _world()
-    metrics = Metrics(world)
+    metrics = Metrics(world, Orders())
     for tick in range(11):
         metrics.add(_states(world, tick, [(0.5 * tick, 0.0), (0.0, 10.0)], speed=0.1 * tick))
     record = _record(metrics, tmp_path)
@@ -66,7 +67,7 @@ def test_goal_time_path_length_and_cross_track(tmp_path: Path) -> None:
         "route": [[0, -1], [20, -1], [20, 20]],
     }
     world = _world(vessels=[{"id": "v0", "pose": {"x_m": 0.0, "y_m": 0.0}, "task": task}])
-    metrics = Metrics(world)
+    metrics = Metrics(world, Orders())
     for tick in range(100):  # 0.1 m a tick along y = 0: 1 m off the route's first leg
         metrics.add(_states(world, tick, [(0.1 * tick, 0.0)]))
     v0 = _record(metrics, tmp_path)["vessels"]["v0"]
@@ -87,7 +88,7 @@ def test_cross_track_of_a_corner_and_an_unreached_goal(tmp_path: Path) -> None:
         "route": [[0, 0], [10, 0], [10, 10]],
     }
     world = _world(vessels=[{"id": "v0", "task": task, "pose": {"x_m": 0.0, "y_m": 0.0}}])
-    metrics = Metrics(world)
+    metrics = Metrics(world, Orders())
     points = [(5.0, 3.0), (13.0, 5.0), (14.0, -3.0)]  # 3 m off each leg, 5 m off the corner
     for tick, p in enumerate(points):
         metrics.add(_states(world, tick, [p]))
@@ -102,7 +103,7 @@ def test_encounter_cpa_and_collision_of_a_head_on_pass(tmp_path: Path) -> None:
     """v1 comes head on at 1 m/tick, 0.5 m to the side: CPA 0.5 m when x meet; the hull
     boxes (1.9 m long) touch from a centre gap of 1.95 m on, and part after they pass."""
     world = _world(recording={"encounter_radius_m": 20.0})
-    metrics = Metrics(world)
+    metrics = Metrics(world, Orders())
     yaw = np.array([0.0, math.pi])
     for tick in range(61):
         metrics.add(_states(world, tick, [(0.0, 0.0), (30.0 - tick, 0.5)], yaw=yaw))
@@ -121,7 +122,7 @@ def test_rotated_hulls_collide_by_their_boxes(tmp_path: Path) -> None:
     """Side by side 1.2 m apart the beams (1.04 m) clear; turned across, the length reaches."""
     world = _world()
     for yaw, touching in ((0.0, False), (math.pi / 2, True)):
-        metrics = Metrics(world)
+        metrics = Metrics(world, Orders())
         metrics.add(_states(world, 0, [(0.0, 0.0), (0.0, 1.2)], yaw=np.array([yaw, 0.0])))
         assert bool(_record(metrics, tmp_path)["collisions"]) is touching
 
@@ -130,7 +131,7 @@ def test_boxes_within_a_centimetre_touch(tmp_path: Path) -> None:
     """Side by side the beams (2 x 0.52 m) leave 5 mm (touching) or 20 mm (apart)."""
     world = _world()
     for y, touching in ((1.045, True), (1.06, False)):
-        metrics = Metrics(world)
+        metrics = Metrics(world, Orders())
         metrics.add(_states(world, 0, [(0.0, 0.0), (0.0, y)]))
         assert bool(_record(metrics, tmp_path)["collisions"]) is touching
 
@@ -138,7 +139,7 @@ def test_boxes_within_a_centimetre_touch(tmp_path: Path) -> None:
 def test_buoys_are_nearest_and_can_be_hit(tmp_path: Path) -> None:
     buoys = [{"id": "far", "x_m": 50.0, "y_m": 0.0}, {"id": "near", "x_m": 5.0, "y_m": 0.0}]
     world = _world(vessels=[{"id": "v0", "pose": {"x_m": 0.0, "y_m": 0.0}}], buoys=buoys)
-    metrics = Metrics(world)
+    metrics = Metrics(world, Orders())
     for tick in range(5):
         metrics.add(_states(world, tick, [(float(tick), 0.0), (50.0, 0.0), (5.0, 0.0)]))
     record = _record(metrics, tmp_path)
@@ -148,16 +149,22 @@ def test_buoys_are_nearest_and_can_be_hit(tmp_path: Path) -> None:
     assert record["collisions"][0]["start_s"] == 0.05  # 1.0 m < 0.95 + 0.22: overlapping
 
 
+def _hear(orders: Orders, metrics: Metrics, msg: Message) -> None:
+    """What the recorder does with a command for v0 (services/recorder/service.py)."""
+    if orders.heard("v0", msg):
+        metrics.order_changed("v0")
+
+
 def test_thrust_impulse_of_script_and_bus_commands(tmp_path: Path) -> None:
     script = [{"t_s": 0.0, "thrust": [0.5, -1.0]}, {"t_s": 0.1, "thrust": [1.0, 1.0]}]
     world = _world(vessels=[{"id": "v0", "script": script, "pose": {"x_m": 0.0, "y_m": 0.0}}])
-    metrics = Metrics(world)
-    key = world.keys.cmd_thrust("v0")
+    orders = Orders()
+    metrics = Metrics(world, orders)
     for tick in range(30):
         if tick == 20:
-            metrics.command(key, ThrustCmd((0.0, 0.0)))
+            _hear(orders, metrics, ThrustCmd((0.0, 0.0)))
         if tick == 25:
-            metrics.command(world.keys.cmd_twist("v0"), TwistCmd(1.0, 0.0))
+            _hear(orders, metrics, TwistCmd(1.0, 0.0))
         metrics.add(_states(world, tick, [(0.0, 0.0)]))
     v0 = _record(metrics, tmp_path)["vessels"]["v0"]
     # 10 ticks at 0.5*36 + 1*28 = 46 N, 10 ticks at 72 N, then nothing; then 5 ticks unknown
@@ -169,13 +176,13 @@ def test_a_path_hands_an_outside_commands_vessel_back_to_its_script(tmp_path: Pa
     """As in physics: an outside thrust outranks the script until a WaypointsCmd."""
     script = [{"t_s": 0.0, "thrust": [1.0, 1.0]}]
     world = _world(vessels=[{"id": "v0", "script": script, "pose": {"x_m": 0.0, "y_m": 0.0}}])
-    metrics = Metrics(world)
+    orders = Orders()
+    metrics = Metrics(world, orders)
     for tick in range(30):
         if tick == 10:
-            metrics.command(world.keys.cmd_thrust("v0"), ThrustCmd((0.0, 0.0)))
+            _hear(orders, metrics, ThrustCmd((0.0, 0.0)))
         if tick == 20:
-            release = WaypointsCmd((), 1.0, 1.0, "release")
-            metrics.command(world.keys.cmd_waypoints("v0"), release)
+            _hear(orders, metrics, WaypointsCmd((), 1.0, 1.0, "release"))
         metrics.add(_states(world, tick, [(0.0, 0.0)]))
     v0 = _record(metrics, tmp_path)["vessels"]["v0"]
     assert v0["thrust_impulse_Ns"] == pytest.approx(0.1 * 72 + 0.1 * 72)  # ticks 0-9, 20-29
@@ -185,7 +192,7 @@ def test_same_states_same_bytes(tmp_path: Path) -> None:
     world = _world(buoys=[{"id": "b", "x_m": 3.0, "y_m": 3.0}])
     outputs = []
     for name in ("a.json", "b.json"):
-        metrics = Metrics(world)
+        metrics = Metrics(world, Orders())
         for tick in range(50):
             metrics.add(
                 _states(world, tick, [(0.1 * tick, 0.0), (5.0 - 0.1 * tick, 1.0), (3.0, 3.0)])
@@ -197,7 +204,7 @@ def test_same_states_same_bytes(tmp_path: Path) -> None:
 
 def test_a_non_finite_batch_is_left_out(tmp_path: Path) -> None:
     world = _world()
-    metrics = Metrics(world)
+    metrics = Metrics(world, Orders())
     metrics.add(_states(world, 0, [(0.0, 0.0), (0.0, 10.0)], speed=1.0))
     metrics.add(_states(world, 1, [(math.nan, 0.0), (0.0, 10.0)], speed=9.0))
     metrics.add(_states(world, 2, [(1.0, 0.0), (0.0, 10.0)], speed=1.0))

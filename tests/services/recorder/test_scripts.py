@@ -4,6 +4,7 @@ from __future__ import annotations
 
 from catabot.bus.messages import ThrustCmd, TwistCmd, WaypointsCmd
 from catabot.config.load import parse_scenario
+from catabot.world.orders import Orders
 from catabot.world.world import World
 from services.recorder.scripts import ScriptedCommands
 
@@ -17,7 +18,7 @@ SCRIPT = [
 
 def test_steps_land_on_the_first_tick_at_or_after_their_time() -> None:
     world = World.resolve(parse_scenario({"vessels": [{"id": "ego", "script": SCRIPT}]}))
-    scripts = ScriptedCommands(world)
+    scripts = ScriptedCommands(world, Orders())
     due = {k: scripts.due(k, k * 10_000_000) for k in range(8)}
     assert due[0] == [("vessel/ego/cmd/thrust", ThrustCmd((0.1, 0.1), 0, 0))]
     assert due[2] == [("vessel/ego/cmd/thrust", ThrustCmd((0.3, 0.3), 2, 20_000_000))]
@@ -26,26 +27,27 @@ def test_steps_land_on_the_first_tick_at_or_after_their_time() -> None:
 
 
 def test_a_vessel_taken_over_from_the_bus_is_not_written_as_following_its_script() -> None:
-    """Physics' precedence (services/physics/commands.py): an outside thrust or twist holds
-    the vessel until a WaypointsCmd hands it back; a lockstep set-point holds it for good."""
+    """Physics' precedence (catabot/world/orders.py): an outside thrust or twist holds the
+    vessel until a WaypointsCmd hands it back; a lockstep set-point holds it for good."""
     world = World.resolve(parse_scenario({"vessels": [{"id": "ego", "script": SCRIPT}]}))
-    scripts, keys = ScriptedCommands(world), world.keys
-    scripts.heard(keys.cmd_thrust("ego"), ThrustCmd((0.9, 0.9)))  # from outside: tick -1
+    orders = Orders()
+    scripts = ScriptedCommands(world, orders)
+    orders.heard("ego", ThrustCmd((0.9, 0.9)))  # from outside: tick -1
     assert scripts.due(2, 20_000_000) == []
-    scripts.heard(keys.cmd_waypoints("ego"), WaypointsCmd((), 1.0, 1.0, "release"))
+    orders.heard("ego", WaypointsCmd((), 1.0, 1.0, "release"))
     assert scripts.due(2, 20_000_000) == [
         ("vessel/ego/cmd/thrust", ThrustCmd((0.3, 0.3), 2, 20_000_000))
     ]
-    scripts.heard(keys.cmd_twist("ego"), TwistCmd(1.0, 0.0, 3, 30_000_000))  # lockstep
-    scripts.heard(keys.cmd_waypoints("ego"), WaypointsCmd((), 1.0, 1.0, "release"))
+    orders.heard("ego", TwistCmd(1.0, 0.0, 3, 30_000_000))  # lockstep
+    orders.heard("ego", WaypointsCmd((), 1.0, 1.0, "release"))
     assert scripts.due(5, 50_000_000) == []
-    scripts.heard(keys.cmd_thrust("other"), ThrustCmd((0.9, 0.9)))  # no such vessel: ignored
 
 
 def test_a_boat_an_outside_command_holds_is_marked_until_a_path_or_release() -> None:
     world = World.resolve(parse_scenario({"vessels": [{"id": "ego"}], "traffic": {"count": 3}}))
-    scripts, keys, boats = ScriptedCommands(world), world.keys, world.boat_ids
-    scripts.heard(keys.cmd_twist("boat_001"), TwistCmd(0.0, 0.0))  # tick -1: from outside
+    orders, boats = Orders(), world.boat_ids
+    scripts = ScriptedCommands(world, orders)
+    orders.heard("boat_001", TwistCmd(0.0, 0.0))  # tick -1: from outside
     assert scripts.taken(boats).tolist() == [False, True, False]
-    scripts.heard(keys.cmd_waypoints("boat_001"), WaypointsCmd((), 1.0, 1.0, "release"))
+    orders.heard("boat_001", WaypointsCmd((), 1.0, 1.0, "release"))
     assert not scripts.taken(boats).any()

@@ -12,6 +12,7 @@ import pytest
 
 from catabot.bus.messages import BodyStates
 from catabot.config.load import parse_scenario
+from catabot.world.orders import Orders
 from catabot.world.terrain import Terrain
 from catabot.world.world import World
 from services.recorder.metrics import Metrics
@@ -137,7 +138,7 @@ def test_pitching_puts_the_bow_on_a_shoal() -> None:
 def test_metrics_report_grounding_episodes_and_shore(tmp_path: Path) -> None:
     terrain = _shore()
     world = _world(terrain, [30.0])
-    metrics = Metrics(world)
+    metrics = Metrics(world, Orders())
     track = [30.0, 35.0, 39.3, 39.5, 39.0, 30.0, 30.0] + [30.0] * 100 + [39.4]
     for tick, x in enumerate(track):
         s = _at(world, x)
