@@ -26,6 +26,7 @@ from dataclasses import dataclass
 from enum import StrEnum
 
 from catabot.ros2 import types
+from catabot.ros2.names import BUOYS, TF_STATIC
 
 
 class Convention(StrEnum):
@@ -45,6 +46,16 @@ class Qos:
     depth: int = 10
     transient_local: bool = False  # /tf_static, /buoys: late subscribers get the last one
     reliable: bool = True
+
+
+DATA = Qos(depth=10)
+LATCHED = Qos(depth=1, transient_local=True)
+LATCHED_TOPICS = frozenset({TF_STATIC, BUOYS})  # sent once, kept for late subscribers
+
+
+def topic_qos(topic: str) -> Qos:
+    """What the gateway offers on `topic` (and what run.mcap says it offered)."""
+    return LATCHED if topic in LATCHED_TOPICS else DATA
 
 
 def bridge_key(topic: str, bridge_namespace: str = "/") -> str:

@@ -2,8 +2,10 @@
 
 `run.mcap` has the `ros2` profile and only CDR channels with `ros2msg` schemas from
 rosbags' Jazzy store (catabot/ros2/types.py), so rosbags' `AnyReader`, `ros2 bag` and
-Foxglove read it as a ROS 2 bag. What has no ROS 2 type (camera boxes and labels, or any
-future message without a conversion) goes to `run.extra.mcap`: JSON with a JSON Schema.
+Foxglove read it as a ROS 2 bag, each channel with the QoS the gateway offers on its topic
+(catabot/ros2/bag.py: `ros2 bag play` offers them again). What has no ROS 2 type (camera
+boxes and labels, or any future message without a conversion) goes to `run.extra.mcap`:
+JSON with a JSON Schema.
 
 Why it is written this way:
 - Chunked and indexed (mcap_writer.py), compressed as `recording.mcap_compression` says, so
@@ -33,7 +35,9 @@ from mcap.well_known import MessageEncoding, SchemaEncoding
 from mcap.writer import LIBRARY_IDENTIFIER
 from numpy.typing import NDArray
 
-from catabot.ros2 import types
+from catabot.ros2 import bag, types
+from catabot.ros2.bag import offered_qos_profiles
+from catabot.ros2.wire import topic_qos
 from services.recorder.csv_sink import DiskError, RecorderError, write_whole
 from services.recorder.mcap_chunks import CHUNK_BYTES
 from services.recorder.mcap_writer import McapWriter
@@ -112,6 +116,8 @@ class McapSink:
             compression=compression,
             chunk_bytes=chunk_bytes,
         )
+        if profile == ROS2:  # what `ros2 bag play` needs to offer the gateway's QoS
+            self._writer.add_metadata(bag.METADATA_NAME, bag.METADATA)
         self._out.flush()  # the file is valid from the first byte on
         self._schemas: dict[str, int] = {}
         self._channels: dict[str, tuple[int, str]] = {}  # topic -> (channel id, schema name)
@@ -179,7 +185,13 @@ class McapSink:
     def _register(self, topic: str, encoding: str, sid: int, name: str) -> tuple[int, str]:
         if self._closed:
             raise RecorderError(f"{topic}: the MCAP sink is closed")
-        chan = (self._writer.register_channel(topic, encoding, sid), name)
+        metadata = {"offered_qos_profiles": offered_qos_profiles(topic_qos(topic))}
+        chan = (
+            self._writer.register_channel(
+                topic, encoding, sid, metadata=metadata if self.profile == ROS2 else {}
+            ),
+            name,
+        )
         self._channels[topic] = chan
         return chan
 

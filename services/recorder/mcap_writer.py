@@ -5,8 +5,8 @@ through a `BytesIO` (~20 us a message), which with 100 boats (an Odometry and a 
 command each, every tick) was most of the recorder's time. Here a tick's messages become
 bytes with one `struct` call each (or one NumPy fill for a block) and go into an open chunk
 (mcap_chunks.py); a full chunk reaches the output compressed, followed by its message
-index records. `finish()` writes the summary: schemas, channels, chunk indexes, statistics
-and their offsets, so readers seek instead of scanning (DESIGN.md §7). Schema and channel
+index records. `finish()` writes the summary: schemas, channels, metadata and chunk indexes,
+statistics and their offsets, so readers seek instead of scanning (DESIGN.md §7). Schema and channel
 records go to the output at once, outside chunks, so they precede every chunk using them.
 Other records are serialised by `mcap.records`; CRCs are computed as `mcap`'s writer does.
 
@@ -29,6 +29,8 @@ from mcap.records import (
     DataEnd,
     Footer,
     Header,
+    Metadata,
+    MetadataIndex,
     Schema,
     Statistics,
     SummaryOffset,
@@ -65,6 +67,7 @@ class McapWriter:
         self._crc = 0
         self._schemas: list[Schema] = []
         self._channels: list[Channel] = []
+        self._metadata: list[MetadataIndex] = []
         self._counts = np.zeros(1, np.int64)  # messages by channel id (ids start at 1)
         self._first = self._last = -1
         self._messages = 0
@@ -77,18 +80,29 @@ class McapWriter:
         self._record(schema)
         return schema.id
 
-    def register_channel(self, topic: str, message_encoding: str, schema_id: int) -> int:
+    def register_channel(
+        self, topic: str, message_encoding: str, schema_id: int, *, metadata: dict[str, str]
+    ) -> int:
         channel = Channel(
             id=len(self._channels) + 1,
             topic=topic,
             message_encoding=message_encoding,
             schema_id=schema_id,
-            metadata={},
+            metadata=metadata,
         )
         self._channels.append(channel)
         self._counts = np.append(self._counts, 0)
         self._record(channel)
         return channel.id
+
+    def add_metadata(self, name: str, metadata: dict[str, str]) -> None:
+        """A Metadata record, indexed in the summary (readers find it there)."""
+        offset = self._stream.tell()
+        builder = RecordBuilder()
+        Metadata(name=name, metadata=metadata).write(builder)
+        data = builder.end()
+        self._write(data)
+        self._metadata.append(MetadataIndex(offset=offset, length=len(data), name=name))
 
     def add_messages(
         self,
@@ -190,6 +204,7 @@ class McapWriter:
         for opcode, records in (
             (Opcode.SCHEMA, self._schemas),
             (Opcode.CHANNEL, self._channels),
+            (Opcode.METADATA_INDEX, self._metadata),
             (Opcode.CHUNK_INDEX, self._chunk_indexes),
             (Opcode.STATISTICS, [self._statistics()]),
         ):
@@ -218,7 +233,7 @@ class McapWriter:
             schema_count=len(self._schemas),
             channel_count=len(self._channels),
             attachment_count=0,
-            metadata_count=0,
+            metadata_count=len(self._metadata),
             chunk_count=len(self._chunk_indexes),
             message_start_time=max(self._first, 0),
             message_end_time=max(self._last, 0),

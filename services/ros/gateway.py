@@ -32,9 +32,10 @@ from catabot.ros2 import types
 from catabot.ros2.convert import Converter
 from catabot.ros2.convert_sensors import Out
 from catabot.ros2.names import CLOCK, TF
+from catabot.ros2.wire import topic_qos
 from catabot.world.world import World
 from services.ros.inbound import Command, Inbound
-from services.ros.wire import LATCHED, Outlet, Wire
+from services.ros.wire import Outlet, Wire
 
 log = logging.getLogger("ros.gateway")
 KINDS = {"twist": "cmd_vel", "thrust": "thrust"}  # controller.command -> ROS command
@@ -96,7 +97,7 @@ class Gateway:
 
     def _latch(self, out: Out) -> Outlet:
         """A topic sent once and kept for late subscribers (/tf_static, /buoys)."""
-        outlet = Outlet(self.wire, out.topic, out.type, LATCHED)
+        outlet = Outlet(self.wire, out.topic, out.type, topic_qos(out.topic))
         outlet.put(out.data)
         return outlet
 

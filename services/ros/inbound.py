@@ -25,9 +25,9 @@ from catabot.bus.messages import Message
 from catabot.config.ros import RosConfig
 from catabot.ros2.commands import CommandError, command
 from catabot.ros2.names import COMMANDS, Names
-from catabot.ros2.wire import Convention
+from catabot.ros2.wire import DATA, Convention
 from catabot.world.world import Body
-from services.ros.wire import DATA, Wire
+from services.ros.wire import Wire
 
 log = logging.getLogger("ros.inbound")
 

@@ -21,6 +21,7 @@ from zenoh.ext import CacheConfig, declare_advanced_publisher
 
 from catabot.config.ros import RosConfig
 from catabot.ros2.wire import (
+    DATA,
     Convention,
     Qos,
     RmwNode,
@@ -31,9 +32,6 @@ from catabot.ros2.wire import (
     gid,
     rmw_key,
 )
-
-DATA = Qos(depth=10)
-LATCHED = Qos(depth=1, transient_local=True)
 
 
 class Wire:

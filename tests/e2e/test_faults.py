@@ -132,7 +132,7 @@ def test_hanging_participant_misses_the_deadline(tmp_path: Path, out: Path) -> N
 
 def test_drop_policy_goes_on_without_the_hanging_participant(tmp_path: Path, out: Path) -> None:
     data = basic_scenario("faults", duration_s=3.0)
-    data["clock"] = {"external_participants": ["autopilot"], "deadline_s": 0.5, "policy": "drop"}
+    data["clock"] = {"external_participants": ["autopilot"], "deadline_s": 2.0, "policy": "drop"}
     code, err = _with_external(scenario_file(tmp_path, data), out, at=50, how="hang")
     assert code == 0, err
     run = only_run_dir(out)

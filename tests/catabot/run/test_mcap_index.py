@@ -20,8 +20,8 @@ def _write(path: Path, *, chunked: bool, messages: int = 50, compression: str = 
         w = Writer(f, use_chunking=chunked, chunk_size=256, compression=kind)
         w.start(profile="", library="test")
         sid = w.register_schema("s", "jsonschema", b"{}")
-        a = w.register_channel("/a", "json", sid)
-        b = w.register_channel("/b", "json", sid)
+        a = w.register_channel("/a", "json", sid, metadata={})
+        b = w.register_channel("/b", "json", sid, metadata={})
         for k in range(messages):
             w.add_message(a, log_time=10 * k, publish_time=10 * k, data=b'{"k":%d}' % k)
             if k % 5 == 0:

@@ -22,8 +22,8 @@ def _write(path: Path, compression: str = "none") -> None:
     with open(path, "wb") as f:
         writer = McapWriter(f, profile="", library="test", compression=compression)
         schema = writer.register_schema("s", "jsonschema", b"{}")
-        a = writer.register_channel("/a", "json", schema)
-        b = writer.register_channel("/b", "json", schema)
+        a = writer.register_channel("/a", "json", schema, metadata={})
+        b = writer.register_channel("/b", "json", schema, metadata={})
         writer.add_messages([a, b], [0, 0], 100, [b'{"x":1}', b'{"y":2}'])
         writer.add_messages([], [], 150, [])  # an empty tick writes nothing
         writer.add_messages([a], [1], 200, [b'{"x":3}'])
@@ -94,8 +94,8 @@ def test_a_block_writes_the_same_bytes_as_one_message_at_a_time(tmp_path: Path) 
         with open(tmp_path / name, "wb") as f:
             writer = McapWriter(f, profile="", library="test")
             schema = writer.register_schema("s", "jsonschema", b"{}")
-            writer.register_channel("/a", "json", schema)
-            writer.register_channel("/b", "json", schema)
+            writer.register_channel("/a", "json", schema, metadata={})
+            writer.register_channel("/b", "json", schema, metadata={})
             add(writer)
             writer.finish()
     assert (tmp_path / "one").read_bytes() == (tmp_path / "block").read_bytes()
@@ -115,8 +115,8 @@ def _many(path: Path, compression: str, chunk_bytes: int, ticks: int = 40) -> No
             f, profile="", library="test", compression=compression, chunk_bytes=chunk_bytes
         )
         schema = writer.register_schema("s", "jsonschema", b"{}")
-        small = [writer.register_channel(t, "json", schema) for t in ("/a", "/b")]
-        big = writer.register_channel("/img", "json", schema)
+        small = [writer.register_channel(t, "json", schema, metadata={}) for t in ("/a", "/b")]
+        big = writer.register_channel("/img", "json", schema, metadata={})
         for tick in range(ticks):
             payloads = [b'{"t":%d}' % tick + b" " * 200] * 2
             writer.add_messages(small, [tick, tick], tick * 10, payloads)
@@ -177,7 +177,7 @@ def test_the_tail_is_the_open_chunks_readable_without_a_summary(tmp_path: Path) 
     out = io.BytesIO()
     writer = McapWriter(out, profile="", library="test", compression="zstd", chunk_bytes=400)
     schema = writer.register_schema("s", "jsonschema", b"{}")
-    chan = writer.register_channel("/a", "json", schema)
+    chan = writer.register_channel("/a", "json", schema, metadata={})
     for tick in range(5):
         writer.add_messages([chan], [tick], tick, [b'{"x":%d}' % tick + b" " * 150])
     (tmp_path / "killed.mcap").write_bytes(out.getvalue() + writer.tail())

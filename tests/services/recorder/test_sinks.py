@@ -10,6 +10,7 @@ from pathlib import Path
 from typing import Any
 
 import pytest
+import yaml
 from mcap.reader import make_reader
 from mcap_ros2.decoder import DecoderFactory
 from rosbags.highlevel import AnyReader
@@ -18,6 +19,7 @@ from rosbags.typesys import Stores, get_typestore
 from catabot.bus.messages import Message, ThrustCmd, TwistCmd, VesselState
 from catabot.ros2 import cdr, cdr_more, types
 from catabot.ros2.convert import thrust
+from catabot.ros2.names import TF_STATIC
 from catabot.run.mcap_index import McapIndex
 from services.recorder.csv_sink import CsvSink, DiskError, RecorderError
 from services.recorder.mcap_read import read_mcap_messages
@@ -261,3 +263,38 @@ def test_a_full_disk_cuts_the_mcap_back_to_its_last_whole_chunk(tmp_path: Path) 
     assert path.stat().st_size == sink._out._size  # cut back to the last whole chunk
     assert [m.log_time for m in left] == finished[: len(left)]
     assert McapIndex(path).channel(ODOM) is not None
+
+
+def test_each_channel_offers_the_gateways_qos_as_every_rosbag2_reads_them(
+    tmp_path: Path,
+) -> None:
+    """Humble's integers, and a `rosbag2` record without serialized metadata, which Jazzy
+    and later take for a version-8 bag (integers): `ros2 bag play` then offers /tf_static
+    TRANSIENT_LOCAL, as the gateway does, so latched subscribers (RViz's) get it."""
+    path = tmp_path / "run.mcap"
+    sink = _record_mcap(path, ticks=1, close=False)
+    sink.write(TF_STATIC, types.TF, b"\x00\x01\x00\x00" + bytes(4), stamp_ns=0)
+    sink.close()
+    with open(path, "rb") as f:
+        reader = make_reader(f, validate_crcs=True)
+        channels = {c.topic: c.metadata for c in reader.get_summary().channels.values()}  # type: ignore[union-attr]
+        records = [(m.name, m.metadata) for m in reader.iter_metadata()]
+    latched = yaml.safe_load(channels[TF_STATIC]["offered_qos_profiles"])
+    data = yaml.safe_load(channels[ODOM]["offered_qos_profiles"])
+    assert latched == [{
+        "history": 1, "depth": 1, "reliability": 1, "durability": 1,
+        "deadline": {"sec": 0, "nsec": 0}, "lifespan": {"sec": 0, "nsec": 0},
+        "liveliness": 1, "liveliness_lease_duration": {"sec": 0, "nsec": 0},
+        "avoid_ros_namespace_conventions": False,
+    }]  # fmt: skip
+    assert (data[0]["durability"], data[0]["depth"], data[0]["reliability"]) == (2, 10, 1)
+    assert records == [("rosbag2", {"ROS_DISTRO": "humble"})]
+    with AnyReader([path], default_typestore=ROSBAGS) as bag:
+        assert {c.topic for c in bag.connections} >= {ODOM, TF_STATIC}
+    extra = McapSink(tmp_path / "run.extra.mcap", profile="")
+    extra.write_json("/labels", "catabot/Labels", {"type": "object"}, b"{}", stamp_ns=0)
+    extra.close()
+    with open(tmp_path / "run.extra.mcap", "rb") as f:
+        reader = make_reader(f)
+        assert [c.metadata for c in reader.get_summary().channels.values()] == [{}]  # type: ignore[union-attr]
+        assert list(reader.iter_metadata()) == []
