@@ -31,11 +31,15 @@ def test_lidar_in_rain_is_recorded_as_point_clouds(tmp_path: Path, out: Path) ->
     assert rows[0] == ["stamp_ns", "tick", "returns", "rain_returns"]
     assert len(rows) == 11 and all(int(r[2]) > 1000 for r in rows[1:])
     assert sum(int(r[3]) for r in rows[1:]) > 0  # 25 mm/h: some returns are raindrops
-    assert (run / "vessel.b1.state.csv").is_file()  # buoys are published and recorded
+    buoy = {r[0] for r in csv_rows(run / "vessel.b1.state.csv")[1:]}  # recorded at 10 Hz
+    assert {r[0] for r in rows[2:]} <= buoy  # each scan after t = 0 joins on stamp_ns
     tf = [m for m in messages if m.topic == "/tf"]
     assert len(tf) == len(rows[1:]) * 10 and tf[0].schema_name == "tf2_msgs/msg/TFMessage"
     frames = [t.child_frame_id for t in tf[0].decoded.transforms]
     assert "ego/base_link" in frames and "b1/base_link" in frames  # buoys only there
-    between = [t.child_frame_id for t in tf[-1].decoded.transforms]  # tick 99
+    between = [t.child_frame_id for t in tf[-2].decoded.transforms]  # tick 98
     assert between == ["ego/base_link"]  # buoys at recording.traffic_rate_hz (10 Hz)
+    last = tf[-1].decoded  # tick 99, stamped 1.0 s: every body, on the LiDAR's grid
+    assert "b1/base_link" in [t.child_frame_id for t in last.transforms]
+    assert (last.transforms[0].header.stamp.sec, last.transforms[0].header.stamp.nanosec) == (1, 0)
     assert "/b1/odom" not in {m.topic for m in messages}
