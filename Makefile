@@ -17,6 +17,7 @@ $(STAMP): pyproject.toml scripts/system-deps.sh
 	bash scripts/system-deps.sh
 	$(PY) -c "from services.sensors.wave_pass import warm_up; warm_up()"  # numba's cache
 	$(PY) -c "from services.physics.kernels import warm_up; warm_up()"
+	$(PY) -c "from services.physics.wet import warm_up; warm_up()"
 	touch $(STAMP)
 
 setup: $(STAMP)

@@ -21,6 +21,7 @@ from pydantic import (
     BeforeValidator,
     Field,
     ValidationError,
+    field_validator,
     model_validator,
 )
 from pydantic.types import FiniteFloat
@@ -121,9 +122,21 @@ class Thruster(Strict):
 
     A command c in [-1, 1] asks for c*max_forward_n (c >= 0) or c*max_reverse_n (c < 0);
     the delivered force follows with a first-order lag of `time_constant_s` (0: none).
+    It pushes only while it is below the water surface (services/physics/wet.py), so
+    `position_m` is below the waterline (z < 0, the body origin being at the waterline).
     """
 
     position_m: Vec3
+
+    @field_validator("position_m")
+    @classmethod
+    def _below_the_waterline(cls, value: tuple[float, float, float]) -> tuple[float, ...]:
+        if value[2] >= 0.0:
+            raise ValueError(
+                f"z = {value[2]:g} m: a thruster pushes only under water; put it below the "
+                "waterline (z < 0)"
+            )
+        return value
     yaw_rad: FiniteFloat = 0.0
     max_forward_n: NonNegativeFloat
     max_reverse_n: NonNegativeFloat

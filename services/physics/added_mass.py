@@ -88,23 +88,40 @@ class AddedMass:
     def active(self) -> bool:
         return self.rows.size > 0
 
-    def wrench(self, rot: Array, nu: Array, current_b: Array, other: Array) -> Array:
+    def wrench(
+        self, rot: Array, nu: Array, current_b: Array, other: Array, *, wet: Array | None = None
+    ) -> Array:
         """tau_A (N, 6), body frame, given every other applied wrench `other` (N, 6).
 
         rot (N, 3, 3) body to world; nu (N, 6) body twist; current_b (N, 3) the current in
         the body frame. `other` excludes gravity, which DART applies and which is added here.
+        `wet` (N,): the share of each body's added mass that acts (None: all of it).
         """
         if self.all_rows:
-            return self._solve(rot[:, 2, :], nu, current_b, other)
+            return self._solve(rot[:, 2, :], nu, current_b, other, wet)
         out = np.zeros((self.count, 6))
         if self.active:
             r = self.rows
-            out[r] = self._solve(rot[r, 2, :], nu[r], current_b[r], other[r])
+            out[r] = self._solve(rot[r, 2, :], nu[r], current_b[r], other[r], wet)
         return out
 
-    def _solve(self, z_b: Array, nu: Array, nu_c: Array, other: Array) -> Array:
+    def _solve(self, z_b: Array, nu: Array, nu_c: Array, other: Array, wet: Array | None) -> Array:
         """tau_A for the chosen rows (kernels.added_mass); z_b is the world up axis in body
         coordinates."""
-        tables = (self.m_rb, self.inverse, self.diag, self.coriolis_diag, self.mass, self.cog)
+        tables = self._tables(None if wet is None else wet[self.rows])
         z_b, nu, nu_c, other = (np.ascontiguousarray(a) for a in (z_b, nu, nu_c, other))
         return kernels.added_mass(tables, z_b, nu, nu_c, other, self.gravity)
+
+    def _tables(self, wet: Array | None) -> tuple[Array, Array, Array, Array, Array, Array]:
+        """The kernel's tables, with M_A scaled by `wet` for the rows out of the water
+        (their augmented inverse solved again: a few bodies, rarely)."""
+        inverse, diag, coriolis = self.inverse, self.diag, self.coriolis_diag
+        dry = np.flatnonzero(wet < 1.0) if wet is not None else np.empty(0, np.intp)
+        if dry.size:
+            assert wet is not None
+            share = wet[dry, None]
+            diag, coriolis, inverse = diag.copy(), coriolis.copy(), inverse.copy()
+            diag[dry] *= share
+            coriolis[dry] *= share
+            inverse[dry] = np.linalg.inv(self.m_rb[dry] + diag[dry, :, None] * np.eye(6))
+        return (self.m_rb, inverse, diag, coriolis, self.mass, self.cog)

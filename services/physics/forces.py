@@ -22,6 +22,7 @@ from services.physics.hydro import Array, Columns, buoyancy_wrench, damping_wren
 from services.physics.loads import EnvironmentLoads
 from services.physics.sea import SeaSampler
 from services.physics.sleep import Sleep
+from services.physics.wet import ThrustLoad, wetness
 
 Rows = NDArray[np.intp]
 OTHER = "wind, moorings and added mass"
@@ -35,11 +36,16 @@ class ForceTables:
     linear: Array  # (N, 6) damping coefficients
     quadratic: Array
     loads: EnvironmentLoads
+    weight_n: Array  # (N,) m g: the buoyancy that floats each body
 
     def take(self, rows: Rows) -> ForceTables:
         """The tables of bodies `rows` (sorted), in that order."""
         return ForceTables(
-            self.columns.take(rows), self.linear[rows], self.quadratic[rows], self.loads.take(rows)
+            self.columns.take(rows),
+            self.linear[rows],
+            self.quadratic[rows],
+            self.loads.take(rows),
+            self.weight_n[rows],
         )
 
 
@@ -84,14 +90,16 @@ def body_wrench(
     tables: ForceTables,
     motion: BodyMotion,
     sea: SeaSampler,
-    thrust: Array,
+    thrust: ThrustLoad,
     *,
     fluid: Fluid,
     time_s: float,
-) -> dict[str, Array]:
+) -> tuple[dict[str, Array], Array | None]:
     """Each load's body-frame wrench (N, 6), Fossen order, about the origin, and their sum
     under "total": buoyancy, damping against the water, thrust, then wind, moorings and
-    added mass (which needs every other load)."""
+    added mass (which needs every other load); and each hull's `wetness` (None: all wet).
+    Damping and added mass act on a hull as far as it is in the water; thrusters push only
+    under water."""
     nu = kernels.body_twist(motion.rot, motion.vel_w)
     current_w = tables.loads.current_world(motion.pos)
     water = sea.sample(motion.pos, time_s)
@@ -99,24 +107,27 @@ def body_wrench(
     if water.velocity_w is not None:  # damping acts on motion relative to the water
         water_w = water_w + water.velocity_w
     current_b = kernels.to_body(motion.rot, np.ascontiguousarray(water_w))
+    buoyancy = buoyancy_wrench(
+        tables.columns,
+        motion.rot,
+        motion.pos,
+        density=fluid.density,
+        gravity=fluid.gravity,
+        time_s=time_s,
+        surface=water.surface,
+    )
+    wet = wetness(buoyancy, motion.rot, tables.weight_n)
+    damping = damping_wrench(nu, tables.linear, tables.quadratic, current_b)
     loads = {
-        "buoyancy": buoyancy_wrench(
-            tables.columns,
-            motion.rot,
-            motion.pos,
-            density=fluid.density,
-            gravity=fluid.gravity,
-            time_s=time_s,
-            surface=water.surface,
-        ),
-        "damping": damping_wrench(nu, tables.linear, tables.quadratic, current_b),
-        "thrust": thrust,
+        "buoyancy": buoyancy,
+        "damping": damping if wet is None else damping * wet[:, None],
+        "thrust": thrust.wrench(motion.rot, motion.pos, water.surface, time_s),
     }
     base = loads["buoyancy"] + loads["damping"] + loads["thrust"]
-    total = tables.loads.total(motion.rot, motion.pos, nu, current_w, base)
+    total = tables.loads.total(motion.rot, motion.pos, nu, current_w, base, wet=wet)
     loads[OTHER] = total - base
     loads["total"] = total
-    return loads
+    return loads, wet
 
 
 def spread(loads: dict[str, Array], rows: Rows, count: int) -> dict[str, Array]:

@@ -103,11 +103,14 @@ class Grounding:
         bx, by = np.clip(cell[:, 0], 0, nbx - 1), np.clip(cell[:, 1], 0, nby - 1)
         return np.flatnonzero(self._block_max[by, bx] > pos[:, 2] - self._radius)
 
-    def generalized_forces(self, rot: Array, pos: Array, vel_w: Array, external: Array) -> Array:
+    def generalized_forces(
+        self, rot: Array, pos: Array, vel_w: Array, external: Array, *, wet: Array | None = None
+    ) -> Array:
         """(N, 6) DART FreeJoint forces [moment about the body origin, force], world frame.
 
         rot (N, 3, 3), pos (N, 3) and vel_w [w, v] (N, 6) are the state at the step's start;
-        external (N, 6) are the other generalized forces of this step (buoyancy, thrust, ...).
+        external (N, 6) are the other generalized forces of this step (buoyancy, thrust, ...);
+        wet (N,) the share of each body's added mass that acted (forces.wetness; None: all).
         """
         out = np.zeros((len(pos), 6))
         self.penetration_m[:] = 0.0
@@ -117,14 +120,15 @@ class Grounding:
         idle[active] = False
         self._touching[idle] = False
         if active.size:
+            share = None if wet is None else wet[active]
             contact, out[active] = self._contact(
-                active, rot[active], pos[active], vel_w[active], external
+                active, rot[active], pos[active], vel_w[active], external, share
             )
             self.force_n[active] = contact[:, 3:]
         return out
 
     def _contact(
-        self, idx: Index, rot: Array, pos: Array, vel: Array, ext: Array
+        self, idx: Index, rot: Array, pos: Array, vel: Array, ext: Array, wet: Array | None
     ) -> tuple[Array, Array]:
         """Generalized contact forces of the vessels `idx` (one implicit step, then clamps):
         the physical one and the one to apply to DART (they differ with added mass)."""
@@ -140,7 +144,7 @@ class Grounding:
         error = stretch - (below * normal[..., 2])[..., None] * normal  # e: into the ground < 0
         f0 = -k[..., None] * error - c[..., None] * _point_velocity(vel, r)
         mass, bias = self._dynamics(idx)
-        m_eff = mass + self._added_mass(idx, rot)
+        m_eff = mass + self._added_mass(idx, rot, wet)
         free = _mul(m_eff, _solve(mass, ext[idx] - bias))  # M_eff times the contact-free accel.
         stiff, damp = _jtj(k, r), _jtj(c, r)
         lhs = m_eff + self._dt * damp + self._dt**2 * stiff
@@ -170,8 +174,9 @@ class Grounding:
         bias = np.array([s.getCoriolisAndGravityForces() for s in skels], dtype=np.float64)
         return mass, bias
 
-    def _added_mass(self, idx: Index, rot: Array) -> Array:
-        """Added mass (A, 6, 6) in DART's coordinates: blockdiag(R A_ang R^T, R A_lin R^T).
+    def _added_mass(self, idx: Index, rot: Array, wet: Array | None) -> Array:
+        """Added mass (A, 6, 6) in DART's coordinates: blockdiag(R A_ang R^T, R A_lin R^T),
+        the share `wet` of it that acted (a hull aground on dry land has none).
 
         The added-mass force (loads.py) is computed from the other loads before contact is
         known, as if the hull would accelerate freely. Contact is therefore solved with the
@@ -179,8 +184,8 @@ class Grounding:
         same acceleration the added-mass force would give had it seen f. Without this a
         grounded hull with a large heave added mass is held up by a phantom added-mass force.
         """
-        r = rot
-        lin, ang = self._added[idx, :3], self._added[idx, 3:]
+        r, added = rot, self._added[idx] if wet is None else self._added[idx] * wet[:, None]
+        lin, ang = added[:, :3], added[:, 3:]
         out = np.zeros((len(idx), 6, 6))
         out[:, :3, :3] = np.einsum("aij,aj,akj->aik", r, ang, r)
         out[:, 3:, 3:] = np.einsum("aij,aj,akj->aik", r, lin, r)

@@ -215,7 +215,3 @@ class ThrusterBank:
         c = self.command
         target = np.where(c >= 0.0, c * self.max_forward_n, c * self.max_reverse_n)
         self.force_n += self.alpha * (target - self.force_n)
-
-    def wrench(self) -> Array:
-        """Body-frame wrench (N, 6) of the delivered thruster forces about the body origin."""
-        return np.einsum("nt,ntk->nk", self.force_n, self.unit_wrench)

@@ -80,11 +80,15 @@ class EnvironmentLoads:
         out[:, :2] = self.current.velocity_at(pos[:, 0], pos[:, 1])
         return out
 
-    def total(self, rot: Array, pos: Array, nu: Array, current_w: Array, base: Array) -> Array:
+    def total(
+        self, rot: Array, pos: Array, nu: Array, current_w: Array, base: Array, *,
+        wet: Array | None = None,
+    ) -> Array:  # fmt: skip
         """base + wind + moorings + added mass, body frame (N, 6).
 
         current_w is `current_world(pos)`: the steady current only (wave orbital velocity is
-        not a uniform current and stays out of the added-mass terms).
+        not a uniform current and stays out of the added-mass terms). `wet`: the added
+        mass's share for each body (forces.wetness; None: all of it).
         """
         total = base
         if self.wind is not None and self.wind_gains is not None:
@@ -97,7 +101,7 @@ class EnvironmentLoads:
             total = total + self._mooring(rot, pos)
         if self.added_mass.active:
             current_b = kernels.to_body(rot, current_w)  # R^T v_c
-            total = total + self.added_mass.wrench(rot, nu, current_b, total)
+            total = total + self.added_mass.wrench(rot, nu, current_b, total, wet=wet)
         return total
 
     def advance(self, dt_s: float) -> None:

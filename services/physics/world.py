@@ -27,7 +27,7 @@ from catabot.config.vessel import VesselModel
 from catabot.world.environment import CurrentField, WindField
 from catabot.world.terrain import Terrain
 from catabot.world.waves import WaveField
-from services.physics import kernels
+from services.physics import kernels, wet
 from services.physics.diverged import check_finite, check_state
 from services.physics.fleet import Fleet, buoy_bodies
 from services.physics.forces import AwakeTables, BodyMotion, Fluid, ForceTables, body_wrench, spread
@@ -37,6 +37,7 @@ from services.physics.loads import EnvironmentLoads
 from services.physics.sea import SeaSampler
 from services.physics.setup_check import check_setup
 from services.physics.sleep import Sleep, plan_radii
+from services.physics.wet import ThrustLoad
 
 StartPose = tuple[float, float, float, float]  # x, y, z (m, map ENU), yaw (rad)
 
@@ -115,7 +116,8 @@ class PhysicsWorld:
         )
         linear = np.array([m.damping.linear for m in models], dtype=np.float64)
         quadratic = np.array([m.damping.quadratic for m in models], dtype=np.float64)
-        self._tables = AwakeTables(ForceTables(columns, linear, quadratic, self._loads))
+        weight = np.array([m.mass_kg for m in models]) * self._g
+        self._tables = AwakeTables(ForceTables(columns, linear, quadratic, self._loads, weight))
         self._sea = SeaSampler(models, columns.bottom_m.transpose(0, 2, 1))
         self._sea.use(waves)  # eta at the columns, orbital velocity at the origins (sea.py)
         # Bottom contact with the terrain (grounding.py); buoyancy knows nothing about it.
@@ -126,7 +128,9 @@ class PhysicsWorld:
         self._read_state()
         self._acc_w = np.zeros((len(models), 6))
         self._last_loads: dict[str, Array] = {}  # this step's loads by kind, for `diverged`
+        self._wet: Array | None = None  # each hull's wetness this step (wet.py)
         kernels.warm_up()  # the compiled force laws load now, not inside the first step
+        wet.warm_up()
 
     # --- public API -----------------------------------------------------------------
 
@@ -215,7 +219,7 @@ class PhysicsWorld:
         generalized = kernels.to_generalized(self._rot, self._body_wrench())
         if self._ground is not None:
             contact = self._ground.generalized_forces(
-                self._rot, self._pos, self._vel_w, generalized
+                self._rot, self._pos, self._vel_w, generalized, wet=self._wet
             )
             generalized += contact
             self._last_loads["terrain contact"] = contact[:, [3, 4, 5, 0, 1, 2]]  # as [F, M]
@@ -294,11 +298,19 @@ class PhysicsWorld:
     def _body_wrench(self) -> Array:
         """Every load on the awake bodies (forces.py), body frame; zero rows for the rest."""
         rows, tables = self._tables.of(self._sleep)
-        motion, thrust = BodyMotion(self._rot, self._pos, self._vel_w), self._thrusters.wrench()
+        motion = BodyMotion(self._rot, self._pos, self._vel_w)
+        bank = self._thrusters
+        thrust = ThrustLoad(bank.force_n, bank.unit_wrench, bank.position_m)
         if rows is not None:
-            motion, thrust = motion.take(rows), thrust[rows]
+            motion, thrust = motion.take(rows), thrust.take(rows)
         fluid = Fluid(self._rho, self._g)
-        loads = body_wrench(tables, motion, self._sea, thrust, fluid=fluid, time_s=self.time_s)
+        loads, share = body_wrench(
+            tables, motion, self._sea, thrust, fluid=fluid, time_s=self.time_s
+        )
+        self._wet = None
+        if share is not None:  # sleeping bodies rest afloat
+            self._wet = np.ones(len(self._ids))
+            self._wet[slice(None) if rows is None else rows] = share
         if rows is not None:
             loads = spread(loads, rows, len(self._ids))
         total = loads.pop("total")

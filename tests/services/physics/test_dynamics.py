@@ -170,6 +170,10 @@ def _bad_model(tmp_path: Path, catabot: VesselModel, edit: dict[str, object]) ->
         ({"damping.linear": [1, 2, 3]}, r"damping\.linear: must be a list of 6 numbers \[X_u"),
         ({"cog_m": [0.0, "x", 0.1]}, r"cog_m\.1: "),
         ({"thrusters.0.max_reverse_n": -3}, r"thrusters\.0\.max_reverse_n: must be >= 0"),
+        (
+            {"thrusters.1.position_m": [-0.9, -0.4, 0.0]},
+            r"thrusters\.1\.position_m: z = 0 m: a thruster pushes only under water",
+        ),
     ],
 )
 def test_bad_vessel_model_names_the_field(

@@ -55,10 +55,11 @@ def monohull() -> VesselModel:
 
 
 def test_first_step_acceleration_is_that_of_rigid_plus_added_mass(catabot: VesselModel) -> None:
-    """In the air without gravity, only thrust acts: DART must give (M_RB + M_A)^-1 tau."""
+    """Under water without gravity (no weight, no buoyancy), only thrust acts: DART must
+    give (M_RB + M_A)^-1 tau."""
     thrusters = [t.model_copy(update={"time_constant_s": 0.0}) for t in catabot.thrusters]
     model = edited(catabot, thrusters=thrusters, added_mass=(150.0, 20.0, 80.0, 10.0, 30.0, 40.0))
-    world = PhysicsWorld([("a", model, (0.0, 0.0, 50.0, 0.0))], dt_s=DT, gravity=0.0)
+    world = PhysicsWorld([("a", model, (0.0, 0.0, -5.0, 0.0))], dt_s=DT, gravity=0.0)
     world.set_thrust("a", [1.0, 0.4])
     world.step()
     f = [36.0, 14.4]

@@ -11,9 +11,10 @@ from catabot.config.vessel import VesselModel, load_vessel_model
 from catabot.world import rotations
 from catabot.world.environment import CurrentField, WindField
 from services.physics.forces import BodyMotion, Fluid, ForceTables, body_wrench
-from services.physics.hydro import build_columns
+from services.physics.hydro import ThrusterBank, build_columns
 from services.physics.loads import EnvironmentLoads
 from services.physics.sea import SeaSampler
+from services.physics.wet import ThrustLoad
 from services.physics.world import PhysicsWorld
 
 FLUID = Fluid(1025.0, 9.81)
@@ -40,7 +41,8 @@ def tables_of(models: list[VesselModel]) -> ForceTables:
     )
     linear = np.array([m.damping.linear for m in models], dtype=np.float64)
     quadratic = np.array([m.damping.quadratic for m in models], dtype=np.float64)
-    return ForceTables(build_columns(models), linear, quadratic, loads)
+    weight = np.array([m.mass_kg for m in models]) * FLUID.gravity
+    return ForceTables(build_columns(models), linear, quadratic, loads, weight)
 
 
 def motion_of(n: int) -> BodyMotion:
@@ -53,11 +55,13 @@ def motion_of(n: int) -> BodyMotion:
 def test_the_awake_rows_get_the_same_wrench_bit_for_bit(models: list[VesselModel]) -> None:
     tables, motion = tables_of(models), motion_of(len(models))
     sea = SeaSampler(models, tables.columns.bottom_m.transpose(0, 2, 1))
-    thrust = np.random.default_rng(3).normal(0.0, 50.0, (len(models), 6))
-    full = body_wrench(tables, motion, sea, thrust, fluid=FLUID, time_s=1.0)
+    bank = ThrusterBank([m.thrusters for m in models], 0.01)
+    bank.force_n[...] = np.random.default_rng(3).normal(0.0, 50.0, bank.force_n.shape)
+    thrust = ThrustLoad(bank.force_n, bank.unit_wrench, bank.position_m)
+    full, _ = body_wrench(tables, motion, sea, thrust, fluid=FLUID, time_s=1.0)
     for rows in (np.array([0, 2, 5]), np.array([1, 3, 4, 6]), np.array([6])):
-        part = body_wrench(
-            tables.take(rows), motion.take(rows), sea, thrust[rows], fluid=FLUID, time_s=1.0
+        part, _ = body_wrench(
+            tables.take(rows), motion.take(rows), sea, thrust.take(rows), fluid=FLUID, time_s=1.0
         )
         for name, wrench in part.items():
             np.testing.assert_array_equal(wrench, full[name][rows], err_msg=name)
