@@ -64,21 +64,35 @@ class Strict(BaseModel):
 
     @model_validator(mode="before")
     @classmethod
-    def _no_bools_for_numbers(cls, data: Any) -> Any:
-        """pydantic's lax mode reads true as 1: `"rate_mm_h": true` would run in rain."""
-        for name, value in data.items() if isinstance(data, dict) else ():
-            kind = _number_kind(cls, name) if _has_bool(value) else None
-            if kind is not None:
-                many = isinstance(value, list | tuple)
-                a = f"a list of {kind}s" if many else f"a{'n' if kind[0] == 'i' else ''} {kind}"
-                raise FieldProblem(name, f"must be {a}, not true or false")
-        return data
+    def _numbers_are_numbers(cls, data: Any) -> Any:
+        """pydantic's lax mode reads true as 1 and "10" as 10: `"rate_mm_h": true` would run
+        in rain, and a schema-driven editor, which says `number`, would disagree with us.
+        Such a value is swapped for a `NotANumber`, which pydantic then refuses where it is
+        (with every other problem of the file, and its list index)."""
+        if not isinstance(data, dict):
+            return data
+        swapped = {k: _swapped(v) if _number_kind(cls, k) else v for k, v in data.items()}
+        return swapped if any(swapped[k] is not data[k] for k in data) else data
 
 
-def _has_bool(value: Any) -> bool:
+class NotANumber:
+    """A true, false or text where a number belongs, shown as the JSON it was."""
+
+    def __init__(self, value: bool | str) -> None:
+        self.value = value
+
+    def __repr__(self) -> str:
+        if isinstance(self.value, bool):
+            return json.dumps(self.value)
+        return f"the text {json.dumps(self.value)}"
+
+
+def _swapped(value: Any) -> Any:
+    """`value`, or a copy, with each true, false or text (in it) as a `NotANumber`."""
     if isinstance(value, list | tuple):
-        return any(isinstance(v, bool) for v in value)
-    return isinstance(value, bool)
+        items = [_swapped(v) for v in value]
+        return items if any(a is not b for a, b in zip(items, value, strict=True)) else value
+    return NotANumber(value) if isinstance(value, bool | str) else value
 
 
 @cache

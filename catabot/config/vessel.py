@@ -137,6 +137,7 @@ class Thruster(Strict):
                 "waterline (z < 0)"
             )
         return value
+
     yaw_rad: FiniteFloat = 0.0
     max_forward_n: NonNegativeFloat
     max_reverse_n: NonNegativeFloat

@@ -121,7 +121,7 @@ def body_wrench(
     loads = {
         "buoyancy": buoyancy,
         "damping": damping if wet is None else damping * wet[:, None],
-        "thrust": thrust.wrench(motion.rot, motion.pos, water.surface, time_s),
+        "thrust": thrust.wrench(motion.rot, motion.pos, water.at_points, time_s),
     }
     base = loads["buoyancy"] + loads["damping"] + loads["thrust"]
     total = tables.loads.total(motion.rot, motion.pos, nu, current_w, base, wet=wet)

@@ -35,7 +35,8 @@ class SeaSample:
     current alone, bit for bit as without waves) and the surface at the columns."""
 
     velocity_w: Array | None
-    surface: WaterHeight
+    surface: WaterHeight  # at the buoyancy columns (the layout the method was chosen for)
+    at_points: WaterHeight = water_height  # anywhere: the exact sum (a few thruster points)
 
 
 class SeaSampler:
@@ -82,7 +83,7 @@ class SeaSampler:
             return SeaSample(None, water_height)
         if self._order is None:
             velocity = waves.velocity(pos[:, 0], pos[:, 1], pos[:, 2], time_s)
-            return SeaSample(velocity, self._surface)
+            return SeaSample(velocity, self._surface, waves.height)
         phase = waves.phases(pos[:, 0], pos[:, 1], time_s)
         m = phase.shape[1]
         trig = np.empty((len(phase), 2 * m), np.float32)  # [cos | sin]: one matmul below
@@ -91,7 +92,7 @@ class SeaSampler:
         velocity = waves.orbital(cos, sin, pos[:, 2])
         order = self._order
         grid = grid.reshape(len(phase), order + 1, order + 1)
-        return SeaSample(velocity, _Expansions(grid, self._row, self._pq, pos))
+        return SeaSample(velocity, _Expansions(grid, self._row, self._pq, pos), waves.height)
 
 
 class _Expansions:

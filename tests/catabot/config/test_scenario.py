@@ -291,20 +291,24 @@ def test_a_setpoint_delay_that_is_not_a_whole_number_of_ticks(delay: object) -> 
 @pytest.mark.parametrize(
     ("path", "value", "message"),
     [
-        (("duration_s",), True, "duration_s: must be a number, not true or false"),
-        (("vessels", 0, "pose"), {"x_m": False}, "pose.x_m: must be a number, not true"),
-        (("traffic",), {"count": True}, "traffic.count: must be an integer, not true"),
-        (("rain",), {"rate_mm_h": True}, "rain.rate_mm_h: must be a number"),
-        (("vessels", 0, "script", 0, "thrust"), [True, 0.5], "thrust: must be a list of numbers"),
+        (("duration_s",), True, "duration_s: must be a number (got true)"),
+        (("vessels", 0, "pose"), {"x_m": False}, "pose.x_m: must be a number (got false)"),
+        (("traffic",), {"count": True}, "traffic.count: must be an integer (got true)"),
+        (("rain",), {"rate_mm_h": True}, "rain.rate_mm_h: must be a number (got true)"),
+        (("vessels", 0, "script", 0, "thrust"), [0.5, True], "thrust.1: must be a number"),
+        (("wind",), {"speed_mps": "10"}, 'wind.speed_mps: must be a number (got the text "10")'),
         (
             ("vessels", 0, "sensors", 0, "params"),
             {"gyro_sigma": True},
-            "sensors.0.params.gyro_sigma: must be a number, not true or false",
+            "sensors.0.params.gyro_sigma: must be a number (got true)",
         ),
     ],
 )
-def test_true_or_false_is_not_a_number(path: tuple[Any, ...], value: Any, message: str) -> None:
-    """pydantic's lax mode took true as 1.0: a run in 1 mm/h rain nobody asked for."""
+def test_true_false_or_text_is_not_a_number(
+    path: tuple[Any, ...], value: Any, message: str
+) -> None:
+    """pydantic's lax mode took true as 1.0 (a run in 1 mm/h rain nobody asked for) and "10"
+    as 10, where the JSON Schema an editor checks against says `number`."""
     root = _base()
     target: Any = root
     for part in path[:-1]:

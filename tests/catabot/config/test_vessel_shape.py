@@ -143,5 +143,7 @@ def test_validate_accepts_a_custom_model_with_a_mesh(
 
 
 def test_a_model_file_refuses_true_for_a_number() -> None:
-    with pytest.raises(VesselModelError, match=r"'m\.json': mass_kg: must be a number, not true"):
+    with pytest.raises(
+        VesselModelError, match=r"'m\.json': mass_kg: must be a number \(got true\)"
+    ):
         parse_vessel_model({**CATABOT, "mass_kg": True}, source="m.json")

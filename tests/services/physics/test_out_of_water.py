@@ -8,7 +8,9 @@ import numpy as np
 import pytest
 
 from catabot.config.vessel import VesselModel, load_vessel_model
+from catabot.config.waves import WaveConfig
 from catabot.world import rotations
+from catabot.world.waves import WaveField
 from services.physics.world import PhysicsWorld
 
 DT, G = 0.01, 9.81
@@ -64,3 +66,28 @@ def test_a_capsized_boat_whose_propellers_are_in_the_air_does_not_drive(
     assert abs(s.position[0]) < 0.05, s.position  # upright, it would have gone ~8 m
     rot = rotations.matrices(np.asarray([s.orientation]))[0]
     assert (s.position + rot @ catabot.thrusters[0].position_m)[2] > 0.0  # in the air indeed
+
+
+@pytest.mark.parametrize(
+    ("sea", "method"),
+    [
+        (WaveConfig(preset="medium"), "vessel expansions"),
+        (
+            WaveConfig(significant_height_m=0.3, peak_period_s=4.0, direction_rad=1.2),
+            "hull patches",
+        ),
+    ],
+)
+def test_in_waves_the_propellers_meet_the_surface_above_them(
+    catabot: VesselModel, sea: WaveConfig, method: str
+) -> None:
+    """Every method of sampling the sea (sea.py) answers for the thrusters too (the exact
+    sum at their points: the harbour's chop, on hull patches, crashed physics at tick 0)."""
+    vessels = [(n, load_vessel_model(n), (20.0 * i, 0.0, 0.0, 0.0))
+               for i, n in enumerate(("catabot", "monohull", "wamv"))]  # fmt: skip
+    world = PhysicsWorld(vessels, dt_s=DT, waves=WaveField(sea, seed=1))
+    assert world._sea.method.startswith(method)
+    world.set_thrusts(np.arange(3), np.ones((3, 2)))
+    for _ in range(300):
+        world.step()
+    assert (world.state_arrays().linear_velocity[:, 0] > 0.5).all()
