@@ -53,6 +53,7 @@ def _check(index: int, vid: str, pose: Pose, model: VesselModel, terrain: Terrai
             draft_m=keel_depth_m(model),
             footprint_m=footprint_m(model),
             clearance_m=CLEARANCE_M,
+            z_m=pose.z_m,
         )
     except TerrainError as exc:
         raise ScenarioError(f"vessels.{index}.pose ({vid}): {exc}") from None

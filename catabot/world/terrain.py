@@ -199,11 +199,14 @@ class Terrain:
         return float(cx[best]), float(cy[best])
 
     def check_start(
-        self, x: float, y: float, *, draft_m: float, footprint_m: float, clearance_m: float = 0.5
-    ) -> None:
+        self, x: float, y: float, *, draft_m: float, footprint_m: float, clearance_m: float = 0.5,
+        z_m: float = 0.0,
+    ) -> None:  # fmt: skip
         """Refuse a start pose outside the map, on land, or in water too shallow for the hull
-        anywhere within `footprint_m` of (x, y) (sampled at <= half a pixel)."""
-        need = _non_negative(draft_m=draft_m, clearance_m=clearance_m) + clearance_m
+        anywhere within `footprint_m` of (x, y) (sampled at <= half a pixel); `z_m`, the
+        body origin's start height: a hull started deep must clear the seabed too (one
+        started inside it was fired out at 117 m/s)."""
+        _non_negative(draft_m=draft_m, clearance_m=clearance_m)
         _non_negative(footprint_m=footprint_m)
         w, h = self.size_m
         where = f"start pose ({x:.1f}, {y:.1f})"
@@ -214,11 +217,18 @@ class Terrain:
             raise TerrainError(f"{where} is on land: ground elevation {ground:.1f} m")
         px, py = disk_samples(x, y, footprint_m, 0.5 * self._mpp)
         depth = float(self.depth(px, py).min())
-        if depth <= need:
+        keel = z_m - draft_m
+        if depth + keel > clearance_m:
+            return
+        if z_m != 0.0:
             raise TerrainError(
-                f"{where}: water depth {depth:.2f} m (shallowest within {footprint_m:g} m) is too "
-                f"shallow for draft {draft_m:g} m + clearance {clearance_m:g} m"
+                f"{where}: its keel at z {keel:.2f} m is not {clearance_m:g} m above the seabed "
+                f"(at z {-depth:.2f} m, the shallowest within {footprint_m:g} m)"
             )
+        raise TerrainError(
+            f"{where}: water depth {depth:.2f} m (shallowest within {footprint_m:g} m) is too "
+            f"shallow for draft {draft_m:g} m + clearance {clearance_m:g} m"
+        )
 
 
 def _non_negative(**values: float) -> float:

@@ -165,6 +165,11 @@ def test_open_water_search_and_start_checks() -> None:
         terrain.check_start(60.0 + 29.5, 40.0, draft_m=0.06, footprint_m=1.0)
     with pytest.raises(TerrainError, match="outside the terrain"):
         terrain.check_start(-1.0, 5.0, draft_m=0.06, footprint_m=1.0)
+    depth = float(terrain.depth(x, y))  # deep water, but a hull started under its bed:
+    with pytest.raises(TerrainError, match=r"its keel at z -\d+\.\d+ m is not 0.5 m above"):
+        terrain.check_start(x, y, draft_m=0.5, footprint_m=4.0, z_m=-depth)
+    terrain.check_start(x, y, draft_m=0.5, footprint_m=4.0, z_m=-2.0)  # under water, clear
+    terrain.check_start(60.0 + 29.5, 40.0, draft_m=0.06, footprint_m=1.0, z_m=5.0)  # a drop
     with pytest.raises(TerrainError, match="no open water deeper than"):
         terrain.find_open_water(30.0)
 
