@@ -244,7 +244,25 @@ class Scenario(Strict):
                 raise FieldProblem("recording.export", f"{fmt!r} needs a {need} on a vessel")
             if need == "camera" and not rec.dataset:
                 raise FieldProblem("recording.export", f"{fmt!r} needs recording.dataset: true")
+            if need == "camera":
+                self._cameras_give(fmt, EXPORT_OUTPUTS[fmt])
         return self
+
+    def _cameras_give(self, fmt: str, outputs: tuple[str, ...]) -> None:
+        """Every camera's frames go into the export: each must make what it is built from
+        (found at the end of the run, a whole run was lost, its export half written)."""
+        for i, vessel in enumerate(self.vessels):
+            for j, sensor in enumerate(vessel.sensors):
+                if sensor.type != "camera":
+                    continue
+                on = sensor.typed_params().outputs
+                off = [o for o in outputs if not getattr(on, o)]
+                if off:
+                    raise FieldProblem(
+                        "recording.export",
+                        f"{fmt!r} is made from each camera's {' and '.join(outputs)}: "
+                        f"vessels.{i}.sensors.{j} ({sensor.name}) has {', '.join(off)} off",
+                    )
 
     @model_validator(mode="after")
     def _shards_have_sensors(self) -> Scenario:
@@ -270,6 +288,7 @@ class Scenario(Strict):
         return ticks_for(self.duration_ns, self.dt_ns)
 
 
+EXPORT_OUTPUTS = {"yolo": ("color",), "coco": ("color", "segmentation")}  # camera outputs
 SERVICE_NAMES = ("conductor", "physics", "sensors", "traffic", "recorder", GATEWAY, "viewer")
 
 

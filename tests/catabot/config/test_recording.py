@@ -40,6 +40,17 @@ def test_everything_asked_for_with_its_sources() -> None:
         ({"export": ["coco"], "dataset": False}, [CAMERA], "'coco' needs recording.dataset: true"),
         ({"export": ["voc"]}, [CAMERA], "recording.export.0: must be one of 'yolo', 'coco'"),
         (
+            {"export": ["coco"]},
+            [CAMERA, {**CAMERA, "name": "c2", "params": {"outputs": {"segmentation": False}}}],
+            "'coco' is made from each camera's color and segmentation: vessels.0.sensors.1 (c2) "
+            "has segmentation off",
+        ),  # it was found as the run ended: a whole run lost, its export half written
+        (
+            {"export": ["yolo"]},
+            [{**CAMERA, "params": {"outputs": {"color": False, "depth": True}}}],
+            "'yolo' is made from each camera's color: vessels.0.sensors.0 (cam) has color off",
+        ),
+        (
             {"mcap_compression": "gzip"},
             [],
             "recording.mcap_compression: must be one of 'zstd', 'lz4' or 'none' (got 'gzip')",
