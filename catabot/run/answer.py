@@ -7,11 +7,21 @@ everywhere and never ends in a traceback.
 
 from __future__ import annotations
 
+import argparse
 import sys
 from collections.abc import Callable
 from pathlib import Path
+from typing import NoReturn
 
 from catabot.errors import CataBotError
+
+
+class OneLineParser(argparse.ArgumentParser):
+    """argparse, refusing a bad option in one line as every other refusal reads (its usage
+    block, printed first, hid the reason). Subcommands' parsers are of the same class."""
+
+    def error(self, message: str) -> NoReturn:
+        self.exit(2, f"{self.prog}: {message} (--help for usage)\n")
 
 
 class OutputPathError(CataBotError, ValueError):

@@ -16,7 +16,7 @@ from catabot.bus.session import Connection, SessionError, add_connection_args, o
 from catabot.config.load import json_schema
 from catabot.errors import CataBotError
 from catabot.run import compose, conduct, launcher, secure, settings_cli
-from catabot.run.answer import answered, output_file
+from catabot.run.answer import OneLineParser, answered, output_file
 from catabot.run.companions import VIEW_MODES
 from catabot.run.generate import add_arguments as add_generate_arguments
 from catabot.run.generate import generate
@@ -143,7 +143,7 @@ def _scenario(args: argparse.Namespace) -> int:
 
 
 def parser() -> argparse.ArgumentParser:
-    p = argparse.ArgumentParser(prog="catabot", description=__doc__)
+    p = OneLineParser(prog="catabot", description=__doc__)
     sub = p.add_subparsers(dest="command", required=True)
     run = sub.add_parser("run", help="run a scenario: conductor and services as processes")
     run.add_argument("scenario", nargs="?", help="scenario file or bundled name (default: default)")

@@ -30,6 +30,7 @@ from catabot.config.scenario import Scenario, participants, services
 from catabot.config.sensors import service_of
 from catabot.errors import CataBotError
 from catabot.run import probe
+from catabot.run.answer import OneLineParser
 from catabot.run.compose_secure import Profile, profile
 from catabot.run.compose_text import HEADER, NOTES, inside_folder
 from catabot.run.compose_yaml import dump
@@ -229,7 +230,7 @@ def text(scenario_arg: str, output: Path, secure_dir: Path | None = None) -> str
 
 
 def parser() -> argparse.ArgumentParser:
-    p = argparse.ArgumentParser(prog="catabot deploy", description="containers for a scenario")
+    p = OneLineParser(prog="catabot deploy", description="containers for a scenario")
     sub = p.add_subparsers(dest="action", required=True)
     c = sub.add_parser("compose", help="write the compose file a scenario needs")
     c.add_argument("scenario", help="scenario file or bundled name")

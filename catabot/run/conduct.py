@@ -33,6 +33,7 @@ from catabot.config import live
 from catabot.config.load import load_scenario
 from catabot.config.scenario import Scenario, participants
 from catabot.errors import CataBotError
+from catabot.run.answer import OneLineParser
 from catabot.run.service import quiet_gc
 from catabot.run.settings_desk import SettingsDesk
 from catabot.run.usage import memory_mb
@@ -78,7 +79,7 @@ def heartbeat(stop: threading.Event) -> None:
 
 
 def main(argv: list[str] | None = None) -> int:
-    parser = argparse.ArgumentParser(prog="catabot conductor")
+    parser = OneLineParser(prog="catabot conductor")
     parser.add_argument("--scenario", help="scenario file (default: the bundled default)")
     add_connection_args(parser)
     add_roster_args(parser)

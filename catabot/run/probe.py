@@ -22,12 +22,13 @@ import sys
 from catabot.bus.keys import lives_of
 from catabot.bus.session import Connection, check_endpoint, open_session
 from catabot.errors import CataBotError
+from catabot.run.answer import OneLineParser
 
 TIMEOUT_S = 3.0
 
 
 def parser() -> argparse.ArgumentParser:
-    p = argparse.ArgumentParser(prog="catabot deploy probe", description=__doc__.split("\n")[0])
+    p = OneLineParser(prog="catabot deploy probe", description=__doc__.split("\n")[0])
     p.add_argument("endpoint", help="the router's endpoint, e.g. tcp/router:7447")
     p.add_argument("--name", help="a process that must be on the bus (its liveliness token)")
     p.add_argument("--zenoh-config", metavar="FILE", help="a login of the secure profile")

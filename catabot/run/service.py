@@ -42,6 +42,7 @@ from catabot.config.load import load_scenario
 from catabot.config.scenario import Scenario, shard_count
 from catabot.config.sensors import shard_names
 from catabot.errors import CataBotError
+from catabot.run.answer import OneLineParser
 from catabot.run.usage import write_usage
 from catabot.world.world import World
 
@@ -98,7 +99,7 @@ BuildFn = Callable[[ServiceContext], Built]
 
 
 def service_parser(name: str) -> argparse.ArgumentParser:
-    parser = argparse.ArgumentParser(prog=f"catabot service {name}")
+    parser = OneLineParser(prog=f"catabot service {name}")
     parser.add_argument("--scenario", help="scenario file (default: the bundled default)")
     parser.add_argument("--run-dir", default=".", help="run folder for outputs")
     add_connection_args(parser)

@@ -31,7 +31,7 @@ from catabot.bus.session import (
 )
 from catabot.config.live import parse_value
 from catabot.errors import CataBotError
-from catabot.run.answer import answered
+from catabot.run.answer import OneLineParser, answered
 
 
 class AskError(CataBotError, RuntimeError):
@@ -39,7 +39,7 @@ class AskError(CataBotError, RuntimeError):
 
 
 def _parser(prog: str) -> argparse.ArgumentParser:
-    parser = argparse.ArgumentParser(prog=f"catabot {prog}")
+    parser = OneLineParser(prog=f"catabot {prog}")
     parser.add_argument("--world", help="the simulation's world name (default: the one running)")
     parser.add_argument("--timeout", type=float, default=5.0, help="seconds to wait (default 5)")
     add_connection_args(parser)

@@ -9,12 +9,13 @@ no camera or LiDAR, an OUT_DIR that is not empty, a bad option), with one line s
 from __future__ import annotations
 
 import argparse
+import shutil
 import sys
 from collections.abc import Callable
 from pathlib import Path
 
 from catabot.errors import CataBotError
-from catabot.run.answer import answered
+from catabot.run.answer import OneLineParser, answered
 from catabot.run.recorded import RecordedRun
 from services.datasets import coco, kitti, yolo
 
@@ -26,7 +27,7 @@ FORMATS: dict[str, Callable[..., str]] = {
 
 
 def parser() -> argparse.ArgumentParser:
-    p = argparse.ArgumentParser(prog="catabot dataset", description=__doc__.split("\n")[0])
+    p = OneLineParser(prog="catabot dataset", description=__doc__.split("\n")[0])
     sub = p.add_subparsers(dest="action", required=True)
     exp = sub.add_parser("export", help="convert a recorded run into a training dataset")
     exp.add_argument("run", help="the run folder (runs/<world>-<time>)")
@@ -72,13 +73,25 @@ def main(argv: list[str] | None = None) -> int:
             summary = FORMATS[args.format](
                 run, out, val_fraction=args.val_fraction, block_s=args.split_block_s
             )
-        except Exception:
-            if made and not any(out.iterdir()):  # a refused export leaves no empty folder
-                out.rmdir()
+        except BaseException:
+            _undo(out, made=made)
             raise
         return f"{args.format} dataset in {out}: {summary}"
 
     return answered("dataset export", export)
+
+
+def _undo(out: Path, *, made: bool) -> None:
+    """A failed export leaves the output as it found it (new, or an empty folder): a half
+    export (train annotations, no val) looked whole, and a second try was refused."""
+    if made:
+        shutil.rmtree(out, ignore_errors=True)
+        return
+    for part in out.iterdir():
+        if part.is_dir() and not part.is_symlink():
+            shutil.rmtree(part, ignore_errors=True)
+        else:
+            part.unlink(missing_ok=True)
 
 
 if __name__ == "__main__":

@@ -12,7 +12,7 @@ import argparse
 import sys
 from pathlib import Path
 
-from catabot.run.answer import answered
+from catabot.run.answer import OneLineParser, answered
 from catabot.run.recorded import RecordedRun
 from services.plots import report, series
 from services.plots.figures import FIGURES
@@ -21,7 +21,7 @@ PNG = {"Software": None}  # no version string: the same run gives the same bytes
 
 
 def parser() -> argparse.ArgumentParser:
-    p = argparse.ArgumentParser(prog="catabot plot", description=__doc__.split("\n")[0])
+    p = OneLineParser(prog="catabot plot", description=__doc__.split("\n")[0])
     p.add_argument("run", help="the run folder (runs/<world>-<time>)")
     p.add_argument("--output", "-o", help="folder for the PNGs and report.html")
     return p

@@ -33,7 +33,7 @@ from catabot.bus.session import (
 from catabot.bus.session import open_session as open_zenoh
 from catabot.config.load import load_scenario
 from catabot.errors import CataBotError
-from catabot.run.answer import output_file
+from catabot.run.answer import OneLineParser, output_file
 from catabot.run.recorded import RecordedRun
 from catabot.world.world import World
 from services.viewer.blueprint import blueprint
@@ -44,7 +44,7 @@ log = logging.getLogger("viewer")
 
 
 def parser() -> argparse.ArgumentParser:
-    p = argparse.ArgumentParser(prog="catabot view", description=__doc__.split("\n")[0])
+    p = OneLineParser(prog="catabot view", description=__doc__.split("\n")[0])
     p.add_argument("source", nargs="?", help="run folder, or (with --connect) a scenario")
     add_connection_args(p)
     p.add_argument("--web", action="store_true", help="serve the web viewer, do not spawn one")

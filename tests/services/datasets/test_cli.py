@@ -1,4 +1,4 @@
-"""`catabot dataset export` refused: one line, exit 2, and no empty output folder left."""
+"""`catabot dataset export` refused: one line, exit 2, and the output left as it was found."""
 
 from __future__ import annotations
 
@@ -7,7 +7,9 @@ from pathlib import Path
 import pytest
 
 from catabot.config.load import load_scenario
+from services.datasets import cli
 from services.datasets.cli import main
+from services.datasets.frames import ExportError
 
 
 def test_a_run_without_a_camera_is_refused_and_leaves_no_folder(
@@ -40,3 +42,36 @@ def test_a_bad_option_is_one_line(
     assert main(argv) == 2
     err = capsys.readouterr().err
     assert err.count("\n") == 1 and why in err and "usage" not in err
+
+
+def test_a_bad_format_is_one_line_too(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    with pytest.raises(SystemExit) as info:
+        main(["export", str(tmp_path), "--format", "voc", "-o", str(tmp_path / "o")])
+    err = capsys.readouterr().err
+    assert info.value.code == 2 and err.count("\n") == 1 and "usage:" not in err
+    assert "invalid choice: 'voc'" in err
+
+
+@pytest.mark.parametrize("existed", [False, True])
+def test_a_failed_export_leaves_the_output_as_it_found_it(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch, existed: bool
+) -> None:
+    """A half export (train written, val not) looked whole, and a second try was refused."""
+    run = tmp_path / "run"
+    run.mkdir()
+    (run / "scenario.json").write_text(load_scenario().model_dump_json())
+    out = tmp_path / "dataset"
+    if existed:
+        out.mkdir()
+
+    def half(_run: object, folder: Path, **_: object) -> str:
+        (folder / "train").mkdir()
+        (folder / "train" / "0001.png").write_bytes(b"png")
+        (folder / "annotations.json").write_text("{}")
+        raise ExportError("frame 0002: no instance image")
+
+    monkeypatch.setitem(cli.FORMATS, "coco", half)
+    assert main(["export", str(run), "--format", "coco", "-o", str(out)]) == 2
+    assert out.exists() == existed and (not existed or not any(out.iterdir()))
+    monkeypatch.setitem(cli.FORMATS, "coco", lambda *_a, **_k: "0 images")
+    assert main(["export", str(run), "--format", "coco", "-o", str(out)]) == 0  # try again
