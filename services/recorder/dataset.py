@@ -6,7 +6,8 @@ Layout (one folder per sensor, `<vessel>.<sensor>`):
   no return: the exact values), `<tick>_normals.png` (RGB = (n + 1) / 2 in
   the optical frame z forward, x right, y down), `<tick>_class.png` (8-bit class ids of
   `LABEL_CLASSES`: 0 none, 1 water, 2 terrain, 3 vessel, 4 buoy) and `<tick>_instance.png`
-  (16-bit), for the outputs that are on, plus one `labels.jsonl` line per frame with its boxes;
+  (16-bit, a body's row + 1), for the outputs that are on, plus one `labels.jsonl` line per
+  frame with its boxes, each naming its body;
   every frame, or with `recording.dataset_rate_hz` the first frame of each of its periods;
 - radars: `ppi_<tick>.png`, the north-up PPI (services/recorder/ppi.py) once per antenna turn.
 PNGs are written with fixed settings and no time chunk, so the same run gives the same bytes.
@@ -41,11 +42,14 @@ def depth_mm(depth: np.ndarray) -> np.ndarray:
     return np.where(mm <= 65535, mm, 0).astype(np.uint16)
 
 
-def labels(frame: CameraFrame, files: dict[str, str]) -> dict[str, Any]:
-    """The labels.jsonl record of one frame."""
+def labels(frame: CameraFrame, files: dict[str, str], *, bodies: dict[int, str]) -> dict[str, Any]:
+    """The labels.jsonl record of one frame; `bodies`: body ids by instance (`instances`), so
+    each object names its body (a user had to rebuild the order of the rows, and the
+    traffic's waypoint buoys are in no scenario file)."""
     objects = [
         {
             "instance": int(row[0]),
+            "body": bodies.get(int(row[0])),
             "class": LABEL_CLASSES[int(row[1])]
             if int(row[1]) < len(LABEL_CLASSES)
             else str(int(row[1])),
@@ -65,6 +69,11 @@ def labels(frame: CameraFrame, files: dict[str, str]) -> dict[str, Any]:
     }
 
 
+def instances(world: World) -> dict[int, str]:
+    """Each body's id by its label instance (catabot/world/world.py: Body.instance)."""
+    return {b.instance: b.id for b in world.bodies}
+
+
 def save_npy(path: Path, values: np.ndarray) -> None:
     """One `.npy` (its header holds only dtype, order and shape: same array, same bytes)."""
     np.save(path, np.ascontiguousarray(values), allow_pickle=False)
@@ -75,6 +84,7 @@ class Dataset:
 
     def __init__(self, root: Path, world: World) -> None:
         self.root = root
+        self.bodies = instances(world)
         recording = world.scenario.recording
         self.cameras = recording.dataset
         rate = recording.dataset_rate_hz
@@ -127,7 +137,8 @@ class Dataset:
             files["depth_m"] = f"{stem}_depth.npy"
             save_npy(folder / files["depth_m"], frame.depth.astype(np.float32, copy=False))
         with open(folder / "labels.jsonl", "a", encoding="utf-8") as out:
-            out.write(json.dumps(labels(frame, files), separators=(",", ":")) + "\n")
+            record = labels(frame, files, bodies=self.bodies)
+            out.write(json.dumps(record, separators=(",", ":")) + "\n")
 
     def _radar(self, stream: str, sweep: RadarSweep) -> None:
         """Paint the sweep; save the PPI when this sweep ends an antenna turn (the next one

@@ -25,7 +25,7 @@ from catabot.ros2.convert import Converter
 from catabot.ros2.names import TF
 from services.recorder import json_schemas
 from services.recorder.batches import Block
-from services.recorder.dataset import labels
+from services.recorder.dataset import instances, labels
 from services.recorder.mcap_sink import McapSink
 
 LABELS_SCHEMA = {
@@ -45,6 +45,7 @@ LABELS_SCHEMA = {
 class McapRecording:
     def __init__(self, run_dir: Path, convert: Converter, *, compression: str) -> None:
         self.convert = convert
+        self.bodies = instances(convert.world)
         self.compression = compression
         self.mcap = McapSink(run_dir / "run.mcap", compression=compression)
         self._extra_path = run_dir / "run.extra.mcap"
@@ -96,7 +97,7 @@ class McapRecording:
                                 stamp_ns=stamp_ns)  # fmt: skip
 
     def _labels(self, stream: str, frame: CameraFrame) -> None:
-        record: dict[str, Any] = labels(frame, {})
+        record: dict[str, Any] = labels(frame, {}, bodies=self.bodies)
         record.pop("files")
         _, vessel, camera = stream.split("/")
         topic = self.convert.names.topic(vessel, camera, "labels")

@@ -8,6 +8,8 @@ from typing import Any
 
 from conftest import basic_scenario, catabot, csv_rows, only_run_dir, scenario_file
 
+from catabot.config.load import load_scenario
+from catabot.world.world import World
 from services.recorder.mcap_read import read_mcap_messages
 
 
@@ -40,6 +42,9 @@ def test_camera_and_radar_run_writes_dataset_and_mcap(tmp_path: Path, out: Path)
     for name in ("color", "depth", "normals", "class", "instance"):
         assert (cam / lines[0]["files"][name]).is_file()
     assert any(o["class"] == "vessel" for line in lines for o in line["objects"])
+    world = World.resolve(load_scenario(run / "scenario.json"))  # each object names its body
+    rows = {b.id: b.row for b in world.bodies}
+    assert all(rows[o["body"]] + 1 == o["instance"] for line in lines for o in line["objects"])
     assert sorted(p.name for p in (run / "dataset" / "ego.radar").glob("ppi_*.png"))
     topics = {m.topic: m.schema_name for m in read_mcap_messages(run / "run.mcap")}
     for output in ("image_raw", "depth", "segmentation", "instance", "normals", "camera_info"):
