@@ -9,6 +9,7 @@ errors into one line per problem naming the dotted field, the rule and the value
 from __future__ import annotations
 
 import json
+import math
 from functools import cache, partial
 from pathlib import Path
 from types import UnionType
@@ -33,6 +34,18 @@ Seed = Annotated[
     Field(ge=0, lt=2**63, description="an integer in [0, 2**63): seeds every random source"),
 ]
 """A seed (catabot.world.seeding): JSON integers only (3.0, "3" or true are refused)."""
+
+
+def _radians(value: float) -> float:
+    if abs(value) > 2.0 * math.pi:
+        raise ValueError(
+            f"angles are radians, within ±2π (degrees? {value:g}° is {math.radians(value):.4g} rad)"
+        )
+    return value
+
+
+Angle = Annotated[float, AfterValidator(_radians)]
+"""A heading or direction in radians; beyond ±2π it is a unit mistake, not a turn."""
 
 
 WorldName = Annotated[str, AfterValidator(partial(check_name, "world"))]

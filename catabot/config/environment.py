@@ -16,7 +16,7 @@ from typing import Annotated, Literal
 
 from pydantic import Field, field_validator, model_validator
 
-from catabot.config.base import ConfigError, Strict
+from catabot.config.base import Angle, ConfigError, Strict
 from catabot.config.geometry import polygon_area, polygon_self_intersects
 
 Vec2 = tuple[float, float]
@@ -86,7 +86,7 @@ class WindZone(Strict):
     radius_m: Positive | None = None
     vertices_m: list[Vec2] | None = None
     speed_mps: WindSpeed
-    toward_rad: float = 0.0
+    toward_rad: Angle = 0.0
     gust_std_mps: GustStd | None = None
 
     @model_validator(mode="after")
@@ -126,7 +126,7 @@ class WindConfig(Strict):
     """
 
     speed_mps: WindSpeed = 0.0
-    toward_rad: float = 0.0
+    toward_rad: Angle = 0.0
     gust_std_mps: GustStd = 0.0
     gust_time_constant_s: Positive = 2.0
     air_density_kg_m3: Positive = 1.225

@@ -13,7 +13,7 @@ import math
 
 from pydantic import Field
 
-from catabot.config.base import Strict
+from catabot.config.base import Angle, Strict
 
 MAX_SPEED_MPS = 50.0  # faster than any surface vessel CataBot models
 MAX_RATE_RADPS = 2 * math.pi
@@ -29,7 +29,7 @@ class Pose(Strict):
     z_m: float = Field(0.0, ge=-20.0, le=100.0, description="height of the body origin")
     roll_rad: float = Field(0.0, ge=-math.pi, le=math.pi)
     pitch_rad: float = Field(0.0, ge=-math.pi / 2, le=math.pi / 2)
-    yaw_rad: float = 0.0
+    yaw_rad: Angle = 0.0
 
     @property
     def level_at_surface(self) -> bool:

@@ -11,7 +11,7 @@ from typing import Literal
 
 from pydantic import Field, StrictBool, field_validator, model_validator
 
-from catabot.config.base import FieldProblem, Seed, Strict
+from catabot.config.base import Angle, FieldProblem, Seed, Strict
 
 BEHAVIOURS = ("circle", "waypoints", "hold")
 Behaviour = Literal["circle", "waypoints", "hold"]
@@ -103,7 +103,7 @@ class BoatOverride(Strict):
     model: str | None = None
     x_m: float | None = None
     y_m: float | None = None
-    yaw_rad: float | None = None
+    yaw_rad: Angle | None = None
     behaviour: Behaviour | None = None
     points: list[Point] | None = None
 

@@ -11,7 +11,7 @@ from typing import Annotated, Any, Literal
 
 from pydantic import Field, ValidationError, model_validator
 
-from catabot.config.base import ConfigError, Strict, explain
+from catabot.config.base import Angle, ConfigError, Strict, explain
 
 GRAVITY = 9.81
 PRESETS: dict[str, dict[str, Any]] = {
@@ -43,9 +43,9 @@ class WaveConfig(Strict):
 
     preset: Literal["calm", "medium", "heavy"] | None = None
     spectrum: Literal["pierson-moskowitz", "jonswap"] = "jonswap"
-    significant_height_m: Annotated[float, Field(ge=0.0)] = 0.0
-    peak_period_s: Annotated[float, Field(gt=0.0)] = 8.0
-    direction_rad: float = 0.0
+    significant_height_m: Annotated[float, Field(ge=0.0, le=20.0)] = 0.0  # 20 m: beyond records
+    peak_period_s: Annotated[float, Field(gt=0.0, le=30.0)] = 8.0  # the longest swells: 25 s
+    direction_rad: Angle = 0.0
     spreading: Annotated[float, Field(gt=0.0, le=1000.0)] | None = 25.0
     gamma: Annotated[float, Field(ge=1.0, le=10.0)] = 3.3
     frequency_components: Annotated[int, Field(ge=1, le=256)] = 12

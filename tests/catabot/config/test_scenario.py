@@ -315,3 +315,24 @@ def test_true_false_or_text_is_not_a_number(
         target = target[part]
     target[path[-1]] = value
     assert message in _error(root)
+
+
+@pytest.mark.parametrize(
+    ("section", "value", "message"),
+    [
+        (("vessels", 0, "pose"), {"x_m": 0, "y_m": 0, "yaw_rad": 90}, "pose.yaw_rad: angles are"),
+        (("wind",), {"speed_mps": 3, "toward_rad": -270}, "wind.toward_rad: angles are radians"),
+        (("water",), {"waves": {"direction_rad": 7}}, "waves.direction_rad: angles are radians"),
+        (("water",), {"waves": {"peak_period_s": 8000}}, "peak_period_s: must be <= 30"),
+    ],
+)
+def test_angles_in_degrees_and_periods_in_ms_are_caught(
+    section: tuple[Any, ...], value: Any, message: str
+) -> None:
+    """Unit mistakes that used to run: a yaw of 90 rad, a wave period of 8000 s."""
+    root = _base()
+    target: Any = root
+    for part in section[:-1]:
+        target = target[part]
+    target[section[-1]] = value
+    assert message in _error(root)
