@@ -36,7 +36,7 @@ class SeaSample:
 
     velocity_w: Array | None
     surface: WaterHeight  # at the buoyancy columns (the layout the method was chosen for)
-    at_points: WaterHeight = water_height  # anywhere: the exact sum (a few thruster points)
+    at_points: WaterHeight = water_height  # at points near each body (its thrusters), (N, k)
 
 
 class SeaSampler:
@@ -92,7 +92,8 @@ class SeaSampler:
         velocity = waves.orbital(cos, sin, pos[:, 2])
         order = self._order
         grid = grid.reshape(len(phase), order + 1, order + 1)
-        return SeaSample(velocity, _Expansions(grid, self._row, self._pq, pos), waves.height)
+        surface = _Expansions(grid, self._row, self._pq, pos)
+        return SeaSample(velocity, surface, surface)  # thrusters: within the columns' radius
 
 
 class _Expansions:
