@@ -45,6 +45,7 @@ from numpy.typing import NDArray
 from catabot.config.vessel import VesselModel
 from services.physics import kernels
 from services.physics.hydro import Array
+from services.physics.wet import scaled_added_mass
 
 
 def rigid_body_matrix(model: VesselModel) -> Array:
@@ -114,14 +115,10 @@ class AddedMass:
 
     def _tables(self, wet: Array | None) -> tuple[Array, Array, Array, Array, Array, Array]:
         """The kernel's tables, with M_A scaled by `wet` for the rows out of the water
-        (their augmented inverse solved again: a few bodies, rarely)."""
+        (their augmented inverse solved again, wet.scaled_added_mass)."""
         inverse, diag, coriolis = self.inverse, self.diag, self.coriolis_diag
-        dry = np.flatnonzero(wet < 1.0) if wet is not None else np.empty(0, np.intp)
-        if dry.size:
-            assert wet is not None
-            share = wet[dry, None]
-            diag, coriolis, inverse = diag.copy(), coriolis.copy(), inverse.copy()
-            diag[dry] *= share
-            coriolis[dry] *= share
-            inverse[dry] = np.linalg.inv(self.m_rb[dry] + diag[dry, :, None] * np.eye(6))
+        if wet is not None and wet.size and wet.min() < 1.0:
+            inverse, diag, coriolis = scaled_added_mass(
+                self.m_rb, inverse, diag, coriolis, np.ascontiguousarray(wet)
+            )
         return (self.m_rb, inverse, diag, coriolis, self.mass, self.cog)

@@ -32,6 +32,12 @@ class ColumnSurface(Protocol):
     def at_columns(self, rot: Array, bottom_m: Array) -> Array: ...
 
 
+def column_surface(surface: WaterHeight) -> ColumnSurface | None:
+    """`surface` if it evaluates columns itself: an attribute lookup, where isinstance on a
+    runtime-checkable Protocol walked its members (≈50 µs, twice a step in waves)."""
+    return surface if callable(getattr(surface, "at_columns", None)) else None  # type: ignore[return-value]
+
+
 def water_height(x: Array, y: Array, time_s: float = 0.0) -> Array:
     """Height of the water surface at world points (x, y): calm water at z = 0.
 
@@ -129,10 +135,11 @@ def buoyancy_wrench(
     (world +z) and acts at the centroid of the submerged part: the total is rho*g times the
     submerged volume (Archimedes, exact for boxes) and tilt gives a restoring moment.
     """
+    columns = column_surface(surface)
     if surface is water_height:  # calm water: nothing to sample
         eta = cols.calm
-    elif isinstance(surface, ColumnSurface):  # a surface that evaluates columns itself
-        eta = surface.at_columns(_plain(rot), cols.bottom_m)
+    elif columns is not None:  # a surface that evaluates columns itself
+        eta = columns.at_columns(_plain(rot), cols.bottom_m)
     else:
         bottom_w = np.matmul(rot, cols.bottom_m, out=cols._world)  # (N, 3, C), world frame
         bottom_w += pos[:, :, None]

@@ -16,7 +16,7 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import NDArray
 
-from services.physics.hydro import Array, WaterHeight, water_height
+from services.physics.hydro import Array, WaterHeight, column_surface, water_height
 from services.physics.kernels import jit
 
 
@@ -46,6 +46,41 @@ def _wetness(rot: Array, buoyancy: Array, weight: Array, out: Array) -> bool:
     return dry
 
 
+@jit
+def scaled_added_mass(
+    m_rb: Array, inverse: Array, diag: Array, coriolis: Array, wet: Array
+) -> tuple[Array, Array, Array]:
+    """added_mass.AddedMass's inverse, diagonal and manoeuvring part with each row's M_A
+    times `wet`, the augmented (M_RB + wet M_A)^-1 solved again for the rows not fully wet
+    (Gauss-Jordan on the 6 x 6, symmetric positive definite; in a swell some hull is
+    partly out of the water most steps, and NumPy's batched inverse cost 0.14 ms a step)."""
+    if len(wet) != len(diag):
+        raise ValueError("scaled_added_mass: one wetness per row of the tables")
+    inv, d, c = inverse.copy(), diag.copy(), coriolis.copy()
+    a = np.empty((6, 12))
+    for i in range(len(wet)):
+        if wet[i] >= 1.0:
+            continue
+        for k in range(6):
+            d[i, k] *= wet[i]
+            c[i, k] *= wet[i]
+        for r in range(6):
+            for k in range(6):
+                a[r, k] = m_rb[i, r, k] + (d[i, r] if r == k else 0.0)
+                a[r, 6 + k] = 1.0 if r == k else 0.0
+        for k in range(6):
+            pivot = a[k, k]
+            for j in range(12):
+                a[k, j] /= pivot
+            for r in range(6):
+                if r != k:
+                    factor = a[r, k]
+                    for j in range(12):
+                        a[r, j] -= factor * a[k, j]
+        inv[i] = a[:, 6:]
+    return inv, d, c
+
+
 @dataclass(frozen=True)
 class ThrustLoad:
     """Delivered thruster forces (N, T), their wrenches per newton (N, T, 6) and positions
@@ -59,9 +94,14 @@ class ThrustLoad:
         return ThrustLoad(self.force_n[rows], self.unit_wrench[rows], self.position_m[rows])
 
     def wrench(self, rot: Array, pos: Array, surface: WaterHeight, time_s: float) -> Array:
-        """Body-frame wrench (N, 6) about the body origin of the thrusters under water."""
+        """Body-frame wrench (N, 6) about the body origin of the thrusters under water; in
+        waves the surface above each: a vessel's own expansion, compiled, as for its columns
+        (its NumPy form cost 0.1 ms a step for 101 vessels), else `surface` at world points."""
         x, y, z = _thruster_points(rot, pos, self.position_m)
-        if surface is not water_height:  # waves: the surface above each thruster
+        columns = column_surface(surface)
+        if columns is not None:
+            z = z - columns.at_columns(rot, self.position_m.transpose(0, 2, 1).copy())
+        elif surface is not water_height:
             z = z - surface(x, y, time_s)
         return _immersed_wrench(self.force_n, self.unit_wrench, z)
 
@@ -96,6 +136,8 @@ def warm_up() -> None:
     """Load these kernels now (kernels.warm_up says why)."""
     rot, one = np.eye(3)[None], np.ones((1, 1))
     wetness(np.zeros((1, 6)), rot, np.ones(1))
+    six = np.eye(6)[None]
+    scaled_added_mass(six, six, np.ones((1, 6)), np.ones((1, 6)), np.full(1, 0.5))
     ThrustLoad(one, np.zeros((1, 1, 6)), np.zeros((1, 1, 3))).wrench(
         rot, np.zeros((1, 3)), water_height, 0.0
     )

@@ -11,6 +11,8 @@ from catabot.config.vessel import VesselModel, load_vessel_model
 from catabot.config.waves import WaveConfig
 from catabot.world import rotations
 from catabot.world.waves import WaveField
+from services.physics.added_mass import AddedMass
+from services.physics.wet import scaled_added_mass
 from services.physics.world import PhysicsWorld
 
 DT, G = 0.01, 9.81
@@ -91,3 +93,19 @@ def test_in_waves_the_propellers_meet_the_surface_above_them(
     for _ in range(300):
         world.step()
     assert (world.state_arrays().linear_velocity[:, 0] > 0.5).all()
+
+
+def test_the_added_mass_of_a_hull_partly_out_of_the_water_is_its_share() -> None:
+    """The compiled 6 x 6 solve against NumPy's inverse; a wet row keeps its own tables."""
+    models = [load_vessel_model(n) for n in ("catabot", "monohull", "catabot")]
+    am = AddedMass(models, G)
+    wet = np.array([1.0, 0.3, 0.0])
+    inverse, diag, coriolis = scaled_added_mass(am.m_rb, am.inverse, am.diag, am.coriolis_diag, wet)
+    scaled = am.diag * wet[:, None]
+    expected = np.linalg.inv(am.m_rb + np.einsum("ni,ij->nij", scaled, np.eye(6)))
+    np.testing.assert_allclose(inverse, expected, rtol=1e-12, atol=1e-15)
+    np.testing.assert_array_equal(diag, scaled)
+    np.testing.assert_array_equal(coriolis, am.coriolis_diag * wet[:, None])
+    np.testing.assert_array_equal(inverse[0], am.inverse[0])
+    with pytest.raises(ValueError, match="one wetness per row"):
+        scaled_added_mass(am.m_rb, am.inverse, am.diag, am.coriolis_diag, np.ones(2))
