@@ -309,12 +309,7 @@ def test_true_false_or_text_is_not_a_number(
 ) -> None:
     """pydantic's lax mode took true as 1.0 (a run in 1 mm/h rain nobody asked for) and "10"
     as 10, where the JSON Schema an editor checks against says `number`."""
-    root = _base()
-    target: Any = root
-    for part in path[:-1]:
-        target = target[part]
-    target[path[-1]] = value
-    assert message in _error(root)
+    assert message in _error(_with(_base(), path, value))
 
 
 @pytest.mark.parametrize(
@@ -330,9 +325,13 @@ def test_angles_in_degrees_and_periods_in_ms_are_caught(
     section: tuple[Any, ...], value: Any, message: str
 ) -> None:
     """Unit mistakes that used to run: a yaw of 90 rad, a wave period of 8000 s."""
-    root = _base()
+    assert message in _error(_with(_base(), section, value))
+
+
+def _with(root: dict[str, Any], path: tuple[Any, ...], value: Any) -> dict[str, Any]:
+    """`root` with the field at `path` (keys and list indices) set to `value`."""
     target: Any = root
-    for part in section[:-1]:
+    for part in path[:-1]:
         target = target[part]
-    target[section[-1]] = value
-    assert message in _error(root)
+    target[path[-1]] = value
+    return root
