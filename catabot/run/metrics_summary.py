@@ -62,7 +62,8 @@ def _parts(m: dict[str, Any]) -> list[str]:
         _goal(goal) if goal else "",
         xte,
         "nearest " + ", ".join(near) if near else "",
-        f"collisions {m['collisions']}, groundings {m['groundings']}",
+        f"collisions {m['collisions']}, groundings {m['groundings']}"
+        + (f", capsizes {m['capsizes']}" if m.get("capsizes") else ""),
         impulse,
     ]  # fmt: skip
 

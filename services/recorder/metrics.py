@@ -7,8 +7,10 @@ everything else: the nearest vessel, buoy and shore it came to (centre to centre
 the nearest land pixel), its goal and route (`tasks.py`), its thrust impulse, and episodes
 (`episodes.py`): encounters (another vessel within `recording.encounter_radius_m`, with the
 closest point of approach), collisions (plan-view hull boxes within `CONTACT_M`, the
-physics collision shapes; other vessels and buoys) and groundings (`seabed.py`). The
-traffic's own collisions, boat with boat or buoy, are `fleet_contacts.py`'s.
+physics collision shapes; other vessels and buoys), groundings (`seabed.py`) and capsizes
+(its deck's normal below the horizon, with its largest tilt: a boat on its side or upside
+down floats on, and its states alone do not say so). The traffic's own collisions, boat
+with boat or buoy, are `fleet_contacts.py`'s.
 
 Cost: arrays of (scenario vessels x bodies) per tick, no loop over bodies (DESIGN.md §8).
 Written with `repr` floats and sorted keys so two runs of one seed give the same bytes.
@@ -55,6 +57,8 @@ class Metrics:
         self.encounters = Episodes((s, n), gap_ns=0)
         self.collisions = Episodes((s, total), gap_ns=gap)
         self.groundings = Episodes((s,), gap_ns=gap)
+        self.capsizes = Episodes((s,), gap_ns=gap)
+        self.max_tilt = np.zeros(s)  # rad: the body's z axis from the world's vertical
         period = traffic_record_period(world.scenario)
         self.fleet = FleetContacts(
             self.offset, self.half, self.reach, first=s, period=period, gap_ns=gap
@@ -101,15 +105,23 @@ class Metrics:
         self.nearest["buoy"].add(gap[:, n:], stamp)
         self.encounters.update(self.pair_vessels & (vessels <= self.radius), stamp, vessels)
         self._collisions(batch, gap, stamp)
+        quat = np.asarray(batch.orientation[:s])
+        self._tilt(quat, stamp)
         if self.seabed is not None:
             shore, shallow = self.seabed.check(pos[:s])
             if shore is not None:
                 self.nearest["shore"].add(shore[:, None], stamp)
-            quat = np.asarray(batch.orientation[:s])
             self.groundings.update(self.seabed.aground(pos[:s], quat, shallow), stamp)
         self.goals.add(pos, self.distance, stamp)
         self.routes.add(pos)
         self.thrust.add(stamp)
+
+    def _tilt(self, quat: np.ndarray, stamp: int) -> None:
+        """Heel and trim together: the angle of the body's z axis from the vertical, whose
+        world z is 1 - 2 (x^2 + y^2) of the (x, y, z, w) quaternion; past 90 deg, capsized."""
+        up = 1.0 - 2.0 * (quat[:, 0] ** 2 + quat[:, 1] ** 2)
+        np.maximum(self.max_tilt, np.arccos(np.clip(up, -1.0, 1.0)), out=self.max_tilt)
+        self.capsizes.update(up < 0.0, stamp)
 
     def _collisions(self, batch: BodyStates, gap: np.ndarray, stamp: int) -> None:
         """Hull boxes of the pairs whose bounding circles are within reach, tested exactly."""

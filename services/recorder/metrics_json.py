@@ -54,6 +54,7 @@ def record(m: Metrics) -> dict[str, Any]:
             {"bodies": [ids[e.slot[0]], ids[e.slot[1]]], **_span(e)} for e in m.collisions.all()
         ],
         "groundings": [{"vessel": ids[e.slot[0]], **_span(e)} for e in m.groundings.all()],
+        "capsizes": [{"vessel": ids[e.slot[0]], **_span(e)} for e in m.capsizes.all()],
         "traffic_collisions": [
             {"bodies": [ids[e.slot[0]], ids[e.slot[1]]], **_span(e)} for e in m.fleet.all()
         ],
@@ -76,6 +77,8 @@ def _subject(m: Metrics, k: int) -> dict[str, Any]:
         "thrust_unknown_s": float(unknown[k]),
         "collisions": sum(k in e.slot for e in m.collisions.all()),
         "groundings": sum(e.slot[0] == k for e in m.groundings.all()),
+        "capsizes": sum(e.slot[0] == k for e in m.capsizes.all()),
+        "max_tilt_rad": float(m.max_tilt[k]),
     }
     goals, last = m.goals, m.last
     if k in goals.rows and last is not None:

@@ -5,7 +5,8 @@ One run (module scope): `a` and `b` are driven head on at full thrust; `c` is dr
 bank (water 10 m deep west of x = 100 m, land east of it) past its goal. Contact times are
 read back from the recorded states: the first tick the hull boxes overlap or a bow probe is
 below the bilinear ground (geometry), and the tick physics' contact force shows (a
-deceleration no thruster can give)."""
+deceleration no thruster can give). `d` starts upside down and floats so (a catamaran
+is stable inverted): a capsize from the first state to the end."""
 
 from __future__ import annotations
 
@@ -44,6 +45,7 @@ def run(tmp_path_factory: pytest.TempPathFactory) -> tuple[Path, subprocess.Comp
             {"id": "b", "pose": {"x_m": 32.0, "y_m": 20.0, "yaw_rad": math.pi}, "script": FULL},
             {"id": "c", "pose": {"x_m": 90.0, "y_m": 60.0}, "script": FULL,
              "task": {"goal": GOAL, "route": [[90.0, 61.0], [100.0, 61.0]]}},
+            {"id": "d", "pose": {"x_m": 50.0, "y_m": 60.0, "roll_rad": 3.0}},  # capsized
         ],
         "recording": {"mcap": False},
     }  # fmt: skip
@@ -67,6 +69,11 @@ def _states(run_dir: Path, vessel: str) -> dict[str, np.ndarray]:
 def _metrics(run_dir: Path) -> dict[str, Any]:
     out: dict[str, Any] = json.loads((run_dir / "metrics.json").read_text())
     return out
+
+
+def _counts(record: dict[str, Any], what: str) -> list[int]:
+    """Each scenario vessel's count of `what` (traffic boats have none)."""
+    return [v[what] for v in record["vessels"].values() if what in v]
 
 
 def _first(mask: np.ndarray, t: np.ndarray) -> float:
@@ -97,7 +104,7 @@ def test_grounding_at_the_contact_tick(run: tuple[Path, Any]) -> None:
     stopped = _first(c["ax"] < -10.0, c["t"])
     assert abs(ground["start_s"] - touch) <= 2 * TICK_S + 1e-9
     assert abs(ground["start_s"] - stopped) <= 2 * TICK_S + 1e-9
-    assert [v["groundings"] for v in record["vessels"].values() if "groundings" in v] == [0, 0, 1]
+    assert _counts(record, "groundings") == [0, 0, 1, 0]
     shore = record["vessels"]["c"]["nearest_shore"]["distance_m"]
     assert shore == pytest.approx(100.5 - c["x"].max(), abs=1e-6)  # the first land pixel
 
@@ -114,3 +121,12 @@ def test_goal_cross_track_and_thrust_impulse(run: tuple[Path, Any]) -> None:
     assert m["thrust_impulse_Ns"] == pytest.approx(2 * 36.0 * 8.0)  # full thrust, 8 s
     assert m["nearest_buoy"]["id"] == "mark" and m["collisions"] == 0
     assert "  c: goal reached at" in result.stdout and "groundings 1" in result.stdout
+
+
+def test_a_vessel_upside_down_is_capsized_for_the_whole_run(run: tuple[Path, Any]) -> None:
+    run_dir, result = run
+    record = _metrics(run_dir)
+    assert record["capsizes"] == [{"vessel": "d", "start_s": TICK_S, "end_s": None}]
+    assert record["vessels"]["d"]["max_tilt_rad"] > math.radians(150)
+    assert _counts(record, "capsizes") == [0, 0, 0, 1]
+    assert "groundings 0, capsizes 1" in result.stdout

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import dataclasses
 import json
 import math
 from pathlib import Path
@@ -214,3 +215,28 @@ def test_a_non_finite_batch_is_left_out(tmp_path: Path) -> None:
     assert "NaN" not in text and record["states_skipped"] == 1
     assert record["vessels"]["v0"]["distance_m"] == 1.0
     assert record["vessels"]["v0"]["max_speed_mps"] == 1.0
+
+
+def test_a_vessel_over_on_its_side_capsized_and_righted(tmp_path: Path) -> None:
+    """v0 rolls over to 180 deg and back by 5 deg a tick and stays upright beyond the episodes'
+    1 s gap, v1 pitches to 30 deg: one capsize, from the first tilt past 90 deg to the last,
+    and each one's largest tilt."""
+    world = _world()
+    metrics = Metrics(world, Orders())
+    rolls = [*range(0, 181, 5), *range(175, -1, -5), *[0] * 120]
+    for tick, deg in enumerate(rolls):
+        batch = _states(world, tick, [(0.0, 0.0), (0.0, 10.0)])
+        a, b = math.radians(deg) / 2, math.radians(min(tick, 30)) / 2
+        quat = np.array(
+            [[math.sin(a), 0.0, 0.0, math.cos(a)], [0.0, math.sin(b), 0.0, math.cos(b)]]
+        )
+        metrics.add(dataclasses.replace(batch, orientation=quat))
+    record = _record(metrics, tmp_path)
+    over = [t for t, deg in enumerate(rolls) if deg > 90]
+    assert record["capsizes"] == [
+        {"vessel": "v0", "start_s": (over[0] + 1) * DT / 1e9, "end_s": (over[-1] + 1) * DT / 1e9}
+    ]
+    v0, v1 = record["vessels"]["v0"], record["vessels"]["v1"]
+    assert (v0["capsizes"], v1["capsizes"]) == (1, 0)
+    assert v0["max_tilt_rad"] == pytest.approx(math.pi)
+    assert v1["max_tilt_rad"] == pytest.approx(math.radians(30))
