@@ -17,6 +17,7 @@ from pydantic import ValidationError
 from catabot.config.base import ScenarioError, explain, read_json
 from catabot.config.rates import check_rates
 from catabot.config.scenario import Scenario
+from catabot.config.sensors import SENSOR_TYPES
 from catabot.config.settings_config import is_settings_config, map_settings_config
 
 BUNDLED = Path(__file__).parents[1] / "data" / "scenarios"
@@ -26,6 +27,8 @@ TERRAINS = BUNDLED.parent / "terrain"  # elevation images a scenario may name ba
 def parse_scenario(data: Any, *, source: str = "<data>") -> Scenario:
     if isinstance(data, dict) and is_settings_config(data):
         data = map_settings_config(data, source=source)
+    if isinstance(data, dict) and isinstance(data.get("$schema"), str):  # an editor's hook
+        data = {k: v for k, v in data.items() if k != "$schema"}
     try:
         scenario = Scenario.model_validate(data)
     except ValidationError as exc:
@@ -108,6 +111,24 @@ def _program(controller: dict[str, Any], base: Path) -> None:
 def json_schema() -> dict[str, Any]:
     """The scenario's JSON Schema, for editors (`catabot scenario schema`)."""
     schema = Scenario.model_json_schema()
+    _sensor_params(schema)
     schema["$schema"] = "https://json-schema.org/draft/2020-12/schema"
     schema["title"] = "CataBot scenario"
+    schema["properties"]["$schema"] = {"type": "string", "description": "this schema's path or "
+                                       "URL, for an editor (ignored by CataBot)"}  # fmt: skip
     return schema
+
+
+def _sensor_params(schema: dict[str, Any]) -> None:
+    """Each sensor's `params` against its type's own model: pydantic sees a free dict there
+    (the type picks the model when it validates), which left an editor nothing to complete
+    or check."""
+    defs, cases = schema["$defs"], []
+    for name, spec in SENSOR_TYPES.items():
+        own = spec.params.model_json_schema(ref_template="#/$defs/{model}")
+        defs.update(own.pop("$defs", {}))
+        defs[spec.params.__name__] = own
+        ref = {"$ref": f"#/$defs/{spec.params.__name__}"}
+        cases.append({"if": {"properties": {"type": {"const": name}}, "required": ["type"]},
+                      "then": {"properties": {"params": ref}}})  # fmt: skip
+    defs["SensorConfig"]["allOf"] = cases

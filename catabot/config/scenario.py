@@ -79,7 +79,7 @@ class ScriptStep(Strict):
 class SensorConfig(Strict):
     name: SensorName
     type: str = Field(
-        description="a sensor type: see catabot/sensor_types.py",
+        description="a sensor type (catabot/config/sensors.py); `params` follow its model",
         json_schema_extra={"enum": list(SENSOR_TYPES)},
     )
     rate_hz: float = Field(gt=0)

@@ -22,9 +22,14 @@ from catabot.config.terrain import TerrainError
 from catabot.config.vessel import VesselModel, load_vessel_model
 from catabot.gym.options import EnvOptions, EnvOptionsError
 from catabot.world import seeding
-from catabot.world.placement import CLEARANCE_M, footprint_m, keel_depth_m, resolve_poses
+from catabot.world.placement import (
+    BUOY_MODEL,
+    CLEARANCE_M,
+    footprint_m,
+    keel_depth_m,
+    resolve_poses,
+)
 from catabot.world.terrain import load_terrain
-from catabot.world.world import BUOY_MODEL
 
 TRIES = 4096  # candidate starts (and goals) drawn before giving up: a region with no water
 KEEP_CLEAR_M = 2.0  # between the ego's start footprint and any other body's

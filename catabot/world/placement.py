@@ -8,6 +8,8 @@ reads, so all processes agree on them. Placement is a pure function of the scena
 from __future__ import annotations
 
 import math
+from collections.abc import Iterator
+from contextlib import contextmanager
 
 from catabot.config.base import ScenarioError
 from catabot.config.scenario import Pose, Scenario
@@ -15,7 +17,9 @@ from catabot.config.terrain import TerrainError
 from catabot.config.vessel import VesselModel, load_vessel_model
 from catabot.world.terrain import Terrain
 
-CLEARANCE_M = 0.5
+CLEARANCE_M = 0.5  # a vessel's keel above the seabed at its start
+BUOY_CLEARANCE_M = 0.1  # a moored buoy's: a mark may lie in shallow water
+BUOY_MODEL = "buoy"  # every buoy's vessel model
 
 
 def keel_depth_m(model: VesselModel) -> float:
@@ -43,6 +47,36 @@ def resolve_poses(scenario: Scenario, terrain: Terrain | None) -> Scenario:
         placed.append((pose.x_m, pose.y_m, footprint_m(model)))
         vessels.append(vessel.model_copy(update={"pose": pose}))
     return scenario.model_copy(update={"vessels": vessels})
+
+
+def check_marks(scenario: Scenario, terrain: Terrain | None) -> None:
+    """Buoys, goals and route points in water: a buoy given on land sat on the ground all
+    run, and a goal on land is a task no vessel can meet, both accepted without a word."""
+    if terrain is None:
+        return
+    buoy = load_vessel_model(BUOY_MODEL)
+    draft, reach = keel_depth_m(buoy), footprint_m(buoy)
+    for i, b in enumerate(scenario.buoys):
+        with _as_field(f"buoys.{i} ({b.id})"):
+            terrain.check_start(b.x_m, b.y_m, draft_m=draft, footprint_m=reach,
+                                clearance_m=BUOY_CLEARANCE_M, what="buoy")  # fmt: skip
+    for i, v in enumerate(scenario.vessels):
+        task, where = v.task, f"vessels.{i}.task"
+        if task is not None and task.goal is not None:
+            with _as_field(f"{where}.goal ({v.id})"):
+                terrain.check_water(task.goal.x_m, task.goal.y_m, what="goal")
+        for k, (x, y) in enumerate(task.route or () if task is not None else ()):
+            with _as_field(f"{where}.route.{k} ({v.id})"):
+                terrain.check_water(x, y, what="route point")
+
+
+@contextmanager
+def _as_field(field: str) -> Iterator[None]:
+    """A terrain check's refusal as the scenario's, naming the field."""
+    try:
+        yield
+    except TerrainError as exc:
+        raise ScenarioError(f"{field}: {exc}") from None
 
 
 def _check(index: int, vid: str, pose: Pose, model: VesselModel, terrain: Terrain) -> None:

@@ -198,9 +198,24 @@ class Terrain:
         best = int(np.argmin((cx - tx) ** 2 + (cy - ty) ** 2))  # ties: first, deterministic
         return float(cx[best]), float(cy[best])
 
+    def check_water(self, x: float, y: float, *, what: str, depth_m: float = 0.0) -> None:
+        """Refuse a point (`what`, as the error names it) outside the map, on land, or in
+        water no deeper than `depth_m`."""
+        w, h = self.size_m
+        where = f"{what} ({x:.1f}, {y:.1f})"
+        if not (0.0 <= x <= w and 0.0 <= y <= h):
+            raise TerrainError(f"{where} is outside the terrain (x 0..{w:g} m, y 0..{h:g} m)")
+        ground = float(self.height(x, y))
+        if ground >= 0.0:
+            raise TerrainError(f"{where} is on land: ground elevation {ground:.1f} m")
+        if -ground <= depth_m:
+            raise TerrainError(
+                f"{where}: water {-ground:.2f} m deep, needs more than {depth_m:g} m"
+            )
+
     def check_start(
         self, x: float, y: float, *, draft_m: float, footprint_m: float, clearance_m: float = 0.5,
-        z_m: float = 0.0,
+        z_m: float = 0.0, what: str = "start pose",
     ) -> None:  # fmt: skip
         """Refuse a start pose outside the map, on land, or in water too shallow for the hull
         anywhere within `footprint_m` of (x, y) (sampled at <= half a pixel); `z_m`, the
@@ -208,13 +223,8 @@ class Terrain:
         started inside it was fired out at 117 m/s)."""
         _non_negative(draft_m=draft_m, clearance_m=clearance_m)
         _non_negative(footprint_m=footprint_m)
-        w, h = self.size_m
-        where = f"start pose ({x:.1f}, {y:.1f})"
-        if not (0.0 <= x <= w and 0.0 <= y <= h):
-            raise TerrainError(f"{where} is outside the terrain (x 0..{w:g} m, y 0..{h:g} m)")
-        ground = float(self.height(x, y))
-        if ground >= 0.0:
-            raise TerrainError(f"{where} is on land: ground elevation {ground:.1f} m")
+        self.check_water(x, y, what=what)
+        where = f"{what} ({x:.1f}, {y:.1f})"
         px, py = disk_samples(x, y, footprint_m, 0.5 * self._mpp)
         depth = float(self.depth(px, py).min())
         keel = z_m - draft_m

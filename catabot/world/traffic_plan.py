@@ -27,13 +27,14 @@ from catabot.config.traffic import (
 from catabot.config.vessel import VesselModel, load_vessel_model
 from catabot.world import seeding
 from catabot.world.clearance import Discs, Rows, clear, densify, off_rings
-from catabot.world.placement import CLEARANCE_M, footprint_m, keel_depth_m
+from catabot.world.placement import BUOY_MODEL, CLEARANCE_M, footprint_m, keel_depth_m
 from catabot.world.terrain import Terrain
 
 TRIES = 2000
 START_ROOM_M = 10.0  # more water between a drawn start and every vessel's: see README § traffic
 PATH_DRAWS = 5000  # random paths per boat before the plan is refused
 MAX_BUOY_COVER = 0.05
+TRACK_DEPTH_M = 2.0  # water under every point of a boat's track: boats must not run aground
 
 
 @dataclass(frozen=True)
@@ -87,7 +88,7 @@ class Planner:
         for v in scenario.vessels:
             assert v.pose is not None
             self.placed.add(v.pose.x_m, v.pose.y_m, footprint_m(self._model(v.model)))
-        self.buoy_r = footprint_m(self._model("buoy"))
+        self.buoy_r = footprint_m(self._model(BUOY_MODEL))
         # Buoys are moored: a boat must not start on one, nor circle through one every lap.
         self.marks = Discs()  # buoys: x, y, footprint radius
         for b in scenario.buoys:
@@ -96,6 +97,7 @@ class Planner:
         self.footprints: dict[str, float] = {}  # by model, as drawn
         self.overrides = {b.index: b for b in self.cfg.boats}
         self._check_room()
+        self._check_given()
 
     def _check_room(self) -> None:
         """Refuse at once a traffic whose waypoint buoys cannot all be laid clear of each
@@ -116,6 +118,34 @@ class Planner:
                 f"region would keep {covered:.0%} of it; at most {MAX_BUOY_COVER:.0%}: use "
                 "fewer points or boats, a larger traffic.waypoints.region, or buoys: false"
             )
+
+    def _check_given(self) -> None:
+        """Given waypoints, and the legs between them, in water `TRACK_DEPTH_M` deep, each
+        refusal naming its field: a point on land used to end 2000 start draws later in
+        "no free open water for boat 1", which named neither."""
+        if self.terrain is None:
+            return
+        loop = self.cfg.waypoints.mode == "loop"
+        given = [("traffic.waypoints.points", self.cfg.waypoints.points)]
+        given += [(f"traffic.boats.{j}.points", b.points) for j, b in enumerate(self.cfg.boats)]
+        for field, points in given:
+            for k, (x, y) in enumerate(points or ()):
+                try:
+                    self.terrain.check_water(x, y, what="waypoint", depth_m=TRACK_DEPTH_M)
+                except TerrainError as exc:
+                    raise ScenarioError(f"{field}.{k}: {exc}") from None
+            if points and len(points) > 1:
+                self._check_legs(field, np.array(points, dtype=np.float64), loop=loop)
+
+    def _check_legs(self, field: str, points: np.ndarray, *, loop: bool) -> None:
+        closed = np.vstack([points, points[:1]]) if loop else points
+        for k in range(len(closed) - 1):
+            if not self._wet(*densify(closed[k : k + 2], loop=False)):
+                a, b = closed[k].tolist(), closed[k + 1].tolist()
+                raise ScenarioError(
+                    f"{field}: the leg from ({a[0]:g}, {a[1]:g}) to ({b[0]:g}, {b[1]:g}) "
+                    f"crosses land or water under {TRACK_DEPTH_M:g} m deep"
+                )
 
     def plan(self) -> TrafficPlan:
         boats = tuple(self._planned(i) for i in range(self.cfg.count))
@@ -158,6 +188,12 @@ class Planner:
             if boat is not None:
                 self.placed.add(x, y, radius)
                 return boat
+        if behaviour == "waypoints" and (over.points or self.cfg.waypoints.points):
+            raise ScenarioError(
+                f"traffic: boat {index}: no free start in traffic.region from which the way to "
+                f"its first given waypoint stays in {TRACK_DEPTH_M:g} m of water ({TRIES} "
+                f"draws): give it a start (traffic.boats[].x_m, y_m) or a nearer region"
+            )
         raise ScenarioError(f"traffic: no free open water for boat {index} in {TRIES} draws")
 
     def _model(self, ref: str) -> VesselModel:
@@ -217,7 +253,7 @@ class Planner:
             return True
         w, h = self.terrain.size_m
         inside = bool(((xs >= 0) & (xs <= w) & (ys >= 0) & (ys <= h)).all())
-        return inside and bool((self.terrain.depth(xs, ys) > 2.0).all())
+        return inside and bool((self.terrain.depth(xs, ys) > TRACK_DEPTH_M).all())
 
     def _buoys_clear(self, path: Sequence[Point], boat: Boat) -> bool:
         """Random waypoints (each to get a buoy) clear of every start, the boat's own

@@ -6,12 +6,25 @@ from __future__ import annotations
 import json
 import shutil
 from pathlib import Path
+from typing import Any
 
+import jsonschema
 import pytest
 
 from catabot.config.base import ScenarioError
-from catabot.config.load import BUNDLED, TERRAINS, load_scenario
+from catabot.config.load import BUNDLED, TERRAINS, json_schema, load_scenario, parse_scenario
 from tests.paths import BAY
+
+
+def _base() -> dict[str, Any]:
+    sensors = [{"name": "imu", "type": "imu", "rate_hz": 100.0}]
+    return {"name": "test", "duration_s": 1.0, "vessels": [{"id": "ego", "sensors": sensors}]}
+
+
+def _refusal(data: Any) -> str:
+    with pytest.raises(ScenarioError) as caught:
+        parse_scenario(data)
+    return str(caught.value)
 
 
 def test_a_copied_bundled_scenario_still_finds_its_terrain(tmp_path: Path) -> None:
@@ -63,3 +76,48 @@ def test_a_sensors_unknown_parameter_lists_that_types_parameters(tmp_path: Path)
     message = str(caught.value)
     assert "vessels.0.sensors.0.params.gyro_noise: unknown field" in message
     assert "(allowed: gyro_sigma, accel_sigma" in message and "rate_hz" not in message
+
+
+def test_json_schema_is_valid_and_accepts_the_bundled_default() -> None:
+    schema = json_schema()
+    validator_cls = jsonschema.validators.validator_for(schema)
+    validator_cls.check_schema(schema)
+    assert validator_cls is jsonschema.Draft202012Validator
+    default = json.loads((BUNDLED / "default.json").read_text())
+    validator_cls(schema).validate(default)
+    validator_cls(schema).validate(_base())
+    assert schema["title"] == "CataBot scenario"
+    assert "vessels" in schema["required"]
+
+
+def test_json_schema_refuses_what_the_loader_refuses() -> None:
+    validator = jsonschema.Draft202012Validator(json_schema())
+    for mutate in (
+        lambda d: d.update(extra=1),
+        lambda d: d.update(duration_s=-1),
+        lambda d: d.update(clock={"policy": "ignore"}),
+        lambda d: d["vessels"][0]["sensors"][0].update(type="sonar"),
+        lambda d: d.pop("vessels"),
+    ):
+        data = _base()
+        mutate(data)
+        assert not validator.is_valid(data)
+        with pytest.raises(ScenarioError):
+            parse_scenario(data)
+
+
+def test_json_schema_checks_each_sensor_types_params_and_allows_a_schema_hook() -> None:
+    """An editor completes and checks `params` by the sensor's type, and a scenario may
+    name its schema (`"$schema"`, the usual editor hook) without being refused."""
+    validator = jsonschema.Draft202012Validator(json_schema())
+    data = _base()
+    data["vessels"][0]["sensors"] = [
+        {"name": "lidar", "type": "lidar", "rate_hz": 10, "params": {"chanels": 16}}
+    ]
+    (error,) = validator.iter_errors(data)
+    assert "'chanels' was unexpected" in error.message
+    assert "params.chanels: unknown field" in _refusal(data)
+    data["vessels"][0]["sensors"][0]["params"] = {"channels": 16}
+    data["$schema"] = "../scenario.schema.json"
+    assert validator.is_valid(data)
+    assert parse_scenario(data).vessels[0].sensors[0].params["channels"] == 16

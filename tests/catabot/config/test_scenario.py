@@ -7,11 +7,10 @@ import json
 from pathlib import Path
 from typing import Any
 
-import jsonschema
 import pytest
 
 from catabot.config.base import ScenarioError
-from catabot.config.load import BUNDLED, json_schema, load_scenario, parse_scenario
+from catabot.config.load import BUNDLED, load_scenario, parse_scenario
 from catabot.config.scenario import Scenario
 
 
@@ -244,34 +243,6 @@ def test_file_round_trip(tmp_path: Path) -> None:
     path.write_text(json.dumps(_base()))
     assert load_scenario(path) == parse_scenario(_base())
     assert load_scenario(str(path)).ticks == 100
-
-
-def test_json_schema_is_valid_and_accepts_the_bundled_default() -> None:
-    schema = json_schema()
-    validator_cls = jsonschema.validators.validator_for(schema)
-    validator_cls.check_schema(schema)
-    assert validator_cls is jsonschema.Draft202012Validator
-    default = json.loads((BUNDLED / "default.json").read_text())
-    validator_cls(schema).validate(default)
-    validator_cls(schema).validate(_base())
-    assert schema["title"] == "CataBot scenario"
-    assert "vessels" in schema["required"]
-
-
-def test_json_schema_refuses_what_the_loader_refuses() -> None:
-    validator = jsonschema.Draft202012Validator(json_schema())
-    for mutate in (
-        lambda d: d.update(extra=1),
-        lambda d: d.update(duration_s=-1),
-        lambda d: d.update(clock={"policy": "ignore"}),
-        lambda d: d["vessels"][0]["sensors"][0].update(type="sonar"),
-        lambda d: d.pop("vessels"),
-    ):
-        data = _base()
-        mutate(data)
-        assert not validator.is_valid(data)
-        with pytest.raises(ScenarioError):
-            parse_scenario(data)
 
 
 @pytest.mark.parametrize("window", [0, -3, 2.5, "ten"])
