@@ -10,6 +10,7 @@ so a bad command is an error in the stack's own process, not a silent drop in ph
 
 from __future__ import annotations
 
+import math
 from collections.abc import Callable
 from typing import Any
 
@@ -28,6 +29,12 @@ from catabot.bus.messages import (
 Check = Callable[[Any], None]
 PATH_MODES = ("loop", "back_and_forth", "release")
 MAX_WAYPOINTS = 1000  # a path widens the traffic's path table for every boat (10^6 stalled it)
+# Finite is not enough: a surge of 1e308 m/s overflowed the velocity controller to a NaN
+# thrust, refused every tick after the command had been accepted and recorded.
+MAX_SPEED_MPS = 50.0  # faster than any surface vessel CataBot models
+MAX_RATE_RADPS = 2 * math.pi  # a turn a second
+MAX_COORDINATE_M = 1e7  # a waypoint within 10 000 km of the world's origin
+MAX_TOLERANCE_M = 1e3
 
 
 def body_states(ids: tuple[str, ...]) -> Check:
@@ -74,6 +81,10 @@ def thrust(thrusters: int) -> Check:
 def twist(msg: TwistCmd) -> None:
     if not finite((msg.surge, msg.yaw_rate)):
         raise ValueError(f"surge {msg.surge} m/s, yaw rate {msg.yaw_rate} rad/s: not finite")
+    if abs(msg.surge) > MAX_SPEED_MPS:
+        raise ValueError(f"surge {msg.surge} m/s: at most {MAX_SPEED_MPS:g} m/s either way")
+    if abs(msg.yaw_rate) > MAX_RATE_RADPS:
+        raise ValueError(f"yaw rate {msg.yaw_rate} rad/s: at most 2π (6.283) rad/s either way")
 
 
 def waypoints(msg: WaypointsCmd) -> None:
@@ -87,8 +98,15 @@ def waypoints(msg: WaypointsCmd) -> None:
         raise ValueError("points: need x0, y0, x1, ...: an even number of finite values")
     if len(pts) > 2 * MAX_WAYPOINTS:
         raise ValueError(f"{len(pts) // 2} waypoints: at most {MAX_WAYPOINTS} in one path")
+    if max(abs(v) for v in pts) > MAX_COORDINATE_M:
+        raise ValueError(f"points: each coordinate within ±{MAX_COORDINATE_M:g} m of the origin")
     if not (finite((msg.speed, msg.tolerance)) and msg.speed > 0 and msg.tolerance > 0):
         raise ValueError(f"speed {msg.speed} and tolerance {msg.tolerance} must be > 0")
+    if msg.speed > MAX_SPEED_MPS or msg.tolerance > MAX_TOLERANCE_M:
+        raise ValueError(
+            f"speed {msg.speed} m/s and tolerance {msg.tolerance} m: at most "
+            f"{MAX_SPEED_MPS:g} m/s and {MAX_TOLERANCE_M:g} m"
+        )
 
 
 def driven(vessel: str, participant: str, command: str, *, kind: str) -> Check:

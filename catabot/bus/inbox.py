@@ -11,7 +11,8 @@ exactly one of the streams (a put on a wildcard reaches every subscriber under t
 a clocked sample must come from its producer's session (identity.py), carry a tag the
 clock could have granted and the stamp of that tag, and pass its stream's content check; a
 free-running sample must carry tick -1. A refused sample raises `Rejected`, which the
-participant counts (rejections.py).
+participant counts (rejections.py); a clocked order refused for its content still answers
+its tick (`ORDERS`).
 """
 
 from __future__ import annotations
@@ -21,7 +22,7 @@ from collections.abc import Iterable, Mapping, Sequence
 from catabot.bus import codec
 from catabot.bus.clock import Stream
 from catabot.bus.identity import Roster
-from catabot.bus.messages import Message
+from catabot.bus.messages import Message, ThrustCmd, TwistCmd, WaypointsCmd
 from catabot.bus.rejections import Rejected
 from catabot.errors import CataBotError
 
@@ -30,6 +31,11 @@ MAX_PENDING = 10_000  # samples held while their producer's session is not yet k
 MAX_PENDING_BYTES = 64 * 2**20  # and their bytes: 2,500 junk samples of 1 MB took 3.2 GB
 MAX_FREE_BYTES = 64 * 2**10  # a free-running command (a 1000-point path is 18 KB)
 OPEN = 2**62  # an off interval not closed yet
+# A lockstep stack's order that fails its check (a NaN, a thrust beyond 1) is refused like a
+# free one, and its tick counts as answered: every consumer refuses it alike, so every run
+# goes on the same way (the order in force stays), where waiting for a valid one held the
+# run until the deadline blamed the consumer.
+ORDERS = (ThrustCmd, TwistCmd, WaypointsCmd)
 
 
 class Inbox:
@@ -72,7 +78,15 @@ class Inbox:
         msg = _decoded(payload, stream)
         tick = _tick_of(msg)
         self._check_tag(stream, msg, tick, horizon)
-        _check_content(stream, msg)
+        try:
+            _check_content(stream, msg)
+        except Rejected as exc:
+            if stream.period is not None and isinstance(msg, ORDERS):
+                self.latest[key] = tick  # answered, without the order: nobody waits for it
+                raise Rejected(
+                    exc.reason, f"{exc.detail}; tick {tick} goes on without it"
+                ) from None
+            raise
         self.held[key].append(msg)
         self._holding.add(key)
         self.latest[key] = max(self.latest[key], tick)

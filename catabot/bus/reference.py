@@ -54,9 +54,11 @@ EXAMPLES: tuple[tuple[Message, str], ...] = (
 COMMAND_RULES = {
     "thrust_cmd": "one value in [-1, 1] per thruster of the vessel's model, in its thruster "
     "order (a value out of range is refused, not clamped)",
-    "twist_cmd": "finite values; the velocity controller clamps what the thrusters can do",
-    "waypoints_cmd": "an even number (>= 2) of finite coordinates, `speed` and `tolerance` "
-    '> 0, `mode` one of "loop", "back_and_forth", "release" (release: the rest is ignored)',
+    "twist_cmd": "finite values, |surge| <= 50 m/s and |yaw_rate| <= 2π rad/s (refused "
+    "beyond, not clamped); the velocity controller clamps what the thrusters can do",
+    "waypoints_cmd": "an even number (>= 2) of finite coordinates within ±1e7 m, `speed` in "
+    '(0, 50] m/s and `tolerance` in (0, 1000] m, `mode` one of "loop", "back_and_forth", '
+    '"release" (release: the rest is ignored)',
 }
 ARRAY_ROWS = "\n".join(
     f"| {n} | {what} |"
@@ -113,6 +115,38 @@ type code `{codec.ARRAY_EXT}` whose data is, byte by byte:
 the size in bytes). For example the float32 array `[[1.5, -2.0]]`, shape (1, 2), is the ext
 data `{_EXAMPLE_ARRAY[3:].hex(" ")}` (the full msgpack value, with its ext header, is
 `{_EXAMPLE_ARRAY.hex(" ")}`).
+"""
+
+
+RAW_CLIENT = """## Joining without `catabot.client` (another language, raw Zenoh)
+
+A free-running client needs nothing but the keys and payloads above: put a command with
+`tick` -1 whenever you like. A **lockstep** participant (a vessel's `controller`, or a name
+in `clock.external_participants`) must also be known by its session, because every clocked
+sample and ack is believed only from the session that owns its participant name:
+
+1. Query `catabot/<world>/world/info`: the resolved world as JSON (`"v": 1`): `world`,
+   `seed`, `dt_ns`, `clock` (`dt_ns`, `ticks`, `window`, `deadline_s`, `policy`, ...),
+   `participants`, `states` (`key`, `producer`, `period`, `stamp_ticks`), `bodies` (`id`,
+   `kind`, `row`, start `pose`), `vessels` (a list: `id`, `row`, `model`, `thrusters`,
+   `state_key`, `commands` by kind, `controller` with `participant`, `command`, `key` and
+   `period_ticks`, `sensors` with `key`, `message`, `period_ticks`, `frame`, `mount`),
+   `traffic`, `buoys`, `scenario`, and `granted` (the last tick granted, -1 before the start).
+2. Declare the Zenoh liveliness token `catabot/<world>/live/<participant>/<zid>`, `<zid>`
+   being your session's id as Zenoh prints it (lower-case hex): the first token that claims
+   the name binds it to your session.
+3. Put **every** clocked sample and every ack with Zenoh source info naming your session
+   (zenoh-python: `put(payload, source_info=zenoh.SourceInfo(publisher.id, sequence))`):
+   a sample without it is refused as `not from its producer: sender ?`.
+4. Subscribe to `catabot/<world>/clock/tick`: each `tick` message grants every tick up to its
+   `tick`. For each granted tick k: at your controller's ticks (k a multiple of
+   `period_ticks`) put one command tagged `tick` k, `stamp_ns` k x `dt_ns` (it is applied
+   from tick k + 1); then ack on `catabot/<world>/clock/ack/<participant>` with `run` from
+   the tick message and `tick` k, at least every `ack_every` ticks and at the grant's last.
+   An ack says every output up to its tick is out: a stack that acks a tick without its
+   command holds physics and the recorder up until the deadline, which then names them.
+   A command that fails its check (below) is refused and its tick goes on without it.
+5. Stop at `catabot/<world>/clock/end`.
 """
 
 
@@ -184,6 +218,7 @@ def reference() -> str:
         "period with `tick` and `stamp_ns` of the tick it answers; physics applies it from the "
         "next tick on every run.",
         *(message_section(c) for c in commands),
+        RAW_CLIENT.rstrip(),
         "## Example payloads",
         *(example_section(m, w) for m, w in EXAMPLES),
         "## Everything else on the bus",

@@ -36,15 +36,20 @@ class ControllerConfig(Strict):
         return self
 
 
-def check_programs(controllers: Sequence[ControllerConfig | None], taken: Sequence[str]) -> None:
-    """A participant started from a program is one process: not a service's name, and the
-    same program and arguments wherever it is named (it may drive several vessels)."""
+def check_programs(
+    controllers: Sequence[ControllerConfig | None], taken: Sequence[str], *, bridge: str
+) -> None:
+    """A controller is not a CataBot process (one named `physics` passed validation, then
+    held the run: physics waited for its own commands), but `bridge`, the ROS gateway, may
+    drive a vessel for a ROS stack; a participant started from a program is one process,
+    the same program and arguments wherever it is named (it may drive several vessels)."""
     seen: dict[str, tuple[str | None, list[str]]] = {}
     for index, c in enumerate(controllers):
         if c is None:
             continue
         field = f"vessels.{index}.controller"
-        if c.program is not None and c.participant.partition(".")[0] in taken:  # or a shard
+        base = c.participant.partition(".")[0]  # or a shard's
+        if base in taken and (c.program is not None or base != bridge):
             raise FieldProblem(
                 field, f"participant {c.participant!r} is a CataBot process's name; pick another"
             )

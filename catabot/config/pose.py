@@ -13,10 +13,8 @@ import math
 
 from pydantic import Field
 
+from catabot.bus.checks import MAX_RATE_RADPS, MAX_SPEED_MPS
 from catabot.config.base import Angle, Strict
-
-MAX_SPEED_MPS = 50.0  # faster than any surface vessel CataBot models
-MAX_RATE_RADPS = 2 * math.pi
 
 
 class Pose(Strict):

@@ -33,7 +33,7 @@ from catabot.config.base import (
 from catabot.config.controller import ControllerConfig, check_programs
 from catabot.config.environment import CurrentConfig, RainConfig, WindConfig
 from catabot.config.live import SettingChange, check_timeline
-from catabot.config.pose import Pose, Velocity
+from catabot.config.pose import MAX_RATE_RADPS, MAX_SPEED_MPS, Pose, Velocity
 from catabot.config.ros import GATEWAY, RosConfig, check_ros
 from catabot.config.sensors import SENSOR_TYPES, SensorFarmConfig, shard_names
 from catabot.config.task import TaskConfig
@@ -54,10 +54,23 @@ class ClockConfig(Strict):
         [], description="names of stepping participants started outside `catabot run`"
     )
 
+    @field_validator("external_participants")
+    @classmethod
+    def _own_names(cls, names: list[str]) -> list[str]:
+        """Each once, and none a CataBot process's: a stack named `physics` took its place."""
+        taken = [n for n in names if n.partition(".")[0] in SERVICE_NAMES]
+        if taken:
+            raise ValueError(f"{taken[0]!r} is a CataBot process's name; pick another")
+        if len(set(names)) != len(names):
+            raise ValueError(f"each name once (got {names})")
+        return names
+
 
 class TwistStep(Strict):
-    surge_mps: float
-    yaw_rate_radps: float
+    """The velocity set-point a script step gives: the bus's limits (catabot/bus/checks.py)."""
+
+    surge_mps: float = Field(ge=-MAX_SPEED_MPS, le=MAX_SPEED_MPS)
+    yaw_rate_radps: float = Field(ge=-MAX_RATE_RADPS, le=MAX_RATE_RADPS)
 
 
 class ScriptStep(Strict):
@@ -230,7 +243,7 @@ class Scenario(Strict):
 
     @model_validator(mode="after")
     def _controller_programs(self) -> Scenario:
-        check_programs([v.controller for v in self.vessels], SERVICE_NAMES)
+        check_programs([v.controller for v in self.vessels], SERVICE_NAMES, bridge=GATEWAY)
         return self
 
     @model_validator(mode="after")

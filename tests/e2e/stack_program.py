@@ -1,6 +1,7 @@
 """A controller program `catabot run` starts itself (`vessels[].controller.program`): takes
 the flags the launcher passes (catabot/run/programs.py), joins the lockstep as its
-participant and sends differential thrust toward a goal; `--crash-at T` raises at tick T.
+participant and sends differential thrust toward a goal; `--crash-at T` raises at tick T,
+`--nan-at T` sends a NaN thrust for tick T (what a buggy stack in another language may do).
 """
 
 import argparse
@@ -24,6 +25,7 @@ def main() -> None:
     p.add_argument("--participant", required=True)
     p.add_argument("--goal", type=float, nargs=2, default=(30.0, 10.0))
     p.add_argument("--crash-at", type=int, default=-1)
+    p.add_argument("--nan-at", type=int, default=-1)
     args = p.parse_args()
     world = World.resolve(load_scenario(os.environ["CATABOT_SCENARIO"]))
     assert world.scenario.name == args.world
@@ -49,7 +51,7 @@ def main() -> None:
             yaw = float(rotations.yaw_of_quaternions(latest.orientation[me.row : me.row + 1])[0])
             error = math.remainder(math.atan2(args.goal[1] - y, args.goal[0] - x) - yaw, math.tau)
             turn = max(-0.5, min(0.5, 1.2 * error))
-            thrust = (0.6 - turn, 0.6 + turn)
+            thrust = (0.6 - turn, 0.6 + turn) if tick.tick != args.nan_at else (math.nan,) * 2
             stack.publish(commands.key, ThrustCmd(thrust, tick=tick.tick, stamp_ns=tick.stamp_ns))
 
         end = stack.run(step)

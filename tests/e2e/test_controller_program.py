@@ -58,3 +58,15 @@ def test_a_missing_program_is_refused_before_anything_starts(tmp_path: Path) -> 
     code, said, run = _run(tmp_path, _scenario(tmp_path, program="no/such/stack.py"), "missing")
     assert code == 2 and run is None
     assert "vessels.0.controller.program: 'no/such/stack.py' is not a file" in said
+
+
+def test_a_programs_nan_command_is_refused_and_its_tick_goes_on(tmp_path: Path) -> None:
+    """Physics and the recorder waited for a valid command for tick 100 until the deadline,
+    which then blamed physics: now both refuse it, the run goes on with the order in force,
+    and the refusal is on the console."""
+    code, said, run = _run(tmp_path, _scenario(tmp_path, "--nan-at", "100"), "nan")
+    assert code == 0 and run is not None, said
+    assert "refused" in said and "not finite" in said and "tick 100 goes on without it" in said
+    rows = csv_rows(run / "vessel.ego.cmd.thrust.csv")
+    ticks = [int(r[rows[0].index("tick")]) for r in rows[1:]]
+    assert 100 not in ticks and 90 in ticks and 110 in ticks

@@ -4,13 +4,13 @@ from __future__ import annotations
 
 import pytest
 
-from catabot.bus import codec
+from catabot.bus import checks, codec
 from catabot.bus import inbox as inbox_module
 from catabot.bus.clock import ClockError, Policy, Stream, period_in_ticks, ticks_for
 from catabot.bus.identity import Roster
 from catabot.bus.inbox import Inbox
 from catabot.bus.keys import Keys
-from catabot.bus.messages import GpsFix, ImuSample, ThrustCmd, VesselState
+from catabot.bus.messages import GpsFix, ImuSample, ThrustCmd, TwistCmd, VesselState
 from catabot.bus.rejections import Rejected
 
 KEYS = Keys("w")
@@ -291,3 +291,27 @@ def test_samples_held_for_an_unknown_producer_are_bounded_in_bytes(
     assert len(inbox.pending) == 2
     inbox.add(CMD, b"\x00" * 900_000, sender="x")  # what fits is still held
     assert len(inbox.pending) == 3
+
+
+def test_a_lockstep_order_refused_for_its_content_still_answers_its_tick() -> None:
+    """A stack's NaN twist for tick 10 held physics (and the recorder) until the deadline,
+    which then blamed physics: it is refused, and tick 10 goes on without it for every
+    consumer alike; a refused reading of a sensor or a state is still waited for."""
+    twist_key = KEYS.cmd_twist("ego")
+    stream = Stream(twist_key, TwistCmd, "p", 10, check=checks.twist)
+    inbox = Inbox([stream], roster=Roster(ZIDS))
+    bad = codec.encode(TwistCmd(float("nan"), 0.0, 10, 100))
+    with pytest.raises(Rejected, match=r"invalid content: surge nan .*tick 10 goes on without it"):
+        inbox.add(twist_key, bad, sender=ZIDS["p"])
+    assert inbox.missing(11) == [] and inbox.release(11) == {}
+    inbox.add(twist_key, codec.encode(TwistCmd(1.0, 0.0, 20, 200)), sender=ZIDS["p"])
+    assert inbox.release(21) == {twist_key: [TwistCmd(1.0, 0.0, 20, 200)]}
+    fixes = Stream("f", GpsFix, "p", 10, check=_refuse)
+    inbox = Inbox([fixes], roster=Roster(ZIDS))
+    with pytest.raises(Rejected, match="invalid content: no"):
+        inbox.add("f", codec.encode(GpsFix(10, 100, 0.0, 0.0, 0.0, 0.0, 0.0)), sender=ZIDS["p"])
+    assert inbox.missing(11) == ["f"]
+
+
+def _refuse(_msg: object) -> None:
+    raise ValueError("no")

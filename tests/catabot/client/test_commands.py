@@ -37,6 +37,12 @@ def test_good_commands_become_their_messages() -> None:
         (Thrust(["fast", 0.0]), "could not convert string to float"),  # type: ignore[list-item]
         (Twist(INF, 0.0), "twist command for vessel 'ego': surge inf m/s"),
         (Twist(1.0, NAN), "not finite"),
+        (Twist(1e308, 0.0), "surge 1e[+]308 m/s: at most 50 m/s either way"),
+        (Twist(-50.5, 0.0), "at most 50 m/s"),
+        (Twist(1.0, 7.0), r"yaw rate 7.0 rad/s: at most 2π \(6.283\) rad/s"),
+        (Waypoints([(1, 2)], speed=1e308), "speed 1e[+]308 m/s and tolerance 2.0 m: at most 50"),
+        (Waypoints([(1, 2)], tolerance=5e3), "at most 50 m/s and 1000 m"),
+        (Waypoints([(1e300, 2)]), "each coordinate within ±1e[+]07 m of the origin"),
         (Waypoints([(1, 2, 3)]), r"a waypoint is \(x, y\) in m"),
         (Waypoints([(1, 2)], speed=0), "speed 0.0 and tolerance 2.0 must be > 0"),
         (Waypoints([(1, NAN)]), "an even number of finite values"),

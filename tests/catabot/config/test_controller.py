@@ -63,6 +63,9 @@ def test_a_program_found_nowhere_is_left_as_written(tmp_path: Path) -> None:
         ([{"participant": "s", "program": "a.py"}, {"participant": "s"}],
          "vessels.1.controller: participant 's' is named with another program"),
         ([{"participant": "s", "program": ""}], "vessels.0.controller.program"),
+        ([{"participant": "physics"}], "vessels.0.controller: participant 'physics' is a "
+         "CataBot process's name"),  # without a program: physics waited for its own commands
+        ([{"participant": "sensors.1"}], "participant 'sensors.1' is a CataBot process's name"),
     ],
 )  # fmt: skip
 def test_bad_controller_programs_are_named(controllers: list[dict[str, Any]], message: str) -> None:
@@ -75,3 +78,18 @@ def test_one_program_may_drive_several_vessels() -> None:
     same = {"participant": "s", "program": "a.py", "args": ["x"]}
     scenario = parse_scenario(_data(same, same))
     assert [v.controller.program for v in scenario.vessels if v.controller] == ["a.py", "a.py"]
+
+
+@pytest.mark.parametrize(
+    ("names", "message"),
+    [
+        (["s", "s"], "clock.external_participants: each name once (got ['s', 's'])"),
+        (["recorder"], "clock.external_participants: 'recorder' is a CataBot process's name"),
+    ],
+)
+def test_external_participants_are_named_once_and_not_as_a_service(
+    names: list[str], message: str
+) -> None:
+    with pytest.raises(ScenarioError) as info:
+        parse_scenario({"clock": {"external_participants": names}, "vessels": [{"id": "ego"}]})
+    assert message in str(info.value)

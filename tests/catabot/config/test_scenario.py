@@ -290,12 +290,18 @@ def test_true_false_or_text_is_not_a_number(
         (("wind",), {"speed_mps": 3, "toward_rad": -270}, "wind.toward_rad: angles are radians"),
         (("water",), {"waves": {"direction_rad": 7}}, "waves.direction_rad: angles are radians"),
         (("water",), {"waves": {"peak_period_s": 8000}}, "peak_period_s: must be <= 30"),
+        (
+            ("vessels", 0, "script"),
+            [{"t_s": 0, "twist": {"surge_mps": 1e308, "yaw_rate_radps": 0}}],
+            "script.0.twist.surge_mps: must be <= 50 (got 1e+308)",
+        ),
     ],
 )
 def test_angles_in_degrees_and_periods_in_ms_are_caught(
     section: tuple[Any, ...], value: Any, message: str
 ) -> None:
-    """Unit mistakes that used to run: a yaw of 90 rad, a wave period of 8000 s."""
+    """Unit mistakes that used to run: a yaw of 90 rad, a wave period of 8000 s, a
+    set-point of 1e308 m/s (the controller's thrust overflowed to NaN)."""
     assert message in _error(_with(_base(), section, value))
 
 
