@@ -2,7 +2,8 @@
 
 Scripted steps are applied at the first tick boundary at or after their time; a command
 from the bus replaces the scripted one from the next tick on and stays until another
-arrives (the vessel keeps the last order it was given, as a real autopilot does).
+arrives (the vessel keeps the last order it was given, as a real autopilot does); a release
+hands it back to the script step in force, or to rest before its first step.
 
 Traffic boats: the traffic service's set-points arrive in one lockstep `TwistBatch` per
 tick on `world/cmd/twist`. Precedence, outside > lockstep set-point > script, is
@@ -20,7 +21,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
-from catabot.bus.messages import Message, ThrustCmd, TwistBatch, TwistCmd
+from catabot.bus.messages import Message, ThrustCmd, TwistBatch, TwistCmd, WaypointsCmd
 from catabot.config.scenario import ScriptStep
 from catabot.world.orders import Orders
 from catabot.world.world import Body
@@ -50,6 +51,7 @@ class CommandBook:
         self.scripts = {v.id: v.script for v in vessels}  # in time order
         self.times = {v.id: v.script_ns for v in vessels}
         self.scripted = [v.id for v in vessels if v.script]
+        self.released: set[str] = set()  # handed back this tick (`take`)
         self.book = Orders()  # who holds each vessel: outside commands, set-points
         self.set_point = np.zeros((len(self.ids), 2))  # (surge m/s, yaw rate rad/s)
         self.has_set_point = np.zeros(len(self.ids), dtype=bool)
@@ -65,7 +67,12 @@ class CommandBook:
             surge, rate = self.set_point[i].tolist()
             return Order(twist=(surge, rate))
         index = bisect.bisect_right(self.times[vessel], stamp_ns) - 1
-        return _from_step(self.scripts[vessel][index]) if index >= 0 else Order()
+        return _from_step(self.scripts[vessel][index]) if index >= 0 else self._rest(vessel)
+
+    def _rest(self, vessel: str) -> Order:
+        """No step in force yet: at rest, as at the start (not the thrust of a command that
+        held it until a release)."""
+        return Order(thrust=(0.0,) * self.thrusters[vessel])
 
     def orders(self, stamp_ns: int) -> tuple[dict[int, tuple[float, ...]], NDArray[np.intp], Array]:
         """Every vessel's order: thrust values by row, then the rows under velocity control
@@ -75,6 +82,10 @@ class CommandBook:
         for vid in self.scripted:
             if not follow[self.row[vid]]:
                 _place(self.order(vid, stamp_ns), self.row[vid], target, follow, thrust)
+        for vid in self.released.difference(self.scripted):  # no script: back to rest
+            if not follow[self.row[vid]]:
+                _place(self._rest(vid), self.row[vid], target, follow, thrust)
+        self.released.clear()
         for vid, held in self.book.held.items():
             _place(_from_command(held), self.row[vid], target, follow, thrust)
         rows = np.flatnonzero(follow)
@@ -103,7 +114,8 @@ class CommandBook:
         thruster, a finite twist: catabot/bus/checks.py). A lockstep twist (tick >= 0) is a
         set-point; an outside command (tick -1) takes the vessel over."""
         for msg in msgs:
-            self.book.heard(vessel, msg)
+            if self.book.heard(vessel, msg) and isinstance(msg, WaypointsCmd):
+                self.released.add(vessel)
             if isinstance(msg, TwistCmd) and msg.tick >= 0:
                 self.set_point[self.row[vessel]] = (msg.surge, msg.yaw_rate)
                 self.has_set_point[self.row[vessel]] = True

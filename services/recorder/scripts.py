@@ -9,7 +9,9 @@ it at). Steps that fall on one tick: the last, the one physics follows. A vessel
 command from the bus has taken over no longer follows its script (physics' precedence:
 an outside thrust or twist until a `WaypointsCmd` hands it back, a lockstep controller's
 set-point from then on), so its later steps are not written as if it had obeyed them; nor
-are a traffic boat's set-points while an outside command holds it (`taken`).
+are a traffic boat's set-points while an outside command holds it (`taken`). A release
+hands a scenario vessel back: the step in force (or rest before the first) is written at
+the tick physics resumes it (`resumed`).
 """
 
 from __future__ import annotations
@@ -31,10 +33,15 @@ class ScriptedCommands:
     def __init__(self, world: World, orders: Orders) -> None:
         dt = world.scenario.dt_ns
         self._due: dict[int, dict[str, ScriptStep]] = {}
+        self._steps: dict[str, list[tuple[int, ScriptStep]]] = {}  # a vessel's, by tick
+        self._thrusters = {
+            v.id: len(v.model.thrusters) for v in world.vessels if v.kind == "vessel"
+        }
         for vessel in world.vessels:
             for step, t_ns in zip(vessel.script, vessel.script_ns, strict=True):
                 tick = -(-t_ns // dt)  # the first tick at or after the step's time
                 self._due.setdefault(tick, {})[vessel.id] = step
+                self._steps.setdefault(vessel.id, []).append((tick, step))
         self._keys = world.keys
         self._orders = orders
 
@@ -45,19 +52,35 @@ class ScriptedCommands:
         held = self._orders.held
         return np.fromiter((b in held for b in ids), dtype=bool, count=len(ids))
 
+    def resumed(self, vessel: str, tick: int, stamp_ns: int) -> tuple[str, Message] | None:
+        """The order a scenario vessel released at `tick` follows again (physics' rule): the
+        script step in force, or rest before its first step; None when a step begins at
+        `tick` itself (`due` writes it)."""
+        if vessel not in self._thrusters:
+            return None
+        begun = [(at, step) for at, step in self._steps.get(vessel, []) if at <= tick]
+        if begun and begun[-1][0] == tick:
+            return None
+        rest = ScriptStep(t_s=0.0, thrust=[0.0] * self._thrusters[vessel])
+        return self._command(vessel, begun[-1][1] if begun else rest, tick, stamp_ns)
+
     def due(self, tick: int, stamp_ns: int) -> list[tuple[str, Message]]:
         """(stream, command) of every step that takes effect at `tick`, for the vessels that
         still follow their script."""
-        out: list[tuple[str, Message]] = []
-        for vessel, step in self._due.get(tick, {}).items():
-            if not self._orders.follows_script(vessel):
-                continue
-            if step.thrust is not None:
-                key = self._keys.cmd_thrust(vessel)
-                out.append((key, ThrustCmd(tuple(step.thrust), tick=tick, stamp_ns=stamp_ns)))
-            elif step.twist is not None:
-                key = self._keys.cmd_twist(vessel)
-                twist = step.twist
-                cmd = TwistCmd(twist.surge_mps, twist.yaw_rate_radps, tick=tick, stamp_ns=stamp_ns)
-                out.append((key, cmd))
-        return [(self._keys.relative(key), cmd) for key, cmd in out]
+        return [
+            self._command(vessel, step, tick, stamp_ns)
+            for vessel, step in self._due.get(tick, {}).items()
+            if self._orders.follows_script(vessel)
+        ]
+
+    def _command(
+        self, vessel: str, step: ScriptStep, tick: int, stamp_ns: int
+    ) -> tuple[str, Message]:
+        """(stream, command) of one step, as the command of its kind would be sent."""
+        if step.thrust is not None:
+            cmd: Message = ThrustCmd(tuple(step.thrust), tick=tick, stamp_ns=stamp_ns)
+            return self._keys.relative(self._keys.cmd_thrust(vessel)), cmd
+        assert step.twist is not None
+        twist = step.twist
+        cmd = TwistCmd(twist.surge_mps, twist.yaw_rate_radps, tick=tick, stamp_ns=stamp_ns)
+        return self._keys.relative(self._keys.cmd_twist(vessel)), cmd

@@ -86,18 +86,23 @@ class Recorder:
                 elif isinstance(msg, TwistBatch):
                     self._write_block(stream, msg, self._twists)
                 else:
-                    self._heard(key, msg)
                     self._write(stream, _stamped(msg, tick))
+                    self._heard(key, msg, tick)
         for change in changes_of(tick.settings):  # what took effect at this tick: an input
             record = SettingsChange(tick.tick, tick.stamp_ns, change.key, change.value)
             self._write(self.changes_stream, record)
 
-    def _heard(self, key: str, msg: Message) -> None:
+    def _heard(self, key: str, msg: Message, tick: Tick) -> None:
         """A command for a vessel: the order physics follows from now on, so an overridden
-        script's steps are not written and the thrust metered is the one in force."""
+        script's steps are not written and the thrust metered is the one in force; after a
+        release, the script's step (or rest) it follows again, written as a command."""
         vessel = self.commanded.get(key)
         if vessel is not None and self.orders.heard(vessel, msg):
             self.metrics.order_changed(vessel)
+            if isinstance(msg, WaypointsCmd):
+                resumed = self.scripts.resumed(vessel, tick.tick, tick.stamp_ns)
+                if resumed is not None:
+                    self._write(*resumed)
 
     def _twists(self, batch: TwistBatch) -> Block:
         """The set-points of the boats that follow them (not those an outside command holds)."""

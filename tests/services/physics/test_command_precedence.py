@@ -27,3 +27,19 @@ def test_a_waypoints_command_hands_the_boat_back() -> None:
     release = WaypointsCmd(points=(), speed=0.0, tolerance=0.0, mode="release")
     book.take("boat_000", [release])
     assert book.order("boat_000", 0) == Order(twist=(5.0, 0.26))
+
+
+def test_a_released_vessel_rests_until_its_script_says_otherwise() -> None:
+    """An outside thrust held until a release used to stay on the thrusters of a vessel with
+    no script step in force (none yet, or no script): it was never unset."""
+    book = CommandBook(vessels({"id": "plain"}, {"id": "late", "script": [
+        {"t_s": 1.0, "thrust": [0.4, 0.4]}]}))  # fmt: skip
+    release = WaypointsCmd(points=(), speed=0.0, tolerance=0.0, mode="release")
+    for vid in ("plain", "late"):
+        book.take(vid, [ThrustCmd((-0.5, -0.5))])
+    assert book.orders(0)[0] == {0: (-0.5, -0.5), 1: (-0.5, -0.5)}
+    book.take("plain", [release])
+    book.take("late", [release])
+    assert book.orders(10_000_000)[0] == {0: (0.0, 0.0), 1: (0.0, 0.0)}
+    assert book.orders(20_000_000)[0] == {1: (0.0, 0.0)}  # plain: set once, then left
+    assert book.orders(1_000_000_000)[0] == {1: (0.4, 0.4)}

@@ -46,7 +46,7 @@ def test_twist_batch_sets_each_boats_order_and_skips_bad_entries(
     batch = TwistBatch(3, 30, boats, np.array([1.0, np.nan]), np.array([0.1, 0.2]))
     book.take_batch(batch, boats)
     assert book.order("boat_000", 40) == Order(twist=(1.0, 0.1))
-    assert book.order("boat_001", 40) == Order()  # non-finite: refused, nothing adopted
+    assert book.order("boat_001", 40) == Order(thrust=(0.0, 0.0))  # refused: still at rest
     assert "non-finite for ['boat_001']" in caplog.text
     assert book.order("boat_000", 50) == Order(twist=(1.0, 0.1))  # held until the next
 

@@ -51,3 +51,16 @@ def test_a_boat_an_outside_command_holds_is_marked_until_a_path_or_release() -> 
     assert scripts.taken(boats).tolist() == [False, True, False]
     orders.heard("boat_001", WaypointsCmd((), 1.0, 1.0, "release"))
     assert not scripts.taken(boats).any()
+
+
+def test_a_release_writes_the_order_the_vessel_follows_again() -> None:
+    """After a release physics follows the script's step in force (or rest before the
+    first): the thrust CSV used to keep the outside command as its last row."""
+    world = World.resolve(parse_scenario({"vessels": [
+        {"id": "ego", "script": SCRIPT}, {"id": "plain"}]}))  # fmt: skip
+    scripts = ScriptedCommands(world, Orders())
+    assert scripts.resumed("ego", 3, 30) == ("vessel/ego/cmd/thrust", ThrustCmd((0.3, 0.3), 3, 30))
+    assert scripts.resumed("ego", 9, 90) == ("vessel/ego/cmd/twist", TwistCmd(1.0, -0.5, 9, 90))
+    assert scripts.resumed("ego", 5, 50) is None  # a step begins then: `due` writes it
+    assert scripts.resumed("plain", 3, 30) == (
+        "vessel/plain/cmd/thrust", ThrustCmd((0.0, 0.0), 3, 30))  # fmt: skip
