@@ -97,6 +97,10 @@ class Keys:
         base = f"{self.prefix}/world/cmd/twist"
         return base if shard is None else f"{base}/{shard:02d}"  # sorted = shard order
 
+    def vessel_commands(self) -> str:
+        """Every command key of every vessel, named or not (physics' watch for strays)."""
+        return f"{self.prefix}/vessel/*/cmd/*"
+
     def cmd_thrust(self, vessel: str) -> str:
         return f"{self.prefix}/vessel/{check_name('vessel', vessel)}/cmd/thrust"
 

@@ -96,6 +96,18 @@ class Participant(Outputs):
 
         return on_sample
 
+    def watch_strays(self, pattern: str, why: Callable[[str], str]) -> None:
+        """Refuse, by `why(key)`, puts under `pattern` on no stream of this participant: a
+        command to a vessel that does not exist reached no subscriber, and nobody said so."""
+        known = frozenset(self.inbox.keys)
+
+        def on_sample(sample: zenoh.Sample) -> None:
+            key = str(sample.key_expr)
+            if key not in known:  # the streams' own samples: a set lookup, nothing queued
+                self.events.put(("stray", key, why(key).encode(), sender_of(sample)))
+
+        self._subs.append(self.session.declare_subscriber(pattern, on_sample))
+
     def _on_live(self, sample: zenoh.Sample) -> None:
         kind = "join" if sample.kind == zenoh.SampleKind.PUT else "leave"
         self.events.put((kind, str(sample.key_expr), b"", ""))
@@ -123,6 +135,8 @@ class Participant(Outputs):
         kind, key, payload, sender = event
         if kind == "data":
             self._take_data(key, payload, sender)
+        elif kind == "stray":
+            self.rejections.add(key, Rejected("no such stream", payload.decode()))
         elif kind in ("tick", "end"):
             return self._take_clock(event)
         return None

@@ -56,6 +56,14 @@ class PhysicsService:
         self.guidance = guidance if guidance.key != streams.states.key else None
         self.scenario, self.specs = world.scenario, live.keys_of(world.scenario)
         self.participant = ctx.participant(self.streams)
+        self.participant.watch_strays(ctx.keys.vessel_commands(), self._stray)
+
+    def _stray(self, key: str) -> str:
+        """Why a command key physics does not take is none: no such vessel, or command."""
+        _, vessel, _, command = self.keys.relative(key).split("/")
+        if vessel not in self.book.row:
+            return f"no vessel {vessel!r} in this world ({_some(self.book.ids)})"
+        return f"no command {command!r} (a vessel takes thrust, twist, waypoints)"
 
     def step(self, tick: Tick, inputs: Inputs) -> None:
         for change in changes_of(tick.settings):
@@ -102,6 +110,11 @@ class PhysicsService:
         for i in self.participant.watched_among(self.state_keys):
             row = (tuple(getattr(v, f)[i].tolist()) for f in FIELDS)
             self.participant.publish(self.state_keys[i], VesselState(tick.tick, stamp, *row))
+
+
+def _some(ids: tuple[str, ...], shown: int = 5) -> str:
+    head = ", ".join(ids[:shown])
+    return f"its vessels: {head}" + (f" and {len(ids) - shown} more" if len(ids) > shown else "")
 
 
 def build(ctx: ServiceContext) -> Built:

@@ -44,3 +44,27 @@ def test_the_first_refusal_of_each_kind_reaches_the_console_once(tmp_path: Path)
     ), said[0]
     log = (only_run_dir(out) / "log" / "physics.log").read_text()
     assert log.count(f"refused a sample on {key}: malformed") >= 2  # the log says it again
+
+
+def test_a_command_to_no_vessel_or_of_no_kind_is_said_not_dropped_unheard(tmp_path: Path) -> None:
+    """`vessel/ghost/cmd/thrust` and `vessel/ego/cmd/pose` reached no subscriber: a typo in
+    an id was silent. Physics watches every command key and names what is wrong."""
+    endpoint = f"tcp/127.0.0.1:{free_port()}"
+    data = basic_scenario("stray", duration_s=4.0)
+    data["clock"] = {"realtime_factor": 2.0}
+    out = tmp_path / "out"
+    proc = start("run", str(scenario_file(tmp_path, data)), "--out", str(out), "--quiet",
+                 "--listen", endpoint)  # fmt: skip
+    wait_for_line(proc, "zenoh:")
+    keys = Keys("stray")
+    ghost, pose = keys.cmd_thrust("ghost"), f"{keys.prefix}/vessel/ego/cmd/pose"
+    with open_session(Connection(connect=(endpoint,))) as session:
+        for key in (ghost, pose):
+            matched_publisher(session, key).put(b"anything")  # once physics' watch is there
+            time.sleep(0.3)
+    stdout, stderr = proc.communicate(timeout=60)
+    assert proc.returncode == 0, stderr
+    said = stdout + stderr
+    assert f"physics refused {ghost}: no such stream: no vessel 'ghost' in this world " in said
+    assert "(its vessels: ego)" in said
+    assert f"physics refused {pose}: no such stream: no command 'pose' (a vessel takes" in said
