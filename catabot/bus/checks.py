@@ -117,7 +117,7 @@ def driven(vessel: str, participant: str, command: str, *, kind: str) -> Check:
     def check(_msg: Any) -> None:
         raise ValueError(
             f"vessel {vessel!r} is driven in lockstep by {participant!r} ({command}): a free "
-            f"{kind} would change the run"
+            f"{kind} command would change the run"
         )
 
     return check

@@ -111,7 +111,9 @@ def decode(payload: bytes | bytearray | memoryview, expect: type[M]) -> M:
     body = unpack(payload)
     if not isinstance(body, dict):
         raise CodecError(f"payload is a {type(body).__name__}, expected a map")
-    version = body.pop("v", None)
+    if "v" not in body:
+        raise CodecError(f'no "v": every payload carries the schema version, {SCHEMA_VERSION}')
+    version = body.pop("v")
     if version != SCHEMA_VERSION:
         raise CodecError(f"schema version {version!r} is not supported (this is {SCHEMA_VERSION})")
     wire = body.pop("type", None)

@@ -122,6 +122,8 @@ class Inbox:
             if tick != -1:
                 raise Rejected("tick of a free-running sample", f"tick {tick}, not -1")
             return
+        if tick == self.latest[stream.key] >= 0:
+            raise Rejected("second sample for one tick", f"tick {tick}: one a tick at most")
         if not stream.is_due(tick) or tick >= horizon or tick <= self.latest[stream.key]:
             raise Rejected(
                 "tag out of the window",

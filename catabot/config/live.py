@@ -61,12 +61,14 @@ class Spec:
 
 
 GLOBAL = {
-    "rain": Spec("rain", "a rate in mm/h from 0 to 50 (rain.rate_mm_h)"),
+    "rain": Spec("rain", "a rate in mm/h from 0 to 50 (the scenario's rain.rate_mm_h)"),
     "wind.speed_mps": Spec("wind.speed_mps", "a speed in m/s from 0 to 80"),
     "wind.toward_rad": Spec(
         "wind.toward_rad", "an angle in rad the wind blows toward (0 east, 1.5708 north)"
     ),
-    "current": Spec("current", "[east, north] in m/s, at most 10 m/s (water.current)"),
+    "current": Spec(
+        "current", "[east, north] in m/s, at most 10 m/s (the scenario's water.current)"
+    ),
     "waves": Spec("waves", f"a wave preset: one of {', '.join(map(repr, PRESETS))}"),
 }
 ON_OFF = "true or false"

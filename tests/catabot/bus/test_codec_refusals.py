@@ -99,6 +99,11 @@ def test_unknown_schema_version(version: object) -> None:
         body["v"] = version
     with pytest.raises(CodecError) as info:
         codec.decode(_payload(body), Ack)
+    if version is None:
+        assert (
+            str(info.value) == f'no "v": every payload carries the schema version, {SCHEMA_VERSION}'
+        )
+        return
     assert f"schema version {version!r} is not supported" in str(info.value)
     assert f"this is {SCHEMA_VERSION}" in str(info.value)
 

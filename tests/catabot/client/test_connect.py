@@ -119,7 +119,9 @@ def test_unknown_vessels_sensors_and_participants(served: Served) -> None:
             CommandError, match="twist is driven in lockstep by participant 'stack'"
         ):
             sim.vessel("ego").send(Twist(1.0, 0.0))
-        with pytest.raises(CommandError, match=r"'stack' \(twist\): a free thrust would change"):
+        with pytest.raises(
+            CommandError, match=r"'stack' \(twist\): a free thrust command would change"
+        ):
             sim.vessel("ego").send(Thrust([0.5, 0.5]))
 
 
