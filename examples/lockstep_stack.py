@@ -12,7 +12,7 @@ python examples/lockstep_stack.py --connect tcp/127.0.0.1:7447 --goal 40 20
 
 import math
 
-from common import parser
+from common import clear_errors, parser
 from guidance import yaw_of
 
 from catabot.client import Client, Observation, Thrust
@@ -42,7 +42,7 @@ def main() -> None:
         seen[0] = (x, y)
         return Thrust(decide(x, y, yaw_of(obs.state.orientation), goal))
 
-    with Client.from_args(args) as sim:
+    with clear_errors("lockstep_stack.py"), Client.from_args(args) as sim:
         end = sim.run_lockstep(args.name, step, vessel=args.vessel)
         x, y = seen[0]
         print(f"run ended at tick {end.tick} ({end.reason}); {args.vessel} at ({x:.2f}, {y:.2f})")
