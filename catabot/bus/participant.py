@@ -302,6 +302,8 @@ class Participant(Outputs):
 
     def _finish(self, end: End, on_end: EndFn | None) -> End:
         """Collect samples due up to the last complete tick, bounded in time."""
+        if end.error:
+            self._waited(self.next_tick)
         limit = time.monotonic() + (self.drain_s if not end.error else 1.0)
         while self.inbox.missing(end.tick + 1) and time.monotonic() < limit:
             try:
@@ -317,6 +319,15 @@ class Participant(Outputs):
         if on_end is not None:
             on_end(end, self.inbox.release(end.tick + 1))
         return end
+
+    def _waited(self, tick: int) -> None:
+        """Say whose data held this participant at a fault: the deadline names those that
+        did not ack, and one waiting for a stack that acked a tick without its command
+        looked hung (the launcher repeats this line in the cause)."""
+        missing = self.inbox.missing(tick)
+        if missing:
+            whose = ", ".join(f"{key} from {self.inbox.streams[key].producer!r}" for key in missing)
+            log.error("%s waited at tick %d for %s", self.name, tick, whose)
 
     def stop(self) -> None:
         """Make `run()` raise `Stopped` at its next event (from another thread: a client

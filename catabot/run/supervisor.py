@@ -64,6 +64,7 @@ class Child:
         self.fatal = ""  # the first CRITICAL line: the process's own fatal fault
         self.fatal_at = 0.0
         self.last_line = ""  # a program's last line, for its fatal fault
+        self.waited = ""  # whose data it waited for when the run failed (Participant._waited)
         self.refused: list[str] = []  # console lines: the first refusal of each kind
         self._refusals: set[tuple[str, str]] = set()
         self._relay = threading.Thread(target=self._copy_stderr, daemon=True)
@@ -77,6 +78,8 @@ class Child:
             if " CRITICAL " in line and not self.fatal:
                 self.fatal, self.fatal_at = line.split(" CRITICAL ", 1)[1].strip(), time.monotonic()
             self.last_line = line.strip() or self.last_line
+            if " waited at tick " in line and not self.waited:
+                self.waited = line.split(" ERROR ", 1)[-1].strip()
             self._note_refusal(line)
             log = _write(log, line, self)
 
@@ -277,7 +280,8 @@ class Supervisor:
                 state = {"T": "stopped by a signal", "t": "stopped by a debugger"}.get(
                     child.state(), "alive but not stepping"
                 )
-                self._kill(child, f"participant {name!r} hung ({state}): {error}")
+                waited = f"; {child.waited}" if child.waited else ""
+                self._kill(child, f"participant {name!r} hung ({state}): {error}{waited}")
 
     def _reap(self) -> None:
         """Services end by themselves after the conductor's End (15 s allows the recorder's

@@ -1,7 +1,8 @@
 """A controller program `catabot run` starts itself (`vessels[].controller.program`): takes
 the flags the launcher passes (catabot/run/programs.py), joins the lockstep as its
 participant and sends differential thrust toward a goal; `--crash-at T` raises at tick T,
-`--nan-at T` sends a NaN thrust for tick T (what a buggy stack in another language may do).
+`--nan-at T` sends a NaN thrust for tick T and `--skip-at T` none (yet acks the tick): what
+a buggy stack in another language may do.
 """
 
 import argparse
@@ -26,6 +27,7 @@ def main() -> None:
     p.add_argument("--goal", type=float, nargs=2, default=(30.0, 10.0))
     p.add_argument("--crash-at", type=int, default=-1)
     p.add_argument("--nan-at", type=int, default=-1)
+    p.add_argument("--skip-at", type=int, default=-1)
     args = p.parse_args()
     world = World.resolve(load_scenario(os.environ["CATABOT_SCENARIO"]))
     assert world.scenario.name == args.world
@@ -45,7 +47,7 @@ def main() -> None:
             for batch in inputs.get(world.streams.states.key, []):
                 assert isinstance(batch, BodyStates)
                 latest = batch
-            if tick.tick % commands.period:
+            if tick.tick % commands.period or tick.tick == args.skip_at:
                 return
             x, y, _ = latest.position[me.row].tolist()
             yaw = float(rotations.yaw_of_quaternions(latest.orientation[me.row : me.row + 1])[0])

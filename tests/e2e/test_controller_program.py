@@ -11,8 +11,8 @@ from conftest import basic_scenario, catabot, csv_rows, files_of, only_run_dir, 
 PROGRAM = "tests/e2e/stack_program.py"  # from the repository root: the current directory
 
 
-def _scenario(tmp: Path, *args: str, program: str = PROGRAM) -> Path:
-    data: dict[str, Any] = basic_scenario("program", duration_s=3.0)
+def _scenario(tmp: Path, *args: str, program: str = PROGRAM, **top: Any) -> Path:
+    data: dict[str, Any] = basic_scenario("program", duration_s=3.0, **top)
     data["vessels"][0] = {
         "id": "ego",
         "pose": {"x_m": 0.0, "y_m": 0.0, "yaw_rad": 0.0},
@@ -70,3 +70,14 @@ def test_a_programs_nan_command_is_refused_and_its_tick_goes_on(tmp_path: Path) 
     rows = csv_rows(run / "vessel.ego.cmd.thrust.csv")
     ticks = [int(r[rows[0].index("tick")]) for r in rows[1:]]
     assert 100 not in ticks and 90 in ticks and 110 in ticks
+
+
+def test_a_program_that_acks_a_tick_without_its_command_is_named(tmp_path: Path) -> None:
+    """Physics waits for the command the stack owed; the deadline names physics (it did not
+    ack), and the cause now says whose data it waited for."""
+    scenario = _scenario(tmp_path, "--skip-at", "100", clock={"deadline_s": 2.0})
+    code, said, _ = _run(tmp_path, scenario, "skip")
+    assert code == 1, said
+    cause = next(line for line in said.splitlines() if line.startswith("run failed:"))
+    assert "missed the 2 s deadline of tick 101" in cause, cause
+    assert "waited at tick 101 for catabot/program/vessel/ego/cmd/thrust from 'stack'" in cause
