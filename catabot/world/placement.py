@@ -11,10 +11,14 @@ import math
 from collections.abc import Iterator
 from contextlib import contextmanager
 
+import numpy as np
+
 from catabot.config.base import ScenarioError
 from catabot.config.scenario import Pose, Scenario
 from catabot.config.terrain import TerrainError
 from catabot.config.vessel import VesselModel, load_vessel_model
+from catabot.world.hulls import box_gaps, footprints
+from catabot.world.rotations import turn_xy
 from catabot.world.terrain import Terrain
 
 CLEARANCE_M = 0.5  # a vessel's keel above the seabed at its start
@@ -37,14 +41,20 @@ def footprint_m(model: VesselModel) -> float:
 
 def resolve_poses(scenario: Scenario, terrain: Terrain | None) -> Scenario:
     """Every vessel with a pose: given ones checked, missing ones placed in open water."""
-    placed: list[tuple[float, float, float]] = []
+    models = [load_vessel_model(v.model) for v in scenario.vessels]
+    placed = [  # given poses first: a vessel placed for you keeps clear of later ones too
+        (v.pose.x_m, v.pose.y_m, footprint_m(m))
+        for v, m in zip(scenario.vessels, models, strict=True)
+        if v.pose is not None
+    ]
     vessels = []
-    for index, vessel in enumerate(scenario.vessels):
-        model = load_vessel_model(vessel.model)
-        pose = vessel.pose or _choose(index, model, terrain, placed)
+    for index, (vessel, model) in enumerate(zip(scenario.vessels, models, strict=True)):
+        pose = vessel.pose
+        if pose is None:
+            pose = _choose(index, model, terrain, placed)
+            placed.append((pose.x_m, pose.y_m, footprint_m(model)))
         if terrain is not None:
             _check(index, vessel.id, pose, model, terrain)
-        placed.append((pose.x_m, pose.y_m, footprint_m(model)))
         vessels.append(vessel.model_copy(update={"pose": pose}))
     return scenario.model_copy(update={"vessels": vessels})
 
@@ -68,6 +78,32 @@ def check_marks(scenario: Scenario, terrain: Terrain | None) -> None:
         for k, (x, y) in enumerate(task.route or () if task is not None else ()):
             with _as_field(f"{where}.route.{k} ({v.id})"):
                 terrain.check_water(x, y, what="route point")
+
+
+def check_apart(scenario: Scenario) -> None:
+    """No hull starts inside another or on a buoy (plan-view boxes, physics' collision
+    shapes): two vessels given one pose collided at t = 0, and the run said nothing."""
+    named = [
+        (f"vessels.{i}.pose ({v.id})", v.model, v.pose) for i, v in enumerate(scenario.vessels)
+    ]
+    named += [(f"buoys.{i} ({b.id})", BUOY_MODEL, Pose(x_m=b.x_m, y_m=b.y_m))
+              for i, b in enumerate(scenario.buoys)]  # fmt: skip
+    if len(named) < 2:
+        return
+    offset, half = footprints([load_vessel_model(model) for _, model, _ in named])
+    poses = [pose for _, _, pose in named]
+    assert all(p is not None for p in poses), "resolve_poses placed every vessel"
+    heading = np.array([p.yaw_rad for p in poses if p is not None])
+    xy = np.array([(p.x_m, p.y_m) for p in poses if p is not None])
+    a, b = np.triu_indices(len(named), k=1)
+    gaps = box_gaps(xy + turn_xy(offset, heading), heading, half, a, b)
+    over = np.flatnonzero(gaps < 0.0)
+    if over.size:
+        k = int(over[0])
+        raise ScenarioError(
+            f"{named[b[k]][0]}: starts overlapping {named[a[k]][0]} by {-gaps[k]:.2f} m "
+            "(their hulls as seen from above): start them apart"
+        )
 
 
 @contextmanager

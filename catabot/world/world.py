@@ -38,7 +38,7 @@ from catabot.config.sensors import shard_names
 from catabot.config.vessel import VesselModel, load_vessel_model
 from catabot.world import rotations
 from catabot.world.environment.current import CurrentField
-from catabot.world.placement import BUOY_MODEL, check_marks, resolve_poses
+from catabot.world.placement import BUOY_MODEL, check_apart, check_marks, resolve_poses
 from catabot.world.shapes import ShapeMesh, vessel_mesh
 from catabot.world.shards import blocks, sensor_owners
 from catabot.world.streams import Streams
@@ -115,6 +115,7 @@ class World:
         current = CurrentField.from_config(scenario.water.current)
         scenario = resolve_poses(scenario, terrain)
         check_marks(scenario, terrain)
+        check_apart(scenario)
         plan = plan_traffic(scenario, terrain, progress)
         bodies = _bodies(scenario, plan)
         keys = Keys(scenario.name)

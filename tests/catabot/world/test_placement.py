@@ -1,15 +1,19 @@
 """Marks in water: buoys, a task's goal and route, and given traffic waypoints on land or
 off the terrain are refused before anything starts, each naming its field (the bundled bay:
-an island about x 416-480 m, y 240-290 m, the north shore from y 470 m)."""
+an island about x 416-480 m, y 240-290 m, the north shore from y 470 m); hulls do not start
+inside each other or on a buoy."""
 
 from __future__ import annotations
 
+import re
 from typing import Any
 
 import pytest
 
 from catabot.config.base import ScenarioError
 from catabot.config.load import parse_scenario
+from catabot.config.vessel import load_vessel_model
+from catabot.world.hulls import footprints
 from catabot.world.world import World
 from tests.paths import BAY
 
@@ -106,3 +110,30 @@ def test_a_given_leg_across_the_island_is_refused() -> None:
         "traffic.waypoints.points: the leg from (350, 265) to (540, 265) crosses land or "
         "water under 2 m deep"
     )
+
+
+@pytest.mark.parametrize(
+    ("top", "message"),
+    [
+        ({"vessels": [{"id": "a", "pose": {"x_m": 0.0, "y_m": 0.0}},
+                      {"id": "b", "pose": {"x_m": 0.5, "y_m": 0.3, "yaw_rad": 1.0}}]},
+         "vessels.1.pose (b): starts overlapping vessels.0.pose (a) by 1.30 m"),
+        ({"vessels": [{"id": "a", "pose": {"x_m": 0.0, "y_m": 0.0}}],
+          "buoys": [{"id": "m", "x_m": 0.2, "y_m": 0.0}]},
+         "buoys.0 (m): starts overlapping vessels.0.pose (a)"),
+    ],
+)  # fmt: skip
+def test_hulls_that_start_inside_each_other_are_refused(top: dict[str, Any], message: str) -> None:
+    """Two vessels given one pose collided at t = 0 without a word."""
+    with pytest.raises(ScenarioError, match=re.escape(message)):
+        World.resolve(parse_scenario({"name": "apart"} | top))
+
+
+def test_alongside_is_apart_and_a_placed_vessel_keeps_clear_of_later_given_poses() -> None:
+    beam = 2 * float(footprints([load_vessel_model("catabot")])[1][0, 1])
+    alongside = [{"id": "a", "pose": {"x_m": 0.0, "y_m": 0.0}},
+                 {"id": "b", "pose": {"x_m": 0.0, "y_m": beam + 0.05}}]  # fmt: skip
+    World.resolve(parse_scenario({"name": "apart", "vessels": alongside}))
+    later = [{"id": "a"}, {"id": "b", "pose": {"x_m": 0.0, "y_m": 0.0}}]
+    pose = World.resolve(parse_scenario({"name": "apart", "vessels": later})).scenario.vessels[0]
+    assert pose.pose is not None and (pose.pose.x_m, pose.pose.y_m) != (0.0, 0.0)
