@@ -12,12 +12,13 @@ from catabot.config.scenario import Scenario
 
 def check_rates(scenario: Scenario) -> None:
     """Refuse sensor and guidance rates that are not a whole number of ticks (DESIGN.md §4),
-    and sensors too big to sample in memory."""
+    sensors too big to sample in memory, and parameters that do not go with their rate."""
     for v_index, vessel in enumerate(scenario.vessels):
         for s_index, sensor in enumerate(vessel.sensors):
             where = f"vessels.{v_index}.sensors.{s_index}.rate_hz ({vessel.id}/{sensor.name})"
             rate_in_ticks(sensor.rate_hz, scenario.dt_ns, where=where)
-            problem = sensor.typed_params().memory_problem()
+            params = sensor.typed_params()
+            problem = params.memory_problem() or params.rate_problem(sensor.rate_hz)
             if problem:
                 at = f"vessels.{v_index}.sensors.{s_index}.params ({vessel.id}/{sensor.name})"
                 raise ScenarioError(f"{at}: {problem}")

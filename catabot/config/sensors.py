@@ -27,6 +27,10 @@ class SensorParams(Strict):
         """Why one sample would not fit in `SENSOR_MEMORY_BUDGET` ("" when it fits)."""
         return ""
 
+    def rate_problem(self, rate_hz: float) -> str:
+        """Why these parameters do not go with sampling at `rate_hz` ("" when they do)."""
+        return ""
+
     def rays_per_s(self, rate_hz: float) -> float:
         """Rays cast a second: what a sensor costs, for sharing sensors out between
         processes (catabot/world/shards.py); 0 for a sensor that casts none."""
@@ -67,7 +71,9 @@ class RadarParams(SensorParams):
     """Marine radar (paper III-B.2.b: 250 m, one turn in 2 s, range noise sigma 0.2 m)."""
 
     range_m: float = Field(250.0, gt=0)
-    rotation_period_s: float = Field(2.0, gt=0, description="one antenna turn, clockwise")
+    rotation_period_s: float = Field(
+        2.0, ge=0.25, le=60, description="one antenna turn, clockwise (marine: 1-2.5 s)"
+    )
     range_bins: int = Field(512, ge=1, le=4096)
     beam_width_deg: float = Field(1.5, gt=0, le=20, description="horizontal; beams at half")
     sub_rays: int = Field(3, ge=1, le=16, description="rays across one beam's width")
@@ -77,12 +83,30 @@ class RadarParams(SensorParams):
     fan_target_height_m: float = Field(
         0.3, ge=0, description="down-looking fan sees targets this tall at any range; 0: no fan"
     )
-    fan_min_range_m: float = Field(10.0, gt=0, description="nearest sea range of the fan")
+    fan_min_range_m: float = Field(
+        10.0, gt=0, description="nearest sea range of the fan: nearer low targets are unseen"
+    )
     range_noise_sigma_m: float = Field(0.2, ge=0)
     antenna_height_m: float = Field(3.0, description="above the body origin")
     sea_clutter: StrictBool = Field(False, description="keep returns from the water surface")
     ppi_size_px: int = Field(256, ge=16, le=2048)
-    fade_s: float = Field(1.0, gt=0, description="PPI returns fade to nothing in this time")
+    fade_s: float | None = Field(
+        None, gt=0, description="PPI returns fade to nothing in this time; null: 1.5 turns"
+    )
+
+    @property
+    def fade(self) -> float:
+        """The PPI's persistence: by default a turn and a half, so the image made once a turn
+        shows the whole turn, the oldest returns faintest (1 s of a 2 s turn showed half)."""
+        return self.fade_s if self.fade_s is not None else 1.5 * self.rotation_period_s
+
+    def rate_problem(self, rate_hz: float) -> str:
+        if self.rotation_period_s * rate_hz < 1.0:
+            return (
+                f"rotation_period_s {self.rotation_period_s:g}: one sample sweeps at most one "
+                f"turn, so at least 1 / rate_hz = {1.0 / rate_hz:g} s"
+            )
+        return ""
 
     def rays_per_s(self, rate_hz: float) -> float:
         beams = 360.0 / (self.beam_width_deg / 2)  # a turn, whatever the sampling rate

@@ -180,7 +180,7 @@ def _radar(names: Names, sensor: MountedSensor) -> Convert:
     image = image_encoder(frame, "mono8")
     points, ppi_topic = names.sensor_topic(sensor, "points"), names.sensor_topic(sensor, "ppi")
     step, period_ns = beam_step(sensor), sensor.config.period_ns
-    ppi = Ppi(size_px=p.ppi_size_px, range_m=p.range_m, fade_s=p.fade_s, beam_step_rad=step)
+    ppi = Ppi(size_px=p.ppi_size_px, range_m=p.range_m, fade_s=p.fade, beam_step_rad=step)
     turn_ns = round(p.rotation_period_s * 1e9)
 
     def convert(msg: Message, want: Want) -> list[Out]:

@@ -147,7 +147,7 @@ class Dataset:
         ppi = self._ppi.get(stream)
         if ppi is None:
             step = 2 * np.pi / max(1, round(720.0 / p.beam_width_deg))  # as radar.py spaces beams
-            ppi = Ppi(size_px=p.ppi_size_px, range_m=p.range_m, fade_s=p.fade_s, beam_step_rad=step)
+            ppi = Ppi(size_px=p.ppi_size_px, range_m=p.range_m, fade_s=p.fade, beam_step_rad=step)
             self._ppi[stream] = ppi
         ppi.add(sweep)
         turn_ns = round(p.rotation_period_s * 1e9)

@@ -125,9 +125,7 @@ def test_ppi_paints_north_up_and_fades() -> None:
     scene = scene_with(0.0, 150.0, math.pi / 2)  # due north
     radar = RadarModel(RadarParams(), Mount(scene=scene, period_ns=5 * DT, seed=1, name="v/r"))
     p = RadarParams()
-    ppi = Ppi(
-        size_px=p.ppi_size_px, range_m=p.range_m, fade_s=p.fade_s, beam_step_rad=radar.step_rad
-    )
+    ppi = Ppi(size_px=p.ppi_size_px, range_m=p.range_m, fade_s=p.fade, beam_step_rad=radar.step_rad)
     sweeps = turn(radar, own(math.radians(45.0)))
     for s in sweeps:
         ppi.add(s)
@@ -139,6 +137,9 @@ def test_ppi_paints_north_up_and_fades() -> None:
     centre = p.ppi_size_px / 2
     assert np.all(rows < centre - 50) and np.all(np.abs(cols - centre) < 8)  # above: north
     peak = int(img.max())
-    half = ppi.render(now + int(0.5e9))
+    assert p.fade == 3.0  # a turn and a half: the image made once a turn shows all of it
+    half = ppi.render(now + int(1.5e9))
     assert 0.4 * peak <= int(half.max()) <= 0.6 * peak + 1
-    assert not ppi.render(now + int(1.01e9)).any()
+    turn_later = int(ppi.render(now + int(2.0e9)).max())  # (1 s showed half a turn)
+    assert 0.25 * peak <= turn_later <= 0.4 * peak + 1
+    assert not ppi.render(now + int(3.01e9)).any()

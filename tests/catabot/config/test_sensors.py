@@ -1,0 +1,40 @@
+"""Sensor parameters that cannot go together, or with their rate, are refused by field."""
+
+from __future__ import annotations
+
+from typing import Any
+
+import pytest
+
+from catabot.config.base import ScenarioError
+from catabot.config.load import parse_scenario
+
+
+def _radar(rate_hz: float, **params: Any) -> dict[str, Any]:
+    radar = {"name": "radar", "type": "radar", "rate_hz": rate_hz, "params": params}
+    return {"name": "r", "vessels": [{"id": "ego", "sensors": [radar]}]}
+
+
+@pytest.mark.parametrize(
+    ("rate_hz", "params", "message"),
+    [
+        (10.0, {"rotation_period_s": 0.001}, "params.rotation_period_s: must be >= 0.25"),
+        (1.0, {"rotation_period_s": 0.5}, "vessels.0.sensors.0.params (ego/radar): "
+         "rotation_period_s 0.5: one sample sweeps at most one turn, so at least "
+         "1 / rate_hz = 1 s"),
+    ],
+)  # fmt: skip
+def test_a_radar_turning_faster_than_it_is_sampled_is_refused(
+    rate_hz: float, params: dict[str, Any], message: str
+) -> None:
+    """A 1 ms turn ran: 48 000 beams a sample, a real-time factor of 0.0."""
+    with pytest.raises(ScenarioError) as info:
+        parse_scenario(_radar(rate_hz, **params))
+    assert message in str(info.value)
+
+
+def test_the_ppi_persists_a_turn_and_a_half_unless_told() -> None:
+    (radar,) = parse_scenario(_radar(10.0, rotation_period_s=2.5)).vessels[0].sensors
+    assert radar.typed_params().fade == 3.75
+    (radar,) = parse_scenario(_radar(10.0, fade_s=0.5)).vessels[0].sensors
+    assert radar.typed_params().fade == 0.5
