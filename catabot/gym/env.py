@@ -12,6 +12,8 @@ from __future__ import annotations
 
 import itertools
 import os
+import threading
+import weakref
 from typing import Any
 
 import gymnasium as gym
@@ -51,6 +53,11 @@ class CataBotEnv(gym.Env[Obs, np.ndarray]):
         self.action_space = gym.spaces.Box(-1.0, 1.0, (n,), np.float32)
         self.observation_space = observation_space(o)  # type: ignore[assignment]
         self._runner = Runner(o, self._draw, self.world)
+        # An env never closed (a script's end, a dropped env in a notebook) left its run's
+        # processes behind, and Zenoh's callback threads held the interpreter's exit: its
+        # runs end when it is collected, and at exit before those threads are joined.
+        self._closer = weakref.finalize(self, self._runner.close)
+        threading._register_atexit(self._closer)  # type: ignore[attr-defined]
         self._origin = EnuFrame(**self._draw.base.origin.model_dump())
         self._episode: Episode | None = None
         self._judge: Judge | None = None
@@ -64,6 +71,11 @@ class CataBotEnv(gym.Env[Obs, np.ndarray]):
     def reset(
         self, *, seed: int | None = None, options: dict[str, Any] | None = None
     ) -> tuple[Obs, dict[str, Any]]:
+        if options:
+            raise gym.error.Error(
+                f"reset options: this env takes none (got {sorted(options)}); its episodes "
+                "are set by gymnasium.make's keywords (catabot.gym.options.EnvOptions)"
+            )
         super().reset(seed=seed)
         if seed is not None or self._upcoming is None:
             episode_seed = int(self.np_random.integers(0, SEED_HIGH))
@@ -117,7 +129,7 @@ class CataBotEnv(gym.Env[Obs, np.ndarray]):
 
     def close(self) -> None:
         self._over = True
-        self._runner.close()
+        self._closer()
         super().close()
 
     # -- helpers ----------------------------------------------------------------------

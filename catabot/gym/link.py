@@ -138,6 +138,9 @@ def _session(endpoint: str) -> zenoh.Session:
     config = Connection(connect=(endpoint,)).config()
     config.insert_json5("connect/retry", json.dumps(RETRY))
     config.insert_json5("scouting/delay", "0")
+    # every episode's run offered its shared-memory segments, which this process mapped and
+    # kept: ≈1.3 files and 2-10 MB a reset, never released; loopback TCP is enough here
+    config.insert_json5("transport/shared_memory/enabled", "false")
     try:
         return zenoh.open(config)
     except Exception as exc:
