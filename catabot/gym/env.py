@@ -137,9 +137,12 @@ class CataBotEnv(gym.Env[Obs, np.ndarray]):
     def _checked(self, action: Any) -> np.ndarray:
         space = self.action_space
         try:
-            a = np.asarray(action, dtype=np.float64)
+            given = np.asarray(action)
+            if given.dtype.kind in "bc":  # True as full thrust, 1j as 0: silently not meant
+                raise TypeError
+            a = given.astype(np.float64)
         except (TypeError, ValueError):
-            raise ActionError(f"action {action!r} is not an array of numbers") from None
+            raise ActionError(f"action {action!r} is not an array of real numbers") from None
         if a.shape != space.shape:
             raise ActionError(f"action has shape {a.shape}; this env takes {space.shape} "
                               f"({self._action_meaning()})")  # fmt: skip

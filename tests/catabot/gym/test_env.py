@@ -61,8 +61,9 @@ def test_bad_actions_are_clear_errors_and_the_episode_goes_on(env: gym.Env) -> N
         env.step(np.zeros(3))
     with pytest.raises(ActionError, match=r"outside \[-1, 1\]"):
         env.step(np.array([1.5, 0.0]))
-    with pytest.raises(ActionError, match="not an array of numbers"):
-        env.step("full ahead")
+    for bad in ("full ahead", np.array([True, False]), np.array([1j, 0])):
+        with pytest.raises(ActionError, match="not an array of real numbers"):
+            env.step(bad)
     obs, *_ = env.step(FORWARD)
     assert env.observation_space.contains(obs)
 
