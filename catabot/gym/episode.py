@@ -16,7 +16,9 @@ from typing import Any
 
 import numpy as np
 
+from catabot.config.base import ScenarioError
 from catabot.config.load import load_scenario, parse_scenario
+from catabot.config.rates import rate_in_ticks
 from catabot.config.scenario import Pose, Scenario
 from catabot.config.terrain import TerrainError
 from catabot.config.vessel import VesselModel, load_vessel_model
@@ -60,6 +62,10 @@ class Draw:
         self.vessel = options.vessel or ids[0]
         if self.vessel not in ids:
             raise EnvOptionsError(f"vessel {self.vessel!r} is not in the scenario (vessels: {ids})")
+        try:  # named as the keyword, not as the scenario field it becomes
+            rate_in_ticks(options.control_hz, base.dt_ns, where="control_hz")
+        except ScenarioError as exc:
+            raise EnvOptionsError(str(exc)) from None
         self.terrain = load_terrain(base.terrain) if base.terrain is not None else None
         self.base = resolve_poses(base, self.terrain)
         self.index = ids.index(self.vessel)
