@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import subprocess
 import time
 from pathlib import Path
 
@@ -19,14 +20,22 @@ from catabot.bus.keys import Keys
 from catabot.bus.session import Connection, free_port, open_session
 
 
-def test_the_first_refusal_of_each_kind_reaches_the_console_once(tmp_path: Path) -> None:
+def _listening_run(
+    tmp: Path, name: str, *, duration_s: float
+) -> tuple[subprocess.Popen[str], str, Path]:
+    """`catabot run` at half real time, listening for a client: (process, endpoint, out)."""
     endpoint = f"tcp/127.0.0.1:{free_port()}"
-    data = basic_scenario("echo", duration_s=6.0)
+    data = basic_scenario(name, duration_s=duration_s)
     data["clock"] = {"realtime_factor": 2.0}
-    out = tmp_path / "out"
-    proc = start("run", str(scenario_file(tmp_path, data)), "--out", str(out), "--quiet",
+    out = tmp / "out"
+    proc = start("run", str(scenario_file(tmp, data)), "--out", str(out), "--quiet",
                  "--listen", endpoint)  # fmt: skip
     wait_for_line(proc, "zenoh:")
+    return proc, endpoint, out
+
+
+def test_the_first_refusal_of_each_kind_reaches_the_console_once(tmp_path: Path) -> None:
+    proc, endpoint, out = _listening_run(tmp_path, "echo", duration_s=6.0)
     key = Keys("echo").cmd_twist("ego")
     wrong = codec.pack({"v": 1, "type": "twist_cmd", "surge_mps": 1.0, "yaw_rate_radps": 0.1})
     with open_session(Connection(connect=(endpoint,))) as session:
@@ -49,13 +58,7 @@ def test_the_first_refusal_of_each_kind_reaches_the_console_once(tmp_path: Path)
 def test_a_command_to_no_vessel_or_of_no_kind_is_said_not_dropped_unheard(tmp_path: Path) -> None:
     """`vessel/ghost/cmd/thrust` and `vessel/ego/cmd/pose` reached no subscriber: a typo in
     an id was silent. Physics watches every command key and names what is wrong."""
-    endpoint = f"tcp/127.0.0.1:{free_port()}"
-    data = basic_scenario("stray", duration_s=4.0)
-    data["clock"] = {"realtime_factor": 2.0}
-    out = tmp_path / "out"
-    proc = start("run", str(scenario_file(tmp_path, data)), "--out", str(out), "--quiet",
-                 "--listen", endpoint)  # fmt: skip
-    wait_for_line(proc, "zenoh:")
+    proc, endpoint, _ = _listening_run(tmp_path, "stray", duration_s=4.0)
     keys = Keys("stray")
     ghost, pose = keys.cmd_thrust("ghost"), f"{keys.prefix}/vessel/ego/cmd/pose"
     with open_session(Connection(connect=(endpoint,))) as session:
