@@ -92,9 +92,16 @@ class Draw:
                 return Pose(x_m=x, y_m=y, yaw_rad=heading)
         raise EnvOptionsError(
             f"no start in open water within start_radius_m={self.options.start_radius_m:g} m of "
-            f"({self.home.x_m:g}, {self.home.y_m:g}) clear of every body: widen it or move the "
-            f"vessel's pose"
+            f"({self.home.x_m:g}, {self.home.y_m:g}) clear of every body ({TRIES} draws): "
+            f"{self._start_hint()}"
         )
+
+    def _start_hint(self) -> str:
+        """What to change: a radius that reaches past the terrain draws starts off it."""
+        if self.terrain is not None and self.options.start_radius_m > max(self.terrain.size_m):
+            w, h = self.terrain.size_m
+            return f"it reaches past the terrain ({w:g} x {h:g} m): narrow it"
+        return "widen it or move the vessel's pose"
 
     def _goal(self, seed: int, start: Pose) -> Goal:
         if self.options.task == "station_keep":

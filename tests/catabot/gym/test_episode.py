@@ -68,6 +68,8 @@ def test_bad_options_name_the_field() -> None:
         env_options(speed=3)
     with pytest.raises(EnvOptionsError, match=r"^control_hz: period 333333333 ns is not a whole"):
         Draw(env_options(control_hz=3))  # named as the keyword, not the scenario's field
+    with pytest.raises(EnvOptionsError, match=r"reaches past the terrain \(600 x 600 m\): narrow"):
+        Draw(env_options(start_radius_m=1e9)).episode(0, "w")  # "widen it" was the advice
     with pytest.raises(EnvOptionsError, match="vessel 'boat' is not in the scenario"):
         Draw(env_options(scenario="navigate", vessel="boat"))
     crowded = {"vessels": [{"id": "ego"}], "buoys": [{"id": "b", "x_m": 0.0, "y_m": 0.0}]}
