@@ -280,8 +280,7 @@ class Supervisor:
                 state = {"T": "stopped by a signal", "t": "stopped by a debugger"}.get(
                     child.state(), "alive but not stepping"
                 )
-                waited = f"; {child.waited}" if child.waited else ""
-                self._kill(child, f"participant {name!r} hung ({state}): {error}{waited}")
+                self._kill(child, f"participant {name!r} hung ({state}): {self._waited(error)}")
 
     def _reap(self) -> None:
         """Services end by themselves after the conductor's End (15 s allows the recorder's
@@ -308,7 +307,17 @@ class Supervisor:
             return f"{first.name}: {first.fatal}"
         if self.hung:
             return self.hung[0]
-        return str(self.result.get("error", "") or "")
+        return self._waited(str(self.result.get("error", "") or ""))
+
+    def _waited(self, error: str) -> str:
+        """The conductor's fault, and whose data the participant it names waited for."""
+        for name, child in self.services.items():
+            if f"participant {name!r}" in error:
+                if child.proc.poll() is not None:
+                    child._relay.join(timeout=1.0)  # its last lines are in
+                if child.waited:
+                    return f"{error}; {child.waited}"
+        return error
 
 
 def ended(proc: subprocess.Popen[str], *, grace_s: float) -> None:
