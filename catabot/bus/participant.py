@@ -33,6 +33,7 @@ from catabot.bus.rejections import Rejected, Rejections
 from catabot.bus.settings import from_wire
 
 log = logging.getLogger("catabot.bus.participant")
+WAITED = "waited at tick"  # the fault line `_waited` logs, which the launcher quotes
 ORPHAN_GRACE_S = 0.5
 MAX_HELD_CLOCK = 64  # clock messages held while the conductor's session is not known yet
 StepFn = Callable[[Tick, Inputs], None]
@@ -327,7 +328,7 @@ class Participant(Outputs):
         missing = self.inbox.missing(tick)
         if missing:
             whose = ", ".join(f"{key} from {self.inbox.streams[key].producer!r}" for key in missing)
-            log.error("%s waited at tick %d for %s", self.name, tick, whose)
+            log.error("%s %s %d for %s", self.name, WAITED, tick, whose)
 
     def stop(self) -> None:
         """Make `run()` raise `Stopped` at its next event (from another thread: a client

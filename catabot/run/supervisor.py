@@ -24,6 +24,7 @@ from collections.abc import Callable, Iterator
 from pathlib import Path
 from typing import IO
 
+from catabot.bus.participant import WAITED
 from catabot.bus.rejections import report_of
 
 HANG_S = 3.0  # the conductor's heartbeat is every 0.5 s
@@ -78,7 +79,7 @@ class Child:
             if " CRITICAL " in line and not self.fatal:
                 self.fatal, self.fatal_at = line.split(" CRITICAL ", 1)[1].strip(), time.monotonic()
             self.last_line = line.strip() or self.last_line
-            if " waited at tick " in line and not self.waited:
+            if f" {WAITED} " in line and not self.waited:
                 self.waited = line.split(" ERROR ", 1)[-1].strip()
             self._note_refusal(line)
             log = _write(log, line, self)
@@ -99,6 +100,13 @@ class Child:
         said = f"{reason}: {detail}" if detail else reason
         self.refused.append(f"{self.name} refused {key}: {said}{hint}; first of its kind, all "
                             f"counted in {self.log_path}")  # fmt: skip
+
+    def waited_line(self) -> str:
+        """Whose data it waited for at the fault (`Participant._waited`), once an exited
+        process's last lines are read."""
+        if self.proc.poll() is not None:
+            self._relay.join(timeout=1.0)
+        return self.waited
 
     def crashed(self) -> None:
         """A program that ended with an error while the run went: that is its fatal fault."""
@@ -313,10 +321,9 @@ class Supervisor:
         """The conductor's fault, and whose data the participant it names waited for."""
         for name, child in self.services.items():
             if f"participant {name!r}" in error:
-                if child.proc.poll() is not None:
-                    child._relay.join(timeout=1.0)  # its last lines are in
-                if child.waited:
-                    return f"{error}; {child.waited}"
+                waited = child.waited_line()
+                if waited:
+                    return f"{error}; {waited}"
         return error
 
 

@@ -4,13 +4,18 @@ physics, which applies it, and the recorder, which writes and meters what physic
 An outside command (a thrust or a twist at tick -1) takes a vessel over until a
 `WaypointsCmd` hands it back; a lockstep set-point (a controller's twist at tick >= 0, or a
 traffic boat's row of the traffic's batch) steers it from the first one on; otherwise it
-follows its script: outside > lockstep set-point > script. Commands reach here checked
-(catabot/bus/checks.py).
+follows its script: outside > lockstep set-point > script, the step in force (`script_step`),
+or rest before its first. Commands reach here checked (catabot/bus/checks.py).
 """
 
 from __future__ import annotations
 
+import bisect
+import functools
+from collections.abc import Sequence
+
 from catabot.bus.messages import Message, ThrustCmd, TwistCmd, WaypointsCmd
+from catabot.config.scenario import ScriptStep
 
 Order = ThrustCmd | TwistCmd
 
@@ -42,3 +47,18 @@ class Orders:
 
     def follows_script(self, vessel: str) -> bool:
         return vessel not in self.held and vessel not in self.steered
+
+
+def script_step(
+    script: Sequence[ScriptStep], script_ns: Sequence[int], thrusters: int, stamp_ns: int
+) -> ScriptStep:
+    """The step of a script (in time order, its times `script_ns`) in force at `stamp_ns`,
+    or rest before its first: what a vessel no command holds follows (after a release the
+    outside thrust stayed on). Physics applies it; the recorder writes it."""
+    index = bisect.bisect_right(script_ns, stamp_ns) - 1
+    return script[index] if index >= 0 else _rest(thrusters)
+
+
+@functools.lru_cache(maxsize=16)
+def _rest(thrusters: int) -> ScriptStep:
+    return ScriptStep(t_s=0.0, thrust=[0.0] * thrusters)

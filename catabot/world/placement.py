@@ -91,10 +91,10 @@ def check_apart(scenario: Scenario) -> None:
     if len(named) < 2:
         return
     offset, half = footprints([load_vessel_model(model) for _, model, _ in named])
-    poses = [pose for _, _, pose in named]
-    assert all(p is not None for p in poses), "resolve_poses placed every vessel"
-    heading = np.array([p.yaw_rad for p in poses if p is not None])
-    xy = np.array([(p.x_m, p.y_m) for p in poses if p is not None])
+    poses = [pose for _, _, pose in named if pose is not None]
+    assert len(poses) == len(named), "resolve_poses placed every vessel"
+    heading = np.array([p.yaw_rad for p in poses])
+    xy = np.array([(p.x_m, p.y_m) for p in poses])
     a, b = np.triu_indices(len(named), k=1)
     gaps = box_gaps(xy + turn_xy(offset, heading), heading, half, a, b)
     over = np.flatnonzero(gaps < 0.0)

@@ -12,7 +12,6 @@ catabot/world/orders.py's; the set-points' values live here in arrays, whatever 
 
 from __future__ import annotations
 
-import bisect
 import logging
 from collections.abc import Sequence
 from dataclasses import dataclass
@@ -23,7 +22,7 @@ from numpy.typing import NDArray
 
 from catabot.bus.messages import Message, ThrustCmd, TwistBatch, TwistCmd, WaypointsCmd
 from catabot.config.scenario import ScriptStep
-from catabot.world.orders import Orders
+from catabot.world.orders import Orders, script_step
 from catabot.world.world import Body
 
 Array = NDArray[np.float64]
@@ -66,13 +65,9 @@ class CommandBook:
         if self.has_set_point[i]:
             surge, rate = self.set_point[i].tolist()
             return Order(twist=(surge, rate))
-        index = bisect.bisect_right(self.times[vessel], stamp_ns) - 1
-        return _from_step(self.scripts[vessel][index]) if index >= 0 else self._rest(vessel)
-
-    def _rest(self, vessel: str) -> Order:
-        """No step in force yet: at rest, as at the start (not the thrust of a command that
-        held it until a release)."""
-        return Order(thrust=(0.0,) * self.thrusters[vessel])
+        step = script_step(self.scripts[vessel], self.times[vessel], self.thrusters[vessel],
+                           stamp_ns)  # fmt: skip
+        return _from_step(step)
 
     def orders(self, stamp_ns: int) -> tuple[dict[int, tuple[float, ...]], NDArray[np.intp], Array]:
         """Every vessel's order: thrust values by row, then the rows under velocity control
@@ -84,7 +79,7 @@ class CommandBook:
                 _place(self.order(vid, stamp_ns), self.row[vid], target, follow, thrust)
         for vid in self.released.difference(self.scripted):  # no script: back to rest
             if not follow[self.row[vid]]:
-                _place(self._rest(vid), self.row[vid], target, follow, thrust)
+                _place(self.order(vid, 0), self.row[vid], target, follow, thrust)
         self.released.clear()
         for vid, held in self.book.held.items():
             _place(_from_command(held), self.row[vid], target, follow, thrust)

@@ -23,7 +23,7 @@ from numpy.typing import NDArray
 
 from catabot.bus.messages import Message, ThrustCmd, TwistCmd
 from catabot.config.scenario import ScriptStep
-from catabot.world.orders import Orders
+from catabot.world.orders import Orders, script_step
 from catabot.world.world import World
 
 
@@ -33,15 +33,12 @@ class ScriptedCommands:
     def __init__(self, world: World, orders: Orders) -> None:
         dt = world.scenario.dt_ns
         self._due: dict[int, dict[str, ScriptStep]] = {}
-        self._steps: dict[str, list[tuple[int, ScriptStep]]] = {}  # a vessel's, by tick
-        self._thrusters = {
-            v.id: len(v.model.thrusters) for v in world.vessels if v.kind == "vessel"
-        }
+        self._dt_ns = dt
+        self._scenario_vessels = {v.id: v for v in world.vessels if v.kind == "vessel"}
         for vessel in world.vessels:
             for step, t_ns in zip(vessel.script, vessel.script_ns, strict=True):
                 tick = -(-t_ns // dt)  # the first tick at or after the step's time
                 self._due.setdefault(tick, {})[vessel.id] = step
-                self._steps.setdefault(vessel.id, []).append((tick, step))
         self._keys = world.keys
         self._orders = orders
 
@@ -56,13 +53,12 @@ class ScriptedCommands:
         """The order a scenario vessel released at `tick` follows again (physics' rule): the
         script step in force, or rest before its first step; None when a step begins at
         `tick` itself (`due` writes it)."""
-        if vessel not in self._thrusters:
+        body = self._scenario_vessels.get(vessel)
+        if body is None or vessel in self._due.get(tick, {}):
             return None
-        begun = [(at, step) for at, step in self._steps.get(vessel, []) if at <= tick]
-        if begun and begun[-1][0] == tick:
-            return None
-        rest = ScriptStep(t_s=0.0, thrust=[0.0] * self._thrusters[vessel])
-        return self._command(vessel, begun[-1][1] if begun else rest, tick, stamp_ns)
+        thrusters = len(body.model.thrusters)
+        step = script_step(body.script, body.script_ns, thrusters, tick * self._dt_ns)
+        return self._command(vessel, step, tick, stamp_ns)
 
     def due(self, tick: int, stamp_ns: int) -> list[tuple[str, Message]]:
         """(stream, command) of every step that takes effect at `tick`, for the vessels that
