@@ -15,7 +15,7 @@ import math
 from common import clear_errors, parser
 from guidance import yaw_of
 
-from catabot.client import Client, Observation, Thrust
+from catabot.client import Client, EndRun, Observation, Thrust
 
 
 def decide(x: float, y: float, yaw: float, goal: tuple[float, float]) -> tuple[float, float]:
@@ -31,6 +31,12 @@ def main() -> None:
     p = parser(__doc__)
     p.add_argument("--name", default="stack", help="the participant name the scenario expects")
     p.add_argument("--goal", type=float, nargs=2, default=(40.0, 20.0), metavar=("X", "Y"))
+    p.add_argument(
+        "--end-within",
+        type=float,
+        metavar="M",
+        help="end the run once the vessel is within M metres of the goal",
+    )
     p.set_defaults(world=None)  # the one world running
     args = p.parse_args()
     goal = (args.goal[0], args.goal[1])
@@ -40,6 +46,8 @@ def main() -> None:
         assert obs.state is not None  # the state at the start of this control period
         x, y, _ = obs.state.position
         seen[0] = (x, y)
+        if args.end_within and math.dist((x, y), goal) < args.end_within:
+            raise EndRun(f"goal reached at t = {obs.time_s:.1f} s")  # ends it for everyone
         return Thrust(decide(x, y, yaw_of(obs.state.orientation), goal))
 
     with clear_errors("lockstep_stack.py"), Client.from_args(args) as sim:

@@ -23,6 +23,7 @@ from catabot.errors import CataBotError
 
 NS_PER_S = 1_000_000_000
 CONDUCTOR = "conductor"  # the participant name of the clock's owner
+MAX_END_REASON = 200  # characters of an `Ack.end`: why the run ends, not a payload
 
 
 class ClockError(CataBotError, RuntimeError):

@@ -18,7 +18,7 @@ from dataclasses import dataclass, field
 import zenoh
 
 from catabot.bus import codec
-from catabot.bus.clock import CONDUCTOR, ClockError, Policy
+from catabot.bus.clock import CONDUCTOR, MAX_END_REASON, ClockError, Policy
 from catabot.bus.identity import Roster, sender_of
 from catabot.bus.keys import Keys
 from catabot.bus.members import Members
@@ -86,6 +86,7 @@ class Conductor:
         self.rejections = Rejections(log, CONDUCTOR)
         self.dropped: list[str] = []
         self._stop_reason = ""
+        self._end_at: int | None = None  # the last tick, when a participant ended the run
         self._done = 0  # ticks every active participant has acked
         self._granted = -1  # the last tick granted
         self._acked = {name: -1 for name in spec.participants}
@@ -183,7 +184,7 @@ class Conductor:
             if on_progress and now - last_report >= 0.25:
                 on_progress(self._progress(self._done - 1, now - start))
                 last_report = now
-        while self._done <= self._granted:
+        while self._done <= (self._granted if self._end_at is None else self._end_at):
             self._await_progress()
         if on_progress:
             on_progress(self._progress(self._done - 1, time.monotonic() - start))
@@ -250,7 +251,20 @@ class Conductor:
             self.rejections.add(key, exc)
             return
         self._acked[name] = max(self._acked[name], min(ack.tick, self._granted))
+        if ack.end:
+            self._end_request(name, ack)
         self._advance()
+
+    def _end_request(self, name: str, ack: Ack) -> None:
+        """A participant ends the run after `ack.tick`: nothing more is granted, everyone is
+        asked for its progress (a repeated grant: they ack as they go from then on), and the
+        run ends cleanly once all have stepped that tick. The first stop or request wins."""
+        if self._stop_reason:
+            return
+        self._end_at = max(min(ack.tick, self._granted), self._done - 1)
+        self._stop_reason = f"ended by {name!r} after tick {self._end_at}: {ack.end}"
+        log.info("run %s", self._stop_reason)
+        self._grant(self._granted, again=True)
 
     def _checked_ack(self, key: str, sample: zenoh.Sample) -> tuple[str, Ack]:
         """An ack believed only from the session whose token names its participant."""
@@ -265,6 +279,8 @@ class Conductor:
             raise Rejected("malformed", str(exc)) from None
         if ack.run != self.run_id or ack.tick < -1:
             raise Rejected("ack of another run or tick", f"run {ack.run}, tick {ack.tick}")
+        if len(ack.end) > MAX_END_REASON or not ack.end.isprintable():
+            raise Rejected("end request with a bad reason", repr(ack.end[:40]))
         return name, ack
 
     def _advance(self) -> None:
@@ -288,12 +304,16 @@ class Conductor:
         while not self.events.empty():
             self._next_event(0.0)
         active = self._active()
-        for name in [n for n in active if n not in self.members]:
+        for name in [n for n in active if n not in self.members and not self._through(n)]:
             self._fault(name, f"left the run at tick {self._acked[name] + 1}")
         k = self._done
         if self._deadline is not None and time.monotonic() > self._deadline:
             for name in [n for n in active if self._acked[n] < k <= self._granted]:
                 self._fault(name, f"missed the {self.spec.deadline_s:g} s deadline of tick {k}")
+
+    def _through(self, name: str) -> bool:
+        """`name` has stepped the run's last tick (ended by a participant): it may leave."""
+        return self._end_at is not None and self._acked[name] >= self._end_at
 
     def _fault(self, name: str, what: str) -> None:
         message = f"participant {name!r} {what}"

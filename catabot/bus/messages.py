@@ -65,9 +65,14 @@ class Tick(Message):
 
 @dataclass(frozen=True)
 class Ack(Message):
+    """`tick` and every tick before it stepped. A non-empty `end` (why, at most 200
+    characters) asks the conductor to end the run after `tick`: the run ends cleanly once
+    every participant has stepped it (a controller whose episode is over)."""
+
     TYPE: ClassVar[str] = "ack"
     run: str
     tick: int
+    end: str = ""
 
 
 @dataclass(frozen=True)
@@ -151,14 +156,8 @@ class BodyStates(Message):
 
     def arrays(self) -> tuple[np.ndarray, ...]:
         """The six arrays in `VesselState` field order."""
-        return (
-            self.position,
-            self.orientation,
-            self.linear_velocity,
-            self.angular_velocity,
-            self.linear_acceleration,
-            self.angular_acceleration,
-        )
+        return (self.position, self.orientation, self.linear_velocity, self.angular_velocity,
+                self.linear_acceleration, self.angular_acceleration)  # fmt: skip
 
 
 @dataclass(frozen=True)

@@ -22,7 +22,7 @@ from collections.abc import Callable, Sequence
 import zenoh
 
 from catabot.bus import codec
-from catabot.bus.clock import CONDUCTOR, ClockError, ClockLimits, Stream
+from catabot.bus.clock import CONDUCTOR, MAX_END_REASON, ClockError, ClockLimits, Stream
 from catabot.bus.identity import Roster, sender_of
 from catabot.bus.inbox import Inbox, Inputs
 from catabot.bus.keys import Keys
@@ -30,7 +30,7 @@ from catabot.bus.members import Members
 from catabot.bus.messages import Ack, End, Tick
 from catabot.bus.outputs import Outputs
 from catabot.bus.rejections import Rejected, Rejections
-from catabot.bus.settings import from_wire
+from catabot.bus.settings import from_wire, settings_problem
 
 log = logging.getLogger("catabot.bus.participant")
 WAITED = "waited at tick"  # the fault line `_waited` logs, which the launcher quotes
@@ -43,6 +43,11 @@ Event = tuple[str, str, bytes, str]  # kind, key, payload, sender zid
 
 class Stopped(ClockError):
     """`run()` was stopped from another thread before the run ended (a client leaving)."""
+
+
+class EndRun(Exception):
+    """Raised by a step at tick k: end the run after tick k - 1, the last this participant
+    stepped (a controller whose episode is over); its text is the reason everyone sees."""
 
 
 class Participant(Outputs):
@@ -70,6 +75,8 @@ class Participant(Outputs):
         self.drain_s = drain_s
         self.next_tick = 0
         self._acked = -1  # the last tick acked
+        self._ended = False  # asked the conductor to end the run: no more steps
+        self._asked = False  # a repeated grant: ack progress as it comes from then on
         self._grant: Tick | None = None
         self._settings: dict[int, list[str]] = {}  # changes granted, by the tick they apply
         self._held_clock: list[Event] = []  # until the conductor's session is known
@@ -129,7 +136,7 @@ class Participant(Outputs):
             if end is not None:
                 return self._finish(end, on_end)
             self._step_ready(step)
-            if event[0] == "idle":
+            if event[0] == "idle" or self._asked:
                 self._ack_waiting()
 
     def _take(self, event: Event) -> End | None:
@@ -146,11 +153,15 @@ class Participant(Outputs):
         """Step every granted tick whose inputs are complete, in order, acking every
         `ack_every` ticks and at the grant's end."""
         grant = self._grant
-        while grant is not None and self.next_tick <= grant.tick:
+        while grant is not None and self.next_tick <= grant.tick and not self._ended:
             k = self.next_tick
             if not self._ready(k):
                 break
-            step(self._tick_of(grant, k), self.inbox.release(k))
+            try:
+                step(self._tick_of(grant, k), self.inbox.release(k))
+            except EndRun as request:
+                self._end_before(grant, k, str(request))
+                return
             self.next_tick = k + 1
             if (k + 1) % grant.ack_every == 0 or k == grant.tick:
                 self._ack_through(grant, k)
@@ -159,6 +170,13 @@ class Participant(Outputs):
     def _ack_through(self, grant: Tick, k: int) -> None:
         self.put(self._ack, codec.encode(Ack(grant.run, k)))
         self._acked = k
+
+    def _end_before(self, grant: Tick, k: int, reason: str) -> None:
+        """Ask the conductor to end the run after tick k - 1 (an Ack with a reason)."""
+        self._ended = True
+        reason = "".join(c if c.isprintable() else " " for c in reason)[:MAX_END_REASON]
+        self.put(self._ack, codec.encode(Ack(grant.run, k - 1, end=reason or "no reason given")))
+        self._acked = k - 1
 
     def _ack_waiting(self) -> None:
         """A second without events while ticks stepped since the last ack wait for inputs:
@@ -250,6 +268,8 @@ class Participant(Outputs):
         self.peers -= set(tick.dropped)  # a dropped peer that crashed will never be present
         if self._grant is None or self.next_tick > self._grant.tick:
             self._waiting_since = time.monotonic()  # it had run dry: a wait begins
+        was = self._grant  # the same grant again, no one dropped: the run is ending
+        self._asked |= was is not None and (was.tick, was.dropped) == (tick.tick, tick.dropped)
         self._grant = tick  # grants only grow (checked); a repeat carries a new dropped list
 
     def _tick_problem(self, tick: Tick) -> str:
@@ -263,19 +283,7 @@ class Participant(Outputs):
         unknown = set(tick.dropped) - self._everyone
         if unknown:
             return f"drops unknown participants {sorted(unknown)}"
-        return self._settings_problem(tick, grant)
-
-    def _settings_problem(self, tick: Tick, grant: int) -> str:
-        """A grant's changes must fall in the ticks it adds: one for a tick already granted
-        could reach a participant that has stepped it, and the run would fork."""
-        for text in tick.settings:
-            try:
-                at = from_wire(text).tick
-            except ValueError as exc:
-                return str(exc)
-            if not max(grant, self.next_tick - 1) < at <= tick.tick:
-                return f"a setting change at tick {at} outside the grant's {grant + 1}..{tick.tick}"
-        return ""
+        return settings_problem(tick.settings, tick.tick, after=max(grant, self.next_tick - 1))
 
     def _checked_end(self, end: End) -> End:
         if self.run_id and end.run != self.run_id:

@@ -56,6 +56,20 @@ def from_wire(text: str) -> Change:
     return Change(tick, key, value)
 
 
+def settings_problem(settings: Iterable[str], last: int, *, after: int) -> str:
+    """A grant's changes must fall in the ticks it adds (`after` + 1 to `last`): one for a
+    tick already granted could reach a participant that has stepped it, and the run would
+    fork. Empty when every change does."""
+    for text in settings:
+        try:
+            at = from_wire(text).tick
+        except ValueError as exc:
+            return str(exc)
+        if not after < at <= last:
+            return f"a setting change at tick {at} outside the grant's {after + 1}..{last}"
+    return ""
+
+
 def changes_of(settings: Iterable[str]) -> list[Change]:
     """The changes a step's Tick carries, in the order they apply."""
     return [from_wire(text) for text in settings]

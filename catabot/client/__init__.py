@@ -15,6 +15,7 @@ from catabot.bus.messages import (
     RadarSweep,
     VesselState,
 )
+from catabot.bus.participant import EndRun
 from catabot.client.client import Client
 from catabot.client.commands import Command, Thrust, Twist, Waypoints
 from catabot.client.errors import (
@@ -43,6 +44,7 @@ __all__ = [
     "CommandError",
     "ControllerInfo",
     "End",
+    "EndRun",
     "GpsFix",
     "ImuSample",
     "Joined",

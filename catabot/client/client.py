@@ -22,6 +22,7 @@ from catabot.bus.clock import NS_PER_S, ClockError, period_in_ticks
 from catabot.bus.keys import Keys
 from catabot.bus.messages import End
 from catabot.bus.outputs import Outputs
+from catabot.bus.participant import EndRun
 from catabot.bus.session import Connection, connection_from_args, open_session
 from catabot.client.commands import Command
 from catabot.client.discover import find_world
@@ -176,7 +177,8 @@ class Client:
         rate_hz: float | None = None,
     ) -> End:  # fmt: skip
         """Join as `name` and call `step(observation) -> command | None` every control
-        period until the run ends; returns its End."""
+        period until the run ends; returns its End. A step that raises `EndRun(reason)`
+        ends the run there for everyone (`Joined.end_run`)."""
         joined = self.join(name, vessel=vessel, sensors=sensors, rate_hz=rate_hz)
         try:
             while True:
@@ -186,7 +188,11 @@ class Client:
                     if ended.end is None:
                         raise
                     return ended.end
-                joined.act(step(obs))
+                try:
+                    command = step(obs)
+                except EndRun as request:
+                    return joined.end_run(str(request))
+                joined.act(command)
         finally:
             joined.close()
 

@@ -20,10 +20,11 @@ from typing import Any
 
 import zenoh
 
+from catabot.bus.clock import MAX_END_REASON
 from catabot.bus.inbox import Inputs
 from catabot.bus.keys import Keys
 from catabot.bus.messages import BodyStates, End, Message, ThrustCmd, Tick, TwistCmd, VesselState
-from catabot.bus.participant import Participant, Stopped
+from catabot.bus.participant import EndRun, Participant, Stopped
 from catabot.client.commands import Command, Thrust, Twist, kind_of, message
 from catabot.client.errors import ClientError, CommandError, NoData, RunEnded
 from catabot.client.info import SensorInfo, VesselInfo, WorldInfo
@@ -115,6 +116,8 @@ class Joined:
         command = self._commands.get()  # the stack's act(); the conductor's deadline runs
         if command is _LEAVE:
             raise Stopped(f"{self.name} left the run at tick {tick.tick}")
+        if isinstance(command, EndRun):
+            raise command
         if self._control is not None:
             self.participant.publish(self._control.key, command)
 
@@ -186,6 +189,23 @@ class Joined:
         self._pending = None
         self._last = msg if msg is not None else self._last
         self._commands.put(msg)
+
+    def end_run(self, reason: str, *, timeout_s: float = 10.0) -> End:
+        """End the run instead of acting on the period last observed (an episode is over):
+        the run ends cleanly after the tick before it, for everyone, and its recording holds
+        every tick up to that one. Returns the End; NoData if it does not come in time."""
+        if self._pending is None:
+            raise ClientError(f"{self.name}: end_run() before observe(): no period to end at")
+        if not reason or len(reason) > MAX_END_REASON or not reason.isprintable():
+            raise ClientError(f"{self.name}: end_run() takes a reason of 1-{MAX_END_REASON} "
+                              f"printable characters, not {reason[:40]!r}")  # fmt: skip
+        self._pending = None
+        self._commands.put(EndRun(reason))
+        kind, value = self._wait(timeout_s)
+        if kind == "end":
+            self.end = value
+            return value
+        raise RunEnded(f"{self.name}: the run did not end as asked ({kind}: {value})")
 
     def _message(self, command: Command | None, obs: Observation) -> Message:
         vessel, control = self.vessel, self._control

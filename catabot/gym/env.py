@@ -124,7 +124,7 @@ class CataBotEnv(gym.Env[Obs, np.ndarray]):
         }
         if verdict.terminated or truncated:
             self._over = True
-            self._runner.end()
+            self._runner.end(verdict.why(self._steps))
         return self._observer(frame), verdict.reward, verdict.terminated, truncated, info
 
     def close(self) -> None:

@@ -42,6 +42,14 @@ class Verdict:
     collision: str | None = None  # the id of the body hit
     grounded: bool = False
 
+    def why(self, steps: int) -> str:
+        """The episode's end in words: the run's end reason (log/run.json)."""
+        what = ("goal reached" if self.reached else f"collision with {self.collision}"
+                if self.collision else "grounded" if self.grounded else "")  # fmt: skip
+        return f"episode {'terminated' if what else 'truncated'} after {steps} steps" + (
+            f": {what}" if what else ""
+        )
+
 
 class Judge:
     def __init__(self, world: World, vessel: str, options: EnvOptions) -> None:

@@ -36,6 +36,7 @@ from catabot.world.world import World
 
 Command = Thrust | Twist
 ASK_S = 0.5  # how long one look for the run's world/info waits before the run is checked
+END_WAIT_S = 5.0  # an ended run's End comes in milliseconds; past this, the run is stopped
 RETRY = {"period_init_ms": 20, "period_max_ms": 100, "period_increase_factor": 1.5}
 _zenoh = {"opened": False, "forked": False}  # this process opened a session; then forked
 
@@ -117,6 +118,15 @@ class ClientLink:
             self._joined.act(command)
         except ClientError as exc:
             raise LinkError(str(exc)) from None
+
+    def end(self, reason: str) -> bool:
+        """End the run after the last period observed (the episode is over), so its
+        recording stops there on every run; False if the run was over or did not end."""
+        try:
+            self._joined.end_run(reason, timeout_s=END_WAIT_S)
+        except ClientError:  # RunEnded and NoData included: the run's own end, or a kill
+            return False
+        return True
 
     def close(self) -> None:
         self._client.close()

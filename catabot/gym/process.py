@@ -67,8 +67,12 @@ class SimProcess:
         mine = [p for p in self.out.iterdir() if p.name.startswith(f"{self.name}-2")]
         return mine[0] if len(mine) == 1 else None
 
-    def stop(self) -> None:
-        """End the run as Ctrl-C does and wait for every process of it; kill on a hang."""
+    def stop(self, *, ended: bool = False) -> None:
+        """Wait for every process of the run (`ended`: it is ending by itself), ending it
+        as Ctrl-C does if it has not; kill on a hang."""
+        if ended:
+            with contextlib.suppress(subprocess.TimeoutExpired):
+                self.proc.wait(timeout=STOP_S)
         if self.alive:
             self.proc.send_signal(signal.SIGTERM)
             try:

@@ -42,7 +42,7 @@ class Runner:
     def start(self, seed: int, upcoming: int | None) -> Live:
         """The episode of `seed` joined at tick 0 (its frame taken: act next); with
         `upcoming`, that episode's run starts now in the background."""
-        self.end()
+        self.end("reset before the episode ended")
         early, self.next = self.next, None
         if early is not None and early.episode.seed == seed and early.run.alive:
             try:
@@ -112,25 +112,36 @@ class Runner:
             raise LinkError("no episode is running: call reset()")
         return self.live
 
-    def end(self) -> None:
-        """Stop the episode's run in the background (the next reset does not wait for it)."""
+    def end(self, reason: str = "") -> None:
+        """Stop the episode's run in the background (the next reset does not wait for it):
+        ended after the last period observed when a `reason` is given (its recording stops
+        there on every run), else stopped as Ctrl-C does."""
         live, self.live = self.live, None
-        self._retire(live)
+        self._retire(live, reason)
 
-    def _retire(self, live: Live | None) -> None:
+    def _retire(self, live: Live | None, reason: str = "") -> None:
         if live is None:
             return
-        if live.link is not None:
-            live.link.close()
-        thread = threading.Thread(target=live.run.stop, name="catabot-stop", daemon=True)
+        thread = threading.Thread(target=_finish, args=(live, reason), name="catabot-stop",
+                                  daemon=True)  # fmt: skip
         thread.start()
         self._ending = [t for t in self._ending if t.is_alive()] + [thread]
 
     def close(self) -> None:
         """Every run of this env stopped, every process gone."""
-        self.end()
+        self.end("the env was closed before the episode ended")
         self._retire(self.next)
         self.next = None
         for thread in self._ending:
             thread.join()
         self._ending = []
+
+
+def _finish(live: Live, reason: str) -> None:
+    """End `live`'s run (by its seat when there is a reason), leave it, wait for its
+    processes; a run that does not end by itself is stopped."""
+    link = live.link
+    ended = bool(reason) and link is not None and link.end(reason)
+    if link is not None:
+        link.close()
+    live.run.stop(ended=ended)

@@ -35,20 +35,24 @@ class CommandError(CataBotError, ValueError):
     """A command payload that cannot be taken (malformed, wrong type, out of range)."""
 
 
+class Malformed(CommandError):
+    """A payload that is not CDR of the topic's type (as against values out of range)."""
+
+
 def decode(payload: bytes, typename: str) -> Any:
     """The message in `payload`, strictly: CDR little-endian of `typename` and nothing else
     (re-encoding it gives the payload back, but for at most 3 bytes of final padding)."""
     if len(payload) > MAX_PAYLOAD:
-        raise CommandError(f"{len(payload)} bytes: too big for a {typename}")
+        raise Malformed(f"{len(payload)} bytes: too big for a {typename}")
     if payload[:4] != ENCAPSULATION:
-        raise CommandError(f"not little-endian CDR (header {payload[:4].hex() or 'missing'})")
+        raise Malformed(f"not little-endian CDR (header {payload[:4].hex() or 'missing'})")
     try:
         msg = types.deserialize(payload, typename)
         again = types.serialize(msg, typename)
     except Exception as exc:  # rosbags raises several types for truncated or garbled data
-        raise CommandError(f"not a {typename}: {type(exc).__name__}: {exc}") from None
+        raise Malformed(f"not a {typename}: {type(exc).__name__}: {exc}") from None
     if not 0 <= len(payload) - len(again) <= 3 or payload[: len(again)] != again:
-        raise CommandError(f"not a {typename} ({len(payload)} bytes, {len(again)} expected)")
+        raise Malformed(f"not a {typename} ({len(payload)} bytes, {len(again)} expected)")
     return msg
 
 

@@ -26,7 +26,7 @@ from mcap_ros2.decoder import DecoderFactory
 from numpy.typing import NDArray
 
 from catabot.bus.fields import FieldSpec, fields_of
-from catabot.bus.messages import BodyStates, ImuSample, LidarScan, Message, ThrustCmd
+from catabot.bus.messages import BodyStates, ImuSample, LidarScan, Message, ThrustCmd, TwistCmd
 from catabot.config.load import load_scenario
 from catabot.config.ros import RosConfig
 from catabot.errors import CataBotError
@@ -161,6 +161,12 @@ class RecordedRun:
         """(stamp_ns, command) of every thrust command the vessel was given (`thrust`)."""
         for stamp, m in self.decoded(self.names.topic(vessel, "thrust")):
             yield stamp, ThrustCmd(tuple(float(v) for v in m.data))
+
+    def twist(self, vessel: str) -> Iterator[tuple[int, TwistCmd]]:
+        """(stamp_ns, set-point) of every twist the vessel was given (`cmd_vel`): scripted,
+        sent from outside or by the traffic service."""
+        for stamp, m in self.decoded(self.names.topic(vessel, "cmd_vel")):
+            yield stamp, TwistCmd(float(m.linear.x), float(m.angular.z))
 
     def imu(self, sensor: MountedSensor) -> Iterator[ImuSample]:
         """Every sample of an IMU from its sensor_msgs/Imu (`<sensor>/imu`)."""

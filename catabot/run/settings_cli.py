@@ -171,7 +171,7 @@ def _camera(settings: dict[str, Any], vessel: str | None, camera: str | None) ->
             v, c = name[:cut], name[cut + 1 :]
             if vessel in (None, v) and camera in (None, c):
                 return v, c
-    wanted = f"{vessel or '*'}/{camera or '*'}"
+    wanted = f"{vessel or '*'}.{camera or '*'}"  # spelt as the cameras' settings keys
     raise AskError(f"no camera {wanted} in this run (cameras: {', '.join(cameras) or 'none'})")
 
 

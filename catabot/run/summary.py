@@ -129,6 +129,8 @@ def summarise(
         log = run_dir / "log" / f"{name}.log"
         print(f"  {name}: {describe_exit(code)} (see {log})", file=sys.stderr)
     _print_rejected(record["rejected"], run_dir)
+    if str(record["reason"]).startswith("ended by "):  # a participant's end (Ack.end)
+        print(f"run {record['reason']}")
     print(f"run folder: {run_dir}")
     if error:
         print(f"run failed: {error}", file=sys.stderr)

@@ -78,7 +78,7 @@ def document(run: RecordedRun, frames: list[Frame], subset: str) -> dict[str, An
 
 
 def export(run: RecordedRun, out: Path, *, val_fraction: float, block_s: float | None) -> str:
-    frames = camera_frames(run, val_fraction=val_fraction, block_s=block_s)
+    frames, note = camera_frames(run, val_fraction=val_fraction, block_s=block_s)
     (out / "annotations").mkdir(parents=True, exist_ok=True)
     counts = []
     for subset in ("train", "val"):
@@ -90,4 +90,4 @@ def export(run: RecordedRun, out: Path, *, val_fraction: float, block_s: float |
         text = json.dumps(doc, separators=(",", ":"))
         (out / "annotations" / f"instances_{subset}.json").write_text(text)
         counts.append(f"{subset} {len(mine)} images / {len(doc['annotations'])} annotations")
-    return ", ".join(counts)
+    return ", ".join(counts) + note

@@ -34,8 +34,12 @@ class Frame:
         return path
 
 
-def camera_frames(run: RecordedRun, *, val_fraction: float, block_s: float | None) -> list[Frame]:
-    """Every labelled frame with a colour image, split into train and val."""
+def camera_frames(
+    run: RecordedRun, *, val_fraction: float, block_s: float | None
+) -> tuple[list[Frame], str]:
+    """Every labelled frame with a colour image, split into train and val, and a note on
+    the frames left out for want of one (a camera's colour output switched off for a
+    while: `catabot set`), empty when none was."""
     found = cameras(run.folder, run.world.sensors)
     if not found:
         raise ExportError(
@@ -46,15 +50,19 @@ def camera_frames(run: RecordedRun, *, val_fraction: float, block_s: float | Non
         (f"{s.vessel}.{s.config.name}", f) for s in found for f in labelled_frames(run.folder, s)
     ]
     without = [f"{cam}@{f.tick}" for cam, f in pairs if f.path("color") is None]
-    if without:
-        raise ExportError(f"frames recorded without a colour image: {without[:5]}")
+    pairs = [(cam, f) for cam, f in pairs if f.path("color") is not None]
+    if not pairs:
+        raise ExportError(f"{run.folder}: no labelled frame has a colour image (the cameras' "
+                          "colour output was off: outputs.color)")  # fmt: skip
+    note = f"; left out {len(without)} frames without a colour image ({without[:1]}...)"
     subsets = split(
         [f.stamp_ns for _, f in pairs],
         seed=run.world.scenario.seed,
         val_fraction=val_fraction,
         block_s=block_s,
     )
-    return [
+    frames = [
         Frame(f"{cam}_{f.tick:08d}", cam, f, subset)
         for (cam, f), subset in zip(pairs, subsets, strict=True)
     ]
+    return frames, (note if without else "")

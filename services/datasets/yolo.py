@@ -52,7 +52,7 @@ def data_yaml(out: Path, run: RecordedRun) -> str:
 
 
 def export(run: RecordedRun, out: Path, *, val_fraction: float, block_s: float | None) -> str:
-    frames = camera_frames(run, val_fraction=val_fraction, block_s=block_s)
+    frames, note = camera_frames(run, val_fraction=val_fraction, block_s=block_s)
     for subset in ("train", "val"):
         (out / "images" / subset).mkdir(parents=True, exist_ok=True)
         (out / "labels" / subset).mkdir(parents=True, exist_ok=True)
@@ -62,4 +62,4 @@ def export(run: RecordedRun, out: Path, *, val_fraction: float, block_s: float |
     (out / "data.yaml").write_text(data_yaml(out, run))
     val = sum(f.subset == "val" for f in frames)
     boxes = sum(len(f.labelled.boxes) for f in frames)
-    return f"{len(frames)} images ({len(frames) - val} train, {val} val), {boxes} boxes"
+    return f"{len(frames)} images ({len(frames) - val} train, {val} val), {boxes} boxes{note}"

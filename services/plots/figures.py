@@ -13,7 +13,9 @@ import numpy as np
 from matplotlib.axes import Axes
 from matplotlib.colors import LinearSegmentedColormap, TwoSlopeNorm
 from matplotlib.figure import Figure
+from numpy.typing import NDArray
 
+from catabot.config.scenario import Scenario
 from services.plots.series import RunSeries
 
 SEA = ["#0a1e5a", "#2870be", "#96d2e6"]
@@ -139,25 +141,36 @@ def imu(data: RunSeries) -> Figure | None:
     return fig
 
 
+def rain_steps(scenario: Scenario, t_end: float) -> tuple[NDArray[np.float64], ...]:
+    """The rain rate over the run as steps (times, rates): the scenario's, then every
+    change of its `settings` timeline (a run folder's holds the live ones `catabot set` made)."""
+    points = [(0.0, scenario.rain.rate_mm_h)]
+    changes = [(c.t_s, c.value) for c in scenario.settings if c.key == "rain"]
+    points += sorted((t, float(v)) for t, v in changes if isinstance(v, int | float))
+    points.append((max(t_end, points[-1][0]), points[-1][1]))
+    return np.array([t for t, _ in points]), np.array([r for _, r in points])
+
+
 def lidar_rain(data: RunSeries) -> Figure | None:
     """Returns and rain returns per scan over time beside the rain rate, and the rain share."""
     if not data.lidar:
         return None
-    rate = data.run.world.scenario.rain.rate_mm_h
+    t_end = max(float(s.t[-1]) for s in data.lidar.values())
+    steps_t, steps_rate = rain_steps(data.run.world.scenario, t_end)
     fig = _figure(1, 2, size=(11, 4))
     counts, share = _axes(fig)
     for k, (owner, s) in enumerate(data.lidar.items()):
         counts.plot(s.t, s.values[:, 0], color=_color(k), label=f"{owner}: returns")
         counts.plot(s.t, s.values[:, 1], "--", color=_color(k), label=f"{owner}: rain returns")
         fraction = s.values[:, 1] / np.maximum(s.values[:, 0], 1)
-        share.plot(np.full(len(s.t), rate), 100 * fraction, "o", alpha=0.5, color=_color(k),
+        rate = steps_rate[np.searchsorted(steps_t, s.t, side="right") - 1]  # at each scan
+        share.plot(rate, 100 * fraction, "o", alpha=0.5, color=_color(k),
                    label=f"{owner} ({len(s.t)} scans)")  # fmt: skip
     counts.set(title="LiDAR returns per scan", xlabel="simulated time [s]", ylabel="points")
     counts.set_ylim(0, counts.get_ylim()[1] * 1.3)  # room for the legend above the lines
     rain = counts.twinx()
-    t_end = max(float(s.t[-1]) for s in data.lidar.values())
-    rain.plot([0, t_end], [rate, rate], color="magenta", lw=1.2, label="rain rate [mm/h]")
-    rain.set(ylabel="rain rate [mm/h]", ylim=(0, max(50.0, rate * 1.1)))
+    rain.step(steps_t, steps_rate, where="post", color="magenta", lw=1.2, label="rain rate [mm/h]")
+    rain.set(ylabel="rain rate [mm/h]", ylim=(0, max(50.0, float(steps_rate.max()) * 1.1)))
     lines = counts.get_legend_handles_labels()
     more = rain.get_legend_handles_labels()
     counts.legend(lines[0] + more[0], lines[1] + more[1], fontsize=8, loc="upper right", ncol=2)

@@ -92,9 +92,12 @@ def _commands(run: RecordedRun, out: RunSeries) -> None:
             values = np.array([[*v, *[np.nan] * (n - len(v))] for _, v in both])
             names = tuple(f"thruster {i}" for i in range(n))
             out.thrust[vid] = Series(np.array([t for t, _ in both]), values, names)
-        twist = [(s.t_s, s.twist) for s in body.script if s.twist is not None]
+        scripted = [(s.t_s, (s.twist.surge_mps, s.twist.yaw_rate_radps))
+                    for s in body.script if s.twist is not None]  # fmt: skip
+        given = [(stamp_ns / 1e9, (c.surge, c.yaw_rate)) for stamp_ns, c in run.twist(vid)]
+        twist = given or scripted  # every one recorded (sent, scripted), else the script's
         if twist:
-            values = np.array([[w.surge_mps, w.yaw_rate_radps] for _, w in twist])
+            values = np.array([w for _, w in twist])
             names = ("surge [m/s]", "yaw rate [rad/s]")
             out.setpoint[vid] = Series(np.array([t for t, _ in twist]), values, names)
 

@@ -25,6 +25,7 @@ from catabot.bus import codec
 from catabot.bus.clock import Stream
 from catabot.bus.inbox import Inputs
 from catabot.bus.messages import BodyStates, Message, ThrustCmd, Tick, TwistCmd, check_ids
+from catabot.bus.rejections import Rejections
 from catabot.bus.session import BLOCK
 from catabot.config.rates import rate_in_ticks
 from catabot.config.ros import GATEWAY, RosConfig
@@ -62,6 +63,8 @@ class Gateway:
         session: zenoh.Session,
         publish: Callable[[str, Message], None] | None = None,
         on_command: Callable[[], None] = lambda: None,
+        *,
+        rejections: Rejections,
     ) -> None:
         self.world, self.ros, self.keys = world, ros, world.keys
         self.convert = convert = Converter(world, ros, boats=ros.traffic)
@@ -79,7 +82,7 @@ class Gateway:
         self.outlets = {o.topic: o for outlets in self.sensors.values() for o in outlets}
         self.latched = [self._latch(out) for out in (convert.static_tf(), convert.buoys()) if out]
         vessels = [v for v in world.vessels if ros.traffic or v.kind == "vessel"]
-        self.inbound = Inbound(wire, convert.names, vessels, ros, on_command)
+        self.inbound = Inbound(wire, convert.names, vessels, ros, on_command, rejections=rejections)
         self._session, self._publish = session, publish
         self._free: dict[str, zenoh.Publisher] = {}
         streams = world.streams
@@ -237,7 +240,7 @@ class Gateway:
             if check is not None:
                 check(cmd.message)
         except ValueError as exc:
-            self.inbound.complain(f"{cmd.vessel}/{cmd.name}", str(exc))
+            self.inbound.refuse(f"{cmd.vessel}/{cmd.name}", exc)
             return False
         return True
 

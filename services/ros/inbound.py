@@ -7,14 +7,12 @@ with the Twist type and hash) instead of one per vessel: with 100 boats that is 
 and the bridge creates its DDS readers. Callbacks only queue the sample (no Zenoh call and no
 decoding on Zenoh's threads); the gateway decodes on its own thread. A sample on an unknown
 topic, a malformed payload or a value out of range is logged at most once per topic per
-second and ignored.
+second per topic and kind, counted (log/ros.rejected.json, the run's summary) and ignored.
 """
 
 from __future__ import annotations
 
-import logging
 import queue
-import time
 from collections.abc import Callable
 from dataclasses import dataclass
 
@@ -22,33 +20,17 @@ import zenoh
 
 from catabot.bus.keys import ROOT
 from catabot.bus.messages import Message
+from catabot.bus.rejections import Rejected, Rejections
 from catabot.config.ros import RosConfig
-from catabot.ros2.commands import CommandError, command
+from catabot.ros2.commands import CommandError, Malformed, command
 from catabot.ros2.names import COMMANDS, Names
 from catabot.ros2.wire import DATA, Convention
 from catabot.world.world import Body
 from services.ros.wire import Wire
 
-log = logging.getLogger("ros.inbound")
-
-
-class Complaints:
-    """Warnings at most once per topic per `period_s`, with a count of those held back."""
-
-    def __init__(self, period_s: float = 1.0) -> None:
-        self.period_s = period_s
-        self._last: dict[str, float] = {}
-        self._held: dict[str, int] = {}
-
-    def __call__(self, topic: str, problem: str) -> None:
-        now = time.monotonic()
-        if now - self._last.get(topic, -1e9) < self.period_s:
-            self._held[topic] = self._held.get(topic, 0) + 1
-            return
-        held = self._held.pop(topic, 0)
-        more = f" ({held} more since the last report)" if held else ""
-        log.warning("ignored a command on %s: %s%s", topic, problem, more)
-        self._last[topic] = now
+UNKNOWN = "ROS command on an unknown topic"  # the reasons refusals are counted by
+MALFORMED = "malformed ROS command"
+REFUSED = "ROS command refused"
 
 
 @dataclass(frozen=True)
@@ -76,8 +58,10 @@ class Inbound:
         vessels: list[Body],
         ros: RosConfig,
         on_sample: Callable[[], None] = lambda: None,
+        *,
+        rejections: Rejections,
     ) -> None:
-        self.ros, self.complain = ros, Complaints()
+        self.ros, self.rejections = ros, rejections
         self._samples: queue.SimpleQueue[tuple[str, bytes]] = queue.SimpleQueue()
         self._on_sample = on_sample
         self._routes: dict[str, _Route] = {}
@@ -121,16 +105,21 @@ class Inbound:
     def _checked(self, key: str, payload: bytes) -> list[Command]:
         route = self._routes.get(key)
         if route is None:
-            self.complain(key, "no vessel of this world has that command topic")
+            self.rejections.add(key, Rejected(UNKNOWN, "no vessel of this world has it"))
             return []
         try:
             msg = command(
                 route.name, payload, thrusters=route.thrusters, defaults=self.ros.waypoints
             )
         except CommandError as exc:
-            self.complain(route.topic, str(exc))
+            self.refuse(route.topic, exc)
             return []
         return [Command(route.vessel, route.name, msg)]
+
+    def refuse(self, topic: str, exc: ValueError) -> None:
+        """Counted and logged at most once a second per topic and kind (malformed or not)."""
+        self.rejections.add(topic, Rejected(MALFORMED if isinstance(exc, Malformed) else REFUSED,
+                                            str(exc)))  # fmt: skip
 
     def close(self) -> None:
         for sub in self._subscribers:

@@ -53,10 +53,11 @@ class Observer:
         wake: threading.Event,
         *,
         roster: Roster | None = None,
+        rejections: Rejections | None = None,
     ) -> None:
         self.keys, self.wake, self.session = keys, wake, session
         self.roster = roster if roster is not None else Roster()
-        self.rejections = Rejections(log, "ros")
+        self.rejections = rejections if rejections is not None else Rejections(log, "ros")
         self._wanted, self._pace = wanted, keys.world_states()
         self._data: dict[str, Any] = {}  # key -> subscriber, for the keys wanted now
         self._streams = {s.key: s for s in streams}

@@ -10,12 +10,14 @@ stack's commands at the same tick on every run (gateway.py).
 
 from __future__ import annotations
 
+import logging
 import sys
 import threading
 
 from catabot.bus.inbox import Inputs
 from catabot.bus.messages import End, Tick
 from catabot.bus.participant import EndFn
+from catabot.bus.rejections import Rejections
 from catabot.config.ros import GATEWAY, RosConfig
 from catabot.run.service import Built, ServiceContext, run_service
 from services.ros.gateway import Gateway
@@ -28,7 +30,9 @@ def build(ctx: ServiceContext) -> Built:
     inputs = [world.streams.states, *world.streams.sensors]
     if ros.lockstep:
         participant = ctx.participant(inputs)
-        gateway = Gateway(world, ros, ctx.session, publish=participant.publish)
+        gateway = Gateway(
+            world, ros, ctx.session, publish=participant.publish, rejections=participant.rejections
+        )
 
         def step(tick: Tick, received: Inputs) -> None:
             gateway.publish(received, clock_from_states=False)
@@ -36,8 +40,10 @@ def build(ctx: ServiceContext) -> Built:
 
         return participant, step, _closer(gateway)
     wake = threading.Event()
-    gateway = Gateway(world, ros, ctx.session, on_command=wake.set)
-    observer = Observer(ctx.session, ctx.keys, inputs, gateway.wanted, wake, roster=ctx.roster)
+    refused = Rejections(logging.getLogger("ros"), "ros")  # the observer's and the commands'
+    gateway = Gateway(world, ros, ctx.session, on_command=wake.set, rejections=refused)
+    observer = Observer(ctx.session, ctx.keys, inputs, gateway.wanted, wake, roster=ctx.roster,
+                        rejections=refused)  # fmt: skip
 
     def observe(_: Tick, received: Inputs) -> None:
         gateway.publish(received, clock_from_states=True)

@@ -45,7 +45,11 @@ log = logging.getLogger("viewer")
 
 def parser() -> argparse.ArgumentParser:
     p = OneLineParser(prog="catabot view", description=__doc__.split("\n")[0])
-    p.add_argument("source", nargs="?", help="run folder, or (with --connect) a scenario")
+    p.add_argument(
+        "source",
+        nargs="?",
+        help="a run folder (with --connect: the running run's folder or its scenario file)",
+    )
     add_connection_args(p)
     p.add_argument("--web", action="store_true", help="serve the web viewer, do not spawn one")
     p.add_argument("--web-port", type=int, default=0, help="web viewer port (default: free)")

@@ -324,6 +324,6 @@ def test_cmd_vel_drives_each_vessel_in_its_convention(live: Live) -> None:
 
 def test_malformed_commands_are_logged_at_most_once_a_second(live: Live) -> None:
     log = (live.run / "log" / "ros.log").read_text()
-    bad = re.findall(r"ignored a command on /ego/cmd_vel: not little-endian CDR", log)
-    wrong = re.findall(r"ignored a command on /other/cmd_vel: not a geometry_msgs/msg/Twist", log)
+    bad = re.findall(r"on /ego/cmd_vel: malformed ROS command: not little-endian CDR", log)
+    wrong = re.findall(r"on /other/cmd_vel: malformed ROS command: not a geometry_msgs/msg/Tw", log)
     assert 1 <= len(bad) <= 2 and 1 <= len(wrong) <= 2, log[-3000:]

@@ -8,6 +8,7 @@ run.rrd and export/<format>/ after the lockstep; the other tools are run on its 
 from __future__ import annotations
 
 import json
+import shutil
 import socket
 from collections import Counter
 from pathlib import Path
@@ -194,3 +195,30 @@ def test_refusals_exit_2_with_one_clear_line(
         result = catabot(*filled)
     assert result.returncode == 2, result.stdout + result.stderr
     assert message in result.stderr and "Traceback" not in result.stderr
+
+
+def _without_colour(run: Path, tmp: Path, drop: int) -> Path:
+    """A copy of the run whose first `drop` frames were saved with the colour output off."""
+    copy = tmp / f"off{drop}"
+    shutil.copytree(run, copy, ignore=shutil.ignore_patterns("export", "*.rrd", "*.mcap"))
+    labels = copy / "dataset" / "ego.cam" / "labels.jsonl"
+    records = [json.loads(x) for x in labels.read_text().split()]
+    for record in records[:drop]:
+        del record["files"]["color"]
+    labels.write_text("".join(json.dumps(r) + "\n" for r in records))
+    return copy
+
+
+def test_frames_without_a_colour_image_are_left_out_and_named(run: Path, tmp_path: Path) -> None:
+    """Colour switched off for a while (`catabot set`) made the whole run unexportable."""
+    out = tmp_path / "yolo"
+    result = catabot("dataset", "export", str(_without_colour(run, tmp_path, 3)), "-f", "yolo",
+                     "-o", str(out))  # fmt: skip
+    assert result.returncode == 0, result.stderr
+    assert "7 images" in result.stdout and "left out 3 frames without a colour image" in (
+        result.stdout
+    )
+    assert sum(n for n, _ in check_yolo(out / "data.yaml").values()) == 7
+    none = catabot("dataset", "export", str(_without_colour(run, tmp_path, 10)), "-f", "coco",
+                   "-o", str(tmp_path / "coco"))  # fmt: skip
+    assert none.returncode == 2 and "no labelled frame has a colour image" in none.stderr

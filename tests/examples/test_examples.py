@@ -128,6 +128,17 @@ def test_lockstep_stack_reaches_its_goal_and_records_the_same_bytes_twice(
     assert [c.split(",")[1] for c in commands[1:4]] == ["0", "10", "20"]
 
 
+def test_lockstep_stack_ends_the_run_at_its_goal(run: type[Run]) -> None:
+    sim = run("examples/stack.json")
+    stack = example("lockstep_stack.py", "--connect", sim.endpoint, "--goal", "40", "20",
+                    "--end-within", "3", timeout=120)  # fmt: skip
+    assert stack.returncode == 0, stack.stderr
+    assert "(ended by 'stack' after tick " in stack.stdout, stack.stdout
+    assert ": goal reached at t = " in stack.stdout
+    last = (sim.finish() / "vessel.ego.state.csv").read_text().splitlines()[-1].split(",")
+    assert abs(float(last[2]) - 40.0) < 3.5 and abs(float(last[3]) - 20.0) < 3.5, last
+
+
 def test_follow_waypoints_in_lockstep_with_thrust(run: type[Run]) -> None:
     """The scenario starts the follower itself (controller.program), in current and wind."""
     run_dir = run("examples/follow_waypoints.json").finish()

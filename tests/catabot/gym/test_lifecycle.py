@@ -2,10 +2,12 @@
 
 from __future__ import annotations
 
+import json
 import os
 import subprocess
 import sys
 import textwrap
+from pathlib import Path
 
 import gymnasium as gym
 import numpy as np
@@ -57,3 +59,33 @@ def test_episodes_map_no_shared_memory_and_reset_takes_no_options() -> None:
             env.reset(options={"bogus": 1})
     finally:
         env.close()
+
+
+def _episode(runs: Path, steps: int) -> Path:
+    """One truncated episode's run folder, once its run has ended (env.close waits)."""
+    env = gym.make("CataBot/Navigate-v0", max_steps=steps, recording="csv", runs_dir=str(runs))
+    try:
+        _, info = env.reset(seed=3)
+        truncated = False
+        while not truncated:
+            _, _, terminated, truncated, _ = env.step(np.full(2, 0.4, np.float32))
+            assert not terminated
+    finally:
+        env.close()
+    assert info["run_dir"] is not None
+    return Path(info["run_dir"])
+
+
+def test_an_episode_ends_its_run_at_the_terminal_step_with_the_same_bytes(tmp_path: Path) -> None:
+    """The env left the run at its end: run.json said "participant 'gym' left" and the
+    recording stopped up to 20 ticks early or ran past the end, by timing."""
+    first = _episode(tmp_path / "a", 12)
+    record = json.loads((first / "log" / "run.json").read_text())
+    reason = "ended by 'gym' after tick 129: episode truncated after 12 steps"
+    assert (record["error"], record["reason"], record["ticks"]) == ("", reason, 130)
+    state = (first / "vessel.ego.state.csv").read_text().splitlines()
+    assert state[-1].split(",")[:2] == ["1300000000", "129"]  # the last observation's state
+    second = _episode(tmp_path / "b", 12)
+    names = sorted(p.name for p in first.glob("*.csv"))
+    assert names == sorted(p.name for p in second.glob("*.csv")) and names
+    assert [n for n in names if (first / n).read_bytes() != (second / n).read_bytes()] == []

@@ -17,11 +17,12 @@ from rosbags.typesys import Stores, get_typestore
 
 from catabot.bus import codec
 from catabot.bus.messages import Message, ThrustCmd, Tick, TwistCmd
+from catabot.bus.rejections import Rejections
 from catabot.bus.session import Connection, free_port, open_session
 from catabot.config.load import parse_scenario
 from catabot.world.world import World
 from services.ros.gateway import Gateway
-from services.ros.inbound import Complaints
+from services.ros.inbound import MALFORMED, REFUSED
 from tests.catabot.ros2.world_fixture import scenario
 
 ROSBAGS = get_typestore(Stores.ROS2_JAZZY)
@@ -55,7 +56,7 @@ def _twist(x: float) -> bytes:
 def test_wants_only_what_someone_subscribes_to(sessions: Any) -> None:
     ours, ros = sessions
     world = World.resolve(parse_scenario(scenario(mode="bridge")))
-    gateway = Gateway(world, world.scenario.ros, ours)  # type: ignore[arg-type]
+    gateway = Gateway(world, world.scenario.ros, ours, rejections=_refused())  # type: ignore[arg-type]
     try:
         assert gateway.wanted() == frozenset()
         sub = ros.declare_subscriber("ego/lidar/points", lambda s: None)
@@ -80,7 +81,7 @@ def test_free_commands_go_to_the_bus_and_bad_ones_are_refused(
     bus = ros.declare_subscriber(
         key, lambda s: got.append(codec.decode(s.payload.to_bytes(), TwistCmd))
     )
-    gateway = Gateway(world, world.scenario.ros, ours)  # type: ignore[arg-type]
+    gateway = Gateway(world, world.scenario.ros, ours, rejections=_refused())  # type: ignore[arg-type]
     try:
         time.sleep(0.3)  # the wildcard subscribers reach the other session
         with caplog.at_level(logging.WARNING, logger="ros.inbound"):
@@ -110,7 +111,8 @@ def test_a_lockstep_controller_takes_the_reply_to_its_tick(sessions: Any) -> Non
     data["vessels"][1]["controller"] = {"participant": "ros", "rate_hz": 10, "command": "thrust"}
     world = World.resolve(parse_scenario(data))
     sent: list[tuple[str, Message]] = []
-    gateway = Gateway(world, world.scenario.ros, ours, lambda k, m: sent.append((k, m)))  # type: ignore[arg-type]
+    gateway = Gateway(world, world.scenario.ros, ours, lambda k, m: sent.append((k, m)),  # type: ignore[arg-type]
+                      rejections=_refused())  # fmt: skip
     try:
         gateway.commands(Tick("r", 0, 0, 10_000_000))  # nobody answers tick 0: neutral
         assert sent == [(world.keys.cmd_thrust("other"), ThrustCmd((0.0, 0.0), 0, 0))]
@@ -157,7 +159,7 @@ def test_commands_the_bus_would_refuse_are_refused_here(
     world = World.resolve(parse_scenario(data))
     got: list[str] = []
     bus = ros.declare_subscriber("catabot/**", lambda s: got.append(str(s.key_expr)))
-    gateway = Gateway(world, world.scenario.ros, ours)  # type: ignore[arg-type]
+    gateway = Gateway(world, world.scenario.ros, ours, rejections=_refused())  # type: ignore[arg-type]
     try:
         time.sleep(0.3)  # the wildcard subscribers reach the other session
         with caplog.at_level(logging.WARNING, logger="ros.inbound"):
@@ -167,20 +169,38 @@ def test_commands_the_bus_would_refuse_are_refused_here(
             assert _until(lambda: (gateway.commands(), bool(got))[1])
         assert got == [world.keys.cmd_waypoints("ego")]
         said = " ".join(r.getMessage() for r in caplog.records)
-        assert "on ego/waypoints: 'ego' is a scenario vessel" in said
-        assert "on other/cmd_vel: vessel 'other' is driven in lockstep by 'stack'" in said
+        assert f"on ego/waypoints: {REFUSED}: 'ego' is a scenario vessel" in said
+        assert f"on other/cmd_vel: {REFUSED}: vessel 'other' is driven in lockstep by" in said
     finally:
         bus.undeclare()
         gateway.close()
 
 
-def test_complaints_come_once_a_second_per_topic(caplog: pytest.LogCaptureFixture) -> None:
-    complain = Complaints(period_s=0.2)
-    with caplog.at_level(logging.WARNING, logger="ros.inbound"):
-        for _ in range(5):
-            complain("/a", "bad")
-            complain("/b", "bad")
-        time.sleep(0.25)
-        complain("/a", "bad")
-    messages = [r.getMessage() for r in caplog.records]
-    assert len(messages) == 3 and "(4 more since the last report)" in messages[-1]
+def test_refusals_are_counted_by_kind_and_each_kind_reported(
+    sessions: Any, caplog: pytest.LogCaptureFixture
+) -> None:
+    """Garbage then out-of-range twists on one topic: the out-of-range line said "(9 more
+    since the last report)", and the nine were the garbage."""
+    ours, ros = sessions
+    world = World.resolve(parse_scenario(scenario(mode="bridge")))
+    refused = _refused()
+    gateway = Gateway(world, world.scenario.ros, ours, rejections=refused)  # type: ignore[arg-type]
+    try:
+        time.sleep(0.3)
+        with caplog.at_level(logging.WARNING, logger="ros"):
+            for _ in range(3):
+                ros.put("ego/cmd_vel", b"garbage")
+            for _ in range(2):
+                ros.put("ego/cmd_vel", _twist(1000.0))
+            assert _until(lambda: (gateway.commands(), sum(refused.totals.values()) == 5)[1])
+        assert refused.totals == {MALFORMED: 3, REFUSED: 2}
+        said = [r.getMessage() for r in caplog.records]
+        assert len(said) == 2 and "since the last report" not in " ".join(said), said
+        assert f"{MALFORMED}: not little-endian CDR" in said[0]
+        assert f"{REFUSED}: twist out of range" in said[1]
+    finally:
+        gateway.close()
+
+
+def _refused() -> Rejections:
+    return Rejections(logging.getLogger("ros"), "ros")

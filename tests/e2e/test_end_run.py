@@ -1,0 +1,76 @@
+"""A stack ends the run (`Joined.end_run`, `EndRun` from a `run_lockstep` step) against real
+`catabot run --listen` runs: a clean end, exit 0, the reason in `log/run.json` and on the
+console, the recording up to the last tick stepped and the same bytes on every run."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+from typing import Any
+
+import pytest
+from conftest import files_of
+from test_client import SENSORS, Run
+
+from catabot.client import Client, ClientError, EndRun, Observation, Thrust
+
+pytestmark = pytest.mark.timeout(180)
+CONTROLLER = {"participant": "stack", "rate_hz": 10.0, "command": "thrust"}
+SCENARIO: dict[str, Any] = {
+    "name": "ends", "seed": 5, "duration_s": 60.0,
+    "vessels": [{"id": "ego", "sensors": SENSORS, "controller": CONTROLLER}],
+}  # fmt: skip
+
+
+def _ended_run(tmp: Path) -> tuple[Path, str, int]:
+    """The stack drives for 2.3 s, then ends the run: its folder, console, End tick."""
+    run = Run(tmp, SCENARIO)
+
+    def step(obs: Observation) -> Thrust:
+        if obs.tick == 230:
+            raise EndRun("mission complete")
+        return Thrust([0.5, 0.6])
+
+    try:
+        with Client.connect([run.endpoint], timeout_s=30) as sim:
+            end = sim.run_lockstep("stack", step, sensors=["gps"])
+        out, err = run.proc.communicate(timeout=60)
+        assert run.proc.returncode == 0, out + err
+        return Path(out.split("run folder: ")[-1].strip()), out, end.tick
+    finally:
+        run.kill()
+
+
+def test_a_stack_ends_the_run_cleanly_where_it_stopped(tmp_path: Path) -> None:
+    run_dir, console, tick = _ended_run(tmp_path / "a")
+    reason = "ended by 'stack' after tick 229: mission complete"
+    assert tick == 229 and f"run {reason}" in console
+    record = json.loads((run_dir / "log" / "run.json").read_text())
+    assert (record["error"], record["reason"], record["ticks"]) == ("", reason, 230)
+    state = (run_dir / "vessel.ego.state.csv").read_text().splitlines()
+    assert state[-1].split(",")[1] == "229"  # the state at t = 2.3 s, what the stack saw last
+    commands = (run_dir / "vessel.ego.cmd.thrust.csv").read_text().splitlines()
+    assert commands[-1].split(",")[1] == "220"  # no command for the period it ended at
+    second, _, _ = _ended_run(tmp_path / "b")
+    first, again = files_of(run_dir), files_of(second)
+    assert [n for n in first if first[n] != again.get(n)] == []
+
+
+def test_end_run_is_refused_before_observe_and_without_a_reason(tmp_path: Path) -> None:
+    run = Run(tmp_path, SCENARIO)
+    try:
+        with Client.connect([run.endpoint], timeout_s=30) as sim:
+            stack = sim.join("stack")
+            with pytest.raises(ClientError, match="end_run\\(\\) before observe\\(\\)"):
+                stack.end_run("too early")
+            stack.observe()
+            for bad in ("", "x" * 201, "tab\there"):
+                with pytest.raises(ClientError, match="1-200 printable characters"):
+                    stack.end_run(bad)
+            end = stack.end_run("checked")  # still in the seat: the refusals sent nothing
+            assert (end.tick, end.reason) == (-1, "ended by 'stack' after tick -1: checked")
+            stack.close()
+        out, err = run.proc.communicate(timeout=60)
+        assert run.proc.returncode == 0, out + err
+    finally:
+        run.kill()
