@@ -10,11 +10,14 @@
 # participant) and, for a fault, `fault <kind> <service> at <unix time>`; exits with the
 # conductor's status. Logs and the run folder go to OUT_DIR.
 set -euo pipefail
+usage="usage: $0 SCENARIO OUT_DIR [--cut|--kill SERVICE AFTER_S]"
+[[ $# -ge 2 ]] || { echo "$usage" >&2; exit 2; }
+[[ -f $1 ]] || { echo "$0: no scenario file $1 (give a path: deploy/scenario.json)" >&2; exit 2; }
 scenario=$(realpath "$1"); out=$(realpath -m "$2"); shift 2
 fault=""; victim=""; after=0
 if [[ $# -gt 0 ]]; then
   [[ $# -eq 3 && ( $1 == --cut || $1 == --kill ) ]] || {
-    echo "usage: $0 SCENARIO OUT_DIR [--cut|--kill SERVICE AFTER_S]" >&2; exit 2; }
+    echo "$usage" >&2; exit 2; }
   fault=${1#--}; victim=$2; after=$3
 fi
 mkdir -p "$out"

@@ -35,6 +35,7 @@ from catabot.bus.settings import from_wire, settings_problem
 log = logging.getLogger("catabot.bus.participant")
 WAITED = "waited at tick"  # the fault line `_waited` logs, which the launcher quotes
 ORPHAN_GRACE_S = 0.5
+LOST = "conductor lost"  # the reason of the End a participant makes when the clock vanished
 MAX_HELD_CLOCK = 64  # clock messages held while the conductor's session is not known yet
 StepFn = Callable[[Tick, Inputs], None]
 EndFn = Callable[[End, Inputs], None]
@@ -127,8 +128,11 @@ class Participant(Outputs):
     # -- the loop ------------------------------------------------------------------------
 
     def run(self, step: StepFn, on_end: EndFn | None = None) -> End:
-        """Step every granted tick until the conductor ends the run; returns the end message."""
+        """Step every granted tick until the run ends; its End (`LOST`: the conductor vanished)."""
         while True:
+            if self._orphaned_at and time.monotonic() - self._orphaned_at > ORPHAN_GRACE_S:
+                why = f"{self.name}: the conductor disappeared without ending the run"
+                return self._finish(End(self.run_id, self.next_tick - 1, LOST, why), on_end)
             event = self._next()
             if event[0] == "stop":
                 raise Stopped(f"{self.name} left the run at tick {self.next_tick}")
@@ -179,10 +183,8 @@ class Participant(Outputs):
         self._acked = k - 1
 
     def _ack_waiting(self) -> None:
-        """A second without events while ticks stepped since the last ack wait for inputs:
-        ack them now. Acks come every half window, so a participant that waits for a slow
-        one's data looked as late as it, and a missed deadline named whoever came first
-        (physics, for a stack that slept in its step)."""
+        """Ticks stepped since the last ack wait for inputs (a second without events, or the
+        run is ending): ack them now, or a missed deadline names whoever waits for data."""
         grant, done = self._grant, self.next_tick - 1
         if grant is not None and done > self._acked:
             self._ack_through(grant, done)
@@ -194,8 +196,6 @@ class Participant(Outputs):
 
     def _next(self) -> Event:
         """The next event; an End may trail the conductor's token, so allow it a grace."""
-        if self._orphaned_at and time.monotonic() - self._orphaned_at > ORPHAN_GRACE_S:
-            raise ClockError(f"{self.name}: the conductor disappeared without ending the run")
         try:
             event = self.events.get(timeout=0.1 if self._orphaned_at else 1.0)
         except queue.Empty:

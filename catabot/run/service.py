@@ -28,7 +28,7 @@ from catabot.bus.identity import Roster, add_roster_args
 from catabot.bus.inbox import Inbox, Inputs
 from catabot.bus.keys import Keys
 from catabot.bus.messages import End, Tick
-from catabot.bus.participant import EndFn, Participant, StepFn
+from catabot.bus.participant import LOST, EndFn, Participant, StepFn
 from catabot.bus.rejections import Rejections
 from catabot.bus.scheduling import batch_scheduling
 from catabot.bus.session import (
@@ -243,5 +243,8 @@ def _serve(ctx: ServiceContext, build: BuildFn) -> int:
     except Exception:  # a bug: its traceback in the log, named as the cause
         log.critical("crashed", exc_info=True)
         return 1
+    if end.reason == LOST:  # its files are closed whole, up to the last tick it stepped
+        log.error("%s (its files end at tick %d)", end.error, end.tick)
+        return EXIT_CLOCK
     log.info("%s: run ended at tick %d (%s) %s", ctx.name, end.tick, end.reason, end.error)
     return 0

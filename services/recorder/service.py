@@ -66,11 +66,14 @@ class Recorder:
         self.metrics = Metrics(world, self.orders)
         self.scripts = ScriptedCommands(world, self.orders)
         self.run_dir = ctx.run_dir
+        self.start = world.start_states()
         self._flushed_at = 0.0
         self.changes_stream = self.keys.relative(self.keys.config_changes())
         self.participant = ctx.participant(streams)
 
     def step(self, tick: Tick, inputs: Inputs) -> None:
+        if tick.tick == 0:  # the state at t = 0 (tagged -1): where every body starts
+            self._states(self.keys.relative(self.keys.world_states()), self.start)
         self._inputs(tick, inputs)
         for stream, cmd in self.scripts.due(tick.tick, tick.stamp_ns):  # as if sent
             self._write(stream, cmd)
@@ -81,8 +84,7 @@ class Recorder:
             stream = self.keys.relative(key)
             for msg in inputs[key]:
                 if isinstance(msg, BodyStates):
-                    if self._write_block(stream, msg, self.batches.states):
-                        self.metrics.add(msg)  # only batches of this run's bodies
+                    self._states(stream, msg)
                 elif isinstance(msg, TwistBatch):
                     self._write_block(stream, msg, self._twists)
                 else:
@@ -91,6 +93,10 @@ class Recorder:
         for change in changes_of(tick.settings):  # what took effect at this tick: an input
             record = SettingsChange(tick.tick, tick.stamp_ns, change.key, change.value)
             self._write(self.changes_stream, record)
+
+    def _states(self, stream: str, batch: BodyStates) -> None:
+        if self._write_block(stream, batch, self.batches.states):
+            self.metrics.add(batch)  # only batches of this run's bodies
 
     def _heard(self, key: str, msg: Message, tick: Tick) -> None:
         """A command for a vessel: the order physics follows from now on, so an overridden

@@ -94,3 +94,19 @@ def test_a_lost_host_is_named_within_the_lease_and_the_recording_is_whole(
     assert ended - faulted <= DETECT_S + SLACK_S, ended - faulted
     assert "did not end" not in result.stderr  # every survivor flushed and exited by itself
     assert 100 < _whole(run) < 2000  # ticks from before the fault, none after the run's end
+
+
+def test_a_recorder_cut_off_from_the_clock_still_closes_its_files(tmp_path: Path) -> None:
+    """Its run.mcap had no footer and metrics.json was missing: the recorder exited on
+    losing the conductor without closing them."""
+    paced = traffic_scenario("cutrec", duration_s=20.0, clock={"realtime_factor": 1.0})
+    run = tmp_path / "run"
+    result = hosts(scenario_file(tmp_path, paced), run, "--cut", "recorder", "1.5")
+    assert result.returncode == 1, result.stdout + result.stderr
+    assert "participant 'recorder' left the run" in result.stdout
+    assert 100 < _whole(run) < 2000
+    with (run / "run.mcap").open("rb") as f:
+        assert make_reader(f).get_summary() is not None  # the footer and summary written
+    assert (run / "metrics.json").is_file()
+    log = next(run.glob("**/recorder.log")).read_text()
+    assert "the conductor disappeared without ending the run (its files end at tick" in log

@@ -34,7 +34,8 @@ def test_lidar_in_rain_is_recorded_as_point_clouds(tmp_path: Path, out: Path) ->
     buoy = {r[0] for r in csv_rows(run / "vessel.b1.state.csv")[1:]}  # recorded at 10 Hz
     assert {r[0] for r in rows[2:]} <= buoy  # each scan after t = 0 joins on stamp_ns
     tf = [m for m in messages if m.topic == "/tf"]
-    assert len(tf) == len(rows[1:]) * 10 and tf[0].schema_name == "tf2_msgs/msg/TFMessage"
+    assert len(tf) == len(rows[1:]) * 10 + 1  # every tick, and the start state at t = 0
+    assert tf[0].schema_name == "tf2_msgs/msg/TFMessage"
     frames = [t.child_frame_id for t in tf[0].decoded.transforms]
     assert "ego/base_link" in frames and "b1/base_link" in frames  # buoys only there
     between = [t.child_frame_id for t in tf[-2].decoded.transforms]  # tick 98

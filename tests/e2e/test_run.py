@@ -40,7 +40,8 @@ def test_default_run_writes_run_folder_and_floats_at_archimedes_draft(out: Path)
     rows = csv_rows(run / "vessel.ego.state.csv")
     header, data = rows[0], rows[1:]
     assert header[:3] == ["stamp_ns", "tick", "position_x[m]"]
-    assert len(data) == 2000 and data[-1][0] == str(20 * 10**9)
+    assert len(data) == 2001 and data[-1][0] == str(20 * 10**9)  # the start state, 2000 ticks
+    assert data[0][:3] == ["0", "-1", "0.0"]  # where the vessel starts, at t = 0
     scenario = json.loads((run / "scenario.json").read_text())
     model = load_vessel_model(scenario["vessels"][0]["model"])
     rho = scenario["water"]["density_kg_m3"]

@@ -1,5 +1,5 @@
 """A vessel started off rest (pose z, roll; a body-frame velocity) in a real run: the first
-recorded state is one tick on from that start."""
+recorded state is the start itself (tick -1, t = 0), the next one tick on from it."""
 
 from __future__ import annotations
 
@@ -20,7 +20,10 @@ def test_the_first_recorded_state_follows_from_the_start(tmp_path: Path) -> None
     out = tmp_path / "out"
     result = catabot("run", str(scenario_file(tmp_path, data)), "--out", str(out), "--quiet")
     assert result.returncode == 0, result.stderr
-    header, first, *_ = csv_rows(only_run_dir(out) / "vessel.ego.state.csv")
+    header, start, first, *_ = csv_rows(only_run_dir(out) / "vessel.ego.state.csv")
+    at_start = dict(zip(header, map(float, start), strict=True))
+    assert (at_start["tick"], at_start["stamp_ns"], at_start["position_z[m]"]) == (-1, 0, 0.2)
+    assert at_start["linear_velocity_x[m/s]"] == 1.5  # the start itself, as given
     row = dict(zip(header, map(float, first), strict=True))
     assert row["tick"] == 0
     assert row["linear_velocity_x[m/s]"] == pytest.approx(1.5, rel=0.02)

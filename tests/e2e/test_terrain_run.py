@@ -62,7 +62,7 @@ def test_vessel_without_pose_starts_in_the_new_york_river(tmp_path: Path, out: P
     w, h = terrain.size_m
     assert abs(pose["x_m"] - w / 2) < 400 and abs(pose["y_m"] - h / 2) < 400
     rows = csv_rows(run / "vessel.ego.state.csv")
-    assert len(rows) == 201
+    assert len(rows) == 202  # the header, the start state and 200 ticks
 
 
 @pytest.mark.skipif(not RIVER.is_file(), reason="needs ../shared/data/elevation")

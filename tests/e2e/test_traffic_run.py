@@ -112,7 +112,7 @@ def test_a_hundred_boats_stay_afloat_in_the_bay(tmp_path: Path, out: Path) -> No
     terrain = load_terrain(scenario.terrain)
     for i in range(100):
         rows = _states(run, f"boat_{i:03d}")
-        assert len(rows) == scenario.ticks and np.isfinite(rows).all(), i
+        assert len(rows) == scenario.ticks + 1 and np.isfinite(rows).all(), i  # + the start
         assert (terrain.depth(rows[:, 2], rows[:, 3]) > 0.0).all(), f"boat_{i:03d} on land"
 
 
@@ -142,7 +142,8 @@ def test_a_setpoint_reaches_its_boat_after_the_configured_delay(tmp_path: Path) 
         assert result.returncode == 0, result.stderr
         states = _states(only_run_dir(out), "boat_000")
         moving = np.flatnonzero(states[:, 9] > 1e-4)  # linear_velocity_x
-        assert moving[0] == 1 + delay and (states[moving[0] :, 9] > 1e-4).all(), moving[:3]
+        # row 0 is the start (tick -1): the state of tick 1 + delay is row 2 + delay
+        assert moving[0] == 2 + delay and (states[moving[0] :, 9] > 1e-4).all(), moving[:3]
 
 
 def test_set_points_come_at_the_guidance_rate_and_are_held_between(tmp_path: Path) -> None:
@@ -179,7 +180,7 @@ def test_guidance_reads_the_states_of_the_tick_before_its_own(tmp_path: Path) ->
     assert twists[1:, 1].tolist() == list(range(5, 60, 5))
     assert obstacles is not None and rows.tolist() == [world.body("boat_000").row]
     for _, tick, surge, rate in twists[1:]:
-        s = states[int(tick) - 1]
+        s = states[int(tick)]  # row 0 is the start state (tick -1): tick - 1 is row tick
         assert s[1] == tick - 1
         seen = replace(obstacles, xy=s[None, 2:4].copy())
         yaw = rotations.yaw_of_quaternions(s[None, 5:9])

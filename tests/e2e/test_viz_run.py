@@ -77,7 +77,7 @@ def test_run_rrd_holds_every_stream_on_sim_time(run: Path) -> None:
     rows, static, timelines = _rows(run / "run.rrd")
     topics = _topic_counts(run)
     ticks = topics["/tf"]
-    assert ticks == round(SECONDS * 100) and timelines == {"sim_time"}
+    assert ticks == round(SECONDS * 100) + 1 and timelines == {"sim_time"}  # + the start
     bodies = [
         "/world/bodies/vessel-catabot",
         "/world/bodies/boat-monohull",
@@ -91,7 +91,7 @@ def test_run_rrd_holds_every_stream_on_sim_time(run: Path) -> None:
     sweeps = _topic_counts(run, "run.extra.mcap")["/sensor/ego/radar"]
     assert rows["/minimap/ego.radar/echoes"] == sweeps == topics["/ego/radar/points"] == 40
     assert rows["/series/imu_accel/ego.imu"] == topics["/ego/imu/imu"] == 100
-    assert rows["/world/trails"] == round(SECONDS / 0.2) and rows["/metrics"] == 1
+    assert rows["/world/trails"] == round(SECONDS / 0.2) + 1 and rows["/metrics"] == 1  # from t = 0
     assert {*bodies, "/world/water", "/world/vessels/ego/cam"} <= static  # the shapes, once
 
 
