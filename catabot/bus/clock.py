@@ -30,6 +30,11 @@ class ClockError(CataBotError, RuntimeError):
     """The run cannot go on: a participant vanished, missed the deadline or never came."""
 
 
+class EndRun(Exception):
+    """Raised by a step at tick k: end the run after tick k - 1, the last this participant
+    stepped (a controller whose episode is over); its text is the reason everyone sees."""
+
+
 class Policy(StrEnum):
     """What the conductor does with a faulty participant."""
 
@@ -86,6 +91,43 @@ class Stream:
 
 
 @dataclass(frozen=True)
+class ClockSpec:
+    dt_ns: int
+    ticks: int
+    participants: tuple[str, ...]
+    deadline_s: float = 10.0
+    start_timeout_s: float = 60.0
+    policy: Policy = Policy.ABORT
+    realtime_factor: float | None = None
+    window_ticks: int = 1
+    world: str = ""  # the scenario's digest, sent in every Tick
+
+    @property
+    def ack_every(self) -> int:
+        """Participants ack every this many ticks (and at the end of a grant): half the
+        window, so the slowest one's ack extends the grant before the fastest runs dry."""
+        return max(1, self.window_ticks // 2)
+
+
+@dataclass
+class Progress:
+    tick: int
+    stamp_ns: int
+    ticks_per_s: float
+    realtime_factor: float
+
+
+@dataclass
+class RunResult:
+    ticks_done: int
+    wall_s: float
+    error: str = ""
+    dropped: list[str] = field(default_factory=list)
+    reason: str = "completed"
+    join_s: float = 0.0
+
+
+@dataclass(frozen=True)
 class ClockLimits:
     """What a participant knows of the clock from its scenario, to believe a `Tick` only if
     it could have come from the conductor: the tick length, the run's length, the window."""
@@ -93,6 +135,16 @@ class ClockLimits:
     dt_ns: int
     ticks: int
     window: int
+    world: str = ""  # the scenario's digest (config/load.py); "" checks none
+
+    def check_world(self, tick: Tick) -> None:
+        """A conductor that runs another scenario than this process (hosts given different
+        files) is fatal here, not a sample to refuse: waiting would only time out."""
+        if self.world and tick.world and tick.world != self.world:
+            raise WorldMismatch(
+                f"the conductor runs another scenario (digest {tick.world}, this process's "
+                f"{self.world}): give every process of the run the same scenario file"
+            )
 
     def problem(self, tick: Tick, *, next_tick: int, grant: int) -> str:
         """Why `tick` cannot be a grant of this run ("" if it can). `grant`: the last tick
@@ -110,6 +162,10 @@ class ClockLimits:
         if tick.tick >= next_tick + self.window:  # nobody may run a window ahead of us
             return f"grant {tick.tick} is past the window ({next_tick} + {self.window})"
         return ""
+
+
+class WorldMismatch(CataBotError):
+    """This process and the conductor were started on different scenarios."""
 
 
 def ticks_for(duration_ns: int, dt_ns: int) -> int:

@@ -13,15 +13,22 @@ import threading
 import time
 import uuid
 from collections.abc import Callable
-from dataclasses import dataclass, field
 
 import zenoh
 
 from catabot.bus import codec
-from catabot.bus.clock import CONDUCTOR, MAX_END_REASON, ClockError, Policy
+from catabot.bus.clock import (
+    CONDUCTOR,
+    MAX_END_REASON,
+    ClockError,
+    ClockSpec,
+    Policy,
+    Progress,
+    RunResult,
+)
 from catabot.bus.identity import Roster, sender_of
 from catabot.bus.keys import Keys
-from catabot.bus.members import Members
+from catabot.bus.members import Members, check_free
 from catabot.bus.messages import Ack, End, Tick
 from catabot.bus.outputs import Outputs
 from catabot.bus.rejections import Rejected, Rejections
@@ -29,42 +36,6 @@ from catabot.bus.settings import Schedule
 
 log = logging.getLogger("catabot.bus.conductor")
 WAITING_NOTE_S = 5.0  # how often the log names who has not joined yet
-
-
-@dataclass(frozen=True)
-class ClockSpec:
-    dt_ns: int
-    ticks: int
-    participants: tuple[str, ...]
-    deadline_s: float = 10.0
-    start_timeout_s: float = 60.0
-    policy: Policy = Policy.ABORT
-    realtime_factor: float | None = None
-    window_ticks: int = 1
-
-    @property
-    def ack_every(self) -> int:
-        """Participants ack every this many ticks (and at the end of a grant): half the
-        window, so the slowest one's ack extends the grant before the fastest runs dry."""
-        return max(1, self.window_ticks // 2)
-
-
-@dataclass
-class Progress:
-    tick: int
-    stamp_ns: int
-    ticks_per_s: float
-    realtime_factor: float
-
-
-@dataclass
-class RunResult:
-    ticks_done: int
-    wall_s: float
-    error: str = ""
-    dropped: list[str] = field(default_factory=list)
-    reason: str = "completed"
-    join_s: float = 0.0
 
 
 class Conductor:
@@ -82,7 +53,10 @@ class Conductor:
         self.run_id = uuid.uuid4().hex[:12]
         self._created = time.monotonic()
         self.events: queue.SimpleQueue[tuple[str, str, bytes]] = queue.SimpleQueue()
-        self._members = Members(keys, roster if roster is not None else Roster())
+        roster = roster if roster is not None else Roster()
+        check_free(session, keys, CONDUCTOR, roster)  # NameTaken: a second conductor stops
+        self._members = Members(keys, roster)
+        self._members.roster.bind(CONDUCTOR, str(session.zid()))  # a later one: counted
         self.rejections = Rejections(log, CONDUCTOR)
         self.dropped: list[str] = []
         self._stop_reason = ""
@@ -226,7 +200,8 @@ class Conductor:
             self._restart_deadline()
         k, dt = self._granted, self.spec.dt_ns
         changes = self.settings.grant(k)
-        tick = Tick(self.run_id, k, k * dt, dt, tuple(self.dropped), self.spec.ack_every, changes)
+        tick = Tick(self.run_id, k, k * dt, dt, tuple(self.dropped), self.spec.ack_every, changes,
+                    self.spec.world)  # fmt: skip
         self._out.publish(self.keys.tick(), tick)
 
     def _await_progress(self) -> None:
@@ -256,9 +231,8 @@ class Conductor:
         self._advance()
 
     def _end_request(self, name: str, ack: Ack) -> None:
-        """A participant ends the run after `ack.tick`: nothing more is granted, everyone is
-        asked for its progress (a repeated grant: they ack as they go from then on), and the
-        run ends cleanly once all have stepped that tick. The first stop or request wins."""
+        """A participant ends the run after `ack.tick`: no more grants, a repeated one (ack as
+        you go from now on), the End once all have stepped that tick. The first end wins."""
         if self._stop_reason:
             return
         self._end_at = max(min(ack.tick, self._granted), self._done - 1)

@@ -73,6 +73,10 @@ class Keys:
         """A participant's liveliness token: its name and its session's zid (identity.py)."""
         return f"{self.prefix}/live/{check_name('participant', participant)}/{zid}"
 
+    def live_any(self, participant: str) -> str:
+        """The liveliness tokens of one name, whatever its session (who holds `physics`?)."""
+        return f"{self.prefix}/live/{check_name('participant', participant)}/*"
+
     def lives(self) -> str:
         return f"{self.prefix}/live/*/*"
 

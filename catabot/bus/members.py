@@ -7,8 +7,18 @@ so a stray client cannot join as `physics`, nor make the real physics look absen
 
 from __future__ import annotations
 
+import zenoh
+
 from catabot.bus.identity import Roster
 from catabot.bus.keys import KeyNameError, Keys
+from catabot.errors import CataBotError
+
+ASK_S = 2.0  # how long a newcomer asks who holds its name (a router answers in ms)
+
+
+class NameTaken(CataBotError):
+    """Another session already holds this process's name in the world (a second physics, a
+    second conductor): the newcomer stops, and says so, instead of failing the run later."""
 
 
 class Members:
@@ -36,3 +46,25 @@ class Members:
         """Whether `sender` is the session bound to `name`."""
         zid = self.roster.zid(name)
         return zid is not None and sender == zid
+
+
+def check_free(session: zenoh.Session, keys: Keys, name: str, roster: Roster) -> None:
+    """NameTaken if another session holds `name` in this world now. Asked before this
+    process declares its own token, so the newcomer stops and the one already there goes on
+    (a later token of its name is only counted there). `catabot run` fixes every name's
+    session in its roster: nothing to ask then."""
+    if name in roster.fixed:
+        return
+    own = str(session.zid())
+    for reply in session.liveliness().get(keys.live_any(name), timeout=ASK_S):
+        if reply.ok is None:
+            continue
+        try:
+            _, zid = keys.member_of(str(reply.ok.key_expr))
+        except KeyNameError:
+            continue
+        if zid != own:
+            raise NameTaken(
+                f"another process already runs as {name!r} in world {keys.world!r} (session "
+                f"{zid}): stop one of them, or give this run another scenario name"
+            )

@@ -48,10 +48,10 @@ class Message:
 
 @dataclass(frozen=True)
 class Tick(Message):
-    """On `clock/tick`: every tick up to `tick` may be stepped (a grant; DESIGN.md §4), and
-    participants ack every `ack_every` ticks and at the grant's last tick. A service's step
-    receives one Tick per tick it steps. `settings`: setting changes in the ticks the grant
-    adds; a step's Tick carries those of its tick, applied first (catabot/bus/settings.py)."""
+    """On `clock/tick`: every tick up to `tick` may be stepped (a grant; DESIGN.md §4), acked
+    every `ack_every` ticks and at its last; a step gets one Tick per tick. `settings`: the
+    changes in the ticks it adds (settings.py), a step's those of its tick; `world`: the
+    digest of the conductor's scenario (config/load.py), which every participant checks."""
 
     TYPE: ClassVar[str] = "tick"
     run: str
@@ -61,6 +61,7 @@ class Tick(Message):
     dropped: tuple[str, ...] = ()
     ack_every: int = 1
     settings: tuple[str, ...] = ()
+    world: str = ""
 
 
 @dataclass(frozen=True)
@@ -116,9 +117,9 @@ def check_ids(what: str, tick: int, ids: tuple[str, ...], expected: tuple[str, .
     """Refuse a batch whose rows are not `expected`, in order: a consumer that mapped rows
     to bodies once would otherwise silently write one body's data under another's name."""
     if ids != expected:
+        got, want = list(ids)[:8], list(expected)[:8]
         raise ValueError(
-            f"{what} at tick {tick} lists {list(ids)[:8]}..., "
-            f"expected {list(expected)[:8]}... ({len(expected)} rows)"
+            f"{what} at tick {tick} lists {got}..., expected {want}... ({len(expected)} rows)"
         )
 
 

@@ -22,11 +22,11 @@ from collections.abc import Callable, Sequence
 import zenoh
 
 from catabot.bus import codec
-from catabot.bus.clock import CONDUCTOR, MAX_END_REASON, ClockError, ClockLimits, Stream
+from catabot.bus.clock import CONDUCTOR, MAX_END_REASON, ClockError, ClockLimits, EndRun, Stream
 from catabot.bus.identity import Roster, sender_of
 from catabot.bus.inbox import Inbox, Inputs
 from catabot.bus.keys import Keys
-from catabot.bus.members import Members
+from catabot.bus.members import Members, check_free
 from catabot.bus.messages import Ack, End, Tick
 from catabot.bus.outputs import Outputs
 from catabot.bus.rejections import Rejected, Rejections
@@ -35,6 +35,7 @@ from catabot.bus.settings import from_wire, settings_problem
 log = logging.getLogger("catabot.bus.participant")
 WAITED = "waited at tick"  # the fault line `_waited` logs, which the launcher quotes
 ORPHAN_GRACE_S = 0.5
+NOTE_EVERY_S = 10.0  # before tick 0, how often a participant says it still waits
 LOST = "conductor lost"  # the reason of the End a participant makes when the clock vanished
 MAX_HELD_CLOCK = 64  # clock messages held while the conductor's session is not known yet
 StepFn = Callable[[Tick, Inputs], None]
@@ -44,11 +45,6 @@ Event = tuple[str, str, bytes, str]  # kind, key, payload, sender zid
 
 class Stopped(ClockError):
     """`run()` was stopped from another thread before the run ended (a client leaving)."""
-
-
-class EndRun(Exception):
-    """Raised by a step at tick k: end the run after tick k - 1, the last this participant
-    stepped (a controller whose episode is over); its text is the reason everyone sees."""
 
 
 class Participant(Outputs):
@@ -69,7 +65,9 @@ class Participant(Outputs):
         self.roster = roster if roster is not None else Roster()
         self.limits = limits
         self.inbox = Inbox(inputs, roster=self.roster, dt_ns=limits.dt_ns if limits else 0)
+        check_free(session, keys, name, self.roster)  # NameTaken: a second physics stops
         self.members = Members(keys, self.roster)
+        self.roster.bind(name, str(session.zid()))  # a later token of its name: counted
         self.rejections = Rejections(log, name)
         self.peers = set(peers) - {name}
         self._everyone = self.peers | {name}  # the peers a tick may name as dropped
@@ -86,6 +84,7 @@ class Participant(Outputs):
         self.run_id = ""
         self._orphaned_at = 0.0
         self._warned_tick = -1
+        self._notes = 0  # "no tick yet" lines logged
         self._subs = [
             session.declare_subscriber(keys.tick(), self._push("tick")),
             session.declare_subscriber(keys.end(), self._push("end")),
@@ -105,17 +104,9 @@ class Participant(Outputs):
 
         return on_sample
 
-    def watch_strays(self, pattern: str, why: Callable[[str], str]) -> None:
-        """Refuse, by `why(key)`, puts under `pattern` on no stream of this participant: a
-        command to a vessel that does not exist reached no subscriber, and nobody said so."""
-        known = frozenset(self.inbox.keys)
-
-        def on_sample(sample: zenoh.Sample) -> None:
-            key = str(sample.key_expr)
-            if key not in known:  # the streams' own samples: a set lookup, nothing queued
-                self.events.put(("stray", key, why(key).encode(), sender_of(sample)))
-
-        self._subs.append(self.session.declare_subscriber(pattern, on_sample))
+    def keep(self, subscriber: zenoh.Subscriber[None]) -> None:
+        """A subscriber that feeds `events`, undeclared with this participant (strays.py)."""
+        self._subs.append(subscriber)
 
     def _on_live(self, sample: zenoh.Sample) -> None:
         kind = "join" if sample.kind == zenoh.SampleKind.PUT else "leave"
@@ -186,8 +177,17 @@ class Participant(Outputs):
         """Ticks stepped since the last ack wait for inputs (a second without events, or the
         run is ending): ack them now, or a missed deadline names whoever waits for data."""
         grant, done = self._grant, self.next_tick - 1
-        if grant is not None and done > self._acked:
+        if grant is None:
+            self._note_no_clock()
+        elif done > self._acked:
             self._ack_through(grant, done)
+
+    def _note_no_clock(self) -> None:
+        waited = time.monotonic() - self._waiting_since  # said nothing, however long
+        if waited > NOTE_EVERY_S * (self._notes + 1):
+            self._notes += 1
+            log.warning("%s: no tick from the conductor of world %r after %.0f s (present: %s)",
+                        self.name, self.keys.world, waited, sorted(self.present))  # fmt: skip
 
     def _tick_of(self, grant: Tick, k: int) -> Tick:
         stamp = grant.stamp_ns - (grant.tick - k) * grant.dt_ns
@@ -258,6 +258,8 @@ class Participant(Outputs):
     def _take_tick(self, tick: Tick) -> None:
         if self.run_id and tick.run != self.run_id:
             raise Rejected("tick of another run", tick.run)
+        if self.limits is not None:
+            self.limits.check_world(tick)  # raises: another scenario than the conductor's
         problem = self._tick_problem(tick)
         if problem:
             raise Rejected("tick the clock cannot send", problem)
@@ -330,9 +332,8 @@ class Participant(Outputs):
         return end
 
     def _waited(self, tick: int) -> None:
-        """Say whose data held this participant at a fault: the deadline names those that
-        did not ack, and one waiting for a stack that acked a tick without its command
-        looked hung (the launcher repeats this line in the cause)."""
+        """Whose data held this participant at a fault (the launcher quotes it in the cause):
+        one waiting for a stack that acked a tick without its command looked hung."""
         missing = self.inbox.missing(tick)
         if missing:
             whose = ", ".join(f"{key} from {self.inbox.streams[key].producer!r}" for key in missing)

@@ -5,6 +5,7 @@ messages with NumPy arrays, send Thrust/Twist/Waypoints, and run the stack free 
 to the lockstep (deterministic). See the README, "Plugging in your autonomy stack".
 """
 
+from catabot.bus.clock import EndRun
 from catabot.bus.messages import (
     BodyStates,
     CameraFrame,
@@ -15,7 +16,6 @@ from catabot.bus.messages import (
     RadarSweep,
     VesselState,
 )
-from catabot.bus.participant import EndRun
 from catabot.client.client import Client
 from catabot.client.commands import Command, Thrust, Twist, Waypoints
 from catabot.client.errors import (

@@ -18,11 +18,10 @@ from types import TracebackType
 
 import zenoh
 
-from catabot.bus.clock import NS_PER_S, ClockError, period_in_ticks
+from catabot.bus.clock import NS_PER_S, ClockError, EndRun, period_in_ticks
 from catabot.bus.keys import Keys
 from catabot.bus.messages import End
 from catabot.bus.outputs import Outputs
-from catabot.bus.participant import EndRun
 from catabot.bus.session import Connection, connection_from_args, open_session
 from catabot.client.commands import Command
 from catabot.client.discover import find_world

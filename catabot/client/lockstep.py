@@ -20,11 +20,11 @@ from typing import Any
 
 import zenoh
 
-from catabot.bus.clock import MAX_END_REASON
+from catabot.bus.clock import MAX_END_REASON, EndRun
 from catabot.bus.inbox import Inputs
 from catabot.bus.keys import Keys
 from catabot.bus.messages import BodyStates, End, Message, ThrustCmd, Tick, TwistCmd, VesselState
-from catabot.bus.participant import EndRun, Participant, Stopped
+from catabot.bus.participant import Participant, Stopped
 from catabot.client.commands import Command, Thrust, Twist, kind_of, message
 from catabot.client.errors import ClientError, CommandError, NoData, RunEnded
 from catabot.client.info import SensorInfo, VesselInfo, WorldInfo

@@ -7,9 +7,10 @@ original simulator's `SettingsConfig.json` format are mapped by `settings_config
 
 from __future__ import annotations
 
+import hashlib
 import json
 import os
-from pathlib import Path
+from pathlib import Path, PurePath
 from typing import Any
 
 from pydantic import ValidationError
@@ -132,3 +133,26 @@ def _sensor_params(schema: dict[str, Any]) -> None:
         cases.append({"if": {"properties": {"type": {"const": name}}, "required": ["type"]},
                       "then": {"properties": {"params": ref}}})  # fmt: skip
     defs["SensorConfig"]["allOf"] = cases
+
+
+FILE_SUFFIXES = (".png", ".tif", ".tiff", ".json", ".obj", ".stl", ".gltf", ".glb")
+
+
+def digest(scenario: Scenario) -> str:
+    """12 hex digits of the scenario every process of a run must hold alike: hosts given
+    different files (a pose, a rate, dt) would each simulate a world of their own, and the
+    run would end as if nothing were wrong. Files count by name only: each machine may keep
+    its data in a folder of its own."""
+    data = _names_only(scenario.model_dump(mode="json"))
+    text = json.dumps(data, sort_keys=True, separators=(",", ":"))
+    return hashlib.sha256(text.encode()).hexdigest()[:12]
+
+
+def _names_only(value: Any) -> Any:
+    if isinstance(value, dict):
+        return {k: _names_only(v) for k, v in value.items()}
+    if isinstance(value, list):
+        return [_names_only(v) for v in value]
+    if isinstance(value, str) and value.lower().endswith(FILE_SUFFIXES):
+        return PurePath(value).name
+    return value

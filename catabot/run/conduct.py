@@ -23,6 +23,7 @@ from catabot.bus.conductor import ClockSpec, Conductor, Progress
 from catabot.bus.heap import keep_heap
 from catabot.bus.identity import add_roster_args
 from catabot.bus.keys import Keys
+from catabot.bus.members import NameTaken
 from catabot.bus.session import (
     add_connection_args,
     connection_from_args,
@@ -30,7 +31,7 @@ from catabot.bus.session import (
 )
 from catabot.bus.settings import Schedule
 from catabot.config import live
-from catabot.config.load import load_scenario
+from catabot.config.load import digest, load_scenario
 from catabot.config.scenario import Scenario, participants
 from catabot.errors import CataBotError
 from catabot.run.answer import OneLineParser
@@ -54,6 +55,7 @@ def clock_spec(scenario: Scenario, start_timeout_s: float | None = None) -> Cloc
         policy=Policy(c.policy),
         realtime_factor=c.realtime_factor,
         window_ticks=c.window_ticks,
+        world=digest(scenario),
     )
 
 
@@ -106,16 +108,16 @@ def main(argv: list[str] | None = None) -> int:
         scenario = load_scenario(args.scenario)
         session = open_session(connection_from_args(args))
     except CataBotError as exc:
-        emit("result", ticks=0, wall_s=0.0, error=str(exc), dropped=[])
+        emit("result", ticks_done=0, wall_s=0.0, error=str(exc), dropped=[])
         return 2
     keys, schedule = Keys(scenario.name), Schedule(live.timeline(scenario), ticks=scenario.ticks)
-    conductor = Conductor(
-        session,
-        keys,
-        clock_spec(scenario, args.start_timeout),
-        roster=args.roster,
-        settings=schedule,
-    )
+    spec = clock_spec(scenario, args.start_timeout)
+    try:
+        conductor = Conductor(session, keys, spec, roster=args.roster, settings=schedule)
+    except NameTaken as exc:  # a second conductor of this world
+        emit("result", ticks_done=0, wall_s=0.0, error=str(exc), dropped=[])
+        session.close()
+        return 2
     desk = SettingsDesk(session, keys, scenario, schedule)
     info = WorldInfoDesk(session, scenario, args.roster, schedule)  # for stacks: catabot.client
     quiet_gc()

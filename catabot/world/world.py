@@ -23,6 +23,7 @@ from catabot.bus.clock import NS_PER_S, ClockLimits, period_in_ticks
 from catabot.bus.keys import Keys
 from catabot.bus.messages import CLASS_BUOY, CLASS_VESSEL, BodyStates
 from catabot.config.base import ScenarioError
+from catabot.config.load import digest
 from catabot.config.pose import Velocity
 from catabot.config.scenario import (
     ControllerConfig,
@@ -181,7 +182,7 @@ class World:
     def clock_limits(self) -> ClockLimits:
         """What participants check every Tick against (catabot/bus/clock.py)."""
         s = self.scenario
-        return ClockLimits(s.dt_ns, s.ticks, s.clock.window_ticks)
+        return ClockLimits(s.dt_ns, s.ticks, s.clock.window_ticks, digest(s))
 
     @property
     def participants(self) -> list[str]:

@@ -15,6 +15,7 @@ import numpy as np
 from catabot.bus.inbox import Inputs
 from catabot.bus.messages import BodyStates, Message, Tick, TwistBatch, VesselState
 from catabot.bus.settings import changes_of
+from catabot.bus.strays import watch_strays
 from catabot.config import live
 from catabot.run.service import Built, ServiceContext, run_service
 from services.physics import settings
@@ -56,7 +57,7 @@ class PhysicsService:
         self.guidance = guidance if guidance.key != streams.states.key else None
         self.scenario, self.specs = world.scenario, live.keys_of(world.scenario)
         self.participant = ctx.participant(self.streams)
-        self.participant.watch_strays(ctx.keys.vessel_commands(), self._stray)
+        watch_strays(self.participant, ctx.keys.vessel_commands(), self._stray)
 
     def _stray(self, key: str) -> str:
         """Why a command key physics does not take is none: no such vessel, or command."""

@@ -44,6 +44,9 @@ class Recorder:
     def __init__(self, ctx: ServiceContext) -> None:
         rec = ctx.scenario.recording
         ctx.run_dir.mkdir(parents=True, exist_ok=True)
+        own = ctx.run_dir / "scenario.json"  # `catabot run` wrote it; a split run has none
+        if not own.exists():  # without it, `catabot plot`, `view` and `dataset` refuse the run
+            own.write_text(ctx.scenario.model_dump_json(indent=1) + "\n")
         self.keys = ctx.keys
         world = ctx.world
         convert = Converter(world, ctx.scenario.ros)  # the gateway's topics and frames

@@ -12,10 +12,9 @@ import time
 
 import pytest
 
-from catabot.bus.clock import MAX_END_REASON, Stream
+from catabot.bus.clock import MAX_END_REASON, EndRun, Stream
 from catabot.bus.inbox import Inputs
 from catabot.bus.messages import Ack, GpsFix, Tick
-from catabot.bus.participant import EndRun
 from tests.catabot.bus.lockstep_world import World, _fix
 
 

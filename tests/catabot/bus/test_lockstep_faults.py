@@ -9,6 +9,7 @@ import time
 import pytest
 
 from catabot.bus import codec, conductor
+from catabot.bus import participant as participant_module
 from catabot.bus.clock import Policy, Stream
 from catabot.bus.inbox import Inputs
 from catabot.bus.messages import Tick, VesselState
@@ -256,3 +257,18 @@ def _close_when_stopped(world: World) -> None:
     while a.error is None:
         time.sleep(0.01)
     a.participant.close()  # its token goes: the conductor notices at once
+
+
+def test_a_participant_without_a_conductor_says_what_it_waits_for(
+    world: World, monkeypatch: pytest.MonkeyPatch, caplog: pytest.LogCaptureFixture
+) -> None:
+    """A service started alone (or in the wrong world) said nothing, however long."""
+    monkeypatch.setattr(participant_module, "NOTE_EVERY_S", 0.3)
+    lonely = world.member("lonely")
+    with caplog.at_level(logging.WARNING, logger="catabot.bus.participant"):
+        lonely.thread.start()
+        time.sleep(2.5)  # idle events come every second
+    notes = [
+        r.getMessage() for r in caplog.records if "no tick from the conductor" in r.getMessage()
+    ]
+    assert notes and f"of world {world.keys.world!r} after " in notes[0], notes

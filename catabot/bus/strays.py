@@ -1,0 +1,25 @@
+"""Puts a participant hears on no stream of its own: a command to a vessel that does not
+exist reached no subscriber, and nobody said so. Physics watches `vessel/*/cmd/*` with this
+and names the unknown vessel or command (counted and logged like any refused sample)."""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+
+import zenoh
+
+from catabot.bus.identity import sender_of
+from catabot.bus.participant import Participant
+
+
+def watch_strays(participant: Participant, pattern: str, why: Callable[[str], str]) -> None:
+    """Refuse, by `why(key)`, puts under `pattern` on no stream of `participant`."""
+    known = frozenset(participant.inbox.keys)
+    events = participant.events
+
+    def on_sample(sample: zenoh.Sample) -> None:
+        key = str(sample.key_expr)
+        if key not in known:  # the streams' own samples: a set lookup, nothing queued
+            events.put(("stray", key, why(key).encode(), sender_of(sample)))
+
+    participant.keep(participant.session.declare_subscriber(pattern, on_sample))

@@ -1,0 +1,94 @@
+"""A run whose processes are started one by one (`catabot service ...`, as on several hosts):
+what a user gets wrong there is refused at once and named, not left to a deadline.
+
+- a process given another scenario file than the conductor's (a pose, a rate) stops with
+  the reason; before, the run completed with a world nobody described;
+- a second physics, or a second conductor, of a world already running stops; the run that
+  was there goes on;
+- the recorder leaves the scenario in its run folder, so `catabot plot` and the other tools
+  read a split run's folder.
+"""
+
+from __future__ import annotations
+
+import json
+import subprocess
+import time
+from pathlib import Path
+from typing import Any
+
+import pytest
+from conftest import scenario_file, start
+
+from catabot.bus.session import free_port
+
+pytestmark = pytest.mark.timeout(180)
+SCENARIO: dict[str, Any] = {
+    "name": "split", "seed": 1, "duration_s": 2.0,
+    "vessels": [{"id": "ego", "pose": {"x_m": 0.0, "y_m": 0.0}}],
+}  # fmt: skip
+
+
+def _service(name: str, scenario: Path, endpoint: str, *more: str) -> subprocess.Popen[str]:
+    return start("service", name, "--scenario", str(scenario), "--connect", endpoint, *more)
+
+
+def _conductor(scenario: Path, endpoint: str) -> subprocess.Popen[str]:
+    return start("service", "conductor", "--scenario", str(scenario), "--listen", endpoint)
+
+
+def _result(proc: subprocess.Popen[str]) -> dict[str, Any]:
+    out, err = proc.communicate(timeout=120)
+    lines = [json.loads(x) for x in out.splitlines() if '"result"' in x]
+    assert lines, out + err
+    return dict(lines[-1])
+
+
+def test_a_process_given_another_scenario_stops_and_says_why(tmp_path: Path) -> None:
+    mine = scenario_file(tmp_path, SCENARIO)
+    moved = json.loads(json.dumps(SCENARIO))
+    moved["vessels"][0]["pose"]["x_m"] = 5.0
+    other = scenario_file(tmp_path, moved, "moved.json")
+    endpoint = f"tcp/127.0.0.1:{free_port()}"
+    conductor = _conductor(mine, endpoint)
+    physics = _service("physics", other, endpoint, "--run-dir", str(tmp_path / "run"))
+    recorder = _service("recorder", mine, endpoint, "--run-dir", str(tmp_path / "run"))
+    try:
+        _, err = physics.communicate(timeout=120)
+        assert physics.returncode == 2, err
+        assert "the conductor runs another scenario (digest " in err
+        assert "give every process of the run the same scenario file" in err
+        assert "physics" in _result(conductor)["error"]
+    finally:
+        for proc in (conductor, physics, recorder):
+            proc.kill()
+            proc.communicate()
+
+
+def test_a_second_physics_or_conductor_stops_and_the_run_goes_on(tmp_path: Path) -> None:
+    scenario = scenario_file(tmp_path, SCENARIO)
+    endpoint, run = f"tcp/127.0.0.1:{free_port()}", tmp_path / "run"
+    conductor = _conductor(scenario, endpoint)
+    physics = _service("physics", scenario, endpoint, "--run-dir", str(run))
+    procs = [conductor, physics]
+    try:
+        time.sleep(2.0)  # both joined: the world has its conductor and its physics
+        again = _service("physics", scenario, endpoint, "--run-dir", str(tmp_path / "again"))
+        rival = start("service", "conductor", "--scenario", str(scenario), "--connect", endpoint)
+        procs += [again, rival]
+        _, err = again.communicate(timeout=60)
+        assert again.returncode == 2 and "another process already runs as 'physics'" in err
+        refused = _result(rival)
+        assert rival.returncode == 2, refused
+        assert "another process already runs as 'conductor' in world 'split'" in refused["error"]
+        recorder = _service("recorder", scenario, endpoint, "--run-dir", str(run))
+        procs.append(recorder)
+        result = _result(conductor)
+        assert (result["error"], result["ticks_done"]) == ("", 200), result
+        recorder.communicate(timeout=60)
+        assert json.loads((run / "scenario.json").read_text())["name"] == "split"
+        assert (run / "vessel.ego.state.csv").is_file()
+    finally:
+        for proc in procs:
+            proc.kill()
+            proc.communicate()
