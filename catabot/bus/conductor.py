@@ -36,6 +36,7 @@ from catabot.bus.settings import Schedule
 
 log = logging.getLogger("catabot.bus.conductor")
 WAITING_NOTE_S = 5.0  # how often the log names who has not joined yet
+GONE_GRACE_S = 0.2  # after a participant's token goes, for others gone with it
 
 
 class Conductor:
@@ -278,12 +279,27 @@ class Conductor:
         while not self.events.empty():
             self._next_event(0.0)
         active = self._active()
-        for name in [n for n in active if n not in self.members and not self._through(n)]:
+        gone = self._gone(active)
+        if gone:  # a lost link takes every token behind it: name them together
+            time.sleep(GONE_GRACE_S)
+            while not self.events.empty():
+                self._next_event(0.0)
+            gone = self._gone(active)
+        if len(gone) > 1 and self.spec.policy is Policy.ABORT:  # one link: every token at once
+            raise ClockError(
+                f"participants {', '.join(map(repr, gone))} left the run at once at tick "
+                f"{self._done}: the conductor lost its link to them (a router, or the network "
+                "between them, gone?)"
+            )
+        for name in gone:
             self._fault(name, f"left the run at tick {self._acked[name] + 1}")
         k = self._done
         if self._deadline is not None and time.monotonic() > self._deadline:
             for name in [n for n in active if self._acked[n] < k <= self._granted]:
                 self._fault(name, f"missed the {self.spec.deadline_s:g} s deadline of tick {k}")
+
+    def _gone(self, active: list[str]) -> list[str]:
+        return [n for n in active if n not in self.members and not self._through(n)]
 
     def _through(self, name: str) -> bool:
         """`name` has stepped the run's last tick (ended by a participant): it may leave."""

@@ -272,3 +272,20 @@ def test_a_participant_without_a_conductor_says_what_it_waits_for(
         r.getMessage() for r in caplog.records if "no tick from the conductor" in r.getMessage()
     ]
     assert notes and f"of world {world.keys.world!r} after " in notes[0], notes
+
+
+def test_participants_gone_at_once_are_named_together_as_a_lost_link(world: World) -> None:
+    """A router that died took every token with it, and the error blamed physics alone."""
+    names = ["a", "b", "c"]
+
+    def cut(t: Tick, _inputs: Inputs) -> None:
+        if t.tick == 10:
+            for name in ("b", "c"):
+                world.members[name].participant._token.undeclare()
+
+    world.member("a", cut, peers=names)
+    world.member("b", peers=names)
+    world.member("c", peers=names)
+    result = world.run(names, 500, deadline_s=5.0, start_timeout_s=5.0, window_ticks=1)
+    assert result.error.startswith("participants 'b', 'c' left the run at once at tick "), result
+    assert "the conductor lost its link to them" in result.error
