@@ -181,10 +181,13 @@ def open_session(conn: Connection) -> zenoh.Session:
     try:
         return zenoh.open(conn.config())
     except Exception as exc:
+        said = re.sub(r"\s+at \S+\.rs:\d+\.?$", "", str(exc).strip())  # Zenoh's source line
+        if "Unable to connect" in said:
+            said += " (nothing answers there: start a router first, catabot router --listen ...)"
         raise SessionError(
             f"cannot open zenoh (mode {conn.mode or 'peer'}, connect {list(conn.connect)}, "
             f"listen {list(conn.listen)}, config {conn.file or os.environ.get('ZENOH_CONFIG')}): "
-            f"{exc}"
+            f"{said}"
         ) from None
 
 

@@ -69,11 +69,17 @@ def _secure(args: argparse.Namespace) -> int:
 
 
 def _service(args: argparse.Namespace, rest: list[str]) -> int:
+    names = ", ".join(["conductor", *launcher.SERVICE_MODULES])
+    if args.name is None or args.name.startswith("-"):
+        asked = args.name in ("-h", "--help") or not {"-h", "--help"}.isdisjoint(rest)
+        print(f"usage: catabot service NAME --scenario FILE [flags]; NAME is one of {names} "
+              "(`catabot service physics --help` lists its flags)",
+              file=sys.stdout if asked else sys.stderr)  # fmt: skip
+        return 0 if asked else 2
     if args.name == "conductor":
         return conduct.main(rest)
     module = launcher.SERVICE_MODULES.get(args.name)
     if module is None:
-        names = ", ".join(["conductor", *launcher.SERVICE_MODULES])
         print(f"catabot service: unknown service {args.name!r} (known: {names})", file=sys.stderr)
         return 2
     main = importlib.import_module(f"{module}.service").main
@@ -191,7 +197,7 @@ def parser() -> argparse.ArgumentParser:
     svc = sub.add_parser(  # its --help is the service's own: `catabot service physics -h`
         "service", help="run one service (conductor, physics, ...) alone", add_help=False
     )
-    svc.add_argument("name", help="conductor, or a service: physics, sensors, traffic, ...")
+    svc.add_argument("name", nargs="?", help="conductor, or a service: physics, sensors, ...")
     rtr = sub.add_parser("router", help="run a zenoh router for distributed runs")
     add_connection_args(rtr)
     scen = sub.add_parser("scenario", help="scenario tools")

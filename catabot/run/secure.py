@@ -80,7 +80,8 @@ def init(
     (folder / "users.txt").chmod(0o600)
     endpoint = f"tls/{host}:{port}"
     router = _router(folder, endpoint, users, clients, observers, own)
-    written = [folder / "users.txt", _write(folder / "router.json5", router)]
+    pki = [folder / f for f in ("ca.pem", "ca.key", "router.pem", "router.key")]
+    written = [*pki, folder / "users.txt", _write(folder / "router.json5", router)]
     for name in names:
         written.append(_write(folder / f"{name}.json5", _session(folder, endpoint, name, users)))
     return written
