@@ -77,7 +77,7 @@ def _service(args: argparse.Namespace, rest: list[str]) -> int:
               file=sys.stdout if asked else sys.stderr)  # fmt: skip
         return 0 if asked else 2
     if args.name == "conductor":
-        return conduct.main(rest)
+        conduct.exit_now(conduct.main(rest))
     module = launcher.SERVICE_MODULES.get(args.name)
     if module is None:
         print(f"catabot service: unknown service {args.name!r} (known: {names})", file=sys.stderr)
