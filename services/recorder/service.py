@@ -162,7 +162,9 @@ class Recorder:
         if self.mcap is not None:
             self.mcap.close()
         self.metrics.write(self.run_dir / "metrics.json")
-        log.info("recorder closed its files after tick %d", end.tick)
+        ahead = self.participant.next_tick - 1  # stepped within the window past the end
+        more = f" (it had stepped to tick {ahead}: rows up to it)" if ahead > end.tick else ""
+        log.info("recorder closed its files after tick %d%s", end.tick, more)
 
 
 def _stamped(msg: Message, tick: Tick) -> Message:
