@@ -166,6 +166,12 @@ class LidarParams(SensorParams):
     columns: int = Field(512, ge=1, le=8192)
     vertical_fov_deg: float = Field(45.0, gt=0, le=180, description="symmetric about level")
     max_range_m: float = Field(100.0, gt=0)
+    min_range_m: float = Field(
+        0.0,
+        ge=0,
+        description="returns nearer are dropped, raindrops too (the paper's model "
+        "has no blind zone: 0; an OS1's data sheet gives 0.3-0.8 m)",
+    )
     range_noise_sigma_m: float = Field(0.01, ge=0)
     mount_xyz: Vec3 = (0.0, 0.0, 1.0)
     mount_yaw_deg: float = 0.0
@@ -179,6 +185,13 @@ class LidarParams(SensorParams):
 
     def rays_per_s(self, rate_hz: float) -> float:
         return float(self.channels * self.columns) * rate_hz
+
+    @model_validator(mode="after")
+    def _blind_zone_inside_the_range(self) -> LidarParams:
+        if self.min_range_m >= self.max_range_m:
+            raise FieldProblem("min_range_m", f"{self.min_range_m:g} m must be less than "
+                               f"max_range_m ({self.max_range_m:g} m)")  # fmt: skip
+        return self
 
 
 class SensorFarmConfig(Strict):

@@ -94,6 +94,9 @@ class LidarModel:
         if self.noise:
             distance = np.maximum(distance + noise, 0.0)  # inf stays inf
         rain = apply_rain(distance, p.max_range_m, self.scene.rain_rate_mm_h, self.rain, self.rng)
+        if p.min_range_m > 0:  # the blind zone: a drop (or a surface) nearer gives no return
+            blind = rain.range < p.min_range_m
+            rain.range[blind], rain.intensity[blind], rain.is_rain[blind] = np.inf, 0.0, False
         keep = np.flatnonzero(np.isfinite(rain.range))
         r = np.take(rain.range, keep)
         rain_hit = np.take(rain.is_rain, keep)

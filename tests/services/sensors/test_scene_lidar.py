@@ -129,6 +129,25 @@ def test_scans_are_deterministic_and_rain_is_labelled() -> None:
     assert np.all(sa.instance[sa.is_rain] == 0)
 
 
+def test_no_return_nearer_than_the_minimum_range() -> None:
+    """The paper's rain model puts many drops within centimetres of the sensor (the nearest
+    drop backscatters most); a real LiDAR's blind zone reports none there."""
+    scene = _scene(rain=50.0, ego=(0, 0, 0), boat=(30.0, 0.0, 0.0))
+    ranges = {}
+    for near in (0.0, 1.0):
+        params = LidarParams(mount_xyz=(0.0, 0.0, 1.0), min_range_m=near)
+        scan = LidarModel(params, Mount(scene=scene, seed=1, name="ego/lidar")).sample(
+            _state(), tick=0, stamp_ns=0
+        )
+        ranges[near] = (np.linalg.norm(scan.points, axis=1), scan)
+    seen, blind = ranges[0.0], ranges[1.0]
+    assert (seen[0] < 1.0).sum() > 100 and seen[1].is_rain[seen[0] < 1.0].all()
+    assert blind[0].min() >= 1.0 and blind[1].is_rain.any()  # drops beyond it still show
+    assert not (blind[1].range_image < 1.0).any()
+    with pytest.raises(ValueError, match="min_range_m"):
+        LidarParams(min_range_m=100.0)
+
+
 def test_pose_arrays_from_a_batch_equal_the_named_poses() -> None:
     """The sensors service's per-tick path (batch arrays) casts exactly like named poses;
     a bad row is still named."""
