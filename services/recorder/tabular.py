@@ -47,7 +47,8 @@ class _Column:
 
 
 def _label(name: str, unit: str) -> str:
-    return f"{name}[{unit}]" if unit else name
+    """`surge[m/s]`; a name that already ends in its unit keeps it once (`range_m`)."""
+    return f"{name}[{unit}]" if unit and not name.endswith(f"_{unit}") else name
 
 
 _LAYOUTS: dict[type[Message], tuple[_Column, ...]] = {}

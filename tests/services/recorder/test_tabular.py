@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from catabot.bus.messages import Ack, ThrustCmd, TwistCmd, VesselState
+from catabot.bus.messages import Ack, CameraFrame, RadarSweep, ThrustCmd, TwistCmd, VesselState
 from services.recorder import tabular
 
 
@@ -148,3 +148,10 @@ def test_block_lines_take_any_layout_of_the_table() -> None:
     table = np.arange(12.0).reshape(3, 4) / 8.0
     assert tabular.block_lines(1, 0, table[:, ::2]) == tabular.block_lines(1, 0, table[:, [0, 2]])
     assert tabular.block_lines(1, 0, np.array([[1, 2]])) == ["1,0,1.0,2.0\n"]
+
+
+def test_a_name_that_ends_in_its_unit_keeps_it_once() -> None:
+    """`range_m[m]` and `hfov_rad[rad]` said the unit twice."""
+    assert {"range_m", "heading_rad", "azimuth_start_rad"} <= set(tabular.columns(RadarSweep))
+    assert "hfov_rad" in tabular.columns(CameraFrame)
+    assert "position_x[m]" in tabular.columns(VesselState)  # a name without it gets it
