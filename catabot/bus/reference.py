@@ -126,7 +126,7 @@ in `clock.external_participants`) must also be known by its session, because eve
 sample and ack is believed only from the session that owns its participant name:
 
 1. Query `catabot/<world>/world/info`: the resolved world as JSON (`"v": 1`): `world`,
-   `seed`, `dt_ns`, `clock` (`dt_ns`, `ticks`, `window`, `deadline_s`, `policy`, ...),
+   `seed`, `dt_ns`, `clock` (`dt_ns`, `ticks`, `window`, `digest`, `deadline_s`, ...),
    `participants`, `states` (`key`, `producer`, `period`, `stamp_ticks`), `bodies` (`id`,
    `kind`, `row`, start `pose`), `vessels` (a list: `id`, `row`, `model`, `thrusters`,
    `state_key`, `commands` by kind, `controller` with `participant`, `command`, `key` and
@@ -146,6 +146,8 @@ sample and ack is believed only from the session that owns its participant name:
    An ack says every output up to its tick is out: a stack that acks a tick without its
    command holds physics and the recorder up until the deadline, which then names them.
    A command that fails its check (below) is refused and its tick goes on without it.
+   To end the run (your mission is over), ack the last tick you stepped with `end`, a
+   reason of 1-200 printable characters, and step no more: the End follows.
 5. Stop at `catabot/<world>/clock/end`.
 """
 

@@ -160,7 +160,9 @@ def _parse(d: Mapping[str, Any]) -> WorldInfo:
         seed=int(d["seed"]),
         dt_ns=int(d["dt_ns"]),
         duration_s=float(d["duration_s"]),
-        limits=ClockLimits(int(c["dt_ns"]), int(c["ticks"]), int(c["window"])),
+        limits=ClockLimits(
+            int(c["dt_ns"]), int(c["ticks"]), int(c["window"]), str(c.get("digest", ""))
+        ),
         participants=tuple(map(str, p["stepping"])),
         external=tuple(map(str, p["external"])),
         roster=Roster({str(k): str(v) for k, v in d["roster"].items()}).fixed,  # zids checked

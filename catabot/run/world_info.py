@@ -57,6 +57,7 @@ def describe(world: World, roster: Roster) -> dict[str, Any]:
             "dt_ns": limits.dt_ns,
             "ticks": limits.ticks,
             "window": limits.window,
+            "digest": limits.world,  # of the scenario: every participant checks Tick.world
             "realtime_factor": s.clock.realtime_factor,
             "deadline_s": s.clock.deadline_s,
             "start_timeout_s": s.clock.start_timeout_s,

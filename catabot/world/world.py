@@ -107,11 +107,13 @@ class World:
     bodies: tuple[Body, ...]
     traffic: TrafficPlan
     sensors: tuple[MountedSensor, ...]
+    digest: str = ""  # of the scenario as given (config/load.py): the conductor's is the same
 
     @classmethod
     def resolve(cls, scenario: Scenario, *, progress: Progress | None = None) -> World:
         """Everything a run needs from its scenario; ScenarioError names what cannot run.
         `progress(k, n)` hears of each planned traffic boat (a long plan's progress)."""
+        given = digest(scenario)  # as the conductor, which loads the same file, has it
         terrain = _terrain(scenario)
         current = CurrentField.from_config(scenario.water.current)
         scenario = resolve_poses(scenario, terrain)
@@ -125,7 +127,7 @@ class World:
             for v in scenario.vessels
             for s in v.sensors
         )
-        return cls(scenario, terrain, current, bodies, plan, sensors)
+        return cls(scenario, terrain, current, bodies, plan, sensors, given)
 
     @cached_property
     def keys(self) -> Keys:
@@ -182,7 +184,7 @@ class World:
     def clock_limits(self) -> ClockLimits:
         """What participants check every Tick against (catabot/bus/clock.py)."""
         s = self.scenario
-        return ClockLimits(s.dt_ns, s.ticks, s.clock.window_ticks, digest(s))
+        return ClockLimits(s.dt_ns, s.ticks, s.clock.window_ticks, self.digest)
 
     @property
     def participants(self) -> list[str]:
