@@ -105,8 +105,11 @@ class Participant(Outputs):
         return on_sample
 
     def keep(self, subscriber: zenoh.Subscriber[None]) -> None:
-        """A subscriber that feeds `events`, undeclared with this participant (strays.py)."""
-        self._subs.append(subscriber)
+        self._subs.append(subscriber)  # it feeds `events`: undeclared with this participant
+
+    @property
+    def granted(self) -> int:  # the last tick granted so far (-1 before the first grant)
+        return self._grant.tick if self._grant is not None else -1
 
     def _on_live(self, sample: zenoh.Sample) -> None:
         kind = "join" if sample.kind == zenoh.SampleKind.PUT else "leave"
@@ -302,13 +305,8 @@ class Participant(Outputs):
             return True
         if time.monotonic() - self._waiting_since > 5.0 and self._warned_tick != tick:
             self._warned_tick = tick
-            log.warning(
-                "%s: tick %d still waits for %s (peers absent: %s)",
-                self.name,
-                tick,
-                missing,
-                sorted(self.peers - self.present),
-            )
+            log.warning("%s: tick %d still waits for %s (peers absent: %s)", self.name, tick,
+                        missing, sorted(self.peers - self.present))  # fmt: skip
         return False
 
     def _finish(self, end: End, on_end: EndFn | None) -> End:

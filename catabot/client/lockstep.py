@@ -134,9 +134,7 @@ class Joined:
         are in. RunEnded when the run ends first (the End's reason), NoData after
         `timeout_s` (None: wait as long as the run goes on). Without an act() since the
         previous observation, act(None) is implied."""
-        if self.end is not None:
-            raise RunEnded(f"the run of world {self.info.name!r} has ended ({self.end.reason})",
-                           self.end)  # fmt: skip
+        self._check_running()
         if self._pending is not None:
             self.act(None)
         kind, value = self._wait(timeout_s)
@@ -176,6 +174,7 @@ class Joined:
         """The command for the period last observed, tagged with its tick: applied from the
         next tick on every run. None keeps the last command (zero thrust, or a zero twist,
         before the first)."""
+        self._check_running()
         obs = self._pending
         if obs is None:
             raise ClientError(f"{self.name}: act() before observe(): nothing to answer")
@@ -194,6 +193,7 @@ class Joined:
         """End the run instead of acting on the period last observed (an episode is over):
         the run ends cleanly after the tick before it, for everyone, and its recording holds
         every tick up to that one. Returns the End; NoData if it does not come in time."""
+        self._check_running()
         if self._pending is None:
             raise ClientError(f"{self.name}: end_run() before observe(): no period to end at")
         if not reason or len(reason) > MAX_END_REASON or not reason.isprintable():
@@ -202,10 +202,19 @@ class Joined:
         self._pending = None
         self._commands.put(EndRun(reason))
         kind, value = self._wait(timeout_s)
-        if kind == "end":
-            self.end = value
-            return value
-        raise RunEnded(f"{self.name}: the run did not end as asked ({kind}: {value})")
+        if kind != "end":
+            raise RunEnded(f"{self.name}: the run did not end as asked ({kind}: {value})")
+        self.end = value
+        if not value.reason.startswith(f"ended by {self.name!r}"):  # another ended it first
+            raise RunEnded(f"{self.name}: the run had ended before this request ({value.reason})",
+                           value)  # fmt: skip
+        return value
+
+    def _check_running(self) -> None:
+        """RunEnded, as `observe` says it, once the run is over."""
+        if self.end is not None:
+            raise RunEnded(f"the run of world {self.info.name!r} has ended ({self.end.reason})",
+                           self.end)  # fmt: skip
 
     def _message(self, command: Command | None, obs: Observation) -> Message:
         vessel, control = self.vessel, self._control

@@ -77,7 +77,10 @@ def emit(kind: str, **fields: object) -> bool:
 
 
 def heartbeat(stop: threading.Event) -> None:
-    """`alive` every half second: the launcher takes silence for a hung conductor."""
+    """`alive` every half second: the launcher takes silence for a hung conductor (at a
+    terminal, `catabot service conductor` by hand, nobody reads it)."""
+    if sys.stdout.isatty():
+        return
     while not stop.wait(HEARTBEAT_S):
         emit("alive")
 

@@ -12,6 +12,7 @@ import dataclasses
 import logging
 import sys
 import time
+from collections import deque
 from collections.abc import Callable
 from typing import Any
 
@@ -70,17 +71,31 @@ class Recorder:
         self.scripts = ScriptedCommands(world, self.orders)
         self.run_dir = ctx.run_dir
         self.start = world.start_states()
+        self.window = ctx.scenario.clock.window_ticks
+        self._held: deque[tuple[Tick, Inputs]] = deque()  # stepped, not yet known final
         self._flushed_at = 0.0
         self.changes_stream = self.keys.relative(self.keys.config_changes())
         self.participant = ctx.participant(streams)
 
     def step(self, tick: Tick, inputs: Inputs) -> None:
+        self._held.append((tick, inputs))
+        self._write_final(self.participant.granted - self.window + 1)
+        self._flush()
+
+    def _write_final(self, upto: int) -> None:
+        """Write the ticks stepped up to `upto`. A tick is final once every participant has
+        acked the one before it, which the grant tells (it is at most a window past that):
+        a participant that ends the run ends it no earlier, so nothing is written past the
+        run's end, whoever ends it and however far this one had stepped ahead."""
+        while self._held and self._held[0][0].tick <= upto:
+            self._record(*self._held.popleft())
+
+    def _record(self, tick: Tick, inputs: Inputs) -> None:
         if tick.tick == 0:  # the state at t = 0 (tagged -1): where every body starts
             self._states(self.keys.relative(self.keys.world_states()), self.start)
         self._inputs(tick, inputs)
         for stream, cmd in self.scripts.due(tick.tick, tick.stamp_ns):  # as if sent
             self._write(stream, cmd)
-        self._flush()
 
     def _inputs(self, tick: Tick, inputs: Inputs) -> None:
         for key in sorted(inputs):
@@ -156,14 +171,15 @@ class Recorder:
             self.mcap.flush()
 
     def on_end(self, end: End, inputs: Inputs) -> None:
+        self._write_final(end.tick + 1)  # step k writes the samples of tick k - 1
+        past, self._held = len(self._held), deque()  # stepped past the end: not the run's
         self._inputs(Tick(end.run, end.tick + 1, 0, 0), inputs)  # no tick after the end
         if self.csv is not None:
             self.csv.close()
         if self.mcap is not None:
             self.mcap.close()
         self.metrics.write(self.run_dir / "metrics.json")
-        ahead = self.participant.next_tick - 1  # stepped within the window past the end
-        more = f" (it had stepped to tick {ahead}: rows up to it)" if ahead > end.tick else ""
+        more = f" ({past} ticks stepped past the end left out)" if past else ""
         log.info("recorder closed its files after tick %d%s", end.tick, more)
 
 

@@ -34,11 +34,11 @@ class Thinning:
         self._odometry, self._tf = OdometryBatch(MAP, frames), TfBatch(MAP, frames)
 
     def every_body(self, tick: int) -> bool:
-        """The first tick, then each whose state is stamped on the rate's grid: the batch
-        tagged k is stamped (k + 1) dt, so at k + 1 a multiple of the period it shares its
-        stamp with the samples of a sensor of that rate (k % period == 0, stamped k dt) and
-        a join on `stamp_ns` finds both (ticks 0, 10, 20 had stamps 0.01, 0.11, 0.21 s)."""
-        return tick == 0 or (tick + 1) % self.period == 0
+        """Each tick whose state is stamped on the rate's grid, the start state (tag -1,
+        stamp 0) first: the batch tagged k is stamped (k + 1) dt, so at k + 1 a multiple of
+        the period it shares its stamp with the samples of a sensor of that rate (k % period
+        == 0, stamped k dt) and a join on `stamp_ns` finds both (0, 0.1, 0.2 s, ...)."""
+        return (tick + 1) % self.period == 0
 
     def table(self, batch: BodyStates) -> np.ndarray:
         """The scenario vessels' rows, VesselState's 19 columns: their rows taken first (a

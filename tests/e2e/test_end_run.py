@@ -4,7 +4,9 @@ console, the recording up to the last tick stepped and the same bytes on every r
 
 from __future__ import annotations
 
+import contextlib
 import json
+import threading
 from pathlib import Path
 from typing import Any
 
@@ -12,7 +14,7 @@ import pytest
 from conftest import files_of
 from test_client import SENSORS, Run
 
-from catabot.client import Client, ClientError, EndRun, Observation, Thrust
+from catabot.client import Client, ClientError, EndRun, Observation, RunEnded, Thrust
 
 pytestmark = pytest.mark.timeout(180)
 CONTROLLER = {"participant": "stack", "rate_hz": 10.0, "command": "thrust"}
@@ -69,8 +71,57 @@ def test_end_run_is_refused_before_observe_and_without_a_reason(tmp_path: Path) 
                     stack.end_run(bad)
             end = stack.end_run("checked")  # still in the seat: the refusals sent nothing
             assert (end.tick, end.reason) == (-1, "ended by 'stack' after tick -1: checked")
+            for late in (lambda: stack.end_run("again"), lambda: stack.act(Thrust([0.1, 0.1]))):
+                with pytest.raises(RunEnded, match="has ended \\(ended by 'stack'"):
+                    late()  # it said "before observe()"
             stack.close()
         out, err = run.proc.communicate(timeout=60)
         assert run.proc.returncode == 0, out + err
     finally:
         run.kill()
+
+
+def _watched_run(tmp: Path) -> tuple[Path, int]:
+    """A stack drives the ego; a second participant, driving nothing, ends the run at its
+    sixth period: physics and the recorder may have stepped a window ahead of it."""
+    data = dict(SCENARIO, clock={"external_participants": ["watcher"]})
+    run = Run(tmp, data)
+    ended: list[int] = []
+
+    def drive() -> None:
+        with Client.connect([run.endpoint], timeout_s=30) as sim:
+            stack = sim.join("stack")
+            with contextlib.suppress(RunEnded):
+                while True:
+                    stack.observe()
+                    stack.act(Thrust([0.5, 0.6]))
+
+    driver = threading.Thread(target=drive, daemon=True)
+    driver.start()
+    try:
+        with Client.connect([run.endpoint], timeout_s=30) as sim:
+            watcher = sim.join("watcher", rate_hz=100.0)
+            for _ in range(6):
+                watcher.observe()
+            ended.append(watcher.end_run("seen enough").tick)
+        driver.join(60)
+        out, err = run.proc.communicate(timeout=60)
+        assert run.proc.returncode == 0, out + err
+        return Path(out.split("run folder: ")[-1].strip()), ended[0]
+    finally:
+        run.kill()
+
+
+def test_a_participant_that_drives_nothing_ends_the_recording_at_its_tick(tmp_path: Path) -> None:
+    """The recording ran 34 ticks past the End (rows up to tick 38 for an End at 4)."""
+    run_dir, tick = _watched_run(tmp_path / "a")
+    assert tick == 4
+    for name in ("vessel.ego.state.csv", "sensor.ego.gps.csv", "vessel.ego.cmd.thrust.csv"):
+        last = (run_dir / name).read_text().splitlines()[-1].split(",")
+        assert int(last[1]) <= tick, (name, last[:2])
+    assert (run_dir / "vessel.ego.state.csv").read_text().splitlines()[-1].split(",")[1] == "4"
+    metrics = json.loads((run_dir / "metrics.json").read_text())
+    assert metrics["sim_time_s"] == pytest.approx(0.05)
+    again, _ = _watched_run(tmp_path / "b")
+    first, second = files_of(run_dir), files_of(again)
+    assert [n for n in first if first[n] != second.get(n)] == []

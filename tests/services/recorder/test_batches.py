@@ -83,10 +83,11 @@ def test_traffic_and_buoys_are_recorded_at_their_rate_the_vessels_every_tick(
             block = fmt.states(batch)
             sink.write_lines(block.streams, block.cls, block.lines)
     for i, vid in enumerate(IDS):
-        ticks = range(21) if vid == "ego" else (0, 9, 19)  # stamped 0.01, then 0.1, 0.2 s
+        ticks = range(21) if vid == "ego" else (9, 19)  # stamped 0.1, 0.2 s (the start: -1)
         expected = _csv_by_message(tmp_path / vid, f"vessel/{vid}/state",
                                    [batches[k].row(i) for k in ticks])  # fmt: skip
         assert (tmp_path / "block" / f"vessel.{vid}.state.csv").read_text() == expected
+    assert fmt.thin.every_body(-1) and not fmt.thin.every_body(0)  # the start, not 0.01 s
     between = fmt.states(batches[7])  # the ego alone: its Odometry and its frame on /tf
     assert between.topics == ("/ego/odom",)
     odometry = cdr.odometry_encoder("map", "ego/base_link")
