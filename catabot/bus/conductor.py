@@ -292,7 +292,8 @@ class Conductor:
                 "between them, gone?)"
             )
         for name in gone:
-            self._fault(name, f"left the run at tick {self._acked[name] + 1}")
+            first = " before it stepped one (its own log says why)" if self._acked[name] < 0 else ""
+            self._fault(name, f"left the run at tick {self._acked[name] + 1}{first}")
         k = self._done
         if self._deadline is not None and time.monotonic() > self._deadline:
             for name in [n for n in active if self._acked[n] < k <= self._granted]:

@@ -58,7 +58,8 @@ def test_a_process_given_another_scenario_stops_and_says_why(tmp_path: Path) -> 
         assert physics.returncode == 2, err
         assert "the conductor runs another scenario (digest " in err
         assert "give every process of the run the same scenario file" in err
-        assert "physics" in _result(conductor)["error"]
+        said = _result(conductor)["error"]
+        assert "participant 'physics' left the run at tick 0 before it stepped one" in said
     finally:
         for proc in (conductor, physics, recorder):
             proc.kill()
