@@ -24,6 +24,8 @@ from catabot.errors import CataBotError
 NS_PER_S = 1_000_000_000
 CONDUCTOR = "conductor"  # the participant name of the clock's owner
 MAX_END_REASON = 200  # characters of an `Ack.end`: why the run ends, not a payload
+ENDED_BY = "ended by "  # an End's reason when a participant ended the run
+NEVER_JOINED = "never joined within"
 
 
 class ClockError(CataBotError, RuntimeError):
@@ -33,6 +35,41 @@ class ClockError(CataBotError, RuntimeError):
 class EndRun(Exception):
     """Raised by a step at tick k: end the run after tick k - 1, the last this participant
     stepped (a controller whose episode is over); its text is the reason everyone sees."""
+
+
+def end_reason_problem(reason: str) -> str:
+    """Why `reason` cannot be an `Ack.end` ("" if it can): 1-200 printable characters."""
+    if 0 < len(reason) <= MAX_END_REASON and reason.isprintable():
+        return ""
+    return f"a reason of 1-{MAX_END_REASON} printable characters, not {reason[:40]!r}"
+
+
+def end_reason(text: str) -> str:
+    """A valid `Ack.end` made of any text (a step's `EndRun`): printable, clipped."""
+    clean = "".join(c if c.isprintable() else " " for c in text)[:MAX_END_REASON]
+    return clean if not end_reason_problem(clean) else "no reason given"
+
+
+def ended_by(name: str, tick: int, reason: str) -> str:
+    """The End's reason when a participant ended the run (`ender_of` reads it back)."""
+    return f"{ENDED_BY}{name!r} after tick {tick}: {reason}"
+
+
+def ender_of(reason: str) -> str | None:
+    """Who ended the run, from an End's reason; None for any other end."""
+    head, found, rest = reason.partition(ENDED_BY)
+    return rest.split("'", 2)[1] if found and not head and rest.startswith("'") else None
+
+
+def never_joined(missing: list[str], timeout_s: float) -> str:
+    """The conductor's fault when participants never came (`who_never_joined` reads it)."""
+    return f"participant(s) {NEVER_JOINED} {timeout_s:g} s: {', '.join(missing)}"
+
+
+def who_never_joined(error: str) -> list[str]:
+    """The participants a run's error names as never joined; none for any other error."""
+    _, found, rest = error.partition(NEVER_JOINED)
+    return rest.partition(": ")[2].split(", ") if found else []
 
 
 class Policy(StrEnum):
@@ -100,7 +137,7 @@ class ClockSpec:
     policy: Policy = Policy.ABORT
     realtime_factor: float | None = None
     window_ticks: int = 1
-    world: str = ""  # the scenario's digest, sent in every Tick
+    digest: str = ""  # the scenario's (config/load.py), sent in every Tick
 
     @property
     def ack_every(self) -> int:
@@ -135,15 +172,20 @@ class ClockLimits:
     dt_ns: int
     ticks: int
     window: int
-    world: str = ""  # the scenario's digest (config/load.py); "" checks none
+    digest: str = ""  # the scenario's (config/load.py); "" checks none
 
-    def check_world(self, tick: Tick) -> None:
+    def acked_by_all(self, granted: int) -> int:
+        """A tick every participant has acked, known from the last grant: the conductor
+        grants at most a window past that. No participant can end the run before it."""
+        return granted - self.window
+
+    def check_digest(self, tick: Tick) -> None:
         """A conductor that runs another scenario than this process (hosts given different
         files) is fatal here, not a sample to refuse: waiting would only time out."""
-        if self.world and tick.world and tick.world != self.world:
+        if self.digest and tick.digest and tick.digest != self.digest:
             raise WorldMismatch(
-                f"the conductor runs another scenario (digest {tick.world}, this process's "
-                f"{self.world}): give every process of the run the same scenario file"
+                f"the conductor runs another scenario (digest {tick.digest}, this process's "
+                f"{self.digest}): give every process of the run the same scenario file"
             )
 
     def problem(self, tick: Tick, *, next_tick: int, grant: int) -> str:

@@ -19,16 +19,18 @@ import zenoh
 from catabot.bus import codec
 from catabot.bus.clock import (
     CONDUCTOR,
-    MAX_END_REASON,
     ClockError,
     ClockSpec,
     Policy,
     Progress,
     RunResult,
+    end_reason_problem,
+    ended_by,
+    never_joined,
 )
 from catabot.bus.identity import Roster, sender_of
 from catabot.bus.keys import Keys
-from catabot.bus.members import Members, check_free
+from catabot.bus.members import Members, claim
 from catabot.bus.messages import Ack, End, Tick
 from catabot.bus.outputs import Outputs
 from catabot.bus.rejections import Rejected, Rejections
@@ -55,9 +57,8 @@ class Conductor:
         self._created = time.monotonic()
         self.events: queue.SimpleQueue[tuple[str, str, bytes]] = queue.SimpleQueue()
         roster = roster if roster is not None else Roster()
-        check_free(session, keys, CONDUCTOR, roster)  # NameTaken: a second conductor stops
+        claim(session, keys, CONDUCTOR, roster)  # NameTaken: a second conductor stops
         self._members = Members(keys, roster)
-        self._members.roster.bind(CONDUCTOR, str(session.zid()))  # a later one: counted
         self.rejections = Rejections(log, CONDUCTOR)
         self.dropped: list[str] = []
         self._stop_reason = ""
@@ -141,8 +142,7 @@ class Conductor:
         log.info("waiting for %s to join (%.0f s left)", missing, limit - time.monotonic())
 
     def _start_timeout(self, expected: set[str]) -> str:
-        missing = ", ".join(sorted(expected - self.members))
-        return f"participant(s) never joined within {self.spec.start_timeout_s:g} s: {missing}"
+        return never_joined(sorted(expected - self.members), self.spec.start_timeout_s)
 
     def _tick_loop(self, on_progress: Callable[[Progress], None] | None, start: float) -> None:
         """Grant ticks while the window and the pace allow, take acks, report progress.
@@ -202,7 +202,7 @@ class Conductor:
         k, dt = self._granted, self.spec.dt_ns
         changes = self.settings.grant(k)
         tick = Tick(self.run_id, k, k * dt, dt, tuple(self.dropped), self.spec.ack_every, changes,
-                    self.spec.world)  # fmt: skip
+                    self.spec.digest)  # fmt: skip
         self._out.publish(self.keys.tick(), tick)
 
     def _await_progress(self) -> None:
@@ -237,7 +237,7 @@ class Conductor:
         if self._stop_reason:
             return
         self._end_at = max(min(ack.tick, self._granted), self._done - 1)
-        self._stop_reason = f"ended by {name!r} after tick {self._end_at}: {ack.end}"
+        self._stop_reason = ended_by(name, self._end_at, ack.end)
         log.info("run %s", self._stop_reason)
         self._grant(self._granted, again=True)
 
@@ -254,8 +254,8 @@ class Conductor:
             raise Rejected("malformed", str(exc)) from None
         if ack.run != self.run_id or ack.tick < -1:
             raise Rejected("ack of another run or tick", f"run {ack.run}, tick {ack.tick}")
-        if len(ack.end) > MAX_END_REASON or not ack.end.isprintable():
-            raise Rejected("end request with a bad reason", repr(ack.end[:40]))
+        if ack.end and end_reason_problem(ack.end):
+            raise Rejected("end request with a bad reason", end_reason_problem(ack.end))
         return name, ack
 
     def _advance(self) -> None:

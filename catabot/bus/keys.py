@@ -70,12 +70,9 @@ class Keys:
         return f"{self.prefix}/clock/end"
 
     def live(self, participant: str, zid: str) -> str:
-        """A participant's liveliness token: its name and its session's zid (identity.py)."""
+        """A participant's liveliness token: its name and its session's zid (identity.py);
+        zid "*": every token of that name (who holds `physics`?)."""
         return f"{self.prefix}/live/{check_name('participant', participant)}/{zid}"
-
-    def live_any(self, participant: str) -> str:
-        """The liveliness tokens of one name, whatever its session (who holds `physics`?)."""
-        return f"{self.prefix}/live/{check_name('participant', participant)}/*"
 
     def lives(self) -> str:
         return f"{self.prefix}/live/*/*"

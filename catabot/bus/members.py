@@ -48,15 +48,19 @@ class Members:
         return zid is not None and sender == zid
 
 
-def check_free(session: zenoh.Session, keys: Keys, name: str, roster: Roster) -> None:
-    """NameTaken if another session holds `name` in this world now. Asked before this
-    process declares its own token, so the newcomer stops and the one already there goes on
-    (a later token of its name is only counted there). `catabot run` fixes every name's
-    session in its roster: nothing to ask then."""
-    if name in roster.fixed:
-        return
+def claim(session: zenoh.Session, keys: Keys, name: str, roster: Roster) -> None:
+    """Bind `name` to this session in `roster`; NameTaken if another session holds it in
+    this world now. Asked before this process declares its own token, so the newcomer stops
+    and the one already there goes on (a later token of its name is only counted there).
+    `catabot run` fixes every name's session in its roster: nothing to ask then."""
     own = str(session.zid())
-    for reply in session.liveliness().get(keys.live_any(name), timeout=ASK_S):
+    if name not in roster.fixed:
+        _check_free(session, keys, name, own)
+    roster.bind(name, own)
+
+
+def _check_free(session: zenoh.Session, keys: Keys, name: str, own: str) -> None:
+    for reply in session.liveliness().get(keys.live(name, "*"), timeout=ASK_S):
         if reply.ok is None:
             continue
         try:

@@ -50,8 +50,8 @@ class Message:
 class Tick(Message):
     """On `clock/tick`: every tick up to `tick` may be stepped (a grant; DESIGN.md §4), acked
     every `ack_every` ticks and at its last; a step gets one Tick per tick. `settings`: the
-    changes in the ticks it adds (settings.py), a step's those of its tick; `world`: the
-    digest of the conductor's scenario (config/load.py), which every participant checks."""
+    changes in the ticks it adds (settings.py), a step's those of its tick; `digest`: the
+    conductor's scenario's (config/load.py), which every participant checks."""
 
     TYPE: ClassVar[str] = "tick"
     run: str
@@ -61,7 +61,7 @@ class Tick(Message):
     dropped: tuple[str, ...] = ()
     ack_every: int = 1
     settings: tuple[str, ...] = ()
-    world: str = ""
+    digest: str = ""
 
 
 @dataclass(frozen=True)

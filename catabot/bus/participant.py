@@ -22,11 +22,11 @@ from collections.abc import Callable, Sequence
 import zenoh
 
 from catabot.bus import codec
-from catabot.bus.clock import CONDUCTOR, MAX_END_REASON, ClockError, ClockLimits, EndRun, Stream
+from catabot.bus.clock import CONDUCTOR, ClockError, ClockLimits, EndRun, Stream, end_reason
 from catabot.bus.identity import Roster, sender_of
 from catabot.bus.inbox import Inbox, Inputs
 from catabot.bus.keys import Keys
-from catabot.bus.members import Members, check_free
+from catabot.bus.members import Members, claim
 from catabot.bus.messages import Ack, End, Tick
 from catabot.bus.outputs import Outputs
 from catabot.bus.rejections import Rejected, Rejections
@@ -65,9 +65,8 @@ class Participant(Outputs):
         self.roster = roster if roster is not None else Roster()
         self.limits = limits
         self.inbox = Inbox(inputs, roster=self.roster, dt_ns=limits.dt_ns if limits else 0)
-        check_free(session, keys, name, self.roster)  # NameTaken: a second physics stops
+        claim(session, keys, name, self.roster)  # NameTaken: a second physics stops
         self.members = Members(keys, self.roster)
-        self.roster.bind(name, str(session.zid()))  # a later token of its name: counted
         self.rejections = Rejections(log, name)
         self.peers = set(peers) - {name}
         self._everyone = self.peers | {name}  # the peers a tick may name as dropped
@@ -172,8 +171,7 @@ class Participant(Outputs):
     def _end_before(self, grant: Tick, k: int, reason: str) -> None:
         """Ask the conductor to end the run after tick k - 1 (an Ack with a reason)."""
         self._ended = True
-        reason = "".join(c if c.isprintable() else " " for c in reason)[:MAX_END_REASON]
-        self.put(self._ack, codec.encode(Ack(grant.run, k - 1, end=reason or "no reason given")))
+        self.put(self._ack, codec.encode(Ack(grant.run, k - 1, end=end_reason(reason))))
         self._acked = k - 1
 
     def _ack_waiting(self) -> None:
@@ -262,7 +260,7 @@ class Participant(Outputs):
         if self.run_id and tick.run != self.run_id:
             raise Rejected("tick of another run", tick.run)
         if self.limits is not None:
-            self.limits.check_world(tick)  # raises: another scenario than the conductor's
+            self.limits.check_digest(tick)  # raises: another scenario than the conductor's
         problem = self._tick_problem(tick)
         if problem:
             raise Rejected("tick the clock cannot send", problem)

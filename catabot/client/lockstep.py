@@ -20,7 +20,7 @@ from typing import Any
 
 import zenoh
 
-from catabot.bus.clock import MAX_END_REASON, EndRun
+from catabot.bus.clock import EndRun, end_reason_problem, ender_of
 from catabot.bus.inbox import Inputs
 from catabot.bus.keys import Keys
 from catabot.bus.messages import BodyStates, End, Message, ThrustCmd, Tick, TwistCmd, VesselState
@@ -196,16 +196,16 @@ class Joined:
         self._check_running()
         if self._pending is None:
             raise ClientError(f"{self.name}: end_run() before observe(): no period to end at")
-        if not reason or len(reason) > MAX_END_REASON or not reason.isprintable():
-            raise ClientError(f"{self.name}: end_run() takes a reason of 1-{MAX_END_REASON} "
-                              f"printable characters, not {reason[:40]!r}")  # fmt: skip
+        problem = end_reason_problem(reason)
+        if problem:
+            raise ClientError(f"{self.name}: end_run() takes {problem}")
         self._pending = None
         self._commands.put(EndRun(reason))
         kind, value = self._wait(timeout_s)
         if kind != "end":
             raise RunEnded(f"{self.name}: the run did not end as asked ({kind}: {value})")
         self.end = value
-        if not value.reason.startswith(f"ended by {self.name!r}"):  # another ended it first
+        if ender_of(value.reason) != self.name:  # another ended it first, or a fault
             raise RunEnded(f"{self.name}: the run had ended before this request ({value.reason})",
                            value)  # fmt: skip
         return value

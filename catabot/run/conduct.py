@@ -57,7 +57,7 @@ def clock_spec(scenario: Scenario, start_timeout_s: float | None = None) -> Cloc
         policy=Policy(c.policy),
         realtime_factor=c.realtime_factor,
         window_ticks=c.window_ticks,
-        world=digest(scenario),
+        digest=digest(scenario),
     )
 
 

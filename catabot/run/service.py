@@ -22,7 +22,7 @@ from typing import Protocol
 import zenoh
 
 from catabot.bus.blas import single_thread_blas
-from catabot.bus.clock import ClockError, Stream
+from catabot.bus.clock import ClockError, Stream, who_never_joined
 from catabot.bus.heap import keep_heap
 from catabot.bus.identity import Roster, add_roster_args
 from catabot.bus.inbox import Inbox, Inputs
@@ -246,16 +246,10 @@ def _serve(ctx: ServiceContext, build: BuildFn) -> int:
     if end.reason == LOST:  # its files are closed whole, up to the last tick it stepped
         log.error("%s (its files end at tick %d)", end.error, end.tick)
         return EXIT_CLOCK
-    if getattr(participant, "next_tick", 1) == 0 and _unseen(ctx.name, end.error):
+    if getattr(participant, "next_tick", 1) == 0 and ctx.name in who_never_joined(end.error):
         log.error("%s: the conductor never saw this process join (%s): another world or "
                   "router, or a login (secure profile) that may not declare its token?",
                   ctx.name, end.error)  # fmt: skip
         return 1
     log.info("%s: run ended at tick %d (%s) %s", ctx.name, end.tick, end.reason, end.error)
     return 0
-
-
-def _unseen(name: str, error: str) -> bool:
-    """The conductor's start timeout names this process among those that never joined."""
-    _, found, missing = error.partition("never joined within ")
-    return bool(found) and name in missing.partition(": ")[2].split(", ")

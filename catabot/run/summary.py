@@ -14,6 +14,7 @@ import sys
 from collections.abc import Mapping
 from pathlib import Path
 
+from catabot.bus.clock import ender_of
 from catabot.config.scenario import Scenario
 from catabot.run.metrics_summary import metrics_lines
 from catabot.run.service import EXIT_CLOCK
@@ -129,7 +130,7 @@ def summarise(
         log = run_dir / "log" / f"{name}.log"
         print(f"  {name}: {describe_exit(code)} (see {log})", file=sys.stderr)
     _print_rejected(record["rejected"], run_dir)
-    if str(record["reason"]).startswith("ended by "):  # a participant's end (Ack.end)
+    if ender_of(str(record["reason"])) is not None:  # a participant's end (Ack.end)
         print(f"run {record['reason']}")
     print(f"run folder: {run_dir}")
     if error:

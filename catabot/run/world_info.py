@@ -57,7 +57,7 @@ def describe(world: World, roster: Roster) -> dict[str, Any]:
             "dt_ns": limits.dt_ns,
             "ticks": limits.ticks,
             "window": limits.window,
-            "digest": limits.world,  # of the scenario: every participant checks Tick.world
+            "digest": limits.digest,  # of the scenario: every participant checks Tick.digest
             "realtime_factor": s.clock.realtime_factor,
             "deadline_s": s.clock.deadline_s,
             "start_timeout_s": s.clock.start_timeout_s,

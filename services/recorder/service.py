@@ -71,7 +71,7 @@ class Recorder:
         self.scripts = ScriptedCommands(world, self.orders)
         self.run_dir = ctx.run_dir
         self.start = world.start_states()
-        self.window = ctx.scenario.clock.window_ticks
+        self.limits = world.clock_limits
         self._held: deque[tuple[Tick, Inputs]] = deque()  # stepped, not yet known final
         self._flushed_at = 0.0
         self.changes_stream = self.keys.relative(self.keys.config_changes())
@@ -79,14 +79,14 @@ class Recorder:
 
     def step(self, tick: Tick, inputs: Inputs) -> None:
         self._held.append((tick, inputs))
-        self._write_final(self.participant.granted - self.window + 1)
+        self._write_final(self.limits.acked_by_all(self.participant.granted) + 1)
         self._flush()
 
     def _write_final(self, upto: int) -> None:
         """Write the ticks stepped up to `upto`. A tick is final once every participant has
-        acked the one before it, which the grant tells (it is at most a window past that):
-        a participant that ends the run ends it no earlier, so nothing is written past the
-        run's end, whoever ends it and however far this one had stepped ahead."""
+        acked the one before it (`ClockLimits.acked_by_all`): a participant that ends the run
+        ends it no earlier, so nothing is written past the run's end, whoever ends it and
+        however far this one had stepped ahead."""
         while self._held and self._held[0][0].tick <= upto:
             self._record(*self._held.popleft())
 

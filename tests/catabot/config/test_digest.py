@@ -1,4 +1,4 @@
-"""The scenario digest every process of a run checks against the conductor's (Tick.world)."""
+"""The scenario digest every process of a run checks against the conductor's (Tick.digest)."""
 
 from __future__ import annotations
 
