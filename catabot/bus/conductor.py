@@ -213,9 +213,12 @@ class Conductor:
             self._take(self._acks.recv())  # some tick is outstanding: an ack or a poke comes
         elif wait > 0:
             time.sleep(wait)
+        self._take_queued()
+        self._check_events()
+
+    def _take_queued(self) -> None:
         while (sample := self._acks.try_recv()) is not None:
             self._take(sample)
-        self._check_events()
 
     def _take(self, sample: zenoh.Sample) -> None:
         key = str(sample.key_expr)
@@ -227,7 +230,9 @@ class Conductor:
             self.rejections.add(key, exc)
             return
         self._acked[name] = max(self._acked[name], min(ack.tick, self._granted))
-        if ack.end:
+        if ack.fault:  # its own words, before its token goes: the cause on every host
+            self._fault(name, f"stopped at tick {ack.tick + 1}: {ack.fault}")
+        elif ack.end:
             self._end_request(name, ack)
         self._advance()
 
@@ -254,8 +259,9 @@ class Conductor:
             raise Rejected("malformed", str(exc)) from None
         if ack.run != self.run_id or ack.tick < -1:
             raise Rejected("ack of another run or tick", f"run {ack.run}, tick {ack.tick}")
-        if ack.end and end_reason_problem(ack.end):
-            raise Rejected("end request with a bad reason", end_reason_problem(ack.end))
+        for text, what in ((ack.end, "end request"), (ack.fault, "fault")):
+            if text and end_reason_problem(text):
+                raise Rejected(f"{what} with a bad reason", end_reason_problem(text))
         return name, ack
 
     def _advance(self) -> None:
@@ -282,8 +288,10 @@ class Conductor:
         gone = self._gone(active)
         if gone:  # a lost link takes every token behind it: name them together
             time.sleep(GONE_GRACE_S)
+            self._take_queued()  # a fault told before leaving names the cause (raises)
             while not self.events.empty():
                 self._next_event(0.0)
+            active = self._active()  # less any dropped for a fault it told (policy drop)
             gone = self._gone(active)
         if len(gone) > 1 and self.spec.policy is Policy.ABORT:  # one link: every token at once
             raise ClockError(

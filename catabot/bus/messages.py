@@ -21,8 +21,7 @@ LABEL_CLASSES = ("none", "water", "terrain", "vessel", "buoy")
 is no surface (the sky, a raindrop, beyond range). One table for every producer and reader."""
 CLASS_NONE, CLASS_WATER, CLASS_TERRAIN, CLASS_VESSEL, CLASS_BUOY = range(len(LABEL_CLASSES))
 
-XYZ = ("x", "y", "z")
-QUAT = ("x", "y", "z", "w")
+XYZ, QUAT = ("x", "y", "z"), ("x", "y", "z", "w")
 
 
 def vec(unit: str, axes: tuple[str, ...]) -> Any:
@@ -66,14 +65,15 @@ class Tick(Message):
 
 @dataclass(frozen=True)
 class Ack(Message):
-    """`tick` and every tick before it stepped. A non-empty `end` (why, at most 200
-    characters) asks the conductor to end the run after `tick`: the run ends cleanly once
-    every participant has stepped it (a controller whose episode is over)."""
+    """`tick` and every tick before it stepped. `end` (1-200 printable characters) asks the
+    conductor to end the run cleanly after `tick` (a controller whose episode is over);
+    `fault`, the same, says why this participant stops on a fault of its own (clock.py)."""
 
     TYPE: ClassVar[str] = "ack"
     run: str
     tick: int
     end: str = ""
+    fault: str = ""
 
 
 @dataclass(frozen=True)

@@ -4,12 +4,11 @@ Services write only a `step(tick, inputs)` function; this class owns the protoco
 DESIGN.md §4: membership by a liveliness token, stepping every tick the conductor has
 granted as soon as its inputs are complete (so a fast participant runs ahead of a slow
 one, within the window), Jacobi input release (a sample tagged k is handed over at tick
-k+1, never earlier), acks every few ticks, and a clean end on `clock/end`.
+k+1, never earlier), acks every few ticks, a clean end (`clock/end`), its own faults told.
 
-Nothing from the bus is believed blindly (identity.py, inbox.py): ticks and ends only from
-the conductor's session and only if the run's clock could have sent them (`ClockLimits`),
-lockstep samples only from their producer's session; refused samples are counted and
-logged without flooding (rejections.py), and none can fail a step.
+Nothing from the bus is believed blindly (identity.py, inbox.py): clock messages only from
+the conductor's session and only if its clock could send them (`ClockLimits`), samples only
+from their producer's; refusals are counted and logged without flooding (rejections.py).
 """
 
 from __future__ import annotations
@@ -88,9 +87,7 @@ class Participant(Outputs):
             session.declare_subscriber(keys.tick(), self._push("tick")),
             session.declare_subscriber(keys.end(), self._push("end")),
             session.liveliness().declare_subscriber(keys.lives(), self._on_live, history=True),
-        ]
-        self._subs += [
-            session.declare_subscriber(key, self._push("data")) for key in self.inbox.keys
+            *(session.declare_subscriber(key, self._push("data")) for key in self.inbox.keys),
         ]
         self._ack = self._publisher(keys.ack(name))
         self._token = session.liveliness().declare_token(keys.live(name, str(session.zid())))
@@ -173,6 +170,14 @@ class Participant(Outputs):
         self._ended = True
         self.put(self._ack, codec.encode(Ack(grant.run, k - 1, end=end_reason(reason))))
         self._acked = k - 1
+
+    def report_fault(self, why: str) -> None:
+        """Tell the conductor why this participant stops (a fault of its own: a crash, another
+        scenario), so the run's cause names it on every host, not only in this one's log."""
+        if self.run_id and not self._ended:
+            self._ended = True
+            ack = Ack(self.run_id, self.next_tick - 1, fault=end_reason(why))
+            self.put(self._ack, codec.encode(ack))
 
     def _ack_waiting(self) -> None:
         """Ticks stepped since the last ack wait for inputs (a second without events, or the
@@ -259,12 +264,12 @@ class Participant(Outputs):
     def _take_tick(self, tick: Tick) -> None:
         if self.run_id and tick.run != self.run_id:
             raise Rejected("tick of another run", tick.run)
+        self.run_id = tick.run  # the conductor's (its session checked): a fault names this run
         if self.limits is not None:
             self.limits.check_digest(tick)  # raises: another scenario than the conductor's
         problem = self._tick_problem(tick)
         if problem:
             raise Rejected("tick the clock cannot send", problem)
-        self.run_id = tick.run
         for text in tick.settings:
             self._settings.setdefault(from_wire(text).tick, []).append(text)
         self.inbox.drop_producers(tick.dropped)
@@ -319,10 +324,8 @@ class Participant(Outputs):
                 break
             if event[0] == "data":
                 self._take_data(event[1], event[2], event[3])
-        if self.inbox.missing(end.tick + 1):
-            log.warning(
-                "%s: run ended without samples from %s", self.name, self.inbox.missing(end.tick + 1)
-            )
+        if missing := self.inbox.missing(end.tick + 1):
+            log.warning("%s: run ended without samples from %s", self.name, missing)
         if on_end is not None:
             on_end(end, self.inbox.release(end.tick + 1))
         return end

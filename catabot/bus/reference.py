@@ -147,7 +147,9 @@ sample and ack is believed only from the session that owns its participant name:
    command holds physics and the recorder up until the deadline, which then names them.
    A command that fails its check (below) is refused and its tick goes on without it.
    To end the run (your mission is over), ack the last tick you stepped with `end`, a
-   reason of 1-200 printable characters, and step no more: the End follows.
+   reason of 1-200 printable characters, and step no more: the End follows. If your stack
+   fails, ack the last tick you stepped with `fault` (the same kind of text) before you
+   leave: the run's error quotes it, not only that you left.
 5. Stop at `catabot/<world>/clock/end`.
 """
 

@@ -177,7 +177,8 @@ class Client:
     ) -> End:  # fmt: skip
         """Join as `name` and call `step(observation) -> command | None` every control
         period until the run ends; returns its End. A step that raises `EndRun(reason)`
-        ends the run there for everyone (`Joined.end_run`)."""
+        ends the run there for everyone (`Joined.end_run`); one that raises anything else
+        leaves with that exception as the run's cause (the conductor's error names it)."""
         joined = self.join(name, vessel=vessel, sensors=sensors, rate_hz=rate_hz)
         try:
             while True:
@@ -191,6 +192,9 @@ class Client:
                     command = step(obs)
                 except EndRun as request:
                     return joined.end_run(str(request))
+                except Exception as exc:  # the stack's bug: the run's cause, in its words
+                    joined.close(fault=f"{type(exc).__name__}: {exc}")
+                    raise
                 joined.act(command)
         finally:
             joined.close()

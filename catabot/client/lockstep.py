@@ -242,12 +242,15 @@ class Joined:
         assert isinstance(last, TwistCmd), kind
         return Twist(last.surge, last.yaw_rate)
 
-    def close(self) -> None:
+    def close(self, *, fault: str = "") -> None:
         """Leave the run (mid-run the conductor names this participant gone and, by the
-        scenario's policy, ends the run or drops it)."""
+        scenario's policy, ends the run or drops it). `fault`: why, when the stack failed
+        (at most 200 characters kept): the conductor's error, the run's cause, quotes it."""
         if self._closed:
             return
         self._closed = True
+        if fault and self._thread.is_alive():
+            self.participant.report_fault(fault)
         if self._thread.is_alive():
             self._commands.put(_LEAVE)
             self.participant.stop()

@@ -47,6 +47,7 @@ from catabot.run.usage import write_usage
 from catabot.world.world import World
 
 EXIT_CLOCK = 3  # the lockstep clock was lost (the conductor gone, a hung peer)
+FAULT_SENT_S = 0.1
 log = logging.getLogger("catabot.run.service")
 
 
@@ -223,6 +224,7 @@ def with_switches(ctx: ServiceContext, runner: Runner, step: StepFn) -> StepFn:
 
 
 def _serve(ctx: ServiceContext, build: BuildFn) -> int:
+    participant: Runner | None = None
     try:
         participant, step, on_end = build(ctx)
         step = with_switches(ctx, participant, step)
@@ -235,14 +237,11 @@ def _serve(ctx: ServiceContext, build: BuildFn) -> int:
         log.error("%s", exc)
         return EXIT_CLOCK
     except CataBotError as exc:
-        log.critical("%s", exc)
-        return 2
+        return _failed(participant, 2, str(exc))
     except OSError as exc:
-        log.critical("%s: %s", exc.filename or "I/O", exc.strerror or exc)
-        return 1
-    except Exception:  # a bug: its traceback in the log, named as the cause
-        log.critical("crashed", exc_info=True)
-        return 1
+        return _failed(participant, 1, f"{exc.filename or 'I/O'}: {exc.strerror or exc}")
+    except Exception as exc:  # a bug: its traceback in the log, named as the cause
+        return _failed(participant, 1, f"crashed: {type(exc).__name__}: {exc}", trace=True)
     if end.reason == LOST:  # its files are closed whole, up to the last tick it stepped
         log.error("%s (its files end at tick %d)", end.error, end.tick)
         return EXIT_CLOCK
@@ -253,3 +252,13 @@ def _serve(ctx: ServiceContext, build: BuildFn) -> int:
         return 1
     log.info("%s: run ended at tick %d (%s) %s", ctx.name, end.tick, end.reason, end.error)
     return 0
+
+
+def _failed(runner: Runner | None, code: int, why: str, *, trace: bool = False) -> int:
+    """A fault of this service's own: CRITICAL in its log (the cause `catabot run` quotes),
+    and told to the conductor, whose error names it on every host of a split run."""
+    log.critical("%s", why, exc_info=trace)
+    if isinstance(runner, Participant):
+        runner.report_fault(why)
+        time.sleep(FAULT_SENT_S)  # the put leaves before the session closes
+    return code

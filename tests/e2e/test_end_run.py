@@ -125,3 +125,25 @@ def test_a_participant_that_drives_nothing_ends_the_recording_at_its_tick(tmp_pa
     again, _ = _watched_run(tmp_path / "b")
     first, second = files_of(run_dir), files_of(again)
     assert [n for n in first if first[n] != second.get(n)] == []
+
+
+def test_a_stack_that_raises_is_the_runs_cause_in_its_own_words(tmp_path: Path) -> None:
+    """Not `EndRun`: a bug. The stack's exception reaches it, and the conductor's error (the
+    console, log/run.json) quotes it, where it said only that the stack left."""
+    run = Run(tmp_path, SCENARIO)
+
+    def step(obs: Observation) -> Thrust:
+        if obs.tick == 50:
+            raise ZeroDivisionError("division by zero")
+        return Thrust([0.5, 0.6])
+
+    try:
+        with Client.connect([run.endpoint], timeout_s=30) as sim, pytest.raises(ZeroDivisionError):
+            sim.run_lockstep("stack", step)
+        out, err = run.proc.communicate(timeout=60)
+        cause = "participant 'stack' stopped at tick 50: ZeroDivisionError: division by zero"
+        assert run.proc.returncode != 0 and cause in err, out + err
+        run_dir = Path(out.split("run folder: ")[-1].strip())
+        assert json.loads((run_dir / "log" / "run.json").read_text())["error"] == cause
+    finally:
+        run.kill()
