@@ -25,6 +25,7 @@ from catabot.run.companions import Viewer, after_run, start_viewer
 from catabot.run.progress import PlanningProgress, ProgressBar
 from catabot.run.summary import summarise
 from catabot.run.supervisor import Child, Stops, Supervisor
+from catabot.world.mounts import check_mounts
 from catabot.world.world import World
 
 SERVICE_MODULES = {
@@ -69,6 +70,7 @@ def prepare(opts: RunOptions) -> World:
         data["clock"]["realtime_factor"] = opts.realtime
     world = World.resolve(parse_scenario(data, source="command line"), progress=PlanningProgress())
     _ = world.shapes  # every mesh file read now: a broken one is refused before any start
+    check_mounts(world)  # no camera, LiDAR or radar inside its own hull
     for name in world.services:
         if service_of(name, world.services)[0] not in SERVICE_MODULES:
             raise LaunchError(f"scenario needs service {name!r}, which this version does not have")

@@ -124,11 +124,14 @@ def summarise(
     )
     for line in metrics_lines(run_dir):
         print(line)
+    for name in (n for n, c in service_codes.items() if c == 0 and n.startswith("export-")):
+        print(f"  {name}: {_last_line(run_dir, name)}")  # what it wrote, as the CLI says it
     for name in sorted(unjoined):
         print(f"  {name}: stopped by catabot run before it joined", file=sys.stderr)
     for name, code in failed.items():
         log = run_dir / "log" / f"{name}.log"
-        print(f"  {name}: {describe_exit(code)} (see {log})", file=sys.stderr)
+        said = f": {_last_line(run_dir, name)}" if name.startswith("export-") else ""
+        print(f"  {name}: {describe_exit(code)}{said} (see {log})", file=sys.stderr)
     _print_rejected(record["rejected"], run_dir)
     if ender_of(str(record["reason"])) is not None:  # a participant's end (Ack.end)
         print(f"run {record['reason']}")
@@ -140,3 +143,12 @@ def summarise(
         print("run interrupted; files are complete up to the last tick", file=sys.stderr)
         return 130
     return 0
+
+
+def _last_line(run_dir: Path, name: str) -> str:
+    """A companion program's last line in its log: its one-line answer (catabot/run/answer.py)."""
+    try:
+        lines = (run_dir / "log" / f"{name}.log").read_text(errors="replace").splitlines()
+    except OSError:
+        return "(no log)"
+    return next((x.strip() for x in reversed(lines) if x.strip()), "(empty log)")[:300]

@@ -18,8 +18,9 @@ from catabot.errors import CataBotError
 from catabot.run.answer import OneLineParser, answered
 from catabot.run.recorded import RecordedRun
 from services.datasets import coco, kitti, yolo
+from services.datasets.frames import ExportOptions
 
-FORMATS: dict[str, Callable[..., str]] = {
+FORMATS: dict[str, Callable[[RecordedRun, Path, ExportOptions], str]] = {
     "yolo": yolo.export,
     "coco": coco.export,
     "kitti": kitti.export,
@@ -41,6 +42,10 @@ def parser() -> argparse.ArgumentParser:
         help="simulated seconds that go to train or val together (default: 10, or a tenth "
         "of the run if shorter)",
     )  # fmt: skip
+    exp.add_argument(
+        "--min-box-px", type=int, default=0,
+        help="leave out boxes narrower or lower than this many pixels (default 0: keep all)",
+    )  # fmt: skip
     return p
 
 
@@ -55,6 +60,8 @@ def _check(args: argparse.Namespace) -> Path:
         raise ExportOptionError(f"--val-fraction must be in [0, 1] (got {args.val_fraction})")
     if args.split_block_s is not None and not args.split_block_s > 0:
         raise ExportOptionError(f"--split-block-s must be > 0 (got {args.split_block_s})")
+    if args.min_box_px < 0:
+        raise ExportOptionError(f"--min-box-px must be >= 0 (got {args.min_box_px})")
     out = Path(args.output)
     if out.exists() and (not out.is_dir() or any(out.iterdir())):
         raise ExportOptionError(f"--output {out} exists and is not an empty folder")
@@ -69,16 +76,24 @@ def main(argv: list[str] | None = None) -> int:
         run = RecordedRun(args.run)
         made = not out.exists()
         out.mkdir(parents=True, exist_ok=True)
+        options = ExportOptions(args.val_fraction, args.split_block_s, args.min_box_px)
         try:
-            summary = FORMATS[args.format](
-                run, out, val_fraction=args.val_fraction, block_s=args.split_block_s
-            )
+            summary = FORMATS[args.format](run, out, options)
         except BaseException:
             _undo(out, made=made)
             raise
-        return f"{args.format} dataset in {out}: {summary}"
+        return f"{args.format} dataset in {out}: {summary}{_one_set(args)}"
 
     return answered("dataset export", export)
+
+
+def _one_set(args: argparse.Namespace) -> str:
+    """--val-fraction 0 or 1 is allowed (all to one set), but said: data.yaml still names
+    the empty set's folder."""
+    if args.format == "kitti" or 0.0 < args.val_fraction < 1.0:
+        return ""
+    empty = "val" if args.val_fraction == 0.0 else "train"
+    return f" (--val-fraction {args.val_fraction:g}: the {empty} set is empty)"
 
 
 def _undo(out: Path, *, made: bool) -> None:

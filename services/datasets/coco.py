@@ -24,7 +24,7 @@ from catabot.bus.messages import LABEL_CLASSES
 from catabot.run.recorded import RecordedRun
 from catabot.run.recorded_camera import BOX_CLASSES
 from services.datasets import rle
-from services.datasets.frames import ExportError, Frame, camera_frames
+from services.datasets.frames import ExportError, ExportOptions, Frame, camera_frames
 
 CATEGORIES = [
     {"id": LABEL_CLASSES.index(name), "name": name, "supercategory": "object"}
@@ -35,10 +35,10 @@ CATEGORIES = [
 def frame_annotations(frame: Frame, image_id: int, first_id: int) -> list[dict[str, Any]]:
     """One annotation per box of the frame, masks from its instance image."""
     instance = frame.labelled.read("instance")
-    if instance is None:
+    if instance is None:  # checked for every frame by `camera_frames`
         raise ExportError(f"{frame.name}: no instance image (camera output 'segmentation' off)")
     out = []
-    for k, (row, flags) in enumerate(zip(frame.labelled.boxes, frame.labelled.flags, strict=True)):
+    for k, (row, flags) in enumerate(zip(frame.boxes, frame.flags, strict=True)):
         mask = instance == int(row[0])
         x0, y0, x1, y1 = (int(v) for v in row[2:6])
         out.append({
@@ -77,8 +77,8 @@ def document(run: RecordedRun, frames: list[Frame], subset: str) -> dict[str, An
     }  # fmt: skip
 
 
-def export(run: RecordedRun, out: Path, *, val_fraction: float, block_s: float | None) -> str:
-    frames, note = camera_frames(run, val_fraction=val_fraction, block_s=block_s)
+def export(run: RecordedRun, out: Path, options: ExportOptions) -> str:
+    frames, note = camera_frames(run, options, needs=("color", "instance"))
     (out / "annotations").mkdir(parents=True, exist_ok=True)
     counts = []
     for subset in ("train", "val"):

@@ -7,16 +7,32 @@ one image has the same name in the YOLO and COCO exports and in the run's own `d
 from __future__ import annotations
 
 from dataclasses import dataclass
+from functools import cached_property
 from pathlib import Path
+
+import numpy as np
+from numpy.typing import NDArray
 
 from catabot.errors import CataBotError
 from catabot.run.recorded import RecordedRun
 from catabot.run.recorded_camera import LabelledFrame, cameras, labelled_frames
 from services.datasets.split import split
 
+NAMES = {"color": "colour", "instance": "instance"}  # a frame's image outputs, as said
+
 
 class ExportError(CataBotError, ValueError):
     """A run that cannot give the asked-for dataset (no camera, no LiDAR, no labels)."""
+
+
+@dataclass(frozen=True)
+class ExportOptions:
+    """How a run becomes a dataset: the train/val split (split.py) and the smallest box
+    kept, in pixels of width and height (distant buoys of 1-2 px teach a detector noise)."""
+
+    val_fraction: float = 0.2
+    block_s: float | None = None
+    min_box_px: int = 0
 
 
 @dataclass(frozen=True)
@@ -25,6 +41,7 @@ class Frame:
     camera: str  # `<vessel>.<camera>`
     labelled: LabelledFrame
     subset: str  # "train" or "val"
+    min_box_px: int = 0
 
     @property
     def color(self) -> Path:
@@ -33,13 +50,28 @@ class Frame:
             raise ExportError(f"{self.name}: no colour image")
         return path
 
+    @cached_property
+    def kept(self) -> NDArray[np.bool_]:
+        """The boxes at least `min_box_px` wide and high, in the camera's box order."""
+        boxes = self.labelled.boxes
+        size = np.minimum(boxes[:, 4] - boxes[:, 2], boxes[:, 5] - boxes[:, 3])
+        return np.asarray(size >= self.min_box_px)
+
+    @property
+    def boxes(self) -> NDArray[np.float64]:
+        return self.labelled.boxes[self.kept]
+
+    @property
+    def flags(self) -> NDArray[np.uint8]:
+        return self.labelled.flags[self.kept]
+
 
 def camera_frames(
-    run: RecordedRun, *, val_fraction: float, block_s: float | None
+    run: RecordedRun, options: ExportOptions, *, needs: tuple[str, ...] = ("color",)
 ) -> tuple[list[Frame], str]:
-    """Every labelled frame with a colour image, split into train and val, and a note on
-    the frames left out for want of one (a camera's colour output switched off for a
-    while: `catabot set`), empty when none was."""
+    """Every labelled frame with the outputs the format `needs`, split into train and val,
+    and a note on the frames left out for want of one (a camera's output switched off for a
+    while: the settings timeline, `catabot set`) and the boxes below the size kept."""
     found = cameras(run.folder, run.world.sensors)
     if not found:
         raise ExportError(
@@ -49,20 +81,27 @@ def camera_frames(
     pairs = [
         (f"{s.vessel}.{s.config.name}", f) for s in found for f in labelled_frames(run.folder, s)
     ]
-    without = [f"{cam}@{f.tick}" for cam, f in pairs if f.path("color") is None]
-    pairs = [(cam, f) for cam, f in pairs if f.path("color") is not None]
+    whole = [all(f.path(n) is not None for n in needs) for _, f in pairs]
+    without = [f"{cam}@{f.tick}" for (cam, f), ok in zip(pairs, whole, strict=True) if not ok]
+    pairs = [pair for pair, ok in zip(pairs, whole, strict=True) if ok]
+    what = " or ".join(NAMES[n] for n in needs) + " image"
     if not pairs:
-        raise ExportError(f"{run.folder}: no labelled frame has a colour image (the cameras' "
-                          "colour output was off: outputs.color)")  # fmt: skip
-    note = f"; left out {len(without)} frames without a colour image ({without[:1]}...)"
-    subsets = split(
-        [f.stamp_ns for _, f in pairs],
-        seed=run.world.scenario.seed,
-        val_fraction=val_fraction,
-        block_s=block_s,
-    )
+        raise ExportError(f"{run.folder}: no labelled frame has a {what} (the cameras' outputs "
+                          f"were off: outputs.{', outputs.'.join(needs)})")  # fmt: skip
+    subsets = split([f.stamp_ns for _, f in pairs], seed=run.world.scenario.seed,
+                    val_fraction=options.val_fraction, block_s=options.block_s)  # fmt: skip
     frames = [
-        Frame(f"{cam}_{f.tick:08d}", cam, f, subset)
+        Frame(f"{cam}_{f.tick:08d}", cam, f, subset, options.min_box_px)
         for (cam, f), subset in zip(pairs, subsets, strict=True)
     ]
-    return frames, (note if without else "")
+    return frames, _note(frames, without, what, options.min_box_px)
+
+
+def _note(frames: list[Frame], without: list[str], what: str, min_box_px: int) -> str:
+    note = ""
+    if without:
+        note += f"; left out {len(without)} frames without a {what} (first: {without[0]})"
+    small = sum(int((~f.kept).sum()) for f in frames)
+    if small:
+        note += f"; left out {small} boxes under {min_box_px} px (--min-box-px)"
+    return note

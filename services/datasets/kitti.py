@@ -28,7 +28,7 @@ from catabot.config.sensors import LidarParams
 from catabot.run.recorded import RecordedRun, StateTrack
 from catabot.world import rotations
 from catabot.world.world import MountedSensor
-from services.datasets.frames import ExportError
+from services.datasets.frames import ExportError, ExportOptions
 
 KITTI_CLASSES = (*LABEL_CLASSES, "rain")
 RAIN = KITTI_CLASSES.index("rain")
@@ -91,7 +91,7 @@ def labels_yaml(sequences: dict[str, str]) -> str:
     return f"labels:\n{names}color_map:\n{colors}sequences:\n{seqs}"
 
 
-def export(run: RecordedRun, out: Path, **_: float) -> str:
+def export(run: RecordedRun, out: Path, _options: ExportOptions) -> str:
     lidars = [s for s in run.world.sensors if s.config.type == "lidar"]
     if not lidars:
         raise ExportError(f"{run.folder}: the scenario has no LiDAR (kitti exports LiDAR scans)")

@@ -20,7 +20,7 @@ import numpy as np
 from catabot.bus.messages import LABEL_CLASSES
 from catabot.run.recorded import RecordedRun
 from catabot.run.recorded_camera import BOX_CLASSES
-from services.datasets.frames import ExportError, Frame, camera_frames
+from services.datasets.frames import ExportError, ExportOptions, Frame, camera_frames
 
 YOLO_INDEX = {LABEL_CLASSES.index(name): i for i, name in enumerate(BOX_CLASSES)}
 
@@ -28,7 +28,7 @@ YOLO_INDEX = {LABEL_CLASSES.index(name): i for i, name in enumerate(BOX_CLASSES)
 def label_lines(frame: Frame) -> str:
     """The frame's label file: one normalised xywh line per box, in the camera's box order."""
     width, height = frame.labelled.size
-    boxes = frame.labelled.boxes
+    boxes = frame.boxes
     unknown = sorted({int(c) for c in boxes[:, 1]} - set(YOLO_INDEX))
     if unknown:
         raise ExportError(f"{frame.name}: boxes of classes {unknown} have no YOLO index")
@@ -51,8 +51,8 @@ def data_yaml(out: Path, run: RecordedRun) -> str:
     )
 
 
-def export(run: RecordedRun, out: Path, *, val_fraction: float, block_s: float | None) -> str:
-    frames, note = camera_frames(run, val_fraction=val_fraction, block_s=block_s)
+def export(run: RecordedRun, out: Path, options: ExportOptions) -> str:
+    frames, note = camera_frames(run, options)
     for subset in ("train", "val"):
         (out / "images" / subset).mkdir(parents=True, exist_ok=True)
         (out / "labels" / subset).mkdir(parents=True, exist_ok=True)
@@ -61,5 +61,5 @@ def export(run: RecordedRun, out: Path, *, val_fraction: float, block_s: float |
         (out / "labels" / frame.subset / f"{frame.name}.txt").write_text(label_lines(frame))
     (out / "data.yaml").write_text(data_yaml(out, run))
     val = sum(f.subset == "val" for f in frames)
-    boxes = sum(len(f.labelled.boxes) for f in frames)
+    boxes = sum(len(f.boxes) for f in frames)
     return f"{len(frames)} images ({len(frames) - val} train, {val} val), {boxes} boxes{note}"

@@ -53,7 +53,9 @@ def run(tmp_path_factory: pytest.TempPathFactory) -> Path:
     out.mkdir()
     result = catabot("run", str(scenario_file(tmp, _scenario())), "--out", str(out), "--quiet")
     assert result.returncode == 0, result.stdout + result.stderr
-    return only_run_dir(out)
+    run = only_run_dir(out)
+    (tmp / "console.txt").write_text(result.stdout)
+    return run
 
 
 def _rows(rrd: Path) -> tuple[Counter[str], set[str], set[str]]:
@@ -106,6 +108,14 @@ def test_yolo_export_passes_a_strict_check(run: Path) -> None:
     labels = [json.loads(x) for x in (run / "dataset/ego.cam/labels.jsonl").read_text().split()]
     assert sum(n for n, _ in found.values()) == len(labels) == 10
     assert sum(b for _, b in found.values()) == sum(len(x["objects"]) for x in labels) > 0
+
+
+def test_the_console_says_what_each_export_wrote(run: Path) -> None:
+    """It said nothing: the summary (and a left-out note) was only in log/export-*.log."""
+    console = (run.parent.parent / "console.txt").read_text()
+    for fmt, what in (("yolo", "images"), ("coco", "annotations"), ("kitti", "scans")):
+        assert f"  export-{fmt}: {fmt} dataset in {run / 'export' / fmt}: " in console
+        assert what in console.split(f"export-{fmt}: ")[1].splitlines()[0]
 
 
 def test_coco_masks_match_the_boxes_and_the_class_images(run: Path) -> None:
@@ -197,14 +207,14 @@ def test_refusals_exit_2_with_one_clear_line(
     assert message in result.stderr and "Traceback" not in result.stderr
 
 
-def _without_colour(run: Path, tmp: Path, drop: int) -> Path:
-    """A copy of the run whose first `drop` frames were saved with the colour output off."""
-    copy = tmp / f"off{drop}"
+def _without(run: Path, tmp: Path, drop: int, output: str = "color") -> Path:
+    """A copy of the run whose first `drop` frames were saved with `output` off."""
+    copy = tmp / f"off{drop}{output}"
     shutil.copytree(run, copy, ignore=shutil.ignore_patterns("export", "*.rrd", "*.mcap"))
     labels = copy / "dataset" / "ego.cam" / "labels.jsonl"
     records = [json.loads(x) for x in labels.read_text().split()]
     for record in records[:drop]:
-        del record["files"]["color"]
+        del record["files"][output]
     labels.write_text("".join(json.dumps(r) + "\n" for r in records))
     return copy
 
@@ -212,13 +222,50 @@ def _without_colour(run: Path, tmp: Path, drop: int) -> Path:
 def test_frames_without_a_colour_image_are_left_out_and_named(run: Path, tmp_path: Path) -> None:
     """Colour switched off for a while (`catabot set`) made the whole run unexportable."""
     out = tmp_path / "yolo"
-    result = catabot("dataset", "export", str(_without_colour(run, tmp_path, 3)), "-f", "yolo",
+    result = catabot("dataset", "export", str(_without(run, tmp_path, 3)), "-f", "yolo",
                      "-o", str(out))  # fmt: skip
     assert result.returncode == 0, result.stderr
-    assert "7 images" in result.stdout and "left out 3 frames without a colour image" in (
-        result.stdout
+    assert (
+        "7 images" in result.stdout
+        and "left out 3 frames without a colour image (first: ego.cam@" in result.stdout
     )
     assert sum(n for n, _ in check_yolo(out / "data.yaml").values()) == 7
-    none = catabot("dataset", "export", str(_without_colour(run, tmp_path, 10)), "-f", "coco",
+    none = catabot("dataset", "export", str(_without(run, tmp_path, 10)), "-f", "coco",
                    "-o", str(tmp_path / "coco"))  # fmt: skip
-    assert none.returncode == 2 and "no labelled frame has a colour image" in none.stderr
+    assert (
+        none.returncode == 2 and "no labelled frame has a colour or instance image" in none.stderr
+    )
+
+
+def test_coco_leaves_out_frames_without_segmentation(run: Path, tmp_path: Path) -> None:
+    """Segmentation switched off by the settings timeline failed the whole COCO export, and
+    with it the run that asked for it (`recording.export`)."""
+    out = tmp_path / "coco"
+    result = catabot("dataset", "export", str(_without(run, tmp_path, 4, "instance")), "-f",
+                     "coco", "-o", str(out))  # fmt: skip
+    assert result.returncode == 0, result.stderr
+    assert "left out 4 frames without a colour or instance image" in result.stdout
+    docs = [json.loads((out / "annotations" / f"instances_{s}.json").read_text())
+            for s in ("train", "val")]  # fmt: skip
+    assert sum(len(d["images"]) for d in docs) == 6
+
+
+def test_small_boxes_are_left_out_on_request(run: Path, tmp_path: Path) -> None:
+    every, fewer = tmp_path / "every", tmp_path / "fewer"
+    kept = catabot("dataset", "export", str(run), "-f", "yolo", "-o", str(every))
+    big = catabot("dataset", "export", str(run), "-f", "yolo", "-o", str(fewer),
+                  "--min-box-px", "2", "--val-fraction", "0")  # fmt: skip
+    assert kept.returncode == big.returncode == 0, kept.stderr + big.stderr
+    boxes = [_boxes(every, s) for s in ("train", "val")]
+    wide = [b for rows in boxes for b in rows if min(b[0] * 160, b[1] * 120) >= 2 - 1e-6]
+    assert 0 < len(wide) < sum(map(len, boxes)), boxes
+    assert len(_boxes(fewer, "train")) == len(wide) and _boxes(fewer, "val") == []
+    assert f"left out {sum(map(len, boxes)) - len(wide)} boxes under 2 px" in big.stdout
+    assert "(--val-fraction 0: the val set is empty)" in big.stdout
+
+
+def _boxes(out: Path, subset: str) -> list[tuple[float, float]]:
+    """Each YOLO label's (width, height), normalised."""
+    lines = [x for f in sorted((out / "labels" / subset).glob("*.txt"))
+             for x in f.read_text().splitlines()]  # fmt: skip
+    return [(float(x.split()[3]), float(x.split()[4])) for x in lines]

@@ -64,7 +64,7 @@ def test_a_failed_export_leaves_the_output_as_it_found_it(
     if existed:
         out.mkdir()
 
-    def half(_run: object, folder: Path, **_: object) -> str:
+    def half(_run: object, folder: Path, _options: object) -> str:
         (folder / "train").mkdir()
         (folder / "train" / "0001.png").write_bytes(b"png")
         (folder / "annotations.json").write_text("{}")

@@ -1,0 +1,69 @@
+"""A camera, LiDAR or radar inside its own vessel's shape is refused before the run starts
+(`catabot run`, `catabot scenario validate`); a mount above the deck, between a catamaran's
+hulls, or an IMU inside the boat is not."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+from typing import Any
+
+import pytest
+
+from catabot.config.load import parse_scenario
+from catabot.config.vessel import load_vessel_model
+from catabot.run.cli import main
+from catabot.world.mounts import MountInsideError, check_mounts, inside
+from catabot.world.shapes import vessel_mesh
+from catabot.world.world import World
+
+
+def _world(model: str, sensor: dict[str, Any]) -> World:
+    vessel = {"id": "ego", "model": model, "sensors": [sensor]}
+    return World.resolve(parse_scenario({"name": "m", "vessels": [vessel]}))
+
+
+@pytest.mark.parametrize(
+    ("model", "point", "within"),
+    [
+        ("catabot", (0.0, 0.0, 0.35), True),  # in its electronics box
+        ("catabot", (0.0, 0.5, 0.1), True),  # in a hull
+        ("catabot", (0.0, 0.0, 0.1), False),  # between the hulls, under the deck box
+        ("catabot", (0.5, 0.0, 1.5), False),  # the camera's default, above it all
+        ("monohull", (0.0, 0.0, 1.0), True),  # in the cabin
+        ("wamv", (0.0, 0.0, 0.35), False),  # between the hulls
+    ],
+)
+def test_ray_parity_finds_the_inside_of_the_bundled_shapes(
+    model: str, point: tuple[float, float, float], within: bool
+) -> None:
+    mesh = vessel_mesh(load_vessel_model(model), source=model)
+    assert mesh is not None and inside(mesh, point) is within
+
+
+def test_a_camera_inside_its_hull_is_refused_naming_it_and_where_the_deck_is() -> None:
+    cam = {"name": "cam", "type": "camera", "rate_hz": 5.0, "params": {"mount_xyz": [0, 0, 0.35]}}
+    with pytest.raises(MountInsideError) as info:
+        check_mounts(_world("catabot", cam))
+    said = str(info.value)
+    assert said.startswith("vessels.0.sensors.0 (cam): its rays start at [0.0, 0.0, 0.35] ")
+    assert "inside ego's own shape (model 'catabot', up to z = 0.46 m)" in said
+
+
+def test_a_radar_antenna_inside_the_cabin_is_refused_and_an_imu_is_not() -> None:
+    radar = {"name": "r", "type": "radar", "rate_hz": 10.0, "params": {"antenna_height_m": 1.0}}
+    with pytest.raises(MountInsideError, match=r"\(antenna_height_m\), inside ego's own shape"):
+        check_mounts(_world("monohull", radar))
+    check_mounts(_world("monohull", {"name": "imu", "type": "imu", "rate_hz": 100.0}))
+    check_mounts(_world("catabot", {"name": "l", "type": "lidar", "rate_hz": 10.0}))
+
+
+def test_scenario_validate_refuses_it_in_one_line(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    lidar = {"name": "l", "type": "lidar", "rate_hz": 10, "params": {"mount_xyz": [0, 0.5, 0.1]}}
+    path = tmp_path / "s.json"
+    path.write_text(json.dumps({"name": "m", "vessels": [{"id": "ego", "sensors": [lidar]}]}))
+    assert main(["scenario", "validate", str(path)]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "(l): its rays start at [0.0, 0.5, 0.1] (mount_xyz)" in err
