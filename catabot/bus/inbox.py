@@ -101,9 +101,11 @@ class Inbox:
             self._pending_bytes += len(payload)
             return False
         if sender != producer:
-            raise Rejected(
-                "not from its producer", f"sender {sender or '?'} is not {stream.producer}"
-            )
+            kind = key.rsplit("/", 1)[-1]
+            driven = (f" (the vessel's {kind} is driven in lockstep by it: a free command "
+                      "would change the run)") if "/cmd/" in key else ""  # fmt: skip
+            why = f"sender {sender or '?'} is not {stream.producer}{driven}"
+            raise Rejected("not from its producer", why)
         return True
 
     def retry_pending(self, horizon: int) -> list[tuple[str, Rejected]]:

@@ -1,8 +1,11 @@
 """Inputs a process refused, logged without flooding and counted for the run's summary.
 
 A buggy client can send a bad sample a hundred times a second: each (key, reason) is logged
-at most once a second with the count since the last line, totals are kept per reason, and
-`write` leaves them in `log/<process>.rejected.json` for `catabot run`'s summary.
+at most once a second with the count since the last line, except that each of its first
+`FIRST_DETAILS` different details is logged when first met (a surge out of range and a yaw
+rate out of range are both "invalid content": the second one's words were lost); totals are
+kept per reason, and `write` leaves them in `log/<process>.rejected.json` for `catabot run`'s
+summary.
 """
 
 from __future__ import annotations
@@ -14,6 +17,7 @@ from collections import Counter
 from pathlib import Path
 
 REPORT = ": refused a sample on "  # the log line `report_of` reads back
+FIRST_DETAILS = 8  # per (key, reason): bounded, whatever a hostile client varies
 
 
 class Rejected(Exception):
@@ -30,17 +34,27 @@ class Rejections:
         self.totals: Counter[str] = Counter()
         self._since: Counter[tuple[str, str]] = Counter()
         self._last: dict[tuple[str, str], float] = {}
+        self._details: dict[tuple[str, str], set[str]] = {}
 
     def add(self, key: str, rejected: Rejected) -> None:
         self.totals[rejected.reason] += 1
         item = (key, rejected.reason)
         self._since[item] += 1
         now = time.monotonic()
-        if now - self._last.get(item, -self.every_s) >= self.every_s:
+        if self._new_detail(item, rejected.detail) or (
+            now - self._last.get(item, -self.every_s) >= self.every_s
+        ):
             count = self._since.pop(item)
             more = f" ({count} since the last report)" if count > 1 else ""
             self.log.warning("%s%s%s: %s%s", self.who, REPORT, key, rejected, more)
             self._last[item] = now
+
+    def _new_detail(self, item: tuple[str, str], detail: str) -> bool:
+        seen = self._details.setdefault(item, set())
+        if detail in seen or len(seen) >= FIRST_DETAILS:
+            return False
+        seen.add(detail)
+        return True
 
     def write(self, path: Path) -> None:
         """Totals by reason (nothing is written when nothing was refused)."""

@@ -195,7 +195,9 @@ class Joined:
         every tick up to that one. Returns the End; NoData if it does not come in time."""
         self._check_running()
         if self._pending is None:
-            raise ClientError(f"{self.name}: end_run() before observe(): no period to end at")
+            raise ClientError(f"{self.name}: end_run() takes the place of act() for the period "
+                              "observe() returned, and none is waiting (before the first "
+                              "observe(), or it was acted on): call observe() first")  # fmt: skip
         problem = end_reason_problem(reason)
         if problem:
             raise ClientError(f"{self.name}: end_run() takes {problem}")

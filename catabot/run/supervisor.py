@@ -67,7 +67,7 @@ class Child:
         self.last_line = ""  # a program's last line, for its fatal fault
         self.waited = ""  # whose data it waited for when the run failed (Participant._waited)
         self.refused: list[str] = []  # console lines: the first refusal of each kind
-        self._refusals: set[tuple[str, str]] = set()
+        self._refusals: set[tuple[str, str, str]] = set()
         self._relay = threading.Thread(target=self._copy_stderr, daemon=True)
         self._relay.start()
 
@@ -89,17 +89,18 @@ class Child:
         client whose commands are dropped learns why without reading `log/`; at most
         `MAX_ECHOED` kinds, so a client spraying keys cannot flood the console."""
         report = report_of(line)
-        if report is None or report[:2] in self._refusals or len(self._refusals) > MAX_ECHOED:
+        if report is None or report in self._refusals or len(self._refusals) > MAX_ECHOED:
             return
         key, reason, detail = (_printable(part) for part in report)
-        self._refusals.add(report[:2])
+        self._refusals.add(report)
         if len(self._refusals) > MAX_ECHOED:
             self.refused.append(f"{self.name} refused more kinds of samples: see {self.log_path}")
             return
         hint = " (messages: docs/MESSAGES.md)" if reason in HINTED else ""
         said = f"{reason}: {detail}" if detail else reason
+        counts = self.log_path.with_name(f"{self.name}.rejected.json")
         self.refused.append(f"{self.name} refused {key}: {said}{hint}; first of its kind, all "
-                            f"counted in {self.log_path}")  # fmt: skip
+                            f"counted in {counts}")  # fmt: skip
 
     def waited_line(self) -> str:
         """Whose data it waited for at the fault (`Participant._waited`), once an exited

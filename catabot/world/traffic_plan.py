@@ -156,9 +156,22 @@ class Planner:
                 continue
             for k, (x, y) in enumerate(b.path):  # a point several paths share (given
                 if laid.clear_of(np.array([(x, y)]), self.buoy_r):  # points): one buoy
+                    self._not_under_a_boat(boats, b.id, (x, y))
                     buoys.append(BuoyConfig(id=f"{b.id}_wp{k}", x_m=x, y_m=y))
                     laid.add(x, y, self.buoy_r)
         return TrafficPlan(boats, tuple(buoys))
+
+    def _not_under_a_boat(self, boats: tuple[Boat, ...], owner: str, point: Point) -> None:
+        """A given waypoint where a boat starts (its own first point, often) laid its buoy
+        under that boat: a collision from tick 0 in every run."""
+        for other in boats:
+            gap = math.hypot(point[0] - other.pose.x_m, point[1] - other.pose.y_m)
+            if gap < self.footprints[other.model] + self.buoy_r:
+                raise ScenarioError(
+                    f"traffic: {owner}'s waypoint ({point[0]:g}, {point[1]:g}) is {gap:.2f} m "
+                    f"from where {other.id} starts: its buoy would start under that boat; move "
+                    "the point or the start, or traffic.waypoints.buoys: false"
+                )
 
     def _planned(self, index: int) -> Boat:
         self._path_draws = 0
@@ -180,9 +193,10 @@ class Planner:
             x, y = over.x_m if over.x_m is not None else x, over.y_m if over.y_m is not None else y
             yaw = over.yaw_rad if over.yaw_rad is not None else self.rng.uniform(-math.pi, math.pi)
             fixed = over.x_m is not None and over.y_m is not None  # the user's spot: as given
-            if not self._free(x, y, radius, draft, room=0.0 if fixed else START_ROOM_M):
+            blocked = self._blocked(x, y, radius, draft, room=0.0 if fixed else START_ROOM_M)
+            if blocked:
                 if fixed:
-                    raise ScenarioError(f"traffic.boats: boat {index} at ({x}, {y}) is not free")
+                    raise ScenarioError(f"traffic.boats: boat {index} at ({x}, {y}): {blocked}")
                 continue
             boat = self._behave(index, model, Pose(x_m=x, y_m=y, yaw_rad=yaw), behaviour, over)
             if boat is not None:
@@ -231,21 +245,23 @@ class Planner:
             return w / 2, h / 2
         return 0.0, 0.0
 
-    def _free(self, x: float, y: float, radius: float, draft: float, *, room: float) -> bool:
-        """Clear of every vessel (by `room` more) and buoy placed so far, and in water deep
-        enough for the hull."""
+    def _blocked(self, x: float, y: float, radius: float, draft: float, *, room: float) -> str:
+        """Why a start is not free ("" if it is): clear of every vessel (by `room` more) and
+        buoy placed so far, and in water deep enough for the hull."""
         here = np.array([(x, y)])
-        if not (self.placed.clear_of(here, radius + room) and self.marks.clear_of(here, radius)):
-            return False
+        if not self.placed.clear_of(here, radius + room):
+            return f"its {radius:.2f} m footprint overlaps a vessel or boat placed before it"
+        if not self.marks.clear_of(here, radius):
+            return f"its {radius:.2f} m footprint overlaps a buoy (scenario or waypoint)"
         if self.terrain is None:
-            return True
+            return ""
         try:
             self.terrain.check_start(
                 x, y, draft_m=draft, footprint_m=radius, clearance_m=CLEARANCE_M
             )
-        except TerrainError:
-            return False
-        return True
+        except TerrainError as exc:
+            return str(exc)
+        return ""
 
     def _wet(self, xs: np.ndarray, ys: np.ndarray) -> bool:
         """Every point of a track in water (2 m of depth: boats must not run aground)."""

@@ -63,14 +63,18 @@ def test_end_run_is_refused_before_observe_and_without_a_reason(tmp_path: Path) 
     try:
         with Client.connect([run.endpoint], timeout_s=30) as sim:
             stack = sim.join("stack")
-            with pytest.raises(ClientError, match="end_run\\(\\) before observe\\(\\)"):
-                stack.end_run("too early")
+            with pytest.raises(ClientError, match=r"none is waiting .* call observe\(\)"):
+                stack.end_run("too early")  # before the first observe()
+            stack.observe()
+            stack.act(Thrust([0.1, 0.1]))
+            with pytest.raises(ClientError, match="or it was acted on"):
+                stack.end_run("after act")  # said "before observe()", and it had observed
             stack.observe()
             for bad in ("", "x" * 201, "tab\there"):
                 with pytest.raises(ClientError, match="1-200 printable characters"):
                     stack.end_run(bad)
             end = stack.end_run("checked")  # still in the seat: the refusals sent nothing
-            assert (end.tick, end.reason) == (-1, "ended by 'stack' after tick -1: checked")
+            assert (end.tick, end.reason) == (9, "ended by 'stack' after tick 9: checked")
             for late in (lambda: stack.end_run("again"), lambda: stack.act(Thrust([0.1, 0.1]))):
                 with pytest.raises(RunEnded, match="has ended \\(ended by 'stack'"):
                     late()  # it said "before observe()"

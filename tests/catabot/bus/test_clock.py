@@ -316,3 +316,17 @@ def test_a_lockstep_order_refused_for_its_content_still_answers_its_tick() -> No
 
 def _refuse(_msg: object) -> None:
     raise ValueError("no")
+
+
+def test_a_free_command_to_a_vessel_driven_in_lockstep_is_refused_saying_so() -> None:
+    """It said only `sender ? is not nav`; the twist's check says it in words, so does this."""
+    inbox = Inbox([Stream(CMD, ThrustCmd, "p", 10)], roster=Roster(ZIDS))
+    with pytest.raises(Rejected) as info:
+        inbox.add(CMD, _cmd(0.5), sender="")
+    assert (info.value.reason, info.value.detail) == (
+        "not from its producer",
+        "sender ? is not p (the vessel's thrust is driven in lockstep by it: a free command "
+        "would change the run)",
+    )
+    with pytest.raises(Rejected, match=r"^not from its producer: sender x is not physics$"):
+        _inbox().add(STATE, _state(0), sender="x")  # not a command: no such words

@@ -143,7 +143,8 @@ def test_unknown_field() -> None:
     body["speed"] = 3.0
     with pytest.raises(CodecError) as info:
         codec.decode(_payload(body), Ack)
-    assert "ack: unknown field(s) 'speed' (fields: run, tick; optional: end, fault)" in str(info.value)
+    said = str(info.value)
+    assert "ack: unknown field(s) 'speed' (fields: run, tick; optional: end, fault)" in said
 
 
 def test_unknown_fields_of_mixed_key_types() -> None:

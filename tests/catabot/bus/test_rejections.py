@@ -34,3 +34,18 @@ def test_a_twist_with_the_scenario_names_is_refused_naming_the_fields() -> None:
     )
     with pytest.raises(codec.CodecError, match=r"missing field 'yaw_rate' \(fields: surge, yaw"):
         codec.decode(codec.pack({"v": 1, "type": "twist_cmd", "surge": 1.0}), TwistCmd)
+
+
+def test_each_new_detail_is_logged_once_then_a_line_a_second(
+    caplog: pytest.LogCaptureFixture,
+) -> None:
+    """A surge and a yaw rate out of range are one key and reason: the second's words were
+    lost for a second; a client varying its values gets only the first FIRST_DETAILS."""
+    refusals = Rejections(logging.getLogger("t"), "physics", every_s=60.0)
+    key = "catabot/w/vessel/ego/cmd/twist"
+    with caplog.at_level(logging.WARNING):
+        for detail in ["surge 1e6", "yaw rate 1e6", "surge 1e6", *(f"v{i}" for i in range(20))]:
+            refusals.add(key, Rejected("invalid content", detail))
+    details = [report_of(f"x {r.getMessage()}\n")[2] for r in caplog.records]  # type: ignore[index]
+    assert details == ["surge 1e6", "yaw rate 1e6", *(f"v{i}" for i in range(6))]
+    assert refusals.totals == {"invalid content": 23}

@@ -4,7 +4,9 @@ keeps room between the boats' starts."""
 from __future__ import annotations
 
 import numpy as np
+import pytest
 
+from catabot.config.base import ScenarioError
 from catabot.config.load import parse_scenario
 from catabot.config.vessel import load_vessel_model
 from catabot.world.placement import CLEARANCE_M, footprint_m
@@ -63,3 +65,24 @@ def test_boats_start_with_room_between_them_and_an_explicit_start_as_given() -> 
     gap[0, 1] = gap[1, 0] = np.inf  # the two the user placed
     assert gap.min() >= 2 * HULL + 10.0 + CLEARANCE_M == 2 * HULL + START_ROOM_M + CLEARANCE_M
     assert np.hypot(*(starts[0] - starts[1])) == 2 * HULL + 1.0
+
+
+def test_a_given_waypoint_where_a_boat_starts_is_refused_naming_both() -> None:
+    """Its buoy was laid under the boat: a traffic collision from tick 0 in every run."""
+    here = {"index": 0, "x_m": 100.0, "y_m": 100.0, "behaviour": "waypoints"}
+    points = [[100.0, 100.0], [150.0, 100.0]]
+    with pytest.raises(ScenarioError) as info:
+        _plan(1, boats=[here], waypoints={"points": points})
+    assert str(info.value).endswith(
+        "traffic: boat_000's waypoint (100, 100) is 0.00 m from where boat_000 starts: its buoy "
+        "would start under that boat; move the point or the start, or traffic.waypoints.buoys: "
+        "false"
+    )
+    _plan(1, boats=[here], waypoints={"points": points, "buoys": False})  # no buoy: no clash
+
+
+def test_a_start_that_is_not_free_says_what_it_overlaps() -> None:
+    on_mark = {"index": 0, "x_m": 40.0, "y_m": 0.5}
+    with pytest.raises(ScenarioError, match=r"boat 0 at \(40.0, 0.5\): its .* m footprint "
+                       r"overlaps a buoy \(scenario or waypoint\)"):  # fmt: skip
+        _plan(1, boats=[on_mark])
