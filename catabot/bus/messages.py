@@ -125,14 +125,11 @@ def check_ids(what: str, tick: int, ids: tuple[str, ...], expected: tuple[str, .
 
 @dataclass(frozen=True)
 class BodyStates(Message):
-    """Every body's state at one instant in one message: row i of each array is `ids[i]`.
-
-    Per-body messages cost a put, a callback and a decode each on every consumer, which
-    dominates a tick with hundreds of bodies; one batch of float64 arrays costs one. Rows:
-    every vessel (traffic boats included), then every buoy; frames as in `VesselState`.
-    `position` (N, 3) m, `orientation` (N, 4) quaternion x, y, z, w, velocities and
-    accelerations (N, 3) in the body frame.
-    """
+    """Every body's state at one instant in one message: row i of each array is `ids[i]`
+    (a put, callback and decode per body dominated a tick with hundreds). Rows: every vessel
+    (traffic boats included), then every buoy; frames as in `VesselState`; `position` (N, 3)
+    m, `orientation` (N, 4) x, y, z, w, velocities and accelerations (N, 3) body frame.
+    `commands`: the free commands physics took at the start of this tick (taken.py)."""
 
     TYPE: ClassVar[str] = "body_states"
     tick: int
@@ -144,6 +141,7 @@ class BodyStates(Message):
     angular_velocity: np.ndarray = field(metadata={"unit": "rad/s"})
     linear_acceleration: np.ndarray = field(metadata={"unit": "m/s^2"})
     angular_acceleration: np.ndarray = field(metadata={"unit": "rad/s^2"})
+    commands: tuple[str, ...] = field(default=(), metadata={"unit": ""})
 
     def row(self, i: int) -> VesselState:
         """Body i as a `VesselState` (python floats: recorded bytes match the per-body form)."""

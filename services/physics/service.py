@@ -16,6 +16,7 @@ from catabot.bus.inbox import Inputs
 from catabot.bus.messages import BodyStates, Message, Tick, TwistBatch, VesselState
 from catabot.bus.settings import changes_of
 from catabot.bus.strays import watch_strays
+from catabot.bus.taken import entry
 from catabot.config import live
 from catabot.run.service import Built, ServiceContext, run_service
 from services.physics import settings
@@ -69,14 +70,17 @@ class PhysicsService:
     def step(self, tick: Tick, inputs: Inputs) -> None:
         for change in changes_of(tick.settings):
             settings.apply(self.world, self.scenario, self.specs, change)
+        taken: list[str] = []  # free commands (tick -1), for the recorder (taken.py)
         for key, msgs in inputs.items():
             if key in self.blocks:
                 self._take_twists(msgs[-1], self.blocks[key])
-            else:
-                self.book.take(self.vessel_of[key], msgs)
+                continue
+            self.book.take(self.vessel_of[key], msgs)
+            rel = self.keys.relative(key)
+            taken += [entry(rel, m) for m in msgs if getattr(m, "tick", 0) == -1]
         self._apply_orders(tick.stamp_ns)
         self.world.step()
-        self._publish(tick)
+        self._publish(tick, tuple(taken))
 
     def _take_twists(self, batch: Message, boats: tuple[str, ...]) -> None:
         assert isinstance(batch, TwistBatch)  # the inbox decodes each stream as its type
@@ -97,7 +101,7 @@ class PhysicsService:
             except ValueError as exc:
                 log.error("refused controller output: %s", exc)
 
-    def _publish(self, tick: Tick) -> None:
+    def _publish(self, tick: Tick, taken: tuple[str, ...]) -> None:
         """One batch of every body for the lockstep services, then each vessel's own state
         for observers (buoys only in the batch: nobody outside follows a buoy). A vessel's
         own state is encoded only while someone subscribes to it: with 100 boats and no
@@ -106,7 +110,8 @@ class PhysicsService:
         v, b = self.world.state_arrays(), self.world.buoy_state_arrays()
         cols = [np.concatenate((getattr(v, f), getattr(b, f))) for f in FIELDS]
         also = [self.guidance.key] if self.guidance and self.guidance.is_due(tick.tick) else []
-        batch = BodyStates(tick.tick, stamp, self.body_ids, *cols)
+        pos, quat, vel, rate, acc, spin = cols
+        batch = BodyStates(tick.tick, stamp, self.body_ids, pos, quat, vel, rate, acc, spin, taken)
         self.participant.publish(self.keys.world_states(), batch, also=also)
         for i in self.participant.watched_among(self.state_keys):
             row = (tuple(getattr(v, f)[i].tolist()) for f in FIELDS)

@@ -27,6 +27,7 @@ from catabot.bus.messages import (
     WaypointsCmd,
 )
 from catabot.bus.settings import changes_of
+from catabot.bus.taken import taken
 from catabot.ros2.convert import Converter
 from catabot.run.service import Built, ServiceContext, run_service
 from catabot.world.orders import Orders
@@ -58,7 +59,9 @@ class Recorder:
             else None
         )
         self.dataset = Dataset(ctx.run_dir / "dataset", world)
-        streams = [*world.streams.lockstep(), *world.streams.commands, *world.streams.waypoints]
+        streams = world.streams.lockstep()  # free commands: as physics took them (taken.py)
+        free = [*world.streams.commands, *world.streams.waypoints]
+        self.free_kinds = {self.keys.relative(s.key): s.message for s in free}
         self.batches = BatchFormatter(convert)
         self.orders = Orders()  # what physics follows, by its rule: what is written, metered
         k = self.keys
@@ -71,7 +74,7 @@ class Recorder:
         self.scripts = ScriptedCommands(world, self.orders)
         self.run_dir = ctx.run_dir
         self.start = world.start_states()
-        self.limits = world.clock_limits
+        self.limits, self.dt_ns = world.clock_limits, world.scenario.dt_ns
         self._held: deque[tuple[Tick, Inputs]] = deque()  # stepped, not yet known final
         self._flushed_at = 0.0
         self.changes_stream = self.keys.relative(self.keys.config_changes())
@@ -103,6 +106,7 @@ class Recorder:
             for msg in inputs[key]:
                 if isinstance(msg, BodyStates):
                     self._states(stream, msg)
+                    self._taken(msg, tick)
                 elif isinstance(msg, TwistBatch):
                     self._write_block(stream, msg, self._twists)
                 else:
@@ -115,6 +119,19 @@ class Recorder:
     def _states(self, stream: str, batch: BodyStates) -> None:
         if self._write_block(stream, batch, self.batches.states):
             self.metrics.add(batch)  # only batches of this run's bodies
+
+    def _taken(self, batch: BodyStates, tick: Tick) -> None:
+        """The free commands physics took at the start of the batch's tick k: written as
+        heard before tick k (k - 1, stamped k dt), the order physics follows from k on."""
+        at = dataclasses.replace(tick, tick=batch.tick, stamp_ns=batch.stamp_ns - self.dt_ns)
+        for text in batch.commands:
+            try:
+                key, msg = taken(text, self.free_kinds)
+            except ValueError as exc:
+                log.error("not recorded: %s", exc)
+                continue
+            self._write(key, _stamped(msg, at))
+            self._heard(f"{self.keys.prefix}/{key}", msg, at)
 
     def _heard(self, key: str, msg: Message, tick: Tick) -> None:
         """A command for a vessel: the order physics follows from now on, so an overridden

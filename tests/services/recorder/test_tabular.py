@@ -80,8 +80,8 @@ def test_row_matches_columns_to_twelve_digits() -> None:
 
 
 def test_message_without_stamp_or_tick_fields() -> None:
-    assert tabular.columns(Ack) == ["tick", "run", "end"]
-    assert tabular.row(Ack(run="r1", tick=4)) == ["4", "r1", ""]
+    assert tabular.columns(Ack) == ["tick", "run", "end", "fault"]
+    assert tabular.row(Ack(run="r1", tick=4)) == ["4", "r1", "", ""]
 
 
 def test_formatting_is_deterministic_for_numpy_and_specials() -> None:

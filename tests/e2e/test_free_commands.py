@@ -1,0 +1,61 @@
+"""A command from outside the lockstep (tick -1) is recorded at the tick physics took it, so
+the recording never shows a command after (or long before) the state it changed.
+
+The recorder used to stamp it at its own tick when it heard it, up to a window of ticks
+away from physics: a twist sent while a stack held tick 50 was recorded at 0.41-0.43 s in
+three runs whose states were the same bytes. Physics now names the commands it took in
+that tick's `BodyStates.commands` (catabot/bus/taken.py), and the recorder writes them
+from there.
+"""
+
+from __future__ import annotations
+
+import time
+from pathlib import Path
+
+import numpy as np
+import pytest
+from conftest import files_of
+from test_client import Run
+
+from catabot.client import Client, Observation, Twist
+
+pytestmark = pytest.mark.timeout(180)
+SCENARIO = {
+    "name": "taken", "seed": 2, "duration_s": 2.0,
+    "clock": {"external_participants": ["hold"]},
+    "vessels": [{"id": "ego"}],
+}  # fmt: skip
+
+
+def _run(tmp: Path) -> Path:
+    """`hold` steps every tick; at tick 50 it sends ego a free twist and holds the clock
+    half a second, so physics runs to the window's end and takes it there."""
+    run = Run(tmp, SCENARIO)
+    try:
+        with Client.connect([run.endpoint], timeout_s=30) as sim:
+            ego = sim.vessel("ego")
+
+            def step(obs: Observation) -> None:
+                if obs.tick == 50:
+                    ego.send(Twist(1.0, 0.0))
+                    time.sleep(0.5)
+
+            sim.run_lockstep("hold", step)
+        return run.finish()
+    finally:
+        run.kill()
+
+
+def test_a_free_command_is_recorded_at_the_tick_its_state_changes(tmp_path: Path) -> None:
+    folder = _run(tmp_path / "a")
+    twist = np.loadtxt(folder / "vessel.ego.cmd.twist.csv", delimiter=",", skiprows=1, ndmin=2)
+    assert twist.shape[0] == 1 and tuple(twist[0, 2:]) == (1.0, 0.0)
+    stamp = int(twist[0, 0])
+    states = np.loadtxt(folder / "vessel.ego.state.csv", delimiter=",", skiprows=1)
+    moving = states[np.abs(states[:, 9]) > 1e-6]  # linear_velocity_x: surge
+    assert int(moving[0, 0]) == stamp + 10_000_000  # the end of the tick it took effect
+    assert twist[0, 1] > 50  # physics ran on, within the window, while the stack held 50
+    again = _run(tmp_path / "b")
+    first, second = files_of(folder), files_of(again)
+    assert [n for n in first if first[n] != second.get(n)] == []
