@@ -83,7 +83,8 @@ class Client:
     # -- observing and commanding ----------------------------------------------------------
 
     def vessel(self, vessel_id: str) -> Vessel:
-        """A scenario vessel's handle; UnknownVessel (listing the ids) if there is none."""
+        """A scenario vessel's or a traffic boat's handle (a boat: its state and commands,
+        `Waypoints` included, no sensors); UnknownVessel (listing the ids) if there is none."""
         if vessel_id not in self._vessels:
             info, timeout = self._vessel(vessel_id), self.timeout_s
             self._vessels[vessel_id] = Vessel(
@@ -92,14 +93,13 @@ class Client:
         return self._vessels[vessel_id]
 
     def _vessel(self, vessel_id: str) -> VesselInfo:
-        info = self.info.vessels.get(vessel_id)
+        info = self.info.vessels.get(vessel_id) or self.info.boats.get(vessel_id)
         if info is None:
-            boats = " (a traffic boat: its keys take commands, but it has no sensors)"
-            extra = boats if vessel_id in self.info.traffic else ""
             known = ", ".join(self.info.vessels) or "none"
-            raise UnknownVessel(
-                f"world {self.info.name!r} has no vessel {vessel_id!r}{extra}; its vessels: {known}"
-            )
+            boats = list(self.info.boats)
+            more = f"; traffic boats: {', '.join(boats[:3])}{'...' if len(boats) > 3 else ''}"
+            raise UnknownVessel(f"world {self.info.name!r} has no vessel {vessel_id!r}; its "
+                                f"vessels: {known}{more if boats else ''}")  # fmt: skip
         return info
 
     # -- the lockstep ----------------------------------------------------------------------

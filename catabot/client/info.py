@@ -73,6 +73,7 @@ class VesselInfo:
     command_keys: dict[str, str]  # thrust, twist, waypoints -> key
     controller: ControllerInfo | None
     sensors: dict[str, SensorInfo]
+    kind: str = "vessel"  # or "boat": a traffic boat (it follows paths; no sensors)
 
     @property
     def command(self) -> str | None:
@@ -117,6 +118,7 @@ class WorldInfo:
     body_ids: tuple[str, ...]  # the rows of every BodyStates
     vessels: dict[str, VesselInfo]  # scenario vessels (not traffic boats)
     traffic: tuple[str, ...]
+    boats: dict[str, VesselInfo]  # the traffic boats, to observe and command from outside
     buoys: tuple[Buoy, ...]
     granted: int  # the last tick the clock had granted when asked (-1: not started)
     scenario: dict[str, Any] = field(repr=False)
@@ -171,6 +173,7 @@ def _parse(d: Mapping[str, Any]) -> WorldInfo:
         body_ids=tuple(str(b["id"]) for b in bodies),
         vessels={v.id: v for v in vessels},
         traffic=tuple(map(str, d["traffic"])),
+        boats={b.id: b for b in map(_vessel, d.get("boats", []))},
         buoys=tuple(
             Buoy(str(b["id"]), int(b["row"]), float(b["x_m"]), float(b["y_m"])) for b in d["buoys"]
         ),
@@ -203,6 +206,7 @@ def _vessel(v: Mapping[str, Any]) -> VesselInfo:
         command_keys={str(k): str(x) for k, x in v["commands"].items()},
         controller=controller,
         sensors={s.name: s for s in sensors},
+        kind="boat" if v.get("kind") == "boat" else "vessel",
     )
 
 

@@ -91,7 +91,7 @@ class Vessel:
             _refused(
                 checks.driven(self.id, controller.participant, controller.command, kind=kind), msg
             )
-        if isinstance(msg, WaypointsCmd):
+        if isinstance(msg, WaypointsCmd) and self.info.kind != "boat":
             _refused(checks.release_only(self.id), msg, instead=(
                 f"vessel {self.id!r} follows no path from the bus (traffic boats do): send "
                 "Thrust or Twist from your own guidance; Waypoints(mode='release') ends an "

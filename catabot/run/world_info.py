@@ -79,6 +79,7 @@ def describe(world: World, roster: Roster) -> dict[str, Any]:
         "start": _start(world),
         "vessels": [_vessel(world, names, v) for v in world.vessels if v.kind == "vessel"],
         "traffic": list(world.boat_ids),
+        "boats": [_vessel(world, names, v) for v in world.vessels if v.kind == "boat"],
         "buoys": [
             {"id": b.id, "row": b.row, "x_m": b.pose.x_m, "y_m": b.pose.y_m} for b in world.buoys
         ],
@@ -106,6 +107,7 @@ def _vessel(world: World, names: Names, v: Body) -> dict[str, Any]:
         }
     return {
         "id": v.id,
+        "kind": v.kind,
         "row": v.row,
         "model": v.model_ref,
         "thrusters": len(v.model.thrusters),

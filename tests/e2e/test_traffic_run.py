@@ -11,10 +11,8 @@ from typing import Any
 import numpy as np
 from conftest import catabot, files_of, only_run_dir, scenario_file, start, wait_for_line
 
-from catabot.bus import codec
-from catabot.bus.keys import Keys
-from catabot.bus.messages import TwistCmd, WaypointsCmd
-from catabot.bus.session import Connection, free_port, open_session
+from catabot.bus.session import free_port
+from catabot.client import Client, Twist, Waypoints
 from catabot.config.load import load_scenario
 from catabot.config.scenario import ClockConfig
 from catabot.world import rotations
@@ -66,15 +64,14 @@ def test_external_twist_takes_over_a_boat_and_release_restores_it(
     proc = start("run", str(scenario_file(tmp_path, data)), "--out", str(out), "--quiet",
                  "--listen", endpoint)  # fmt: skip
     wait_for_line(proc, "zenoh:")
-    keys = Keys("takeover")
-    with open_session(Connection(connect=(endpoint,))) as session:
+    with Client.connect([endpoint], timeout_s=30) as sim:  # a boat is a vessel to a client
+        boat = sim.vessel("boat_000")
+        assert (boat.info.kind, boat.info.sensors) == ("boat", {})
         time.sleep(6.0)  # circling by now (12 s simulated)
-        for _ in range(20):  # a free command: repeated so no join race can lose it
-            session.put(keys.cmd_twist("boat_000"), codec.encode(TwistCmd(2.0, 0.0)))
-            time.sleep(0.1)
+        assert abs(boat.state().angular_velocity[2] - CIRCLE_RATE) < 0.08  # observed
+        boat.send(Twist(2.0, 0.0))
         time.sleep(6.0)
-        release = WaypointsCmd(points=(), speed=0.0, tolerance=0.0, mode="release")
-        session.put(keys.cmd_waypoints("boat_000"), codec.encode(release))
+        boat.send(Waypoints(points=(), mode="release"))
     _, err = proc.communicate(timeout=90)
     assert proc.returncode == 0, err
     run = only_run_dir(out)

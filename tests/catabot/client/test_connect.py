@@ -101,10 +101,13 @@ def test_a_reply_for_another_worlds_key_or_not_json_is_ignored(served: Served) -
 
 def test_unknown_vessels_sensors_and_participants(served: Served) -> None:
     with Client.connect([served.endpoint], timeout_s=10) as sim:
-        with pytest.raises(UnknownVessel, match="no vessel 'nope'; its vessels: ego, other"):
+        with pytest.raises(UnknownVessel, match="no vessel 'nope'; its vessels: ego, other; "
+                           "traffic boats: boat_000"):  # fmt: skip
             sim.vessel("nope")
-        with pytest.raises(UnknownVessel, match=r"'boat_000' \(a traffic boat"):
-            sim.vessel("boat_000")
+        boat = sim.vessel("boat_000")  # a handle: its state and commands, paths included
+        assert (boat.info.kind, boat.info.sensors, boat.info.thrusters) == ("boat", {}, 2)
+        with pytest.raises(UnknownSensor, match="vessel 'boat_000' has no sensor 'cam'"):
+            boat.sensor("cam")
         with pytest.raises(UnknownSensor, match="vessel 'ego' has no sensor 'cam'"):
             sim.vessel("ego").sensor("cam")
         for name in ("nobody", "physics"):  # a service is no external participant
