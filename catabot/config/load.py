@@ -34,7 +34,10 @@ def parse_scenario(data: Any, *, source: str = "<data>") -> Scenario:
         scenario = Scenario.model_validate(data)
     except ValidationError as exc:
         raise ScenarioError(f"scenario {source}: {explain(exc, model=Scenario)}") from None
-    check_rates(scenario)
+    try:
+        check_rates(scenario)
+    except ScenarioError as exc:  # named like every other scenario error: which file
+        raise ScenarioError(f"scenario {source}: {exc}") from None
     return scenario
 
 

@@ -106,7 +106,7 @@ def test_duration_shorter_than_one_tick() -> None:
     data = _base()
     data["duration_s"] = 0.005
     msg = _error(data)
-    assert msg.startswith("duration_s:")
+    assert msg.startswith("scenario <data>: duration_s:")  # the file named, as every error
     assert "shorter than one tick" in msg
 
 
