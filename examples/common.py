@@ -9,8 +9,8 @@ from contextlib import contextmanager
 import zenoh
 
 from catabot.bus.keys import Keys
-from catabot.bus.session import add_connection_args, connection_from_args, open_session
-from catabot.client import ClientError
+from catabot.bus.session import connection_from_args, open_session
+from catabot.client import ClientError, add_stack_args
 from catabot.client.discover import find_world
 
 
@@ -18,15 +18,7 @@ def parser(description: str | None) -> argparse.ArgumentParser:
     p = argparse.ArgumentParser(
         description=description, formatter_class=argparse.RawDescriptionHelpFormatter
     )
-    add_connection_args(p)
-    p.add_argument(
-        "--world", help="scenario name (key prefix catabot/<world>; default: the one running)"
-    )
-    p.add_argument("--vessel", default="ego", help="vessel id")
-    p.add_argument(
-        "--participant", help="lockstep name (default: the vessel's controller.participant)"
-    )
-    p.add_argument("--timeout", type=float, default=30.0, help="seconds to wait for the run")
+    add_stack_args(p)  # the connection, --world, --vessel, --participant, --timeout
     return p
 
 

@@ -16,7 +16,7 @@ from catabot.bus.messages import (
     RadarSweep,
     VesselState,
 )
-from catabot.client.client import Client
+from catabot.client.client import Client, add_stack_args
 from catabot.client.commands import Command, Thrust, Twist, Waypoints
 from catabot.client.errors import (
     ClientError,
@@ -68,4 +68,5 @@ __all__ = [
     "VesselState",
     "Waypoints",
     "WorldInfo",
+    "add_stack_args",
 ]

@@ -22,7 +22,12 @@ from catabot.bus.clock import NS_PER_S, ClockError, EndRun, period_in_ticks
 from catabot.bus.keys import Keys
 from catabot.bus.messages import End
 from catabot.bus.outputs import Outputs
-from catabot.bus.session import Connection, connection_from_args, open_session
+from catabot.bus.session import (
+    Connection,
+    add_connection_args,
+    connection_from_args,
+    open_session,
+)
 from catabot.client.commands import Command
 from catabot.client.discover import find_world
 from catabot.client.errors import NotAParticipant, RunEnded, TooLate, UnknownVessel
@@ -63,8 +68,8 @@ class Client:
 
     @classmethod
     def from_args(cls, args: argparse.Namespace, *, timeout_s: float | None = None) -> Client:
-        """After `catabot.bus.session.add_connection_args(parser)`; `--world` and
-        `--timeout` are used when the parser has them."""
+        """After `add_stack_args(parser)` (or `catabot.bus.session.add_connection_args`);
+        `--world` and `--timeout` are used when the parser has them."""
         world = getattr(args, "world", None)
         timeout = timeout_s if timeout_s is not None else getattr(args, "timeout", None)
         return cls.open(connection_from_args(args), world=world, timeout_s=timeout or 5.0)
@@ -228,3 +233,16 @@ class Client:
         self, kind: type[BaseException] | None, exc: BaseException | None, tb: TracebackType | None
     ) -> None:
         self.close()
+
+
+def add_stack_args(parser: argparse.ArgumentParser) -> None:
+    """The flags of a stack: the connection's, and `--world`, `--vessel`, `--participant`,
+    `--timeout`, which `catabot run` passes a controller's `program` (README), so one script
+    runs beside a run by hand and as the run's own program alike."""
+    add_connection_args(parser)
+    parser.add_argument("--world", help="scenario name (default: the one running)")
+    parser.add_argument("--vessel", default="ego", help="vessel id (default: ego)")
+    parser.add_argument(
+        "--participant", help="lockstep name (default: the vessel's controller.participant)"
+    )
+    parser.add_argument("--timeout", type=float, default=30.0, help="seconds to wait for the run")

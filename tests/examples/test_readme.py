@@ -1,8 +1,9 @@
 """The README's client example, taken from the README itself and run against live runs:
-free-running on the default scenario, and in lockstep on examples/stack.json."""
+free-running on the default scenario, and in lockstep as examples/stack.json's program."""
 
 from __future__ import annotations
 
+import json
 import re
 import subprocess
 import sys
@@ -63,10 +64,17 @@ def test_the_readme_stack_runs_free_and_in_lockstep(
     pairs = [[float(v) for v in r.split(",")[2:]] for r in thrust[1:]]
     assert pairs and all(a + b <= 1.6 + 1e-9 for a, b in pairs)  # ahead -+ turn, ahead <= 0.8
 
-    sim = live("examples/stack.json")
-    locked = _stack(stack, "--connect", sim.endpoint, "--lockstep")
-    assert locked.returncode == 0, locked.stderr
-    assert "run ended at tick 2999: completed" in locked.stdout
-    rows = (sim.finish() / "vessel.ego.state.csv").read_text().splitlines()
+    # in lockstep as the run's own program: `catabot run` passes --world, --vessel and
+    # --participant, which a stack with only the connection flags refused
+    scenario = json.loads((REPO / "examples" / "stack.json").read_text())
+    scenario["vessels"][0]["controller"]["program"] = str(stack)
+    (tmp_path / "stack.json").write_text(json.dumps(scenario))
+    run = subprocess.run([sys.executable, "-m", "catabot", "run", str(tmp_path / "stack.json"),
+                          "--quiet", "--out", str(tmp_path / "runs")], capture_output=True,
+                         text=True, timeout=120, cwd=REPO)  # fmt: skip
+    assert run.returncode == 0, run.stdout + run.stderr
+    folder = Path(run.stdout.split("run folder: ")[-1].strip())
+    assert "run ended at tick 2999: completed" in (folder / "log" / "stack.log").read_text()
+    rows = (folder / "vessel.ego.state.csv").read_text().splitlines()
     x, y = (float(v) for v in rows[-1].split(",")[2:4])
     assert abs(x - 40) < 3 and abs(y - 20) < 3, (x, y)  # it steered to its goal
