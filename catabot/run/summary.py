@@ -122,7 +122,7 @@ def summarise(
         f"{ticks} ticks, {sim_s:.2f} s simulated in {wall:.2f} s "
         f"({ticks / max(wall, 1e-9):.0f} ticks/s, real-time factor {rtf:.1f})"
     )
-    for line in metrics_lines(run_dir):
+    for line in metrics_lines(run_dir) if ticks else []:  # no tick stepped: nothing measured
         print(line)
     for name in (n for n, c in service_codes.items() if c == 0 and n.startswith("export-")):
         print(f"  {name}: {_last_line(run_dir, name)}")  # what it wrote, as the CLI says it

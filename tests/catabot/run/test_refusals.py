@@ -117,3 +117,4 @@ def test_a_run_says_it_waits_for_a_stack_started_outside_it(tmp_path: Path) -> N
     assert "the run gives up after 4 s" in done.stdout
     assert done.returncode == 1  # under load a service may be late as well: named with it
     assert re.search(r"never joined within 4 s: (\w+, )*stack\n", done.stderr), done.stderr
+    assert "0 ticks" in done.stdout and "ego:" not in done.stdout  # no metrics of 0 ticks
