@@ -102,6 +102,7 @@ class Joined:
             self._observations.put(("error", exc))
 
     def _step(self, tick: Tick, inputs: Inputs) -> None:
+        self._watch.ticking = True  # Vessel.send need not wait for a state (vessel.py)
         for msg in inputs.get(self.info.states_key, ()):
             assert isinstance(msg, BodyStates)
             self._bodies = msg  # the state at the start of this tick (tagged tick - 1)

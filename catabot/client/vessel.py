@@ -76,7 +76,9 @@ class Vessel:
         """Send a Thrust, Twist or Waypoints now (free-running); CommandError if the vessel
         cannot take it. Before the run's first tick it waits for it (up to the client's
         timeout; NoData then): a command sent while the services were still subscribing
-        reached some of them only (the recorder wrote a thrust that physics never got)."""
+        reached some of them only (the recorder wrote a thrust that physics never got). Not
+        from a lockstep step of this client: the run is going, and a state to wait for may
+        never come while the step holds the clock."""
         kind = kind_of(command)
         controller = self.info.controller
         if controller is not None and controller.command == kind:
@@ -96,7 +98,8 @@ class Vessel:
                 f"vessel {self.id!r} follows no path from the bus (traffic boats do): send "
                 "Thrust or Twist from your own guidance; Waypoints(mode='release') ends an "
                 "outside order"))  # fmt: skip
-        self.state(self._ready_timeout_s)  # the run is going: every service hears it
+        if not self._watch.ticking:  # a stack of ours steps: the run is going already
+            self.state(self._ready_timeout_s)  # the run is going: every service hears it
         self._outputs.publish(self.info.command_keys[kind], msg)
 
 

@@ -44,6 +44,7 @@ class Watch:
         self.changed = threading.Condition()  # notified on every sample, end and leave
         self.end: End | None = None
         self.gone_at = 0.0  # when the conductor's token vanished (0: it has not)
+        self.ticking = False  # a stack of this client has stepped a tick: the run is going
         self._subs = [
             session.declare_subscriber(keys.end(), self._on_end),
             session.liveliness().declare_subscriber(keys.lives(), self._on_live, history=True),

@@ -37,8 +37,8 @@ def _run(tmp: Path) -> Path:
             ego = sim.vessel("ego")
 
             def step(obs: Observation) -> None:
-                if obs.tick == 50:
-                    ego.send(Twist(1.0, 0.0))
+                if obs.tick == 50:  # send does not wait for a state here: physics, held at
+                    ego.send(Twist(1.0, 0.0))  # the window's end by this step, sends none
                     time.sleep(0.5)
 
             sim.run_lockstep("hold", step)
