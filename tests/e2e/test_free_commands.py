@@ -5,7 +5,8 @@ The recorder used to stamp it at its own tick when it heard it, up to a window o
 away from physics: a twist sent while a stack held tick 50 was recorded at 0.41-0.43 s in
 three runs whose states were the same bytes. Physics now names the commands it took in
 that tick's `BodyStates.commands` (catabot/bus/taken.py), and the recorder writes them
-from there.
+from there. Which tick that is depends on the wall clock (how far physics ran ahead within
+the window when the command came), so two runs need not agree: only a lockstep command does.
 """
 
 from __future__ import annotations
@@ -15,7 +16,6 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from conftest import files_of
 from test_client import Run
 
 from catabot.client import Client, Observation, Twist
@@ -56,6 +56,3 @@ def test_a_free_command_is_recorded_at_the_tick_its_state_changes(tmp_path: Path
     moving = states[np.abs(states[:, 9]) > 1e-6]  # linear_velocity_x: surge
     assert int(moving[0, 0]) == stamp + 10_000_000  # the end of the tick it took effect
     assert twist[0, 1] > 50  # physics ran on, within the window, while the stack held 50
-    again = _run(tmp_path / "b")
-    first, second = files_of(folder), files_of(again)
-    assert [n for n in first if first[n] != second.get(n)] == []

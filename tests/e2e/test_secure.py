@@ -42,7 +42,7 @@ def profile(tmp_path_factory: pytest.TempPathFactory) -> Iterator[tuple[Path, st
 
 def _scenario(tmp: Path) -> Path:
     imu = {"name": "imu", "type": "imu", "rate_hz": 50.0}
-    data = {"name": "secure", "seed": 2, "duration_s": 4.0, "clock": {"realtime_factor": 2.0},
+    data = {"name": "secure", "seed": 2, "duration_s": 6.0, "clock": {"realtime_factor": 2.0},
             "vessels": [{"id": "ego", "script": [{"t_s": 0.5, "thrust": [0.5, 0.7]}],
                          "sensors": [imu]}]}  # fmt: skip
     return scenario_file(tmp, data)
@@ -131,6 +131,7 @@ def test_a_commanding_client_commands(tmp_path: Path, profile: tuple[Path, str])
     files = _run(tmp_path, folder, "autopilot", "autopilot")
     rows = files["vessel.ego.cmd.thrust.csv"].decode().splitlines()
     assert any(row.endswith(",1.0,-1.0") for row in rows[1:])  # beside the scripted ones
+    # (recorded as physics took it, so sent before the run's last tick: 6 s at 2x gives room)
     assert files["config.changes.csv"].decode().splitlines()[1].endswith(",rain,50.0")
 
 
