@@ -105,8 +105,8 @@ class Recorder:
             stream = self.keys.relative(key)
             for msg in inputs[key]:
                 if isinstance(msg, BodyStates):
+                    self._taken(msg, tick)  # first: the order in force over this batch's tick
                     self._states(stream, msg)
-                    self._taken(msg, tick)
                 elif isinstance(msg, TwistBatch):
                     self._write_block(stream, msg, self._twists)
                 else:

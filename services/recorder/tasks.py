@@ -105,8 +105,7 @@ class Thrust:
     its integral. Commands change rarely: the force is re-derived only when the order in
     force changes (`orders`, physics' rule) or a script step begins, and the integral is
     added up then, so a tick costs a counter. A command from the bus counts from the tick
-    the recorder receives it (physics applies it from the next: the impulse is exact to
-    within a tick per command)."""
+    physics took it (`BodyStates.commands`, told before that tick's batch is added)."""
 
     def __init__(self, bodies: Sequence[Body], dt_ns: int, orders: Orders) -> None:
         self.dt_s = dt_ns / NS_PER_S
