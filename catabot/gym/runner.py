@@ -21,6 +21,8 @@ from catabot.gym.process import RunError, SimProcess
 from catabot.world.world import World
 
 JOIN_POLL_S = 0.5
+PORT_TRIES = 3
+PORT_TAKEN = "Address already in use"  # the run could not bind the port picked for it
 
 
 @dataclass
@@ -52,10 +54,21 @@ class Runner:
         else:
             self._retire(early)
             early = None
-        live = early or self._join(self._launch(seed))
+        live = early or self._fresh(seed)
         if upcoming is not None:
             self.next = self._launch(upcoming)
         return live
+
+    def _fresh(self, seed: int) -> Live:
+        """A new run of `seed`, joined. A port another process took between the pick and the
+        run's bind (a parallel env or test: "Address already in use") is tried again."""
+        for attempt in range(PORT_TRIES):
+            try:
+                return self._join(self._launch(seed))
+            except RunError as exc:
+                if PORT_TAKEN not in str(exc) or attempt == PORT_TRIES - 1:
+                    raise
+        raise AssertionError("unreachable")
 
     def _join(self, live: Live) -> Live:
         """Take the controller's seat in `live` and its tick-0 frame; RunError if the run

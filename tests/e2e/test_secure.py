@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import json
 import shutil
+import threading
 import time
 from collections.abc import Iterator
 from pathlib import Path
@@ -55,9 +56,8 @@ def _run(tmp: Path, folder: Path, tag: str, client: str = "") -> dict[str, bytes
     if client:
         conn = Connection(mode="client", file=str(folder / f"{client}.json5"))
         with open_session(conn) as session:
-            started = time.monotonic()
             replies = _set_rain(session, patient=client == "autopilot")
-            time.sleep(max(2.0 - (time.monotonic() - started), 0.0))  # the run is going by now
+            _going(session)  # physics steps: a command lands inside the run, not before it
             for k in range(20):
                 run = "0" * 12
                 session.put(KEYS.tick(), codec.encode(Tick(run, k, k * 10**7, 10**7, (), 20)))
@@ -70,6 +70,15 @@ def _run(tmp: Path, folder: Path, tag: str, client: str = "") -> dict[str, bytes
     if client:  # only a commanding client may change a setting (`catabot set`)
         assert [r.ok is not None for r in replies] == ([True] if client == "autopilot" else [])
     return files_of(only_run_dir(out))
+
+
+def _going(session: Any, timeout_s: float = 20.0) -> None:
+    """Until the run's states come (or `timeout_s`): a thrust put before physics listened, or
+    after its last tick, is rightly not recorded (the recorder writes what physics took)."""
+    going = threading.Event()
+    sub = session.declare_subscriber(KEYS.world_states(), lambda _sample: going.set())
+    going.wait(timeout_s)
+    sub.undeclare()
 
 
 def _set_rain(session: Any, *, patient: bool) -> list[Any]:

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import json
 import os
+import socket
 import subprocess
 import sys
 import textwrap
@@ -15,6 +16,7 @@ import psutil
 import pytest
 
 import catabot.gym  # noqa: F401 - registers the envs
+from catabot.gym import process
 
 pytestmark = pytest.mark.timeout(180)
 
@@ -89,3 +91,23 @@ def test_an_episode_ends_its_run_at_the_terminal_step_with_the_same_bytes(tmp_pa
     names = sorted(p.name for p in first.glob("*.csv"))
     assert names == sorted(p.name for p in second.glob("*.csv")) and names
     assert [n for n in names if (first / n).read_bytes() != (second / n).read_bytes()] == []
+
+
+def test_a_port_taken_before_the_run_binds_it_is_tried_again(
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    """Another process took the port picked for the episode's run before the run bound it:
+    reset failed ("Address already in use", a CI rehearsal); the runner starts it again."""
+    with socket.socket() as taken:
+        taken.bind(("127.0.0.1", 0))
+        taken.listen()
+        ports = iter([taken.getsockname()[1]])
+        real = process.free_port
+        monkeypatch.setattr(process, "free_port", lambda: next(ports, 0) or real())
+        env = gym.make("CataBot/Navigate-v0", max_steps=2)
+        try:
+            env.reset(seed=1)
+            env.step(np.zeros(2, np.float32))
+        finally:
+            env.close()
+    assert next(ports, None) is None  # the taken one was tried first
