@@ -230,7 +230,7 @@ class Conductor:
             self.rejections.add(key, exc)
             return
         self._acked[name] = max(self._acked[name], min(ack.tick, self._granted))
-        if ack.fault:  # its own words, before its token goes: the cause on every host
+        if ack.fault and name not in self.dropped:  # its own words, before its token goes
             self._fault(name, f"stopped at tick {ack.tick + 1}: {ack.fault}")
         elif ack.end:
             self._end_request(name, ack)
