@@ -100,8 +100,9 @@ def waypoints(msg: WaypointsCmd) -> None:
         raise ValueError(f"{len(pts) // 2} waypoints: at most {MAX_WAYPOINTS} in one path")
     if max(abs(v) for v in pts) > MAX_COORDINATE_M:
         raise ValueError(f"points: each coordinate within ±{MAX_COORDINATE_M:g} m of the origin")
-    if not (finite((msg.speed, msg.tolerance)) and msg.speed > 0 and msg.tolerance > 0):
-        raise ValueError(f"speed {msg.speed} and tolerance {msg.tolerance} must be > 0")
+    for name, value in (("speed", msg.speed), ("tolerance", msg.tolerance)):
+        if not (finite(value) and value > 0):  # the one that is wrong, named alone
+            raise ValueError(f"{name} {value} must be a finite number > 0")
     if msg.speed > MAX_SPEED_MPS or msg.tolerance > MAX_TOLERANCE_M:
         raise ValueError(
             f"speed {msg.speed} m/s and tolerance {msg.tolerance} m: at most "

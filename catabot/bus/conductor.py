@@ -63,6 +63,7 @@ class Conductor:
         self.dropped: list[str] = []
         self._stop_reason = ""
         self._end_at: int | None = None  # the last tick, when a participant ended the run
+        self._told = ""  # the fault a participant told (Ack.fault): the run's error
         self._done = 0  # ticks every active participant has acked
         self._granted = -1  # the last tick granted
         self._acked = {name: -1 for name in spec.participants}
@@ -116,6 +117,7 @@ class Conductor:
             error = ""
         except ClockError as exc:
             error = str(exc)
+        error = self._told or error  # the cause, though another fault followed it
         done = self._done  # complete ticks, also when a fault or a stop cut the run short
         reason = self._stop_reason or ("completed" if not error else "fault")
         self._out.publish(self.keys.end(), End(self.run_id, done - 1, reason, error))
@@ -124,25 +126,22 @@ class Conductor:
 
     def _await_members(self) -> None:
         expected = set(self.spec.participants)
-        limit = time.monotonic() + self.spec.start_timeout_s
+        limit_s = self.spec.start_timeout_s
+        limit = time.monotonic() + limit_s
         note = time.monotonic() + WAITING_NOTE_S
         while not expected <= self.members:
             if self._stop_reason:
                 return
             if self._next_event(min(limit, note))[0] == "late":
                 if time.monotonic() >= limit:
-                    raise ClockError(self._start_timeout(expected))
+                    raise ClockError(never_joined(sorted(expected - self.members), limit_s))
                 note = time.monotonic() + WAITING_NOTE_S
                 self._waiting_note(expected, limit)
 
     def _waiting_note(self, expected: set[str], limit: float) -> None:
-        """Who the run still waits for: a conductor started by hand (one service per
-        machine) said nothing until the start timeout named them."""
+        """Who the run still waits for (a conductor started by hand said nothing until then)."""
         missing = ", ".join(sorted(expected - self.members))
         log.info("waiting for %s to join (%.0f s left)", missing, limit - time.monotonic())
-
-    def _start_timeout(self, expected: set[str]) -> str:
-        return never_joined(sorted(expected - self.members), self.spec.start_timeout_s)
 
     def _tick_loop(self, on_progress: Callable[[Progress], None] | None, start: float) -> None:
         """Grant ticks while the window and the pace allow, take acks, report progress.
@@ -230,20 +229,23 @@ class Conductor:
             self.rejections.add(key, exc)
             return
         self._acked[name] = max(self._acked[name], min(ack.tick, self._granted))
-        if ack.fault and name not in self.dropped:  # its own words, before its token goes
-            self._fault(name, f"stopped at tick {ack.tick + 1}: {ack.fault}")
-        elif ack.end:
-            self._end_request(name, ack)
+        told = f"stopped at tick {ack.tick + 1}: {ack.fault}" if ack.fault else ""
+        if told and self.spec.policy is not Policy.ABORT:  # its words, before it leaves
+            if name not in self.dropped:
+                self._fault(name, told)
+        elif told or ack.end:
+            self._end_request(name, ack, fault=f"participant {name!r} {told}" if told else "")
         self._advance()
 
-    def _end_request(self, name: str, ack: Ack) -> None:
-        """A participant ends the run after `ack.tick`: no more grants, a repeated one (ack as
-        you go from now on), the End once all have stepped that tick. The first end wins."""
+    def _end_request(self, name: str, ack: Ack, *, fault: str = "") -> None:
+        """A participant ends the run after `ack.tick` (first wins): no more grants, a repeated
+        one (ack as you go), the End once all stepped it; a told `fault` alike, but failed."""
         if self._stop_reason:
             return
         self._end_at = max(min(ack.tick, self._granted), self._done - 1)
-        self._stop_reason = ended_by(name, self._end_at, ack.end)
-        log.info("run %s", self._stop_reason)
+        self._stop_reason = "fault" if fault else ended_by(name, self._end_at, ack.end)
+        self._told = fault
+        log.info("run %s", fault or self._stop_reason)
         self._grant(self._granted, again=True)
 
     def _checked_ack(self, key: str, sample: zenoh.Sample) -> tuple[str, Ack]:

@@ -218,10 +218,11 @@ class Client:
 
     # -- the session -----------------------------------------------------------------------
 
-    def close(self) -> None:
+    def close(self, *, fault: str = "") -> None:
+        """Leave the run; `fault` (a stack that failed) is told for every seat it held."""
         try:
             for joined in self._joined:
-                joined.close()
+                joined.close(fault=fault)
             self.watch.close()
         finally:
             self.session.close()
@@ -232,7 +233,10 @@ class Client:
     def __exit__(
         self, kind: type[BaseException] | None, exc: BaseException | None, tb: TracebackType | None
     ) -> None:
-        self.close()
+        """An exception of the stack's own (not the run's end, not Ctrl-C) is the run's
+        cause in its words, as `run_lockstep` tells it."""
+        told = exc is not None and not isinstance(exc, RunEnded | KeyboardInterrupt | SystemExit)
+        self.close(fault=f"{type(exc).__name__}: {exc}" if told else "")
 
 
 def add_stack_args(parser: argparse.ArgumentParser) -> None:

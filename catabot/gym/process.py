@@ -56,7 +56,10 @@ class SimProcess:
     def failure(self) -> str:
         """Why the run stopped, from its console (the launcher's summary names the cause)."""
         code = self.proc.poll()
-        tail = self.log.read_text(errors="replace").strip().splitlines()[-8:]
+        try:
+            tail = self.log.read_text(errors="replace").strip().splitlines()[-8:]
+        except OSError:  # its folder removed already
+            tail = ["(its log is gone)"]
         status = "still running" if code is None else f"exit code {code}"
         return f"catabot run ({status}, log {self.log}): " + " | ".join(tail)
 

@@ -81,10 +81,9 @@ class Runner:
             )  # fmt: skip
             self._first(live)
         except LinkError as exc:
+            why = live.run.failure()  # before `end`, which removes the run's folder
             self.end()
-            raise RunError(
-                f"the episode's run did not start ({exc}): {live.run.failure()}"
-            ) from None
+            raise RunError(f"the episode's run did not start ({exc}): {why}") from None
         return live
 
     def _launch(self, seed: int) -> Live:

@@ -148,6 +148,25 @@ def test_a_stack_that_raises_is_the_runs_cause_in_its_own_words(tmp_path: Path) 
         cause = "participant 'stack' stopped at tick 50: ZeroDivisionError: division by zero"
         assert run.proc.returncode != 0 and cause in err, out + err
         run_dir = Path(out.split("run folder: ")[-1].strip())
-        assert json.loads((run_dir / "log" / "run.json").read_text())["error"] == cause
+        record = json.loads((run_dir / "log" / "run.json").read_text())
+        assert (record["error"], record["ticks"]) == (cause, 50)  # every tick it stepped
+        state = (run_dir / "vessel.ego.state.csv").read_text().splitlines()
+        assert state[-1].split(",")[1] == "49"  # it had 40: the fault's ack did not count
+    finally:
+        run.kill()
+
+
+def test_a_pull_style_stack_that_raises_is_the_cause_too(tmp_path: Path) -> None:
+    """join/observe/act inside `with Client.connect(...)`: the exception leaving the block
+    is told (it said only "participant 'stack' left the run at tick 40")."""
+    run = Run(tmp_path, SCENARIO)
+    try:
+        with pytest.raises(KeyError), Client.connect([run.endpoint], timeout_s=30) as sim:
+            stack = sim.join("stack")
+            while stack.observe().tick < 50:
+                stack.act(Thrust([0.5, 0.6]))
+            raise KeyError("waypoint 7")
+        out, err = run.proc.communicate(timeout=60)
+        assert "participant 'stack' stopped at tick 50: KeyError: 'waypoint 7'" in err, out + err
     finally:
         run.kill()

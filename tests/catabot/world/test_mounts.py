@@ -28,6 +28,9 @@ def _world(model: str, sensor: dict[str, Any]) -> World:
     [
         ("catabot", (0.0, 0.0, 0.35), True),  # in its electronics box
         ("catabot", (0.0, 0.5, 0.1), True),  # in a hull
+        ("catabot", (0.0, 0.4, 0.1), True),  # on a hull's centreline: a ray along x met the
+        ("wamv", (0.0, 1.03, 0.124), True),  # bow's apex edge twice and said "outside"
+        ("monohull", (-0.301, 0.0, 0.295), True),
         ("catabot", (0.0, 0.0, 0.1), False),  # between the hulls, under the deck box
         ("catabot", (0.5, 0.0, 1.5), False),  # the camera's default, above it all
         ("monohull", (0.0, 0.0, 1.0), True),  # in the cabin
