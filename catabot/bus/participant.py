@@ -81,7 +81,7 @@ class Participant(Outputs):
         self.events: queue.SimpleQueue[Event] = queue.SimpleQueue()
         self.run_id = ""
         self._orphaned_at = 0.0
-        self._warned_tick = -1
+        self._warned_tick, self._met = -1, False  # _met: every peer seen present once
         self._notes = 0  # "no tick yet" lines logged
         self._subs = [
             session.declare_subscriber(keys.tick(), self._push("tick")),
@@ -172,8 +172,7 @@ class Participant(Outputs):
         self._acked = k - 1
 
     def report_fault(self, why: str) -> None:
-        """Tell the conductor why this participant stops (a fault of its own: a crash, another
-        scenario), so the run's cause names it on every host, not only in this one's log."""
+        """Tell the conductor why this participant stops (its own fault): every host's cause."""
         if self.run_id and not self._ended:
             self._ended = True
             ack = Ack(self.run_id, self.next_tick - 1, fault=end_reason(why))
@@ -302,9 +301,11 @@ class Participant(Outputs):
         return end
 
     def _ready(self, tick: int) -> bool:
-        """Peers seen (so they know our subscriptions) and every due input arrived."""
+        """Every due input in, and each peer seen once (it knows our subscriptions); one gone
+        later is the conductor's to judge (a told fault: the others still step its ticks)."""
         missing = self.inbox.missing(tick)
-        if not missing and self.peers <= self.present:
+        self._met = self._met or self.peers <= self.present
+        if not missing and self._met:
             return True
         if time.monotonic() - self._waiting_since > 5.0 and self._warned_tick != tick:
             self._warned_tick = tick
