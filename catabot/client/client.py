@@ -198,7 +198,7 @@ class Client:
                 except EndRun as request:
                     return joined.end_run(str(request))
                 except Exception as exc:  # the stack's bug: the run's cause, in its words
-                    joined.close(fault=f"{type(exc).__name__}: {exc}")
+                    joined.close(fault=_told(exc))
                     raise
                 joined.act(command)
         finally:
@@ -236,7 +236,7 @@ class Client:
         """An exception of the stack's own (not the run's end, not Ctrl-C) is the run's
         cause in its words, as `run_lockstep` tells it."""
         told = exc is not None and not isinstance(exc, RunEnded | KeyboardInterrupt | SystemExit)
-        self.close(fault=f"{type(exc).__name__}: {exc}" if told else "")
+        self.close(fault=_told(exc) if told and exc is not None else "")
 
 
 def add_stack_args(parser: argparse.ArgumentParser) -> None:
@@ -250,3 +250,8 @@ def add_stack_args(parser: argparse.ArgumentParser) -> None:
         "--participant", help="lockstep name (default: the vessel's controller.participant)"
     )
     parser.add_argument("--timeout", type=float, default=30.0, help="seconds to wait for the run")
+
+
+def _told(exc: BaseException) -> str:
+    """A stack's exception as the fault the run's error quotes."""
+    return f"{type(exc).__name__}: {exc}"

@@ -156,22 +156,27 @@ class Planner:
                 continue
             for k, (x, y) in enumerate(b.path):  # a point several paths share (given
                 if laid.clear_of(np.array([(x, y)]), self.buoy_r):  # points): one buoy
-                    self._not_under_a_boat(boats, b.id, (x, y))
                     buoys.append(BuoyConfig(id=f"{b.id}_wp{k}", x_m=x, y_m=y))
                     laid.add(x, y, self.buoy_r)
+        self._none_under_a_boat(boats, buoys)
         return TrafficPlan(boats, tuple(buoys))
 
-    def _not_under_a_boat(self, boats: tuple[Boat, ...], owner: str, point: Point) -> None:
+    def _none_under_a_boat(self, boats: tuple[Boat, ...], buoys: list[BuoyConfig]) -> None:
         """A given waypoint where a boat starts (its own first point, often) laid its buoy
         under that boat: a collision from tick 0 in every run."""
-        for other in boats:
-            gap = math.hypot(point[0] - other.pose.x_m, point[1] - other.pose.y_m)
-            if gap < self.footprints[other.model] + self.buoy_r:
-                raise ScenarioError(
-                    f"traffic: {owner}'s waypoint ({point[0]:g}, {point[1]:g}) is {gap:.2f} m "
-                    f"from where {other.id} starts: its buoy would start under that boat; move "
-                    "the point or the start, or traffic.waypoints.buoys: false"
-                )
+        starts = np.array([(b.pose.x_m, b.pose.y_m) for b in boats]).reshape(-1, 2)
+        reach = np.array([self.footprints[b.model] for b in boats]) + self.buoy_r
+        marks = np.array([(m.x_m, m.y_m) for m in buoys]).reshape(-1, 2)
+        gaps = np.hypot(*(marks[:, None] - starts[None]).transpose(2, 0, 1))  # (buoys, boats)
+        under = np.argwhere(gaps < reach)
+        if under.size:
+            (i, j), mark = under[0], buoys[int(under[0][0])]
+            raise ScenarioError(
+                f"traffic: {mark.id.rsplit('_wp', 1)[0]}'s waypoint ({mark.x_m:g}, {mark.y_m:g}) "
+                f"is {gaps[i, j]:.2f} m from where {boats[int(j)].id} starts: its buoy would "
+                "start under that boat; move the point or the start, or "
+                "traffic.waypoints.buoys: false"
+            )
 
     def _planned(self, index: int) -> Boat:
         self._path_draws = 0
