@@ -26,6 +26,7 @@ from typing import IO
 
 from catabot.bus.participant import WAITED
 from catabot.bus.rejections import report_of
+from catabot.run.advice import advice_of
 
 HANG_S = 3.0  # the conductor's heartbeat is every 0.5 s
 START_S = 60.0  # until its first line (Python's imports on a loaded machine take seconds)
@@ -66,7 +67,8 @@ class Child:
         self.fatal_at = 0.0
         self.last_line = ""  # a program's last line, for its fatal fault
         self.waited = ""  # whose data it waited for when the run failed (Participant._waited)
-        self.refused: list[str] = []  # console lines: the first refusal of each kind
+        self.notes: list[str] = []  # console lines: the first refusal of each kind, advice
+        self._advised = 0
         self._refusals: set[tuple[str, str, str]] = set()
         self._relay = threading.Thread(target=self._copy_stderr, daemon=True)
         self._relay.start()
@@ -82,6 +84,7 @@ class Child:
             if f" {WAITED} " in line and not self.waited:
                 self.waited = line.split(" ERROR ", 1)[-1].strip()
             self._note_refusal(line)
+            self._note_advice(line)
             log = _write(log, line, self)
 
     def _note_refusal(self, line: str) -> None:
@@ -94,13 +97,20 @@ class Child:
         key, reason, detail = (_printable(part) for part in report)
         self._refusals.add(report)
         if len(self._refusals) > MAX_ECHOED:
-            self.refused.append(f"{self.name} refused more kinds of samples: see {self.log_path}")
+            self.notes.append(f"{self.name} refused more kinds of samples: see {self.log_path}")
             return
         hint = " (messages: docs/MESSAGES.md)" if reason in HINTED else ""
         said = f"{reason}: {detail}" if detail else reason
         counts = self.log_path.with_name(f"{self.name}.rejected.json")
-        self.refused.append(f"{self.name} refused {key}: {said}{hint}; first of its kind, all "
+        self.notes.append(f"{self.name} refused {key}: {said}{hint}; first of its kind, all "
                             f"counted in {counts}")  # fmt: skip
+
+    def _note_advice(self, line: str) -> None:
+        """A service's advice (catabot/run/advice.py), at most `MAX_ECHOED` a process."""
+        text = advice_of(line)
+        if text is not None and self._advised < MAX_ECHOED:
+            self._advised += 1
+            self.notes.append(f"{self.name}: {_printable(text)}")
 
     def waited_line(self) -> str:
         """Whose data it waited for at the fault (`Participant._waited`), once an exited
@@ -239,9 +249,9 @@ class Supervisor:
     def _echo(self, on_note: Callable[[str], None]) -> None:
         for child in (self.conductor, *self.services.values()):
             done = self._echoed.get(child.name, 0)
-            for line in child.refused[done:]:
+            for line in child.notes[done:]:
                 on_note(line)
-            self._echoed[child.name] = done + len(child.refused[done:])
+            self._echoed[child.name] = done + len(child.notes[done:])
 
     def _silent(self) -> float:
         """How long the conductor has been silent, once that means it hangs (else 0)."""

@@ -49,7 +49,7 @@ class TwistController:
         """Normalised commands in [-1, 1] for (surge m/s, yaw rate rad/s) targets."""
         goal, now = np.asarray(target, dtype=np.float64), np.asarray(measured, dtype=np.float64)
         error = goal - now
-        feed = self.damp[:, 0] * goal + self.damp[:, 1] * goal * np.abs(goal)
+        feed = self.feed_forward(goal)
         trial = np.clip(self.integral + error * self.dt_s, -5.0, 5.0)
         wrench = feed + self.inertia * (self.kp * error + self.ki * trial)
         forces, saturated = self.allocate(wrench)
@@ -57,6 +57,11 @@ class TwistController:
             self.integral = trial
         limit = np.where(forces >= 0, self.fwd, self.rev)
         return np.clip(forces / np.maximum(limit, 1e-9), -1.0, 1.0)
+
+    def feed_forward(self, goal: Array) -> Array:
+        """The [surge force, yaw moment] that holds (surge, yaw rate) `goal` in steady state."""
+        out: Array = self.damp[:, 0] * goal + self.damp[:, 1] * goal * np.abs(goal)
+        return out
 
     def allocate(self, wrench: Array) -> tuple[Array, bool]:
         """Thruster forces (N) for a [surge force, yaw moment] wrench, yaw first; and whether

@@ -22,6 +22,7 @@ from catabot.run.service import Built, ServiceContext, run_service
 from services.physics import settings
 from services.physics.commands import CommandBook
 from services.physics.control import TwistControllerBank
+from services.physics.reach import Reach
 from services.physics.setup import build_world
 
 log = logging.getLogger("physics")
@@ -45,6 +46,7 @@ class PhysicsService:
             [v.model for v in world.vessels], dt_s=self.dt_ns / 1e9
         )
         self.book = CommandBook(world.vessels)
+        self.reach = Reach(world.vessels, dt_s=self.dt_ns / 1e9)  # says a twist is too much
         streams = world.streams
         self.streams = [*streams.commands, *streams.controls, *streams.waypoints]
         self.vessel_of = {s.key: ctx.keys.vessel_of(s.key) for s in self.streams}
@@ -76,6 +78,7 @@ class PhysicsService:
                 self._take_twists(msgs[-1], self.blocks[key])
                 continue
             self.book.take(self.vessel_of[key], msgs)
+            self.reach.heard(self.vessel_of[key], msgs)
             rel = self.keys.relative(key)
             taken += [entry(rel, m) for m in msgs if getattr(m, "tick", 0) == -1]
         self._apply_orders(tick.stamp_ns)

@@ -1,0 +1,26 @@
+"""`catabot run` tells on its console (stderr, with refusals) what a service advises: a
+twist beyond reach."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+from conftest import catabot, only_run_dir, scenario_file
+
+
+def test_a_scripted_twist_beyond_reach_is_told_on_the_console(tmp_path: Path) -> None:
+    def twist(surge: float) -> list[dict[str, object]]:
+        return [{"t_s": 0.0, "twist": {"surge_mps": surge, "yaw_rate_radps": 0.0}}]
+
+    data = {"name": "advice", "duration_s": 0.5, "vessels": [
+        {"id": "fast", "script": twist(3.0)},
+        {"id": "slow", "pose": {"x_m": 10.0, "y_m": 0.0}, "script": twist(1.0)},
+    ]}  # fmt: skip
+    out = tmp_path / "runs"
+    result = catabot("run", str(scenario_file(tmp_path, data)), "--out", str(out), "--quiet")
+    assert result.returncode == 0, result.stderr
+    told = [line for line in result.stderr.splitlines() if "beyond its thrusters" in line]
+    assert len(told) == 1, result.stderr  # the console notes, as refusals
+    assert told[0].startswith("physics: fast: the scripted twist 3 m/s at 0 rad/s is beyond")
+    assert "about 1.88 m/s straight ahead" in told[0]
+    assert told[0].split("physics: ", 1)[1] in (only_run_dir(out) / "log/physics.log").read_text()

@@ -1,0 +1,69 @@
+"""A twist set-point beyond a vessel's thrusters is told once, with how far they reach."""
+
+from __future__ import annotations
+
+import logging
+import math
+from types import SimpleNamespace
+
+import pytest
+
+from catabot.bus.messages import ThrustCmd, TwistCmd
+from catabot.config.scenario import ScriptStep
+from catabot.config.vessel import load_vessel_model
+from catabot.run.advice import advice_of
+from services.physics.reach import Reach
+
+
+def _reach(*vessels: tuple[str, str, tuple[ScriptStep, ...]]) -> Reach:
+    bodies = [SimpleNamespace(id=v, model=load_vessel_model(m), script=s) for v, m, s in vessels]
+    return Reach(bodies, dt_s=0.01)  # type: ignore[arg-type]
+
+
+def _advice(caplog: pytest.LogCaptureFixture) -> list[str]:
+    lines = [f"t physics.reach {r.levelname} {r.getMessage()}" for r in caplog.records]
+    return [text for text in map(advice_of, lines) if text is not None]
+
+
+def test_the_top_speed_told_is_the_damping_law_at_full_thrust(
+    caplog: pytest.LogCaptureFixture,
+) -> None:
+    model = load_vessel_model("wamv")
+    thrust = sum(t.max_forward_n for t in model.thrusters)
+    lin, quad = model.damping.linear[0], model.damping.quadratic[0]
+    top = (-lin + math.sqrt(lin * lin + 4 * quad * thrust)) / (2 * quad)  # lin u + quad u^2 = T
+    reach = _reach(("ego", "wamv", ()))
+    assert not reach.beyond("ego", top - 1e-3, 0.0) and reach.beyond("ego", top + 1e-3, 0.0)
+    with caplog.at_level(logging.WARNING):
+        reach.heard("ego", [TwistCmd(surge=2.0, yaw_rate=0.0)])
+    (said,) = _advice(caplog)
+    assert said.startswith("ego: the commanded twist 2 m/s at 0 rad/s is beyond its thrusters")
+    assert f"about {top:.2f} m/s straight ahead" in said  # 1.52 m/s, the model file says
+
+
+def test_told_once_a_vessel_and_never_for_a_set_point_in_reach(
+    caplog: pytest.LogCaptureFixture,
+) -> None:
+    reach = _reach(("a", "catabot", ()), ("b", "catabot", ()))
+    with caplog.at_level(logging.WARNING):
+        reach.heard("a", [TwistCmd(surge=1.5, yaw_rate=0.0), ThrustCmd(thrust=(1.0, 1.0))])
+        assert _advice(caplog) == []  # 1.5 m/s of its 1.88 straight ahead
+        reach.heard("a", [TwistCmd(surge=1.0, yaw_rate=0.3)])  # the README's turn
+        reach.heard("a", [TwistCmd(surge=3.0, yaw_rate=0.0)])
+        reach.heard("b", [TwistCmd(surge=0.0, yaw_rate=-2.0)])
+    said = _advice(caplog)
+    assert [s.split(":")[0] for s in said] == ["a", "b"]
+    assert "0.27 rad/s turning in place" in said[0]
+
+
+def test_a_scripted_twist_beyond_reach_is_told_at_the_start(
+    caplog: pytest.LogCaptureFixture,
+) -> None:
+    steps = (
+        ScriptStep(t_s=0.0, twist={"surge_mps": 1.0, "yaw_rate_radps": 0.0}),
+        ScriptStep(t_s=5.0, twist={"surge_mps": 4.0, "yaw_rate_radps": 0.1}),
+    )
+    with caplog.at_level(logging.WARNING):
+        _reach(("ego", "catabot", steps))
+    (said,) = _advice(caplog)
+    assert said.startswith("ego: the scripted twist 4 m/s at 0.1 rad/s is beyond")
