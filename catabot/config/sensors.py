@@ -155,6 +155,20 @@ class CameraParams(SensorParams):
         )
 
 
+PAPER_REFLECTIVITY = 0.9  # the paper's s, every surface alike
+
+
+class SurfaceReflectivity(Strict):
+    """Each labelled surface's diffuse reflectance s at a LiDAR's 905 nm (rho = s / pi), for
+    `reflection: "lambertian"`. Calm water sends the beam on, away from the sensor (specular),
+    and returns little; painted hulls and buoys much; soil and rock between. Estimates."""
+
+    water: float = Field(0.02, gt=0, le=1)
+    terrain: float = Field(0.3, gt=0, le=1)
+    vessel: float = Field(0.6, gt=0, le=1)
+    buoy: float = Field(0.8, gt=0, le=1)
+
+
 class LidarParams(SensorParams):
     """A spinning LiDAR (paper III-B.2.a: OS1-like, 32 x 512, 45 deg vertical, 360 deg, 100 m)
     and the constants of its rain model (services/sensors/rain.py; paper defaults, Q at 905 nm).
@@ -179,9 +193,17 @@ class LidarParams(SensorParams):
     drop_diameter_mm: float = Field(3.25, gt=0, le=10)
     beam_radius_m: float = Field(0.02, gt=0)
     detection_threshold: float = Field(5e-6, gt=0)
-    reflectivity: float = Field(0.9, gt=0, le=1, description="s in rho = s / pi")
+    reflectivity: float = Field(PAPER_REFLECTIVITY, gt=0, le=1, description="s in rho = s / pi")
     q_ext: float = Field(2.0, ge=0)
     q_back: float = Field(2.0, ge=0)
+    reflection: Literal["paper", "lambertian"] = Field(
+        "paper",
+        description="paper: every surface returns `reflectivity` and the detection threshold "
+        "applies only with a raindrop in the beam, as the paper's model; lambertian: each "
+        "surface its `surface_reflectivity` times the cosine of the beam's incidence, and "
+        "every return must pass the threshold (water returns only near the sensor)",
+    )
+    surface_reflectivity: SurfaceReflectivity = SurfaceReflectivity()
 
     def rays_per_s(self, rate_hz: float) -> float:
         return float(self.channels * self.columns) * rate_hz
@@ -191,6 +213,19 @@ class LidarParams(SensorParams):
         if self.min_range_m >= self.max_range_m:
             raise FieldProblem("min_range_m", f"{self.min_range_m:g} m must be less than "
                                f"max_range_m ({self.max_range_m:g} m)")  # fmt: skip
+        return self
+
+    @model_validator(mode="after")
+    def _reflectivities_of_their_model(self) -> LidarParams:
+        """A value the chosen model would ignore is a mistake to name, not to drop (values,
+        not fields given: a resolved scenario.json spells out every default)."""
+        if self.reflection == "paper" and self.surface_reflectivity != SurfaceReflectivity():
+            raise FieldProblem("surface_reflectivity", "applies with reflection 'lambertian'; "
+                               "the paper's model gives every surface `reflectivity`")  # fmt: skip
+        if self.reflection == "lambertian" and self.reflectivity != PAPER_REFLECTIVITY:
+            raise FieldProblem("reflectivity", "is the paper model's one value for every "
+                               "surface; with reflection 'lambertian' set "
+                               "surface_reflectivity")  # fmt: skip
         return self
 
 

@@ -20,13 +20,14 @@ import math
 import numpy as np
 from numpy.typing import NDArray
 
-from catabot.bus.messages import CLASS_NONE, LidarScan, VesselState
+from catabot.bus.messages import CLASS_NONE, LABEL_CLASSES, LidarScan, VesselState
 from catabot.config.sensors import LidarParams
 from catabot.world import rotations, seeding
 from services.sensors.common import SensorError, rotation_from_quaternion
 from services.sensors.cull import grid_pairs
 from services.sensors.mount import Mount
 from services.sensors.rain import RainParams, apply_rain
+from services.sensors.scene import Hits
 
 F64 = NDArray[np.float64]
 
@@ -77,6 +78,14 @@ class LidarModel:
         self.mount_xyz = np.asarray(params.mount_xyz, dtype=np.float64)
         self.ring = np.repeat(np.arange(params.channels, dtype=np.uint16), params.columns)
         self.rng = seeding.rng(seed, name)
+        self.lambertian = params.reflection == "lambertian"
+        shown = params.surface_reflectivity  # s of each label class, by its index
+        self.s_of_class = np.array([getattr(shown, c, 0.0) for c in LABEL_CLASSES]) / math.pi
+
+    def _backscatter(self, beams: F64, hits: Hits) -> F64:
+        """rho of each beam's surface, Lambertian: s / pi times the cosine of its incidence."""
+        incidence = np.abs(np.einsum("ij,ij->i", beams, hits.normal))
+        return np.asarray(self.s_of_class[hits.cls] * incidence)
 
     def sample(self, state: VesselState, *, tick: int, stamp_ns: int) -> LidarScan:
         """One scan at the vessel's pose in `state`, stamped `stamp_ns`."""
@@ -88,12 +97,15 @@ class LidarModel:
         unit = (cones.axis / cones.dist[:, None]) @ rot  # in the sensor frame
         pairs = grid_pairs(unit, cones.cos_half, self.elevations, p.columns)
         pairs = pairs[0], cones.body[pairs[1]]
-        hits = self.scene.cast(origin, self.dirs @ rot.T, p.max_range_m, pairs, normals=False)
+        beams = self.dirs @ rot.T
+        hits = self.scene.cast(origin, beams, p.max_range_m, pairs, normals=self.lambertian)
         distance = hits.range.astype(np.float64)
         noise = self.rng.normal(0.0, p.range_noise_sigma_m, distance.shape)
         if self.noise:
             distance = np.maximum(distance + noise, 0.0)  # inf stays inf
-        rain = apply_rain(distance, p.max_range_m, self.scene.rain_rate_mm_h, self.rain, self.rng)
+        rho = self._backscatter(beams, hits) if self.lambertian else None
+        rain = apply_rain(distance, p.max_range_m, self.scene.rain_rate_mm_h, self.rain, self.rng,
+                          rho=rho, gated=self.lambertian)  # fmt: skip
         if p.min_range_m > 0:  # the blind zone: a drop (or a surface) nearer gives no return
             blind = rain.range < p.min_range_m
             rain.range[blind], rain.intensity[blind], rain.is_rain[blind] = np.inf, 0.0, False

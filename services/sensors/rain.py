@@ -95,13 +95,23 @@ def mean_drops(rate_mm_h: float, distance_m: F64 | float, p: RainParams) -> F64:
 
 
 def apply_rain(
-    distance: F64, max_range: float, rate_mm_h: float, p: RainParams, rng: np.random.Generator
+    distance: F64,
+    max_range: float,
+    rate_mm_h: float,
+    p: RainParams,
+    rng: np.random.Generator,
+    *,
+    rho: F64 | None = None,
+    gated: bool = False,
 ) -> RainReturns:
-    """Steps one to three for every beam; `distance` is the raycast range (inf: no hit)."""
+    """Steps one to three for every beam; `distance` is the raycast range (inf: no hit).
+    `rho`: each beam's object backscatter (default (5) for every surface, the paper's);
+    `gated`: every return must pass the detection threshold, not only one through rain (a
+    receiver does not see a surface too dim for it because the air is dry)."""
     hit = np.isfinite(distance) & (distance <= max_range)
     z = np.where(hit, distance, max_range)  # Z: to the object, or the whole beam
     z = np.maximum(z, 1e-6)  # a beam starting on a surface still has a length
-    rho = p.reflectivity / math.pi  # (5)
+    rho_obj = p.reflectivity / math.pi if rho is None else rho  # (5)
     area = math.pi * (p.drop_diameter_mm * 1e-3) ** 2 / 4.0  # drop cross-section, m^2
     beam = math.pi * p.beam_radius_m**2  # beam cross-section, m^2
     # step one
@@ -113,13 +123,13 @@ def apply_rain(
     np.maximum(z_drop, 1e-6, out=z_drop)
     # step two
     alpha_obj = n * p.q_ext * area / (beam * z)  # (6)
-    rio = np.where(hit, rho / z**2 * np.exp(-2.0 * alpha_obj * z), 0.0)  # (4)
+    rio = np.where(hit, rho_obj / z**2 * np.exp(-2.0 * alpha_obj * z), 0.0)  # (4)
     rho_drop = n * p.q_back * area / (beam * z_drop)  # (7)
     rird = np.where(n > 0, rho_drop / z_drop**2, 0.0)  # (4) with alpha = 0
     # step three
     thr = p.detection_threshold
     object_wins = hit & ((n == 0) | (rio >= rird))
-    show_object = object_wins & ((n == 0) | (rio > thr))
+    show_object = object_wins & (((n == 0) & (not gated)) | (rio > thr))
     show_drop = ~object_wins & (rird > thr)
     out_range, intensity = np.full(z.shape, np.inf), np.zeros(z.shape)
     for out, obj, drop in ((out_range, z, z_drop), (intensity, rio, rird)):

@@ -7,6 +7,7 @@ from pathlib import Path
 import numpy as np
 from conftest import basic_scenario, catabot, csv_rows, only_run_dir, scenario_file
 
+from catabot.run.recorded import RecordedRun
 from services.recorder.mcap_read import read_mcap_messages
 
 
@@ -44,3 +45,26 @@ def test_lidar_in_rain_is_recorded_as_point_clouds(tmp_path: Path, out: Path) ->
     assert "b1/base_link" in [t.child_frame_id for t in last.transforms]
     assert (last.transforms[0].header.stamp.sec, last.transforms[0].header.stamp.nanosec) == (1, 0)
     assert "/b1/odom" not in {m.topic for m in messages}
+
+
+def test_a_lambertian_lidar_sees_calm_water_only_near_it(tmp_path: Path, out: Path) -> None:
+    """Two LiDARs 1 m up on one vessel, the paper's model and `reflection: "lambertian"`: the
+    second's water returns end at 10.8 m (README: Z^3 < s h / (pi t)); both see the buoy."""
+    data = basic_scenario("lambert", duration_s=0.3)
+    data["buoys"] = [{"id": "b1", "x_m": 20.0, "y_m": 0.0}]
+    lidar = {"type": "lidar", "rate_hz": 10.0, "params": {"mount_xyz": [0.0, 0.0, 1.0]}}
+    data["vessels"][0]["sensors"] = [
+        {**lidar, "name": "paper"},
+        {**lidar, "name": "lambert", "params": {**lidar["params"], "reflection": "lambertian"}},
+    ]
+    result = catabot("run", str(scenario_file(tmp_path, data)), "--out", str(out), "--quiet")
+    assert result.returncode == 0, result.stderr
+    run = RecordedRun(only_run_dir(out))
+    for sensor in run.world.sensors:
+        scans = list(run.lidar_scans(sensor))
+        assert len(scans) == 3
+        water = np.concatenate([np.linalg.norm(s.points[s.cls == 1], axis=1) for s in scans])
+        buoy = sum(int((s.cls == 4).sum()) for s in scans)
+        name, far = sensor.config.name, water.max()
+        assert buoy > 0, name
+        assert far < 10.9 if name == "lambert" else far > 70.0, (name, far)

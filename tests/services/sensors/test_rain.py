@@ -113,6 +113,17 @@ def test_no_rain_no_rain_returns_and_objects_kept() -> None:
     assert out.intensity[0] == pytest.approx(0.9 / math.pi / 25.0)
 
 
+def test_a_gated_receiver_drops_a_dim_object_in_dry_air_as_in_rain() -> None:
+    """The paper's step three applies the threshold only with a drop in the beam; `gated`
+    (reflection "lambertian") applies it to every return, at the paper's threshold."""
+    d, rho = np.array([5.0, 5.0]), np.array([1e-4, 1e-3])  # RIO 4e-6 and 4e-5 at 5 m
+    paper = apply_rain(d, 100.0, 0.0, RainParams(), np.random.default_rng(0), rho=rho)
+    gated = apply_rain(d, 100.0, 0.0, RainParams(), np.random.default_rng(0), rho=rho, gated=True)
+    assert np.array_equal(paper.range, d)  # below the threshold and still seen: dry air
+    assert np.array_equal(gated.range, [np.inf, 5.0])
+    assert gated.intensity[1] == pytest.approx(1e-3 / 25.0) and gated.intensity[0] == 0.0
+
+
 def test_bad_parameters_are_refused() -> None:
     with pytest.raises(RainModelError, match="drop_diameter_mm must be > 0"):
         RainParams(drop_diameter_mm=0.0)

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import math
+import re
 
 import numpy as np
 import pytest
@@ -16,6 +17,8 @@ from catabot.bus.messages import (
     LidarScan,
     VesselState,
 )
+from catabot.config.base import ScenarioError
+from catabot.config.load import parse_scenario
 from catabot.config.sensors import LidarParams
 from catabot.config.waves import WaveConfig
 from catabot.world.terrain import Terrain
@@ -166,3 +169,48 @@ def test_pose_arrays_from_a_batch_equal_the_named_poses() -> None:
     pos[1, 0] = np.nan
     with pytest.raises(SceneError, match="buoy"):
         arrays.update_arrays(ids, pos, quat, 3.0)
+
+
+def test_lambertian_water_returns_end_where_its_echo_falls_below_the_threshold() -> None:
+    """A beam dipping onto calm water from height h meets it at Z with cos(incidence) = h / Z,
+    so its echo s / pi (h / Z) / Z^2 passes the threshold t while Z^3 < s h / (pi t): 10.8 m
+    for the default water (s 0.02) seen from 1 m. The same beams, paper model: water to 79 m."""
+    scene = _scene(ego=(0, 0, 0), boat=(30.0, 0.0, 0.0), buoy=(0.0, -10.0, 0.0))
+    scans = {}
+    for model in ("paper", "lambertian"):
+        params = LidarParams(mount_xyz=(0.0, 0.0, 1.0), reflection=model)
+        mount = Mount(scene=scene, noise=False, seed=1, name="ego/lidar")
+        scans[model] = LidarModel(params, mount).sample(_state(), tick=0, stamp_ns=0)
+    reach = (0.02 * 1.0 / (math.pi * 5e-6)) ** (1 / 3)
+    paper, lambertian = scans["paper"], scans["lambertian"]
+    water = {m: np.linalg.norm(s.points[s.cls == CLASS_WATER], axis=1) for m, s in scans.items()}
+    assert water["paper"].max() > 70.0 and water["lambertian"].max() < reach
+    assert np.array_equal(
+        np.sort(water["lambertian"]), np.sort(water["paper"][water["paper"] < reach])
+    )
+    boat = lambertian.cls == CLASS_VESSEL  # face-on at 28 m (the boat's stern): s 0.6, cos 1
+    ahead = boat & (lambertian.ring == 15) & (np.abs(lambertian.points[:, 1]) < 0.05)
+    z = np.linalg.norm(lambertian.points[ahead], axis=1)
+    cos = lambertian.points[ahead, 0] / z
+    assert np.allclose(lambertian.intensity[ahead], 0.6 / math.pi * cos / z**2, rtol=1e-4)
+    assert (paper.cls == CLASS_VESSEL).sum() == boat.sum()  # a hull's echo is far above it
+
+
+@pytest.mark.parametrize(
+    ("params", "said"),
+    [
+        ({"surface_reflectivity": {"water": 0.1}},
+         "params.surface_reflectivity: applies with reflection 'lambertian'"),
+        ({"reflection": "lambertian", "reflectivity": 0.5},
+         "params.reflectivity: is the paper model's one value for every surface"),
+        ({"reflection": "lambertian", "surface_reflectivity": {"water": 0.0}},
+         "params.surface_reflectivity.water: must be > 0 (got 0.0)"),
+    ],
+)  # fmt: skip
+def test_a_reflectivity_the_chosen_model_ignores_is_refused(
+    params: dict[str, object], said: str
+) -> None:
+    lidar = {"name": "lidar", "type": "lidar", "rate_hz": 10.0, "params": params}
+    data = {"name": "refl", "vessels": [{"id": "ego", "sensors": [lidar]}]}
+    with pytest.raises(ScenarioError, match=re.escape(f"vessels.0.sensors.0.{said}")):
+        parse_scenario(data)
