@@ -12,6 +12,7 @@ Then the same scans with every body as its hull box, side by side with the shape
 rays, for reference. Last, the scan on calm water, the medium swell and the harbour chop
 side by side (interleaved, SEA_ROUNDS each), with what the water's ray cast chose (grid or
 exact march).
+Then the paper's reflection against "lambertian" (README, Sensors), interleaved.
 Targets: a scan with rain within 5 ms (issue "Sensor farm"); shapes at most 1.2 x boxes
 (issue #17, "Vessel shapes"); a scan with 50 mm/h rain in the medium swell at most
 1.25 x calm water (issue #17, "Sensors in waves").
@@ -178,6 +179,19 @@ def seas_compared(rain: float) -> list[str]:
     return sea_lines(f"LiDAR 32 x 512, {rain:g} mm/h", times, plans)
 
 
+def reflections_compared(sea: str, rain: float) -> str:
+    """The scan with the paper's reflection and with "lambertian" (each hit's normal and
+    class: the wave surface's normals, an incidence per beam), interleaved on one scene."""
+    scene, scans = scene_of(SEAS[sea], rain)[0], {}
+    for model in ("paper", "lambertian"):
+        params = LidarParams(reflection=model)
+        lidar = LidarModel(params, Mount(scene=scene, seed=1, name="ego/lidar"))
+        scans[model] = lambda lidar=lidar: lidar.sample(ego(), tick=0, stamp_ns=0)
+    times = interleaved(scans, SEA_ROUNDS)
+    paper, lambertian = (statistics.median(times[m]) for m in scans)
+    return f"{sea:>8} {rain:>9.0f} {paper:>9.2f} {lambertian:>11.2f} {lambertian / paper:>7.2f}"
+
+
 def embree_alone() -> str:
     """Embree's own rate on the terrain scene with the scan's rays (float32, as cast)."""
     import open3d as o3d
@@ -216,6 +230,12 @@ def main() -> None:
     print(sea_head())
     for rain in (0.0, 50.0):
         print("\n".join(seas_compared(rain)))
+    print(f"\nreflection: the paper's vs lambertian (interleaved, {SEA_ROUNDS} each; median ms)")
+    print(
+        "{:>8} {:>9} {:>9} {:>11} {:>7}".format("sea", "rain mm/h", "paper", "lambertian", "ratio")
+    )
+    for sea in ("calm", "medium"):
+        print(reflections_compared(sea, 50.0))
     print(f"load average during the run: {os.getloadavg()[0]:.1f} on {os.cpu_count()} CPUs")
 
 

@@ -267,17 +267,17 @@ class Conductor:
         return name, ack
 
     def _advance(self) -> None:
-        """Every active participant has acked up to `_done - 1`; restart the deadline on
-        progress."""
+        """Every active participant has acked up to `_done - 1`: restart the deadline."""
         done = min((self._acked[n] for n in self._active()), default=self._granted) + 1
         if done > self._done:
             self._done = done
             self._restart_deadline()
 
     def _restart_deadline(self) -> None:
-        """`deadline_s` from now while a granted tick is outstanding; none otherwise."""
-        outstanding = self._done <= self._granted
-        self._deadline = time.monotonic() + self.spec.deadline_s if outstanding else None
+        """`deadline_s` (and a slow setting change's grace) from now while a granted tick
+        is outstanding; none otherwise."""
+        wait = self.spec.deadline_s + self.settings.grace(self._done, self._granted)
+        self._deadline = time.monotonic() + wait if self._done <= self._granted else None
 
     def _active(self) -> list[str]:
         return [n for n in sorted(self._acked) if n not in self.dropped]

@@ -13,7 +13,7 @@ from __future__ import annotations
 
 import json
 import threading
-from collections.abc import Iterable
+from collections.abc import Callable, Iterable
 from dataclasses import dataclass
 from typing import Any
 
@@ -81,8 +81,16 @@ class Schedule:
     every grant. One lock makes "the first tick not granted" and "what this grant carries"
     agree: no change can land on a tick some participant has already been granted."""
 
-    def __init__(self, timeline: Iterable[Change] = (), *, ticks: int) -> None:
-        self.ticks = ticks
+    def __init__(
+        self,
+        timeline: Iterable[Change] = (),
+        *,
+        ticks: int,
+        grace_s: Callable[[str], float] = lambda _key: 0.0,
+    ) -> None:
+        """`grace_s(key)`: how much longer than the tick's deadline a change of `key` may
+        take to apply (catabot/config/live.py's `apply_grace_s`)."""
+        self.ticks, self.grace_of = ticks, grace_s
         self._lock = threading.Lock()
         self._granted = -1
         self._by_tick: dict[int, list[Change]] = {}
@@ -114,6 +122,12 @@ class Schedule:
         with self._lock:
             first, self._granted = self._granted + 1, max(self._granted, last)
             return tuple(c.wire() for k in range(first, last + 1) for c in self._by_tick.get(k, ()))
+
+    def grace(self, first: int, last: int) -> float:
+        """The most grace any change at ticks `first`..`last` has (0 with none)."""
+        with self._lock:
+            keys = {c.key for k in range(first, last + 1) for c in self._by_tick.get(k, ())}
+        return max(map(self.grace_of, keys), default=0.0)
 
     def applied(self) -> list[Change]:
         """Every change granted so far, in the order it applied: the run's timeline."""

@@ -115,7 +115,8 @@ def main(argv: list[str] | None = None) -> int:
     except CataBotError as exc:
         emit("result", ticks_done=0, wall_s=0.0, error=str(exc), dropped=[])
         return 2
-    keys, schedule = Keys(scenario.name), Schedule(live.timeline(scenario), ticks=scenario.ticks)
+    keys = Keys(scenario.name)
+    schedule = Schedule(live.timeline(scenario), ticks=scenario.ticks, grace_s=live.apply_grace_s)
     spec = clock_spec(scenario, args.start_timeout)
     try:
         conductor = Conductor(session, keys, spec, roster=args.roster, settings=schedule)

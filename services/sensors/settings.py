@@ -3,6 +3,7 @@ camera's outputs; applied before the step of the tick they take effect in."""
 
 from __future__ import annotations
 
+import logging
 from collections.abc import Callable, Mapping
 
 from catabot.bus.settings import Change
@@ -10,6 +11,8 @@ from catabot.config import live
 from catabot.config.scenario import Scenario
 from catabot.world.waves import WaveField
 from services.sensors.scene import Scene
+
+log = logging.getLogger("sensors.settings")
 
 
 class SensorSettings:
@@ -27,6 +30,8 @@ class SensorSettings:
         if kind == "rain" and self.scene is not None:
             self.scene.rain_rate_mm_h = float(value)  # LiDAR returns and camera streaks
         elif kind == "waves" and self.scene is not None:
+            log.info("the sea becomes %r at tick %d (waves load the compiled wave kernels: "
+                     "numba, ≈10 s where its cache is cold)", value, change.tick)  # fmt: skip
             self.scene.set_waves(
                 WaveField(live.wave_config(self.scenario, value), self.scenario.seed)
             )

@@ -4,6 +4,7 @@ above every grant, carried by the grant, handed to each participant's step of th
 from __future__ import annotations
 
 import threading
+import time
 
 import pytest
 
@@ -89,6 +90,26 @@ def test_every_participant_steps_each_change_at_its_tick(world: World) -> None:
         Change(7, "waves", '"heavy"'),
         proposed[0],
     ]
+
+
+@pytest.mark.parametrize("key", ["waves", "rain"])
+def test_a_slow_change_has_its_grace_past_the_deadline(world: World, key: str) -> None:
+    """A participant that takes 1.2 s over the tick carrying a change (a sea with waves:
+    its kernels compile) keeps the run only where the change's grace covers it."""
+    grace = {"waves": 3.0}
+    schedule = Schedule([Change(5, key, '"x"')], ticks=12, grace_s=lambda k: grace.get(k, 0.0))
+    assert schedule.grace(0, 4) == 0.0 and schedule.grace(5, 5) == grace.get(key, 0.0)
+
+    def step(tick: Tick, _: Inputs) -> None:
+        if tick.settings:
+            time.sleep(1.2)
+
+    world.member("sensors", step)
+    result = world.run(["sensors"], 12, settings=schedule, deadline_s=0.6)
+    if key == "waves":
+        assert result.error == "" and result.ticks_done == 12
+    else:
+        assert "missed the 0.6 s deadline of tick 5" in result.error
 
 
 def test_a_switched_off_stream_is_not_waited_for() -> None:
