@@ -18,13 +18,16 @@ from catabot.config.base import Angle, Strict
 
 
 class Pose(Strict):
-    """Start pose in `map` (ENU). z_m 0 is the body origin on the calm surface (a vessel
-    then settles to its draft); roll and pitch turn the body about its own x and y axes
+    """Start pose in `map` (ENU). z_m 0 is the body origin on the surface at its point (the
+    calm level, or the waves' surface at t = 0: `World.start_states`), where a vessel then
+    settles to its draft; roll and pitch turn the body about its own x and y axes
     (map <- body = Rz(yaw) Ry(pitch) Rx(roll))."""
 
     x_m: float = 0.0
     y_m: float = 0.0
-    z_m: float = Field(0.0, ge=-20.0, le=100.0, description="height of the body origin")
+    z_m: float = Field(
+        0.0, ge=-20.0, le=100.0, description="height of the body origin above the surface at t = 0"
+    )
     roll_rad: float = Field(0.0, ge=-math.pi, le=math.pi)
     pitch_rad: float = Field(0.0, ge=-math.pi / 2, le=math.pi / 2)
     yaw_rad: Angle = 0.0

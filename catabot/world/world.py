@@ -45,6 +45,7 @@ from catabot.world.shards import blocks, sensor_owners
 from catabot.world.streams import Streams
 from catabot.world.terrain import Terrain, load_terrain
 from catabot.world.traffic_plan import Progress, TrafficPlan, plan_traffic
+from catabot.world.waves import WaveField
 
 BodyKind = Literal["vessel", "boat", "buoy"]
 
@@ -203,12 +204,19 @@ class World:
 
     def start_states(self) -> BodyStates:
         """Every body at its start pose and velocity (tick -1, t = 0): what physics starts
-        from (services/physics/setup.py), velocities in the body frame."""
+        from (services/physics/setup.py), velocities in the body frame. In waves `z_m` is
+        above the surface at the body's point, and the body moves with the water there: one
+        set at z = 0 in a trough fell freely, one under a crest was thrown up at 1 g."""
         n = len(self.bodies)
         p = np.array([(b.pose.x_m, b.pose.y_m, b.pose.z_m) for b in self.bodies]).reshape(n, 3)
         turns = [(b.pose.roll_rad, b.pose.pitch_rad, b.pose.yaw_rad) for b in self.bodies]
         quat = np.array([rotations.from_rpy(*t) for t in turns]).reshape(n, 4)
         linear = np.array([b.velocity.linear for b in self.bodies]).reshape(n, 3)
+        if not self.scenario.water.waves.is_calm and n:
+            sea = WaveField(self.scenario.water.waves, self.scenario.seed)
+            p[:, 2] += sea.height(p[:, 0], p[:, 1])
+            water = sea.velocity(p[:, 0], p[:, 1], p[:, 2])  # map frame, at the surface
+            linear += np.einsum("nji,nj->ni", rotations.matrices(quat), water)  # in the body's
         angular = np.array([b.velocity.angular for b in self.bodies]).reshape(n, 3)
         zero = np.zeros((n, 3))
         return BodyStates(-1, 0, self.body_ids, p, quat, linear, angular, zero, zero)

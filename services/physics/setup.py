@@ -34,12 +34,13 @@ def build_world(world: World) -> PhysicsWorld:
 
 
 def _off_rest(physics: PhysicsWorld, world: World) -> None:
-    """Vessels that start tilted or under way, placed exactly as `World.start_states` says
-    (body-frame velocities turned into the map frame physics integrates in); the others
-    keep the level start that records the same bytes as before these existed."""
-    rows = np.flatnonzero(
-        [not (b.pose.level_at_surface and b.velocity.at_rest) for b in world.vessels]
-    )
+    """Vessels that start tilted or under way, and in waves every body (on the surface,
+    moving with it), placed exactly as `World.start_states` says (body-frame velocities
+    turned into the map frame physics integrates in); on calm water the others keep the
+    level start that records the same bytes as before these existed."""
+    moved = [not (b.pose.level_at_surface and b.velocity.at_rest) for b in world.vessels]
+    waves = not world.scenario.water.waves.is_calm
+    rows = np.arange(len(world.bodies)) if waves else np.flatnonzero(moved)
     if rows.size == 0:
         return
     start = world.start_states()

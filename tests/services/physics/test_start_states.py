@@ -16,6 +16,7 @@ from catabot.config.base import ScenarioError
 from catabot.config.load import parse_scenario
 from catabot.config.vessel import load_vessel_model
 from catabot.world import rotations
+from catabot.world.waves import WaveField
 from catabot.world.world import World
 from services.physics.setup import build_world
 from services.physics.wind import wind_gains
@@ -127,3 +128,26 @@ def test_bad_start_states_are_named(vessel: dict[str, Any], message: str) -> Non
     with pytest.raises(ScenarioError) as info:
         parse_scenario({"vessels": [{"id": "a", **vessel}]})
     assert message in str(info.value)
+
+
+def test_in_waves_every_body_starts_on_the_surface_moving_with_it() -> None:
+    """z_m is above the surface at the body's point: set at the calm level, a catamaran in a
+    trough fell freely (a_z -9.81 m/s^2 for its first ticks), one under a crest was thrown
+    up. On the surface and with the water's velocity, its first accelerations are small."""
+    data = {
+        "seed": 4,
+        "water": {"waves": {"preset": "medium"}},
+        "vessels": [{"id": f"v{i}", "pose": {"x_m": 7.0 * i, "y_m": 3.0 * i}} for i in range(4)],
+        "buoys": [{"id": "b", "x_m": 40.0, "y_m": -5.0}],
+    }
+    world = World.resolve(parse_scenario(data))
+    sea = WaveField(world.scenario.water.waves, world.scenario.seed)
+    start, physics = world.start_states(), build_world(world)
+    x, y, z = start.position.T
+    assert np.allclose(z, sea.height(x, y), atol=1e-12) and np.ptp(z) > 0.05  # not all at 0
+    placed = np.concatenate([physics.state_arrays().position, physics.buoy_state_arrays().position])
+    assert np.allclose(placed, start.position, atol=1e-12)
+    for _ in range(5):
+        physics.step()
+        heave = physics.state_arrays().linear_acceleration[:, 2]
+        assert np.all(np.abs(heave) < 3.0), heave  # a fraction of g, not a fall
