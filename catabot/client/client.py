@@ -52,18 +52,19 @@ class Client:
     @classmethod
     def connect(
         cls,
-        connect: Sequence[str] = (),
+        connect: str | Sequence[str] = (),
         *,
         world: str | None = None,
         timeout_s: float = 5.0,
-        listen: Sequence[str] = (),
+        listen: str | Sequence[str] = (),
         mode: str | None = None,
         zenoh_config: str | None = None,
     ) -> Client:
         """Open a session (an embedded peer on loopback by default; `connect` endpoints of
         `catabot run --listen` or a router) and find the world: `world`, or the only one
-        running. SimulatorNotFound after `timeout_s` if none answers."""
-        conn = Connection(tuple(connect), tuple(listen), mode, None, zenoh_config)
+        running (a string is one endpoint). SimulatorNotFound after `timeout_s` if none
+        answers."""
+        conn = Connection(_endpoints(connect), _endpoints(listen), mode, None, zenoh_config)
         return cls.open(conn, world=world, timeout_s=timeout_s)
 
     @classmethod
@@ -255,3 +256,8 @@ def add_stack_args(parser: argparse.ArgumentParser) -> None:
 def _told(exc: BaseException) -> str:
     """A stack's exception as the fault the run's error quotes."""
     return f"{type(exc).__name__}: {exc}"
+
+
+def _endpoints(given: str | Sequence[str]) -> tuple[str, ...]:
+    """A string is one endpoint, not a sequence of one-letter ones ('t', 'c', 'p', ...)."""
+    return (given,) if isinstance(given, str) else tuple(given)

@@ -85,7 +85,8 @@ class ScriptStep(Strict):
         if (self.thrust is None) == (self.twist is None):
             raise ValueError("give exactly one of 'thrust' or 'twist'")
         if self.thrust is not None and not all(-1 <= v <= 1 for v in self.thrust):
-            raise ValueError("thrust commands are normalised: each in [-1, 1]")
+            raise FieldProblem("thrust", "commands are normalised: each in [-1, 1] "
+                               f"(got {[round(v, 6) for v in self.thrust]})")  # fmt: skip
         return self
 
 

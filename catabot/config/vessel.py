@@ -12,6 +12,7 @@ the waterline-level reference point on the centreline; SI units, named in the fi
 
 from __future__ import annotations
 
+import math
 from pathlib import Path
 from typing import Annotated, Any, Literal
 
@@ -98,6 +99,13 @@ class Hull(Strict):
     def vertical_extent_m(self) -> float:
         """Full height of the hull along body z."""
         return self.height_m if self.height_m is not None else self.beam_m
+
+    @property
+    def volume_m3(self) -> float:
+        """What the hull displaces wholly under water."""
+        if self.shape == "box":
+            return self.length_m * self.beam_m * self.vertical_extent_m
+        return self.length_m * math.pi * (self.beam_m / 2) ** 2
 
     @property
     def across(self) -> int:

@@ -16,6 +16,7 @@ from catabot.bus.clock import CONDUCTOR
 from catabot.bus.identity import Roster, new_zid
 from catabot.bus.scheduling import requested_policy
 from catabot.bus.session import check_listen, check_router, free_port
+from catabot.config.base import ScenarioError
 from catabot.config.load import load_scenario, parse_scenario
 from catabot.config.scenario import Scenario
 from catabot.config.sensors import service_of
@@ -63,12 +64,17 @@ def prepare(opts: RunOptions) -> World:
     if opts.listen and not opts.connect:  # the embedded mesh: the conductor listens there
         check_listen(opts.listen)
     scenario = load_scenario(opts.scenario)
+    source = opts.scenario or "default"
     data = scenario.model_dump()
     if opts.duration_s is not None:
         data["duration_s"] = opts.duration_s
     if opts.realtime is not None:
         data["clock"]["realtime_factor"] = opts.realtime
-    world = World.resolve(parse_scenario(data, source="command line"), progress=PlanningProgress())
+    parsed = parse_scenario(data, source="command line")
+    try:
+        world = World.resolve(parsed, progress=PlanningProgress())
+    except ScenarioError as exc:  # which file, as the parser's own errors say
+        raise ScenarioError(f"scenario {source}: {exc}") from None
     _ = world.shapes  # every mesh file read now: a broken one is refused before any start
     check_mounts(world)  # no camera, LiDAR or radar inside its own hull
     for name in world.services:

@@ -36,7 +36,7 @@ from catabot.config.scenario import (
     services,
 )
 from catabot.config.sensors import shard_names
-from catabot.config.vessel import VesselModel, load_vessel_model
+from catabot.config.vessel import VesselModel, VesselModelError, load_vessel_model
 from catabot.world import rotations
 from catabot.world.environment.current import CurrentField
 from catabot.world.placement import BUOY_MODEL, check_apart, check_marks, resolve_poses
@@ -115,6 +115,7 @@ class World:
         """Everything a run needs from its scenario; ScenarioError names what cannot run.
         `progress(k, n)` hears of each planned traffic boat (a long plan's progress)."""
         given = digest(scenario)  # as the conductor, which loads the same file, has it
+        _check_models(scenario)
         terrain = _terrain(scenario)
         current = CurrentField.from_config(scenario.water.current)
         scenario = resolve_poses(scenario, terrain)
@@ -244,6 +245,8 @@ def _bodies(scenario: Scenario, plan: TrafficPlan) -> tuple[Body, ...]:
     buoys = [*scenario.buoys, *plan.buoys]
     rows += [(b.id, "buoy", BUOY_MODEL, Pose(x_m=b.x_m, y_m=b.y_m), None) for b in buoys]
     _unique([r[0] for r in rows])
+    for bid, _, ref, _, _ in rows:
+        _check_floats(bid, ref, model(ref), scenario.water.density_kg_m3)
     return tuple(
         Body(bid, kind, ref, model(ref), pose, row, *_scenario_part(config))
         for row, (bid, kind, ref, pose, config) in enumerate(rows)
@@ -269,6 +272,32 @@ def _check_script(vessel: VesselConfig, model: VesselModel, *, where: str) -> No
                 f"{where}.script.{k}.thrust: {len(step.thrust)} value(s), but model "
                 f"{vessel.model!r} has {count} thruster(s) (one value each, in [-1, 1])"
             )
+
+
+def _check_models(scenario: Scenario) -> None:
+    """Each model a scenario names loads, or its error names the field that named it."""
+    named: list[tuple[str, str | None]]
+    named = [(f"vessels.{i}.model", v.model) for i, v in enumerate(scenario.vessels)]
+    named += [(f"traffic.models.{i}.model", m.model) for i, m in enumerate(scenario.traffic.models)]
+    named += [(f"traffic.boats.{i}.model", b.model) for i, b in enumerate(scenario.traffic.boats)]
+    for where, ref in named:
+        try:
+            if ref is not None:
+                load_vessel_model(ref)
+        except VesselModelError as exc:
+            raise ScenarioError(f"{where}: {exc}") from None
+
+
+def _check_floats(body: str, ref: str, model: VesselModel, density: float) -> None:
+    """A model heavier than the water its hulls can displace sinks to the bottom, and no
+    figure of the run says so (a mass typed with an extra zero)."""
+    most = density * sum(h.volume_m3 for h in model.hulls)
+    if model.mass_kg > most:
+        raise ScenarioError(
+            f"{body}: vessel model {ref!r} cannot float: its mass {model.mass_kg:g} kg is more "
+            f"than its hulls displace wholly under water ({most:.0f} kg in water of "
+            f"{density:g} kg/m^3)"
+        )
 
 
 def _unique(ids: list[str]) -> None:

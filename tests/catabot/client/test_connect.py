@@ -60,7 +60,7 @@ def test_no_simulation_is_a_clear_error_after_the_timeout() -> None:
     started = time.monotonic()
     with pytest.raises(SimulatorNotFound, match=r"no simulation of any world answered on "
                        r"catabot/\*/world/info within 0.6 s \(connect \['tcp/127"):  # fmt: skip
-        Client.connect([lonely], timeout_s=0.6)
+        Client.connect(lonely, timeout_s=0.6)  # a string is one endpoint, not its letters
     assert 0.6 <= time.monotonic() - started < 5.0
     with pytest.raises(SimulatorNotFound, match="no simulation of world 'harbour'"):
         Client.connect(timeout_s=0.3, world="harbour")

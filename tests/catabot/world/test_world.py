@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import json
+from pathlib import Path
 from typing import Any
 
 import numpy as np
@@ -11,6 +13,7 @@ from catabot.bus.keys import Keys
 from catabot.bus.messages import BodyStates, GpsFix, ImuSample
 from catabot.config.base import ScenarioError
 from catabot.config.load import parse_scenario
+from catabot.config.vessel import load_vessel_model
 from catabot.world.world import World
 
 KEYS = Keys("w")
@@ -112,3 +115,18 @@ def test_start_states_are_the_start_poses_at_rest() -> None:
 def test_two_bodies_with_one_id_are_refused(changes: dict[str, Any], message: str) -> None:
     with pytest.raises(ScenarioError, match=message):
         _world(**changes)
+
+
+@pytest.mark.parametrize("mass_kg", [55.0, 400.0])
+def test_a_model_heavier_than_its_hulls_displace_is_refused(tmp_path: Path, mass_kg: float) -> None:
+    """The catamaran's pontoons displace 2 x 1.9 x 0.24 x 0.30 m^3 x 1025 kg/m^3 = 280 kg
+    wholly under water: at 55 kg it floats, at 400 kg it would sink to the bottom unreported."""
+    model = json.loads(load_vessel_model("catabot").model_dump_json()) | {"mass_kg": mass_kg}
+    (tmp_path / "cat.json").write_text(json.dumps(model))
+    data = {"vessels": [{"id": "ego", "model": str(tmp_path / "cat.json")}]}
+    if mass_kg < 280.0:
+        World.resolve(parse_scenario(data))
+        return
+    said = r"ego: vessel model '.*cat.json' cannot float: its mass 400 kg is more than its hulls "
+    with pytest.raises(ScenarioError, match=said + r"displace wholly under water \(280 kg"):
+        World.resolve(parse_scenario(data))
