@@ -44,7 +44,8 @@ class CataBotEnv(gym.Env[Obs, np.ndarray]):
     def __init__(self, render_mode: str | None = None, **kwargs: Any) -> None:
         if render_mode is not None:
             raise gym.error.Error(f"CataBot envs render nothing here (got {render_mode!r}); "
-                                  "watch a run with `catabot view --connect`")  # fmt: skip
+                                  "watch an episode's run with `catabot view --connect "
+                                  "ENDPOINT` (reset's info['endpoint'])")  # fmt: skip
         self.options = o = env_options(**kwargs)
         self._draw = Draw(o)
         base = (o.world or self._draw.base.name)[:40]
@@ -98,7 +99,8 @@ class CataBotEnv(gym.Env[Obs, np.ndarray]):
         self._judge.start(self._episode.goal, frame.bodies)
         self._steps, self._over = 0, False
         run_dir = live.run.run_dir() if self.options.runs_dir is not None else None
-        return self._observer(frame), self._info(frame) | {"run_dir": run_dir}
+        where = {"run_dir": run_dir, "endpoint": live.run.endpoint}  # `catabot view --connect`
+        return self._observer(frame), self._info(frame) | where
 
     def step(self, action: Any) -> tuple[Obs, float, bool, bool, dict[str, Any]]:
         if self._over or self._judge is None or self._observer is None:

@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import contextlib
 import os
+import shutil
 import signal
 import subprocess
 import sys
@@ -33,8 +34,8 @@ class SimProcess:
     """One `catabot run` of one episode's scenario, in a temporary folder of its own."""
 
     def __init__(self, scenario: Scenario, *, out: str | None = None) -> None:
-        self._tmp = tempfile.TemporaryDirectory(prefix=f"catabot-{scenario.name}-")
-        self.folder = Path(self._tmp.name)
+        self.folder = Path(tempfile.mkdtemp(prefix=f"catabot-{scenario.name}-"))
+        self.failed = False  # a failed run's folder is kept: its error names its log
         self.out = Path(out) if out is not None else self.folder / "runs"
         self.name = scenario.name
         self.file = self.folder / "episode.json"
@@ -54,14 +55,15 @@ class SimProcess:
         return self.proc.poll() is None
 
     def failure(self) -> str:
-        """Why the run stopped, from its console (the launcher's summary names the cause)."""
-        code = self.proc.poll()
+        """Why the run stopped, from its console (the launcher's summary names the cause);
+        its folder is kept from now on, so the log named here is still there to read."""
+        self.failed, code = True, self.proc.poll()
         try:
             tail = self.log.read_text(errors="replace").strip().splitlines()[-8:]
         except OSError:  # its folder removed already
             tail = ["(its log is gone)"]
         status = "still running" if code is None else f"exit code {code}"
-        return f"catabot run ({status}, log {self.log}): " + " | ".join(tail)
+        return f"catabot run ({status}, log {self.log}, kept): " + " | ".join(tail)
 
     def run_dir(self) -> Path | None:
         """The run folder `catabot run` made for this run (None before it has)."""
@@ -83,7 +85,8 @@ class SimProcess:
             except subprocess.TimeoutExpired:
                 _kill_tree(self.proc.pid)
                 self.proc.wait()
-        self._tmp.cleanup()
+        if not self.failed:
+            shutil.rmtree(self.folder, ignore_errors=True)
 
 
 def _child_env() -> dict[str, str]:

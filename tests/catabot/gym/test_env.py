@@ -3,8 +3,10 @@ seed, the usual errors after an episode ends and for bad actions, nothing left r
 
 from __future__ import annotations
 
+import shutil
 import time
 from collections.abc import Iterator
+from pathlib import Path
 
 import gymnasium as gym
 import numpy as np
@@ -120,13 +122,17 @@ def test_a_run_that_fails_mid_episode_is_a_clear_error_and_reset_recovers(env: g
     launcher = psutil.Process(live.run.proc.pid)
     (physics,) = [p for p in launcher.children(recursive=True) if "services.physics" in p.cmdline()]
     physics.kill()
-    with pytest.raises(LinkError, match="physics"):
+    with pytest.raises(LinkError, match="physics") as failed:
         for _ in range(50):
             env.step(FORWARD)
     with pytest.raises(ResetNeeded):
         env.step(FORWARD)
-    obs, _ = env.reset(seed=4)
+    obs, info = env.reset(seed=4)
     assert env.observation_space.contains(obs)
+    assert info["endpoint"].startswith("tcp/127.0.0.1:")  # for `catabot view --connect`
+    log = Path(str(failed.value).split("log ", 1)[1].split(", kept")[0])
+    assert log.is_file() and "physics" in log.read_text()  # named, and still there to read
+    shutil.rmtree(log.parent)
 
 
 def test_max_steps_above_the_default_is_not_cut_by_a_time_limit() -> None:
