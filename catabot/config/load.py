@@ -20,6 +20,7 @@ from catabot.config.rates import check_rates
 from catabot.config.scenario import Scenario
 from catabot.config.sensors import SENSOR_TYPES
 from catabot.config.settings_config import is_settings_config, map_settings_config
+from catabot.config.vessel import VesselModel
 
 BUNDLED = Path(__file__).parents[1] / "data" / "scenarios"
 TERRAINS = BUNDLED.parent / "terrain"  # elevation images a scenario may name bare: "bay.png"
@@ -120,6 +121,15 @@ def json_schema() -> dict[str, Any]:
     schema["title"] = "CataBot scenario"
     schema["properties"]["$schema"] = {"type": "string", "description": "this schema's path or "
                                        "URL, for an editor (ignored by CataBot)"}  # fmt: skip
+    return schema
+
+
+def model_schema() -> dict[str, Any]:
+    """A vessel model file's JSON Schema (`catabot scenario model-schema`): its fields were
+    documented only by the bundled files and the errors."""
+    schema = VesselModel.model_json_schema()
+    schema["$schema"] = "https://json-schema.org/draft/2020-12/schema"
+    schema["title"] = "CataBot vessel model"
     return schema
 
 

@@ -13,7 +13,7 @@ import threading
 from pathlib import Path
 
 from catabot.bus.session import Connection, SessionError, add_connection_args, open_session
-from catabot.config.load import json_schema
+from catabot.config.load import json_schema, model_schema
 from catabot.errors import CataBotError
 from catabot.run import compose, conduct, launcher, secure, settings_cli
 from catabot.run.answer import OneLineParser, answered, output_file
@@ -45,13 +45,13 @@ def _run(args: argparse.Namespace) -> int:
     return launcher.run(opts)
 
 
-def _schema(output: str | None) -> str | None:
-    text = json.dumps(json_schema(), indent=2) + "\n"
+def _schema(output: str | None, *, model: bool = False) -> str | None:
+    text = json.dumps(model_schema() if model else json_schema(), indent=2) + "\n"
     if output is None:
         sys.stdout.write(text)
         return None
     output_file(output, flag="--output").write_text(text)
-    return f"{output}: the scenario's JSON Schema"
+    return f"{output}: the {'vessel model' if model else 'scenario'}'s JSON Schema"
 
 
 def _secure(args: argparse.Namespace) -> int:
@@ -130,8 +130,9 @@ def _router(args: argparse.Namespace) -> int:
 
 
 def _scenario(args: argparse.Namespace) -> int:
-    if args.action == "schema":
-        return answered("scenario schema", lambda: _schema(args.output))
+    if args.action in ("schema", "model-schema"):
+        model = args.action == "model-schema"
+        return answered(f"scenario {args.action}", lambda: _schema(args.output, model=model))
     if args.action == "generate":
         return generate(args)
     try:  # what `catabot run` checks before it starts anything, no less
@@ -201,7 +202,7 @@ def parser() -> argparse.ArgumentParser:
     rtr = sub.add_parser("router", help="run a zenoh router for distributed runs")
     add_connection_args(rtr)
     scen = sub.add_parser("scenario", help="scenario tools")
-    scen.add_argument("action", choices=["schema", "validate", "generate"])
+    scen.add_argument("action", choices=["schema", "model-schema", "validate", "generate"])
     scen.add_argument("file", nargs="?", help="scenario to validate")
     scen.add_argument("--output", "-o", help="write the schema (or generated scenario) here")
     add_generate_arguments(scen)

@@ -14,8 +14,11 @@ import sys
 from pathlib import Path
 from typing import Any
 
+import jsonschema
 import pytest
 
+from catabot.config.vessel import BUNDLED_DIR as BUNDLED_VESSELS
+from catabot.config.vessel import bundled_vessel_names
 from catabot.run.cli import main
 
 
@@ -118,3 +121,13 @@ def test_a_run_says_it_waits_for_a_stack_started_outside_it(tmp_path: Path) -> N
     assert done.returncode == 1  # under load a service may be late as well: named with it
     assert re.search(r"never joined within 4 s: (\w+, )*stack\n", done.stderr), done.stderr
     assert "0 ticks" in done.stdout and "ego:" not in done.stdout  # no metrics of 0 ticks
+
+
+def test_the_vessel_model_schema_checks_every_bundled_model(tmp_path: Path) -> None:
+    assert main(["scenario", "model-schema", "-o", str(tmp_path / "m.json")]) == 0
+    schema = json.loads((tmp_path / "m.json").read_text())
+    assert schema["title"] == "CataBot vessel model"
+    for name in bundled_vessel_names():
+        jsonschema.validate(json.loads((BUNDLED_VESSELS / f"{name}.json").read_text()), schema)
+    with pytest.raises(jsonschema.ValidationError, match="mass_kg"):
+        jsonschema.validate({"name": "x", "hulls": []}, schema)
