@@ -13,15 +13,19 @@ import numpy as np
 from matplotlib.axes import Axes
 from matplotlib.colors import LinearSegmentedColormap, TwoSlopeNorm
 from matplotlib.figure import Figure
+from matplotlib.patches import Circle
 from numpy.typing import NDArray
 
 from catabot.config.scenario import Scenario
+from catabot.config.task import TaskConfig
+from catabot.world.world import World
 from services.plots.series import RunSeries
 
 SEA = ["#0a1e5a", "#2870be", "#96d2e6"]
 LAND = ["#468c46", "#96a050", "#8c6e46", "#c8c8c8"]
 OWN_COLORS = ["#ff8c00", "#d62728", "#9467bd", "#8c564b", "#e377c2", "#17becf"]
 MARGIN_M = 40.0
+NAMED_BOATS = 40  # traffic boats numbered on the trajectories, at most
 
 
 def _figure(rows: int = 1, cols: int = 1, *, size: tuple[float, float] = (10, 4)) -> Figure:
@@ -43,8 +47,8 @@ def trajectories(data: RunSeries) -> Figure:
     world, pos = data.run.world, data.states.position
     vessels = len(world.vessels)
     xy = pos[:, :, :2]
-    lo, hi = np.nanmin(xy.reshape(-1, 2), axis=0) - MARGIN_M, np.nanmax(xy.reshape(-1, 2), axis=0)
-    hi = hi + MARGIN_M
+    seen = np.concatenate([xy.reshape(-1, 2), _task_points(world, data.own)])
+    lo, hi = np.nanmin(seen, axis=0) - MARGIN_M, np.nanmax(seen, axis=0) + MARGIN_M
     fig = _figure(size=(8.5, 8))
     ax = _axes(fig)[0]
     _terrain(ax, data, lo, hi)
@@ -53,11 +57,13 @@ def trajectories(data: RunSeries) -> Figure:
         ax.plot(xy[:, row, 0], xy[:, row, 1], color="white", lw=0.8, alpha=0.8)
     if vessels > len(own):
         ax.plot([], [], color="white", lw=0.8, label=f"traffic ({vessels - len(own)} boats)")
+    _boat_names(ax, world, xy)
     for k, vid in enumerate(data.own):
         row = world.body(vid).row
         ax.plot(xy[:, row, 0], xy[:, row, 1], color=_color(k), lw=2.2, label=vid)
         ax.plot(*xy[0, row], "o", color=_color(k), ms=7, mec="black")
         ax.plot(*xy[-1, row], "s", color=_color(k), ms=7, mec="black")
+        _task(ax, world.scenario.vessels[row].task, _color(k))
     if world.buoys:
         b = xy[-1, vessels:]
         ax.scatter(b[:, 0], b[:, 1], s=14, c="#fac81e", edgecolors="black", lw=0.4,
@@ -66,6 +72,44 @@ def trajectories(data: RunSeries) -> Figure:
            title=f"Trajectories, {data.t[-1]:.1f} s (o start, ■ end)", aspect="equal")  # fmt: skip
     ax.legend(loc="upper right", fontsize=8, framealpha=0.9, facecolor="#9fb0c0")  # white shows
     return fig
+
+
+def _boat_names(ax: Axes, world: World, xy: np.ndarray) -> None:
+    """Each traffic boat's number where its track ends (up to `NAMED_BOATS`): which white
+    track is boat_007's, to read beside its CSV or a takeover."""
+    first = len(world.scenario.vessels)
+    if len(world.vessels) - first > NAMED_BOATS:
+        return
+    for row in range(first, len(world.vessels)):
+        number = world.vessels[row].id.rsplit("_", 1)[-1].lstrip("0") or "0"
+        ax.annotate(number, xy[-1, row], fontsize=6, color="white", xytext=(3, 3),
+                    textcoords="offset points")  # fmt: skip
+
+
+def _task_points(world: World, own: Any) -> np.ndarray:
+    """The goals and route points of the vessels drawn, (K, 2): the view must hold them."""
+    points: list[tuple[float, float]] = []
+    for vid in own:
+        task = world.scenario.vessels[world.body(vid).row].task
+        if task is not None and task.goal is not None:
+            points.append((task.goal.x_m, task.goal.y_m))
+        if task is not None and task.route is not None:
+            points += [(float(x), float(y)) for x, y in task.route]
+    return np.array(points, dtype=np.float64).reshape(-1, 2)
+
+
+def _task(ax: Axes, task: TaskConfig | None, color: str) -> None:
+    """A vessel's goal region (dashed circle) and route (dotted line), as metrics.json
+    measures them."""
+    if task is None:
+        return
+    if task.goal is not None:
+        goal = task.goal
+        ax.add_patch(Circle((goal.x_m, goal.y_m), goal.radius_m, fill=False, ls="--", lw=1.4,
+                            ec=color))  # fmt: skip
+    if task.route is not None:
+        route = np.asarray(task.route, dtype=np.float64)
+        ax.plot(route[:, 0], route[:, 1], ":", color=color, lw=1.4, marker=".")
 
 
 def _terrain(ax: Axes, data: RunSeries, lo: Any, hi: Any) -> None:

@@ -1,11 +1,15 @@
-"""What the figures draw from a run's scenario: the rain rate as the run had it."""
+"""What the figures draw from a run's scenario: the rain rate as the run had it, the
+vessels' tasks, the boats' numbers."""
 
 from __future__ import annotations
 
+import matplotlib.pyplot as plt
 import numpy as np
+from matplotlib.patches import Circle
 
 from catabot.config.load import parse_scenario
-from services.plots.figures import rain_steps
+from catabot.world.world import World
+from services.plots.figures import _boat_names, _task, _task_points, rain_steps
 
 
 def test_the_rain_rate_follows_the_settings_timeline() -> None:
@@ -27,3 +31,22 @@ def test_without_changes_the_rain_is_the_scenarios() -> None:
     scenario = parse_scenario({"name": "dry", "duration_s": 4.0, "vessels": [{"id": "ego"}]})
     t, rate = rain_steps(scenario, 4.0)
     assert t.tolist() == [0.0, 4.0] and rate.tolist() == [0.0, 0.0]
+
+
+def test_trajectories_mark_the_task_and_number_the_boats() -> None:
+    """A scenario author checks a vessel's goal and route against its track, and which
+    white track is which boat."""
+    world = World.resolve(parse_scenario({
+        "name": "task", "vessels": [{"id": "ego", "task": {
+            "goal": {"x_m": 60.0, "y_m": 20.0, "radius_m": 4.0}, "route": [[0, 0], [30, 5]]}}],
+        "traffic": {"count": 12, "region": {"center_m": [0.0, 300.0], "size_m": [200.0, 200.0]}},
+    }))  # fmt: skip
+    assert _task_points(world, ["ego"]).tolist() == [[60.0, 20.0], [0.0, 0.0], [30.0, 5.0]]
+    fig, ax = plt.subplots()
+    _task(ax, world.scenario.vessels[0].task, "#ff8c00")
+    xy = np.zeros((2, len(world.bodies), 2))
+    _boat_names(ax, world, xy)
+    (goal,) = [p for p in ax.patches if isinstance(p, Circle)]
+    assert goal.center == (60.0, 20.0) and goal.radius == 4.0
+    assert [t.get_text() for t in ax.texts] == [str(i) for i in range(12)]  # boat_000 -> "0"
+    plt.close(fig)
