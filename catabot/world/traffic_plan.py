@@ -16,14 +16,7 @@ import numpy as np
 from catabot.config.base import ScenarioError
 from catabot.config.scenario import BuoyConfig, Pose, Scenario
 from catabot.config.terrain import TerrainError
-from catabot.config.traffic import (
-    BEHAVIOURS,
-    BoatOverride,
-    Point,
-    Region,
-    TrafficConfig,
-    boat_id,
-)
+from catabot.config.traffic import BEHAVIOURS, BoatOverride, Point, Region, TrafficConfig, boat_id
 from catabot.config.vessel import VesselModel, load_vessel_model
 from catabot.world import seeding
 from catabot.world.clearance import Discs, Rows, clear, densify, off_rings
@@ -84,9 +77,10 @@ class Planner:
         seed = scenario.seed if self.cfg.seed is None else self.cfg.seed
         self.rng = seeding.rng(seed, "traffic")
         self._models: dict[str, VesselModel] = {}
-        self.placed = Discs()  # vessels' starts: x, y, footprint radius
+        self.placed, self.named = Discs(), []  # vessels' starts: x, y, footprint radius; ids
         for v in scenario.vessels:
             assert v.pose is not None
+            self.named.append(v.id)
             self.placed.add(v.pose.x_m, v.pose.y_m, footprint_m(self._model(v.model)))
         self.buoy_r = footprint_m(self._model(BUOY_MODEL))
         # Buoys are moored: a boat must not start on one, nor circle through one every lap.
@@ -187,7 +181,8 @@ class Planner:
 
     def _boat(self, index: int) -> Boat:
         over = self.overrides.get(index, BoatOverride(index=index))
-        model = over.model or self._pick([m.model for m in self.cfg.models], self._model_w())
+        models = self.cfg.models
+        model = over.model or self._pick([m.model for m in models], [m.weight for m in models])
         mix = self.cfg.behaviour_mix
         behaviour = over.behaviour or self._pick(list(mix), list(mix.values()))
         hull = self._model(model)
@@ -206,6 +201,7 @@ class Planner:
             boat = self._behave(index, model, Pose(x_m=x, y_m=y, yaw_rad=yaw), behaviour, over)
             if boat is not None:
                 self.placed.add(x, y, radius)
+                self.named.append(boat.id)
                 return boat
         if behaviour == "waypoints" and (over.points or self.cfg.waypoints.points):
             raise ScenarioError(
@@ -213,16 +209,14 @@ class Planner:
                 f"its first given waypoint stays in {TRACK_DEPTH_M:g} m of water ({TRIES} "
                 f"draws): give it a start (traffic.boats[].x_m, y_m) or a nearer region"
             )
-        raise ScenarioError(f"traffic: no free open water for boat {index} in {TRIES} draws")
+        raise ScenarioError(f"traffic: no free open water for boat {index} in {TRIES} draws: "
+                            "give a larger traffic.region or fewer boats")  # fmt: skip
 
     def _model(self, ref: str) -> VesselModel:
         """Each model file read once per plan (500 boats share a handful of models)."""
         if ref not in self._models:
             self._models[ref] = load_vessel_model(ref)
         return self._models[ref]
-
-    def _model_w(self) -> list[float]:
-        return [m.weight for m in self.cfg.models]
 
     def _pick(self, names: list[str], weights: list[float]) -> str:
         p = np.asarray(weights, dtype=np.float64)
@@ -250,12 +244,17 @@ class Planner:
             return w / 2, h / 2
         return 0.0, 0.0
 
+    def _nearest(self, x: float, y: float) -> str:
+        """The vessel or boat placed so far whose footprint comes nearest (x, y)."""
+        disc = self.placed.array
+        return self.named[int(np.argmin(np.hypot(disc[:, 0] - x, disc[:, 1] - y) - disc[:, 2]))]
+
     def _blocked(self, x: float, y: float, radius: float, draft: float, *, room: float) -> str:
         """Why a start is not free ("" if it is): clear of every vessel (by `room` more) and
         buoy placed so far, and in water deep enough for the hull."""
         here = np.array([(x, y)])
         if not self.placed.clear_of(here, radius + room):
-            return f"its {radius:.2f} m footprint overlaps a vessel or boat placed before it"
+            return f"its {radius:.2f} m footprint overlaps {self._nearest(x, y)}'s (or its room)"
         if not self.marks.clear_of(here, radius):
             return f"its {radius:.2f} m footprint overlaps a buoy (scenario or waypoint)"
         if self.terrain is None:

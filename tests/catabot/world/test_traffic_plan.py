@@ -86,3 +86,10 @@ def test_a_start_that_is_not_free_says_what_it_overlaps() -> None:
     with pytest.raises(ScenarioError, match=r"boat 0 at \(40.0, 0.5\): its .* m footprint "
                        r"overlaps a buoy \(scenario or waypoint\)"):  # fmt: skip
         _plan(1, boats=[on_mark])
+    on_ego = {"index": 1, "x_m": 1.0, "y_m": 0.0}  # boat_000 is drawn far from the ego
+    with pytest.raises(ScenarioError, match=r"boat 1 at \(1.0, 0.0\): its .* m footprint "
+                       r"overlaps ego's \(or its room\)"):  # fmt: skip
+        _plan(2, boats=[on_ego])
+    with pytest.raises(ScenarioError, match="no free open water for boat .* give a larger "
+                       "traffic.region or fewer boats"):  # fmt: skip
+        _plan(40, region={"size_m": [30.0, 30.0]})
