@@ -90,6 +90,6 @@ def test_a_start_that_is_not_free_says_what_it_overlaps() -> None:
     with pytest.raises(ScenarioError, match=r"boat 1 at \(1.0, 0.0\): its .* m footprint "
                        r"overlaps ego's \(or its room\)"):  # fmt: skip
         _plan(2, boats=[on_ego])
-    with pytest.raises(ScenarioError, match="no free open water for boat .* give a larger "
-                       "traffic.region or fewer boats"):  # fmt: skip
+    with pytest.raises(ScenarioError, match=r"no free open water for boat .* give a larger "
+                       r"traffic.region or fewer boats"):  # fmt: skip
         _plan(40, region={"size_m": [30.0, 30.0]})
