@@ -195,6 +195,9 @@ def parse_value(text: str) -> Any:
         return text
 
 
+AS_PLANNED = "as planned"  # a drawn boat's behaviour before the plan is at hand
+
+
 def initial_values(scenario: Scenario) -> dict[str, Any]:
     """Every key's value at tick 0 (a boat's behaviour: its override, else "as planned")."""
     overrides = {b.index: b.behaviour for b in scenario.traffic.boats}
@@ -223,7 +226,7 @@ def _initial(scenario: Scenario, spec: Spec, overrides: Mapping[int, str | None]
                       if s.name == spec.name)  # fmt: skip
         return getattr(sensor.typed_params().outputs, spec.output)
     index = scenario.traffic.boat_ids.index(spec.owner)
-    return overrides.get(index) or "as planned"
+    return overrides.get(index) or AS_PLANNED
 
 
 def tick_at(t_s: float, dt_ns: int) -> int:

@@ -124,8 +124,8 @@ def main(argv: list[str] | None = None) -> int:
         emit("result", ticks_done=0, wall_s=0.0, error=str(exc), dropped=[])
         session.close()
         return 2
-    desk = SettingsDesk(session, keys, scenario, schedule)
     info = WorldInfoDesk(session, scenario, args.roster, schedule)  # for stacks: catabot.client
+    desk = SettingsDesk(session, keys, scenario, schedule, planned=info.behaviours)
     quiet_gc()
     for sig in (signal.SIGINT, signal.SIGTERM):
         signal.signal(sig, lambda *_: conductor.stop("interrupted"))

@@ -13,6 +13,7 @@ from __future__ import annotations
 
 import json
 import logging
+from collections.abc import Callable, Mapping
 from typing import Any
 
 import zenoh
@@ -33,9 +34,18 @@ class QueryRefused(Exception):
 
 class SettingsDesk:
     def __init__(
-        self, session: zenoh.Session, keys: Keys, scenario: Scenario, schedule: Schedule
+        self,
+        session: zenoh.Session,
+        keys: Keys,
+        scenario: Scenario,
+        schedule: Schedule,
+        *,
+        planned: Callable[[], Mapping[str, str]] = dict,
     ) -> None:
+        """`planned()`: each traffic boat's behaviour as the plan drew it, once the world
+        is resolved (WorldInfoDesk; until then a drawn boat's is "as planned")."""
         self.keys, self.scenario, self.schedule = keys, scenario, schedule
+        self.planned = planned
         self.rejections = Rejections(log, "settings")
         self.answered = 0
         self._initial = live.initial_values(scenario)
@@ -84,6 +94,9 @@ class SettingsDesk:
     def in_force(self) -> dict[str, Any]:
         """Every key's value once the changes scheduled so far apply, and where it stands."""
         values = dict(self._initial)
+        for boat, behaviour in self.planned().items():
+            if values.get(f"traffic.{boat}.behaviour") == live.AS_PLANNED:
+                values[f"traffic.{boat}.behaviour"] = behaviour
         changes = self.schedule.in_force()
         for change in changes:
             values[change.key] = change.decoded

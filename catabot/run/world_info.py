@@ -169,13 +169,16 @@ class WorldInfoDesk:
         self._closed = False
         self._queryable: zenoh.Queryable | None = None
         self._answer: dict[str, Any] = {}
+        self._behaviours: dict[str, str] = {}
         self.served = threading.Event()
         args = (session, scenario, roster)
         threading.Thread(target=self._serve, args=args, name="world-info", daemon=True).start()
 
     def _serve(self, session: zenoh.Session, scenario: Scenario, roster: Roster) -> None:
         try:
-            self._answer = describe(World.resolve(scenario), roster)
+            world = World.resolve(scenario)
+            self._answer = describe(world, roster)
+            self._behaviours = {b.id: b.behaviour for b in world.traffic.boats}
         except Exception:  # the run goes on without it; the log says why
             log.exception("world/info cannot be served")
             return
@@ -189,6 +192,10 @@ class WorldInfoDesk:
             query.reply(self.key, json.dumps({**self._answer, "granted": self.schedule.granted}))
         except zenoh.ZError as exc:  # the asker gave up; nothing to do
             log.warning("could not answer a world info query: %s", exc)
+
+    def behaviours(self) -> dict[str, str]:
+        """Each traffic boat's planned behaviour (empty until the world is resolved)."""
+        return self._behaviours
 
     def close(self) -> None:
         with self._lock:

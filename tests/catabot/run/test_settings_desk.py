@@ -91,3 +91,26 @@ def test_a_wildcard_query_gets_the_settings_on_their_own_key(
     assert len(replies) == 1 and replies[0].ok is not None
     assert str(replies[0].ok.key_expr) == KEYS.config("settings")
     assert json.loads(replies[0].ok.payload.to_bytes())["world"] == "desk"
+
+
+def test_a_drawn_boat_shows_its_planned_behaviour_once_the_plan_is_known() -> None:
+    """`catabot get` showed every drawn boat as "as planned"; the world info desk resolves
+    the plan on its own thread, and from then on the desk shows what each boat was drawn."""
+    held = {"index": 1, "behaviour": "hold"}
+    scenario = parse_scenario({"name": "desk", "duration_s": 1.0, "vessels": [{"id": "ego"}],
+                               "traffic": {"count": 2, "boats": [held]}}, source="test")  # fmt: skip
+    session = open_session(Connection(listen=(f"tcp/127.0.0.1:{free_port()}",)))
+    plan: dict[str, str] = {}
+    desk = SettingsDesk(
+        session, KEYS, scenario, Schedule(ticks=scenario.ticks), planned=lambda: plan
+    )
+    try:
+        shown = desk.in_force()["settings"]
+        assert shown["traffic.boat_000.behaviour"] == "as planned"
+        plan.update({"boat_000": "circle", "boat_001": "hold"})
+        shown = desk.in_force()["settings"]
+        assert (shown["traffic.boat_000.behaviour"], shown["traffic.boat_001.behaviour"]) == (
+            "circle", "hold")  # fmt: skip
+    finally:
+        desk.close()
+        session.close()
