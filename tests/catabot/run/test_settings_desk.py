@@ -96,9 +96,9 @@ def test_a_wildcard_query_gets_the_settings_on_their_own_key(
 def test_a_drawn_boat_shows_its_planned_behaviour_once_the_plan_is_known() -> None:
     """`catabot get` showed every drawn boat as "as planned"; the world info desk resolves
     the plan on its own thread, and from then on the desk shows what each boat was drawn."""
-    held = {"index": 1, "behaviour": "hold"}
-    scenario = parse_scenario({"name": "desk", "duration_s": 1.0, "vessels": [{"id": "ego"}],
-                               "traffic": {"count": 2, "boats": [held]}}, source="test")  # fmt: skip
+    traffic = {"count": 2, "boats": [{"index": 1, "behaviour": "hold"}]}
+    data = {"name": "desk", "duration_s": 1.0, "vessels": [{"id": "ego"}], "traffic": traffic}
+    scenario = parse_scenario(data, source="test")
     session = open_session(Connection(listen=(f"tcp/127.0.0.1:{free_port()}",)))
     plan: dict[str, str] = {}
     desk = SettingsDesk(
