@@ -22,8 +22,11 @@ SLACK_S = 1.0  # a loaded CI machine
 def _netns_available() -> bool:
     if os.geteuid() != 0 or shutil.which("ip") is None:
         return False
-    probe = subprocess.run(["ip", "netns", "add", "cbprobe"], capture_output=True)
-    subprocess.run(["ip", "netns", "del", "cbprobe"], capture_output=True)
+    # Each pytest worker probes a name of its own: two workers adding one name at once made
+    # one of them skip every test here.
+    name = f"cbprobe{os.getpid()}"
+    probe = subprocess.run(["ip", "netns", "add", name], capture_output=True)
+    subprocess.run(["ip", "netns", "del", name], capture_output=True)
     return probe.returncode == 0
 
 

@@ -3,6 +3,7 @@ seed, the usual errors after an episode ends and for bad actions, nothing left r
 
 from __future__ import annotations
 
+import re
 import shutil
 import time
 from collections.abc import Iterator
@@ -130,7 +131,7 @@ def test_a_run_that_fails_mid_episode_is_a_clear_error_and_reset_recovers(env: g
     obs, info = env.reset(seed=4)
     assert env.observation_space.contains(obs)
     assert info["endpoint"].startswith("tcp/127.0.0.1:")  # for `catabot view --connect`
-    log = Path(str(failed.value).split("log ", 1)[1].split(", kept")[0])
+    log = Path(re.findall(r"log (/\S+/run\.log), kept", str(failed.value))[0])
     assert log.is_file() and "physics" in log.read_text()  # named, and still there to read
     shutil.rmtree(log.parent)
 
