@@ -217,7 +217,7 @@ class World:
             sea = WaveField(self.scenario.water.waves, self.scenario.seed)
             p[:, 2] += sea.height(p[:, 0], p[:, 1])
             water = sea.velocity(p[:, 0], p[:, 1], p[:, 2])  # map frame, at the surface
-            linear += np.einsum("nji,nj->ni", rotations.matrices(quat), water)  # in the body's
+            linear += np.einsum("nji,nj->ni", rotations.matrices(quat), water)  # R^T: body frame
         angular = np.array([b.velocity.angular for b in self.bodies]).reshape(n, 3)
         zero = np.zeros((n, 3))
         return BodyStates(-1, 0, self.body_ids, p, quat, linear, angular, zero, zero)
@@ -245,7 +245,8 @@ def _bodies(scenario: Scenario, plan: TrafficPlan) -> tuple[Body, ...]:
     buoys = [*scenario.buoys, *plan.buoys]
     rows += [(b.id, "buoy", BUOY_MODEL, Pose(x_m=b.x_m, y_m=b.y_m), None) for b in buoys]
     _unique([r[0] for r in rows])
-    for bid, _, ref, _, _ in rows:
+    first = {ref: bid for bid, _, ref, _, _ in reversed(rows)}  # each model's first body
+    for ref, bid in first.items():
         _check_floats(bid, ref, model(ref), scenario.water.density_kg_m3)
     return tuple(
         Body(bid, kind, ref, model(ref), pose, row, *_scenario_part(config))
