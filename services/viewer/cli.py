@@ -4,7 +4,8 @@
     catabot view RUN_FOLDER --web              ... into the web viewer (prints its address)
     catabot view RUN_FOLDER --save out.rrd     ... into a file (what `recording.rerun` does)
     catabot view --connect ENDPOINT [SOURCE]   attach to a running simulation; SOURCE is its
-                                               run folder or scenario (default: the default)
+                                               run folder or scenario (default: the world
+                                               running there, asked for: --world NAME)
 
 `catabot run --view [web]` starts the live form beside the run. The web viewer is served
 until Ctrl-C (a browser that opens it late still gets everything logged so far). Exit codes:
@@ -23,6 +24,7 @@ from typing import Any
 from urllib.parse import quote
 
 import rerun as rr
+import zenoh
 
 from catabot.bus.session import (
     SessionError,
@@ -31,7 +33,8 @@ from catabot.bus.session import (
     free_port,
 )
 from catabot.bus.session import open_session as open_zenoh
-from catabot.config.load import load_scenario
+from catabot.client.discover import find_world
+from catabot.config.load import load_scenario, parse_scenario
 from catabot.errors import CataBotError
 from catabot.run.answer import OneLineParser, output_file
 from catabot.run.recorded import RecordedRun
@@ -41,6 +44,7 @@ from services.viewer.live import LiveView
 from services.viewer.replay import replay
 
 log = logging.getLogger("viewer")
+FIND_S = 10.0  # how long --connect without a SOURCE asks for the running world
 
 
 def parser() -> argparse.ArgumentParser:
@@ -51,6 +55,7 @@ def parser() -> argparse.ArgumentParser:
         help="a run folder (with --connect: the running run's folder or its scenario file)",
     )
     add_connection_args(p)
+    p.add_argument("--world", help="with --connect and no SOURCE: which running world")
     p.add_argument("--web", action="store_true", help="serve the web viewer, do not spawn one")
     p.add_argument("--web-port", type=int, default=0, help="web viewer port (default: free)")
     p.add_argument("--grpc-port", type=int, default=0, help="data port (default: free)")
@@ -92,17 +97,23 @@ class ViewerPortError(CataBotError, OSError):
     """The web viewer could not serve on its ports."""
 
 
-def _world(args: argparse.Namespace) -> World:
+def _world(args: argparse.Namespace, session: zenoh.Session) -> World:
+    """SOURCE's world, else the one running where it connects (its world/info: a Gym
+    episode's run has no folder to name; the default scenario's world never matched it)."""
     source = args.source
-    if source is not None and Path(source).is_dir():
+    if source is None:
+        where = f"connect {list(args.connect)}"
+        info = find_world(session, args.world, FIND_S, where)
+        return World.resolve(parse_scenario(info.scenario, source=f"world {info.name}"))
+    if Path(source).is_dir():
         source = str(Path(source) / "scenario.json")
     return World.resolve(load_scenario(source))
 
 
 def _live(args: argparse.Namespace) -> rr.RecordingStream:
-    world = _world(args)
     session = open_zenoh(connection_from_args(args))
     try:
+        world = _world(args, session)
         view = LiveView(session, world)  # subscribed before anything is logged
         rec = recording(world, args, live=True)
         if view.linked(session) and args.ready_file is not None:

@@ -73,3 +73,21 @@ def test_a_run_with_the_view_records_the_same_bytes(tmp_path: Path) -> None:
             assert "rerun web viewer: http://127.0.0.1:" in result.stdout
             assert "run ended: completed" in (run / "log" / "viewer.log").read_text()
     assert recorded[0] == recorded[1] and "run.mcap" in recorded[0]
+
+
+def test_view_finds_the_running_world_without_a_source(tmp_path: Path) -> None:
+    """A Gym episode's run has no folder to name: `catabot view --connect` alone asks the
+    endpoint for its world (it used the default scenario's, matched nothing, and hung)."""
+    endpoint = f"tcp/127.0.0.1:{free_port()}"
+    scenario = scenario_file(tmp_path, _scenario(3.0) | {"name": "unnamed"})
+    sim = start("run", str(scenario), "--out", str(tmp_path / "runs"), "--quiet", "--listen",
+                endpoint, "--realtime", "1.0")  # fmt: skip
+    try:
+        wait_for_line(sim, "run folder:")
+        viewer = start("view", "--connect", endpoint, "--save", str(tmp_path / "live.rrd"))
+        assert sim.wait(timeout=60) == 0
+        stdout, stderr = viewer.communicate(timeout=60)
+    finally:
+        sim.kill()
+    assert viewer.returncode == 0, stderr
+    assert "run ended: completed" in stdout and "shown: nothing" not in stdout, stdout
