@@ -245,9 +245,11 @@ def _bodies(scenario: Scenario, plan: TrafficPlan) -> tuple[Body, ...]:
     buoys = [*scenario.buoys, *plan.buoys]
     rows += [(b.id, "buoy", BUOY_MODEL, Pose(x_m=b.x_m, y_m=b.y_m), None) for b in buoys]
     _unique([r[0] for r in rows])
-    first = {ref: bid for bid, _, ref, _, _ in reversed(rows)}  # each model's first body
-    for ref, bid in first.items():
-        _check_floats(bid, ref, model(ref), scenario.water.density_kg_m3)
+    fields = {"vessel": "vessels.{}.model", "boat": "traffic.models", "buoy": "buoys"}
+    first = {ref: (fields[kind].format(i), bid) for i, (bid, kind, ref, _, _) in
+             reversed(list(enumerate(rows)))}  # each model's first body  # fmt: skip
+    for ref, (where, bid) in first.items():
+        _check_floats(f"{where} ({bid})", ref, model(ref), scenario.water.density_kg_m3)
     return tuple(
         Body(bid, kind, ref, model(ref), pose, row, *_scenario_part(config))
         for row, (bid, kind, ref, pose, config) in enumerate(rows)
@@ -289,13 +291,13 @@ def _check_models(scenario: Scenario) -> None:
             raise ScenarioError(f"{where}: {exc}") from None
 
 
-def _check_floats(body: str, ref: str, model: VesselModel, density: float) -> None:
+def _check_floats(where: str, ref: str, model: VesselModel, density: float) -> None:
     """A model heavier than the water its hulls can displace sinks to the bottom, and no
     figure of the run says so (a mass typed with an extra zero)."""
     most = density * sum(h.volume_m3 for h in model.hulls)
     if model.mass_kg > most:
         raise ScenarioError(
-            f"{body}: vessel model {ref!r} cannot float: its mass {model.mass_kg:g} kg is more "
+            f"{where}: vessel model {ref!r} cannot float: its mass {model.mass_kg:g} kg is more "
             f"than its hulls displace wholly under water ({most:.0f} kg in water of "
             f"{density:g} kg/m^3)"
         )

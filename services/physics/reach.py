@@ -4,8 +4,8 @@ The velocity controller clamps to the thrusters' limits (control.py), so a surge
 rate the vessel cannot hold settles short without an error: a stack that asks the
 catamaran for 1 m/s in a 0.3 rad/s turn gets 0.58 m/s. Physics compares each vessel's
 first such order (scripted, or from the bus) with the thrust its steady state needs under
-the model's damping law and says how far the thrusters reach: straight ahead and turning in
-place. Where a combined set-point settles also depends on terms that law leaves out (the
+the model's damping law and says how far the thrusters reach: straight ahead, astern and
+turning in place. Where a combined set-point settles also depends on terms that law leaves out (the
 catamaran turns at 0.29 rad/s, not 0.27, once under way), so no figure is promised for it.
 """
 
@@ -45,11 +45,13 @@ class Reach:
             return
         self.told.add(vessel)
         ahead = _most(lambda x: not self.beyond(vessel, x, 0.0), MAX_SURGE)
+        astern = _most(lambda x: not self.beyond(vessel, -x, 0.0), MAX_SURGE)
         around = _most(lambda x: not self.beyond(vessel, 0.0, x), MAX_YAW_RATE)
+        reach = (f"about {ahead:.2f} m/s straight ahead, {astern:.2f} m/s astern, "
+                 f"{around:.2f} rad/s turning in place")  # fmt: skip
         advise(log, f"{vessel}: the {how} twist {surge:g} m/s at {yaw_rate:g} rad/s is beyond "
-                    f"its thrusters (they hold about {ahead:.2f} m/s straight ahead, "
-                    f"{around:.2f} rad/s turning in place), so it settles short of it: compare "
-                    "the recorded state with the twist (said once a vessel)")  # fmt: skip
+                    f"its thrusters (they hold {reach}), so it settles short of it: compare the "
+                    "recorded state with the twist (said once a vessel)")  # fmt: skip
 
     def beyond(self, vessel: str, surge: float, yaw_rate: float) -> bool:
         """Whether holding the set-point in steady state needs more than the thrusters give."""

@@ -127,6 +127,7 @@ def test_a_model_heavier_than_its_hulls_displace_is_refused(tmp_path: Path, mass
     if mass_kg < 280.0:
         World.resolve(parse_scenario(data))
         return
-    said = r"ego: vessel model '.*cat.json' cannot float: its mass 400 kg is more than its hulls "
-    with pytest.raises(ScenarioError, match=said + r"displace wholly under water \(280 kg"):
+    said = r"vessels.0.model \(ego\): vessel model '.*cat.json' cannot float: its mass 400 kg "
+    with pytest.raises(ScenarioError, match=said + r"is more than its hulls displace wholly") as e:
         World.resolve(parse_scenario(data))
+    assert "under water (280 kg in water of 1025 kg/m^3)" in str(e.value)

@@ -53,7 +53,7 @@ def test_told_once_a_vessel_and_never_for_a_set_point_in_reach(
         reach.heard("b", [TwistCmd(surge=0.0, yaw_rate=-2.0)])
     said = _advice(caplog)
     assert [s.split(":")[0] for s in said] == ["a", "b"]
-    assert "0.27 rad/s turning in place" in said[0]
+    assert "1.88 m/s straight ahead, 1.62 m/s astern, 0.27 rad/s turning in place" in said[0]
 
 
 def test_a_scripted_twist_beyond_reach_is_told_at_the_start(
