@@ -43,11 +43,14 @@ def _color(k: int) -> str:
 
 
 def trajectories(data: RunSeries) -> Figure:
-    """Every vessel's track over the terrain (cropped to the tracks), buoys, starts and ends."""
+    """Every vessel's track over the terrain (cropped to the tracks, the tasks and the
+    scenario's buoys: the traffic's waypoint buoys may lie far off), buoys, starts and ends."""
     world, pos = data.run.world, data.states.position
     vessels = len(world.vessels)
     xy = pos[:, :, :2]
-    seen = np.concatenate([xy.reshape(-1, 2), _task_points(world, data.own)])
+    moored = [(b.x_m, b.y_m) for b in world.scenario.buoys]  # not the traffic's far waypoints
+    seen = np.concatenate([xy[:, :vessels].reshape(-1, 2), _task_points(world, data.own),
+                           np.array(moored, dtype=np.float64).reshape(-1, 2)])  # fmt: skip
     lo, hi = np.nanmin(seen, axis=0) - MARGIN_M, np.nanmax(seen, axis=0) + MARGIN_M
     fig = _figure(size=(8.5, 8))
     ax = _axes(fig)[0]
@@ -63,7 +66,7 @@ def trajectories(data: RunSeries) -> Figure:
         ax.plot(xy[:, row, 0], xy[:, row, 1], color=_color(k), lw=2.2, label=vid)
         ax.plot(*xy[0, row], "o", color=_color(k), ms=7, mec="black")
         ax.plot(*xy[-1, row], "s", color=_color(k), ms=7, mec="black")
-        _task(ax, world.scenario.vessels[row].task, _color(k))
+        _task(ax, world.scenario.vessels[row].task, _color(k), vid)
     if world.buoys:
         b = xy[-1, vessels:]
         ax.scatter(b[:, 0], b[:, 1], s=14, c="#fac81e", edgecolors="black", lw=0.4,
@@ -98,7 +101,7 @@ def _task_points(world: World, own: Any) -> np.ndarray:
     return np.array(points, dtype=np.float64).reshape(-1, 2)
 
 
-def _task(ax: Axes, task: TaskConfig | None, color: str) -> None:
+def _task(ax: Axes, task: TaskConfig | None, color: str, vid: str) -> None:
     """A vessel's goal region (dashed circle) and route (dotted line), as metrics.json
     measures them."""
     if task is None:
@@ -106,10 +109,11 @@ def _task(ax: Axes, task: TaskConfig | None, color: str) -> None:
     if task.goal is not None:
         goal = task.goal
         ax.add_patch(Circle((goal.x_m, goal.y_m), goal.radius_m, fill=False, ls="--", lw=1.4,
-                            ec=color))  # fmt: skip
+                            ec=color, label=f"{vid} goal"))  # fmt: skip
     if task.route is not None:
         route = np.asarray(task.route, dtype=np.float64)
-        ax.plot(route[:, 0], route[:, 1], ":", color=color, lw=1.4, marker=".")
+        ax.plot(route[:, 0], route[:, 1], ":", color=color, lw=1.4, marker=".",
+                label=f"{vid} route")  # fmt: skip
 
 
 def _terrain(ax: Axes, data: RunSeries, lo: Any, hi: Any) -> None:

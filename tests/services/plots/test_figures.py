@@ -43,10 +43,11 @@ def test_trajectories_mark_the_task_and_number_the_boats() -> None:
     }))  # fmt: skip
     assert _task_points(world, ["ego"]).tolist() == [[60.0, 20.0], [0.0, 0.0], [30.0, 5.0]]
     fig, ax = plt.subplots()
-    _task(ax, world.scenario.vessels[0].task, "#ff8c00")
+    _task(ax, world.scenario.vessels[0].task, "#ff8c00", "ego")
     xy = np.zeros((2, len(world.bodies), 2))
     _boat_names(ax, world, xy)
     (goal,) = [p for p in ax.patches if isinstance(p, Circle)]
-    assert goal.center == (60.0, 20.0) and goal.radius == 4.0
+    assert goal.center == (60.0, 20.0) and goal.radius == 4.0 and goal.get_label() == "ego goal"
+    assert [line.get_label() for line in ax.lines] == ["ego route"]
     assert [t.get_text() for t in ax.texts] == [str(i) for i in range(12)]  # boat_000 -> "0"
     plt.close(fig)
