@@ -219,6 +219,16 @@ class VesselModel(Strict):
                 )
         return self
 
+    def sinks_in(self, density: float) -> str:
+        """Why this model cannot float in water of `density` kg/m^3 ("" if it can): heavier
+        than its hulls displace wholly under, it sinks to the bottom, and no figure of a run
+        says so (a mass typed with an extra zero)."""
+        most = density * sum(h.volume_m3 for h in self.hulls)
+        if self.mass_kg <= most:
+            return ""
+        return (f"cannot float: its mass {self.mass_kg:g} kg is more than its hulls displace "
+                f"wholly under water ({most:.0f} kg in water of {density:g} kg/m^3)")  # fmt: skip
+
     def hull_box(self) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
         """The axis-aligned body-frame box (lo, hi corners, m) around every hull: the body's
         collision shape in physics, and what sensors see of a model without a `shape`."""

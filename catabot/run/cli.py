@@ -14,6 +14,8 @@ from pathlib import Path
 
 from catabot.bus.session import Connection, SessionError, add_connection_args, open_session
 from catabot.config.load import json_schema, model_schema
+from catabot.config.scenario import WaterConfig
+from catabot.config.vessel import VesselModelError, load_vessel_model
 from catabot.errors import CataBotError
 from catabot.run import compose, conduct, launcher, secure, settings_cli
 from catabot.run.answer import OneLineParser, answered, output_file
@@ -135,6 +137,8 @@ def _scenario(args: argparse.Namespace) -> int:
         return answered(f"scenario {args.action}", lambda: _schema(args.output, model=model))
     if args.action == "generate":
         return generate(args)
+    if args.file is not None and _is_model(Path(args.file)):
+        return answered("scenario validate", lambda: _valid_model(args.file))
     try:  # what `catabot run` checks before it starts anything, no less
         world = launcher.prepare(launcher.RunOptions(scenario=args.file))
     except CataBotError as exc:
@@ -147,6 +151,25 @@ def _scenario(args: argparse.Namespace) -> int:
     )
     print(f"{args.file or 'default'}: valid ({counts})")
     return 0
+
+
+def _is_model(path: Path) -> bool:
+    """A vessel model file given to `validate` (its `hulls`, no `vessels`): checked as one,
+    not refused field by field as a scenario."""
+    try:
+        data = json.loads(path.read_text())
+    except (OSError, ValueError):
+        return False  # the scenario path says what is wrong with it
+    return isinstance(data, dict) and "hulls" in data and "vessels" not in data
+
+
+def _valid_model(file: str) -> str:
+    model = load_vessel_model(str(Path(file).resolve()))
+    sinks = model.sinks_in(WaterConfig().density_kg_m3)  # a scenario's water: with it
+    if sinks:
+        raise VesselModelError(f"vessel model {file!r} {sinks}")
+    return (f"{file}: a valid vessel model {model.name!r} ({model.mass_kg:g} kg, "
+            f"{len(model.hulls)} hull(s), {len(model.thrusters)} thruster(s))")  # fmt: skip
 
 
 def parser() -> argparse.ArgumentParser:

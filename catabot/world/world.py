@@ -292,15 +292,9 @@ def _check_models(scenario: Scenario) -> None:
 
 
 def _check_floats(where: str, ref: str, model: VesselModel, density: float) -> None:
-    """A model heavier than the water its hulls can displace sinks to the bottom, and no
-    figure of the run says so (a mass typed with an extra zero)."""
-    most = density * sum(h.volume_m3 for h in model.hulls)
-    if model.mass_kg > most:
-        raise ScenarioError(
-            f"{where}: vessel model {ref!r} cannot float: its mass {model.mass_kg:g} kg is more "
-            f"than its hulls displace wholly under water ({most:.0f} kg in water of "
-            f"{density:g} kg/m^3)"
-        )
+    sinks = model.sinks_in(density)
+    if sinks:
+        raise ScenarioError(f"{where}: vessel model {ref!r} {sinks}")
 
 
 def _unique(ids: list[str]) -> None:

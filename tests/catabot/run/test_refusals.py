@@ -131,3 +131,21 @@ def test_the_vessel_model_schema_checks_every_bundled_model(tmp_path: Path) -> N
         jsonschema.validate(json.loads((BUNDLED_VESSELS / f"{name}.json").read_text()), schema)
     with pytest.raises(jsonschema.ValidationError, match="mass_kg"):
         jsonschema.validate({"name": "x", "hulls": []}, schema)
+
+
+def test_validate_checks_a_vessel_model_file_as_one(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """A model file given to `validate` was read as a scenario: 15 unknown fields."""
+    assert main(["scenario", "validate", str(BUNDLED_VESSELS / "wamv.json")]) == 0
+    assert (
+        "a valid vessel model 'wamv' (211 kg, 2 hull(s), 2 thruster(s))" in capsys.readouterr().out
+    )
+    heavy = json.loads((BUNDLED_VESSELS / "catabot.json").read_text()) | {"mass_kg": 400.0}
+    (tmp_path / "heavy.json").write_text(json.dumps(heavy))
+    assert main(["scenario", "validate", str(tmp_path / "heavy.json")]) == 2
+    assert "cannot float: its mass 400 kg" in capsys.readouterr().err
+    typo = {k: v for k, v in heavy.items() if k != "damping"} | {"dampng": heavy["damping"]}
+    (tmp_path / "typo.json").write_text(json.dumps(typo))
+    assert main(["scenario", "validate", str(tmp_path / "typo.json")]) == 2
+    assert "damping: required field missing; dampng: unknown field" in capsys.readouterr().err
