@@ -158,7 +158,7 @@ def _is_model(path: Path) -> bool:
     not refused field by field as a scenario."""
     try:
         data = json.loads(path.read_text())
-    except (OSError, ValueError):
+    except (OSError, ValueError, RecursionError):
         return False  # the scenario path says what is wrong with it
     return isinstance(data, dict) and "hulls" in data and "vessels" not in data
 
