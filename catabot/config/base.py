@@ -198,7 +198,10 @@ def describe(err: Any, *, model: type[BaseModel], where: str = "") -> str:
 
 
 def _short(value: Any) -> str:
-    """A value as shown in a message: its repr, cut short (a 10,000-character name)."""
+    """A value as shown in a message: its repr, cut short (a 10,000-character name); the
+    file's own words for what JSON spells differently (null, true, false)."""
+    if value is None or isinstance(value, bool):
+        return json.dumps(value)
     text = repr(value)
     return text if len(text) <= 80 else text[:77] + "..."
 

@@ -82,6 +82,7 @@ class McapIndex:
             raise McapIndexError(f"{self.path}: cannot read ({exc.strerror})") from None
         if self.data[: len(MAGIC)] != MAGIC:
             raise McapIndexError(f"{self.path}: not an MCAP file (no magic bytes)")
+        self.finished = self.data[-len(MAGIC) :] == MAGIC  # else a killed writer's, or cut off
         self.channels: dict[str, Channel] = {}
         indexed = _from_summary(self.data, self.path)
         if indexed is not None:

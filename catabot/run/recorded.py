@@ -14,6 +14,7 @@ from __future__ import annotations
 
 import base64
 import json
+import logging
 from collections.abc import Iterator
 from dataclasses import dataclass
 from functools import cached_property
@@ -35,6 +36,7 @@ from catabot.run import cdr_columns, recorded_poses
 from catabot.run.mcap_index import Channel, McapIndex
 from catabot.world.world import MountedSensor, World
 
+log = logging.getLogger("catabot.recorded")
 M = TypeVar("M", bound=Message)
 IMAGE_TOPICS = {"color": "image_raw"}  # a camera output -> its topic, where they differ
 _POINT_TYPES = {1: "i1", 2: "u1", 3: "<i2", 4: "<u2", 5: "<i4", 6: "<u4", 7: "<f4", 8: "<f8"}
@@ -83,7 +85,8 @@ class RecordedRun:
     def __init__(self, folder: str | Path) -> None:
         self.folder = Path(folder)
         if not self.folder.is_dir():
-            raise RunFolderError(f"{self.folder}: no such run folder")
+            what = "a file, not a run folder" if self.folder.exists() else "no such run folder"
+            raise RunFolderError(f"{self.folder}: {what}")
         scenario = self.folder / "scenario.json"
         if not scenario.is_file():
             raise RunFolderError(f"{self.folder}: not a run folder (it has no scenario.json)")
@@ -103,7 +106,12 @@ class RecordedRun:
                 f"{self.folder}: no run.mcap (recorded with recording.mcap false?); "
                 "replay, export and plots read it"
             )
-        return McapIndex(path)
+        index = McapIndex(path)
+        if not index.finished:  # what is there is read, and the reader is told so
+            count = sum(len(c) for c in index.channels.values())
+            log.warning("%s: cut off (no end: the run was killed or the file truncated); read "
+                        "to its last whole record, %d messages", path, count)  # fmt: skip
+        return index
 
     @cached_property
     def extra(self) -> McapIndex | None:

@@ -66,8 +66,12 @@ def parser() -> argparse.ArgumentParser:
 
 
 def recording(world: World, args: argparse.Namespace, *, live: bool) -> rr.RecordingStream:
-    """A recording on `sim_time` only (no wall-clock timelines), sent where `args` say."""
-    rec = rr.RecordingStream("catabot", recording_id=world.scenario.name, send_properties=False)
+    """A recording on `sim_time` only (no wall-clock timelines), sent where `args` say. Its
+    id is the run folder's name where there is one: the viewer merges recordings of one id,
+    so two runs of a scenario opened side by side were one recording."""
+    folder = Path(args.source) if args.source and Path(args.source).is_dir() else None
+    name = folder.resolve().name if folder is not None else world.scenario.name
+    rec = rr.RecordingStream("catabot", recording_id=name, send_properties=False)
     rec.set_log_time_enabled(False)
     rec.set_log_tick_enabled(False)
     layout = blueprint(world, live=live)

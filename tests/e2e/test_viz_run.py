@@ -95,6 +95,8 @@ def test_run_rrd_holds_every_stream_on_sim_time(run: Path) -> None:
     assert rows["/series/imu_accel/ego.imu"] == topics["/ego/imu/imu"] == 100
     assert rows["/world/trails"] == round(SECONDS / 0.2) + 1 and rows["/metrics"] == 1  # from t = 0
     assert {*bodies, "/world/water", "/world/vessels/ego/cam"} <= static  # the shapes, once
+    (entry,) = rr.chunk.RrdReader(run / "run.rrd").recordings()
+    assert entry.recording_id == run.name  # two runs' files open side by side, not merged
 
 
 def test_view_replays_the_run_into_the_same_rows(run: Path, tmp_path: Path) -> None:
@@ -178,6 +180,7 @@ def test_plot_writes_figures_and_a_report(run: Path, tmp_path: Path) -> None:
     [
         (("view", "{tmp}/nowhere", "--save", "{tmp}/x.rrd"), "no such run folder"),
         (("plot", "{tmp}/nowhere"), "no such run folder"),
+        (("plot", "{run}/scenario.json"), "scenario.json: a file, not a run folder"),
         (("dataset", "export", "{tmp}/nowhere", "-f", "yolo", "-o", "{tmp}/o"), "no such run"),
         (("dataset", "export", "{run}", "-f", "voc", "-o", "{tmp}/o"), "invalid choice: 'voc'"),
         (("dataset", "export", "{run}", "-f", "yolo", "-o", "{run}"), "is not an empty folder"),

@@ -313,3 +313,13 @@ def _with(root: dict[str, Any], path: tuple[Any, ...], value: Any) -> dict[str, 
         target = target[part]
     target[path[-1]] = value
     return root
+
+
+def test_a_value_is_shown_in_the_files_own_words() -> None:
+    """JSON's null and true were shown as Python's None and True."""
+    data = _base()
+    data["traffic"] = {"count": 1, "region": None}
+    data["duration_s"] = True
+    msg = _error(data)
+    assert "traffic.region: must be an object (got null)" in msg
+    assert "duration_s: must be a number (got true)" in msg
