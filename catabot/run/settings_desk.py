@@ -93,14 +93,14 @@ class SettingsDesk:
 
     def in_force(self) -> dict[str, Any]:
         """Every key's value once the changes scheduled so far apply, and where it stands."""
-        values = dict(self._initial)
-        for boat, behaviour in self.planned().items():
-            if values.get(f"traffic.{boat}.behaviour") == live.AS_PLANNED:
-                values[f"traffic.{boat}.behaviour"] = behaviour
+        values, planned = dict(self._initial), self.planned()
+        specs = live.keys_of(self.scenario)
+        for key, spec in specs.items():  # a drawn boat's behaviour, once the plan is known
+            if spec.kind == "behaviour" and values[key] == live.AS_PLANNED:
+                values[key] = planned.get(spec.owner, live.AS_PLANNED)
         changes = self.schedule.in_force()
         for change in changes:
             values[change.key] = change.decoded
-        specs = live.keys_of(self.scenario)
         return {
             "world": self.keys.world,
             "granted": self.schedule.granted,

@@ -87,7 +87,7 @@ class TwistControllerBank:
     with 100 traffic boats a controller call per boat would cost more than the physics."""
 
     def __init__(self, models: list[VesselModel], *, dt_s: float) -> None:
-        single = [TwistController(m, dt_s=dt_s) for m in models]
+        self.single = single = [TwistController(m, dt_s=dt_s) for m in models]  # reach.py too
         width = max(len(c.fwd) for c in single)
         self.count = np.array([len(c.fwd) for c in single])
         self.damp = np.stack([c.damp for c in single])  # (N, 2, 2)

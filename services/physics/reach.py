@@ -5,8 +5,8 @@ rate the vessel cannot hold settles short without an error: a stack that asks th
 catamaran for 1 m/s in a 0.3 rad/s turn gets 0.58 m/s. Physics compares each vessel's
 first such order (scripted, or from the bus) with the thrust its steady state needs under
 the model's damping law and says how far the thrusters reach: straight ahead, astern and
-turning in place. Where a combined set-point settles also depends on terms that law leaves out (the
-catamaran turns at 0.29 rad/s, not 0.27, once under way), so no figure is promised for it.
+turning in place. Where a combined set-point settles also depends on terms that law leaves
+out (the catamaran turns at 0.29 rad/s, not 0.27, once under way), so no figure is promised.
 """
 
 from __future__ import annotations
@@ -27,8 +27,9 @@ MAX_SURGE, MAX_YAW_RATE = 100.0, 100.0  # m/s, rad/s: where the search for a top
 
 
 class Reach:
-    def __init__(self, vessels: Sequence[Body], *, dt_s: float) -> None:
-        self.control = {v.id: TwistController(v.model, dt_s=dt_s) for v in vessels}
+    def __init__(self, vessels: Sequence[Body], controllers: Sequence[TwistController]) -> None:
+        """`controllers`: each vessel's, in the same order (TwistControllerBank.single)."""
+        self.control = {v.id: c for v, c in zip(vessels, controllers, strict=True)}
         self.told: set[str] = set()
         for v in vessels:
             for step in v.script:

@@ -46,7 +46,7 @@ class PhysicsService:
             [v.model for v in world.vessels], dt_s=self.dt_ns / 1e9
         )
         self.book = CommandBook(world.vessels)
-        self.reach = Reach(world.vessels, dt_s=self.dt_ns / 1e9)  # says a twist is too much
+        self.reach = Reach(world.vessels, self.controllers.single)  # says a twist is too much
         streams = world.streams
         self.streams = [*streams.commands, *streams.controls, *streams.waypoints]
         self.vessel_of = {s.key: ctx.keys.vessel_of(s.key) for s in self.streams}

@@ -69,7 +69,7 @@ def recording(world: World, args: argparse.Namespace, *, live: bool) -> rr.Recor
     """A recording on `sim_time` only (no wall-clock timelines), sent where `args` say. Its
     id is the run folder's name where there is one: the viewer merges recordings of one id,
     so two runs of a scenario opened side by side were one recording."""
-    folder = Path(args.source) if args.source and Path(args.source).is_dir() else None
+    folder = _run_folder(args)
     name = folder.resolve().name if folder is not None else world.scenario.name
     rec = rr.RecordingStream("catabot", recording_id=name, send_properties=False)
     rec.set_log_time_enabled(False)
@@ -101,6 +101,11 @@ class ViewerPortError(CataBotError, OSError):
     """The web viewer could not serve on its ports."""
 
 
+def _run_folder(args: argparse.Namespace) -> Path | None:
+    """SOURCE when it is a run folder (not a scenario file, not absent)."""
+    return Path(args.source) if args.source and Path(args.source).is_dir() else None
+
+
 def _world(args: argparse.Namespace, session: zenoh.Session) -> World:
     """SOURCE's world, else the one running where it connects (its world/info: a Gym
     episode's run has no folder to name; the default scenario's world never matched it)."""
@@ -109,8 +114,9 @@ def _world(args: argparse.Namespace, session: zenoh.Session) -> World:
         where = f"connect {list(args.connect)}"
         info = find_world(session, args.world, FIND_S, where)
         return World.resolve(parse_scenario(info.scenario, source=f"world {info.name}"))
-    if Path(source).is_dir():
-        source = str(Path(source) / "scenario.json")
+    folder = _run_folder(args)
+    if folder is not None:
+        source = str(folder / "scenario.json")
     return World.resolve(load_scenario(source))
 
 
@@ -122,8 +128,7 @@ def _live(args: argparse.Namespace) -> rr.RecordingStream:
         rec = recording(world, args, live=True)
         if view.linked(session) and args.ready_file is not None:
             args.ready_file.touch()  # catabot run starts its services now
-        run_dir = Path(args.source) if args.source and Path(args.source).is_dir() else None
-        end = view.run(rec, run_dir)
+        end = view.run(rec, _run_folder(args))
         rec.flush()
     finally:
         session.close()

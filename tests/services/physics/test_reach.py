@@ -12,12 +12,14 @@ from catabot.bus.messages import ThrustCmd, TwistCmd
 from catabot.config.scenario import ScriptStep
 from catabot.config.vessel import load_vessel_model
 from catabot.run.advice import advice_of
+from services.physics.control import TwistController
 from services.physics.reach import Reach
 
 
 def _reach(*vessels: tuple[str, str, tuple[ScriptStep, ...]]) -> Reach:
     bodies = [SimpleNamespace(id=v, model=load_vessel_model(m), script=s) for v, m, s in vessels]
-    return Reach(bodies, dt_s=0.01)  # type: ignore[arg-type]
+    controllers = [TwistController(b.model, dt_s=0.01) for b in bodies]
+    return Reach(bodies, controllers)  # type: ignore[arg-type]
 
 
 def _advice(caplog: pytest.LogCaptureFixture) -> list[str]:
