@@ -267,9 +267,15 @@ def _scenario_part(
 
 def _check_script(vessel: VesselConfig, model: VesselModel, *, where: str) -> None:
     """A thrust step gives one value per thruster of the vessel's model: physics would
-    refuse any other at every tick and the vessel would drift unpowered."""
+    refuse any other at every tick and the vessel would drift unpowered. Steps may come in
+    any order (they are sorted), but one time has one step."""
     count = len(model.thrusters)
+    first_at: dict[float, int] = {}  # time: the first step at it
     for k, step in enumerate(vessel.script):
+        earlier = first_at.setdefault(step.t_s, k)
+        if earlier != k:  # which of the two would rule is a guess: the file's order or not
+            raise ScenarioError(f"{where}.script.{k}.t_s: step {earlier} is also at {step.t_s:g} "
+                                "s; give each time one step")  # fmt: skip
         if step.thrust is not None and len(step.thrust) != count:
             raise ScenarioError(
                 f"{where}.script.{k}.thrust: {len(step.thrust)} value(s), but model "

@@ -116,6 +116,15 @@ class CommandBook:
                 self.has_set_point[self.row[vessel]] = True
 
 
+def never_applied(vessels: Sequence[Body], *, last_ns: int) -> list[str]:
+    """Advice on script steps after the run's last tick (a `--duration` shorter than the
+    script, say): they are taken, and never applied."""
+    return [f"{v.id}: its script step at {step.t_s:g} s comes after the run's last tick "
+            f"({last_ns / 1e9:g} s), so it is never applied"
+            for v in vessels for step, t in zip(v.script, v.script_ns, strict=True)
+            if t > last_ns]  # fmt: skip
+
+
 def _place(
     order: Order, row: int, target: Array, follow: NDArray[np.bool_], thrust: dict[int, Any]
 ) -> None:

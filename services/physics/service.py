@@ -18,9 +18,10 @@ from catabot.bus.settings import changes_of
 from catabot.bus.strays import watch_strays
 from catabot.bus.taken import entry
 from catabot.config import live
+from catabot.run.advice import advise
 from catabot.run.service import Built, ServiceContext, run_service
 from services.physics import settings
-from services.physics.commands import CommandBook
+from services.physics.commands import CommandBook, never_applied
 from services.physics.control import TwistControllerBank
 from services.physics.reach import Reach
 from services.physics.setup import build_world
@@ -47,6 +48,9 @@ class PhysicsService:
         )
         self.book = CommandBook(world.vessels)
         self.reach = Reach(world.vessels, self.controllers.single)  # says a twist is too much
+        last_ns = (world.scenario.ticks - 1) * self.dt_ns
+        for text in never_applied(world.vessels, last_ns=last_ns):
+            advise(log, text)
         streams = world.streams
         self.streams = [*streams.commands, *streams.controls, *streams.waypoints]
         self.vessel_of = {s.key: ctx.keys.vessel_of(s.key) for s in self.streams}

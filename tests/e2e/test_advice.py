@@ -1,5 +1,5 @@
 """`catabot run` tells on its console (stderr, with refusals) what a service advises: a
-twist beyond reach."""
+twist beyond reach, a script step after the run's end."""
 
 from __future__ import annotations
 
@@ -14,7 +14,8 @@ def test_a_scripted_twist_beyond_reach_is_told_on_the_console(tmp_path: Path) ->
 
     data = {"name": "advice", "duration_s": 0.5, "vessels": [
         {"id": "fast", "script": twist(3.0)},
-        {"id": "slow", "pose": {"x_m": 10.0, "y_m": 0.0}, "script": twist(1.0)},
+        {"id": "slow", "pose": {"x_m": 10.0, "y_m": 0.0},
+         "script": [*twist(1.0), {"t_s": 2.0, "thrust": [0.0, 0.0]}]},
     ]}  # fmt: skip
     out = tmp_path / "runs"
     result = catabot("run", str(scenario_file(tmp_path, data)), "--out", str(out), "--quiet")
@@ -24,3 +25,5 @@ def test_a_scripted_twist_beyond_reach_is_told_on_the_console(tmp_path: Path) ->
     assert told[0].startswith("physics: fast: the scripted twist 3 m/s at 0 rad/s is beyond")
     assert "about 1.88 m/s straight ahead" in told[0]
     assert told[0].split("physics: ", 1)[1] in (only_run_dir(out) / "log/physics.log").read_text()
+    late = "physics: slow: its script step at 2 s comes after the run's last tick (0.49 s), so it"
+    assert late in result.stderr

@@ -1,5 +1,5 @@
 """What `catabot` refuses before anything starts, with one line naming why (exit 2): a
-script that does not fit its vessel's thrusters, a controller's missing program (validate
+script that does not fit its vessel's thrusters or gives one time two steps, a controller's missing program (validate
 says what run would), an output file in a folder that is not there, an endpoint nobody
 listens on or that cannot be listened on. And the line a run prints while it waits for a
 stack the user starts."""
@@ -46,6 +46,15 @@ def test_a_thrust_step_needs_one_value_per_thruster(
     script = [{"t_s": 0.0, "thrust": [0.5, 0.5]}, {"t_s": 2.0, "thrust": [0.5]}]
     err = _both_refuse(_scenario(tmp_path, script=script), tmp_path / "runs", capsys)
     assert "vessels.0.script.1.thrust: 1 value(s), but model 'catabot' has 2 thruster(s)" in err
+
+
+def test_two_script_steps_at_one_time_are_refused(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    script = [{"t_s": 2.0, "thrust": [0.5, 0.5]}, {"t_s": 0.0, "thrust": [1.0, 1.0]},
+              {"t_s": 2.0, "twist": {"surge_mps": 1.0, "yaw_rate_radps": 0.0}}]  # fmt: skip
+    err = _both_refuse(_scenario(tmp_path, script=script), tmp_path / "runs", capsys)
+    assert "vessels.0.script.2.t_s: step 0 is also at 2 s; give each time one step" in err
 
 
 def test_validate_refuses_a_missing_program_as_run_does(
