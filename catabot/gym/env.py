@@ -100,7 +100,7 @@ class CataBotEnv(gym.Env[Obs, np.ndarray]):
         self._steps, self._over = 0, False
         run_dir = live.run.run_dir() if self.options.runs_dir is not None else None
         where = {"run_dir": run_dir, "endpoint": live.run.endpoint}  # `catabot view --connect`
-        return self._observer(frame), self._info(frame) | where
+        return self._observer(frame), self._info(frame) | self._judge.flags(frame.bodies) | where
 
     def step(self, action: Any) -> tuple[Obs, float, bool, bool, dict[str, Any]]:
         if self._over or self._judge is None or self._observer is None:

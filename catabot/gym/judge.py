@@ -18,6 +18,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 
@@ -76,7 +77,7 @@ class Judge:
         return math.hypot(self.goal.x_m - x, self.goal.y_m - y)
 
     def __call__(self, bodies: BodyStates, action: np.ndarray) -> Verdict:
-        w, o = self.options.rewards, self.options
+        w = self.options.rewards
         d = self.distance(bodies)
         reward = w.progress * (self.last_distance - d) - w.distance * d - w.time
         reward -= w.energy * float(np.mean(np.square(action)))
@@ -84,13 +85,21 @@ class Judge:
             off = math.remainder(self._yaw(bodies) - self.goal.yaw_rad, math.tau)
             reward -= w.heading * abs(off)
         self.last_distance = d
-        hit, grounded = self.collision(bodies), self.grounded(bodies)
-        reached = o.task == "navigate" and d <= o.goal_radius_m
+        hit, grounded, reached = self.collision(bodies), self.grounded(bodies), self.reached(d)
         reward += w.goal if reached else 0.0
         reward -= w.collision if hit else 0.0
         reward -= w.grounding if grounded else 0.0
         done = reached or hit is not None or grounded
         return Verdict(reward, done, d, reached, hit, grounded)
+
+    def reached(self, distance_m: float) -> bool:
+        return self.options.task == "navigate" and distance_m <= self.options.goal_radius_m
+
+    def flags(self, bodies: BodyStates) -> dict[str, Any]:
+        """The outcome keys of step's info for a frame, so reset's info has them too (a
+        vector env's info arrays, code that reads info['collision'] after any call)."""
+        return {"reached": self.reached(self.distance(bodies)),
+                "collision": self.collision(bodies), "grounded": self.grounded(bodies)}  # fmt: skip
 
     def _yaw(self, bodies: BodyStates) -> float:
         return float(rotations.yaw_of_quaternions(bodies.orientation[self.row : self.row + 1])[0])

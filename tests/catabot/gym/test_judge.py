@@ -106,3 +106,15 @@ def test_reward_is_progress_less_energy_and_ends_on_events() -> None:
     assert reached.reward == pytest.approx(6.5 + 100.0)
     hit = judge(states(w, {"ego": (50.0, 69.5, math.pi / 2)}), np.zeros(2))
     assert hit.terminated and hit.collision == "b1" and hit.reward < -90
+
+
+def test_flags_give_reset_the_outcome_keys_of_step() -> None:
+    w = world()
+    judge = Judge(w, "ego", env_options(goal_radius_m=3.0))
+    judge.start(Goal(52.0, 50.0, 0.0), states(w, {}))
+    clear = judge.flags(states(w, {}))
+    assert clear == {"reached": True, "collision": None, "grounded": False}  # 2 m from it
+    _, hi = w.body("ego").model.hull_box()
+    olo, _ = w.body("other").model.hull_box()
+    touching = states(w, {"other": (50.0 + hi[0] - olo[0] - 0.05, 50.0, 0.0)})
+    assert judge.flags(touching)["collision"] == "other"
