@@ -86,7 +86,11 @@ class SimProcess:
                 _kill_tree(self.proc.pid)
                 self.proc.wait()
         if not self.failed:
-            shutil.rmtree(self.folder, ignore_errors=True)
+            self.discard()
+
+    def discard(self) -> None:
+        """Its temporary folder goes, failed or not (a port clash the env tried again)."""
+        shutil.rmtree(self.folder, ignore_errors=True)
 
 
 def _child_env() -> dict[str, str]:

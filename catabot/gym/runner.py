@@ -63,11 +63,13 @@ class Runner:
         """A new run of `seed`, joined. A port another process took between the pick and the
         run's bind (a parallel env or test: "Address already in use") is tried again."""
         for attempt in range(PORT_TRIES):
+            live = self._launch(seed)
             try:
-                return self._join(self._launch(seed))
+                return self._join(live)
             except RunError as exc:
                 if PORT_TAKEN not in str(exc) or attempt == PORT_TRIES - 1:
                     raise
+                live.run.discard()  # tried again: no error names its log
         raise AssertionError("unreachable")
 
     def _join(self, live: Live) -> Live:

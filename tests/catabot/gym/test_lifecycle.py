@@ -9,6 +9,7 @@ import subprocess
 import sys
 import textwrap
 from pathlib import Path
+from typing import Any
 
 import gymnasium as gym
 import numpy as np
@@ -97,7 +98,16 @@ def test_a_port_taken_before_the_run_binds_it_is_tried_again(
     monkeypatch: pytest.MonkeyPatch,
 ) -> None:
     """Another process took the port picked for the episode's run before the run bound it:
-    reset failed ("Address already in use", a CI rehearsal); the runner starts it again."""
+    reset failed ("Address already in use", a CI rehearsal); the runner starts it again,
+    and the failed start's temporary folder goes (no error names its log)."""
+    folders = []
+    real_init = process.SimProcess.__init__
+
+    def noted(run: process.SimProcess, *args: Any, **kwargs: Any) -> None:
+        real_init(run, *args, **kwargs)
+        folders.append(run.folder)
+
+    monkeypatch.setattr(process.SimProcess, "__init__", noted)
     with socket.socket() as taken:
         taken.bind(("127.0.0.1", 0))
         taken.listen()
@@ -111,3 +121,4 @@ def test_a_port_taken_before_the_run_binds_it_is_tried_again(
         finally:
             env.close()
     assert next(ports, None) is None  # the taken one was tried first
+    assert len(folders) == 2 and not [f for f in folders if f.exists()]
