@@ -17,6 +17,7 @@ from typing import Any
 import numpy as np
 import pytest
 import rerun as rr
+import yaml
 from conftest import basic_scenario, catabot, files_of, only_run_dir, scenario_file
 from PIL import Image
 from pycocotools.coco import COCO
@@ -149,6 +150,7 @@ def test_kitti_labels_one_per_point_with_rain_as_its_class(run: Path) -> None:
     ]
     assert len(sorted((seq / "velodyne").glob("*.bin"))) == len(clouds) == 20
     assert len((seq / "poses.txt").read_text().splitlines()) == len(clouds)
+    per_class = np.zeros(6)
     for n, cloud in enumerate(clouds):
         points = np.fromfile(seq / "velodyne" / f"{n:06d}.bin", dtype="<f4").reshape(-1, 4)
         labels = np.fromfile(seq / "labels" / f"{n:06d}.label", dtype="<u4")
@@ -156,6 +158,15 @@ def test_kitti_labels_one_per_point_with_rain_as_its_class(run: Path) -> None:
         rain = np.frombuffer(bytes(cloud.data), np.uint8).reshape(-1, cloud.point_step)[:, 19]
         assert ((labels & 0xFFFF) == 5).sum() == rain.sum() > 0
         assert set(np.unique(labels & 0xFFFF).tolist()) <= {0, 1, 2, 3, 4, 5}
+        per_class += np.bincount(labels & 0xFFFF, minlength=6)
+    config = yaml.safe_load((run / "export" / "kitti" / "catabot.yaml").read_text())
+    same = {i: i for i in range(6)}  # what SemanticKITTI's visualize.py and trainers read
+    assert config["learning_map"] == config["learning_map_inv"] == same
+    assert config["learning_ignore"] == {i: i == 0 for i in range(6)}
+    assert config["labels"][5] == "rain" and config["color_map"][5] == [255, 0, 255]
+    content = [config["content"][i] for i in range(6)]
+    np.testing.assert_allclose(content, per_class / per_class.sum(), atol=1e-8)
+    assert config["split"]["train"] == [0] and config["sequences"] == {"00": "ego.lidar"}
 
 
 def test_plot_writes_figures_and_a_report(run: Path, tmp_path: Path) -> None:
