@@ -115,10 +115,8 @@ def _program(controller: dict[str, Any], base: Path) -> None:
 
 def json_schema() -> dict[str, Any]:
     """The scenario's JSON Schema, for editors (`catabot scenario schema`)."""
-    schema = Scenario.model_json_schema()
+    schema = _titled(Scenario.model_json_schema(), "CataBot scenario")
     _sensor_params(schema)
-    schema["$schema"] = "https://json-schema.org/draft/2020-12/schema"
-    schema["title"] = "CataBot scenario"
     schema["properties"]["$schema"] = {"type": "string", "description": "this schema's path or "
                                        "URL, for an editor (ignored by CataBot)"}  # fmt: skip
     return schema
@@ -127,10 +125,11 @@ def json_schema() -> dict[str, Any]:
 def model_schema() -> dict[str, Any]:
     """A vessel model file's JSON Schema (`catabot scenario model-schema`): its fields were
     documented only by the bundled files and the errors."""
-    schema = VesselModel.model_json_schema()
-    schema["$schema"] = "https://json-schema.org/draft/2020-12/schema"
-    schema["title"] = "CataBot vessel model"
-    return schema
+    return _titled(VesselModel.model_json_schema(), "CataBot vessel model")
+
+
+def _titled(schema: dict[str, Any], title: str) -> dict[str, Any]:
+    return schema | {"$schema": "https://json-schema.org/draft/2020-12/schema", "title": title}
 
 
 def _sensor_params(schema: dict[str, Any]) -> None:
