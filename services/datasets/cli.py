@@ -46,6 +46,10 @@ def parser() -> argparse.ArgumentParser:
         "--min-box-px", type=int, default=0,
         help="leave out boxes narrower or lower than this many pixels (default 0: keep all)",
     )  # fmt: skip
+    exp.add_argument(
+        "--keep-own", action="store_true",
+        help="keep the boxes of each camera's own vessel (its bow in view; left out by default)",
+    )  # fmt: skip
     return p
 
 
@@ -76,7 +80,9 @@ def main(argv: list[str] | None = None) -> int:
         run = RecordedRun(args.run)
         made = not out.exists()
         out.mkdir(parents=True, exist_ok=True)
-        options = ExportOptions(args.val_fraction, args.split_block_s, args.min_box_px)
+        options = ExportOptions(
+            args.val_fraction, args.split_block_s, args.min_box_px, keep_own=args.keep_own
+        )
         try:
             summary = FORMATS[args.format](run, out, options)
         except BaseException:

@@ -27,12 +27,16 @@ class ExportError(CataBotError, ValueError):
 
 @dataclass(frozen=True)
 class ExportOptions:
-    """How a run becomes a dataset: the train/val split (split.py) and the smallest box
-    kept, in pixels of width and height (distant buoys of 1-2 px teach a detector noise)."""
+    """How a run becomes a dataset: the train/val split (split.py), the smallest box kept,
+    in pixels of width and height (distant buoys of 1-2 px teach a detector noise), and
+    whether the boxes of a camera's own vessel are kept: a camera mounted low sees its own
+    bow in every frame, a box a detector would learn to find there (Cityscapes' "ego
+    vehicle", left out of training the same way)."""
 
     val_fraction: float = 0.2
     block_s: float | None = None
     min_box_px: int = 0
+    keep_own: bool = False
 
 
 @dataclass(frozen=True)
@@ -42,6 +46,7 @@ class Frame:
     labelled: LabelledFrame
     subset: str  # "train" or "val"
     min_box_px: int = 0
+    own: int = 0  # the instance id of the camera's own vessel (0: its boxes are kept)
 
     @property
     def color(self) -> Path:
@@ -51,11 +56,20 @@ class Frame:
         return path
 
     @cached_property
-    def kept(self) -> NDArray[np.bool_]:
-        """The boxes at least `min_box_px` wide and high, in the camera's box order."""
+    def small(self) -> NDArray[np.bool_]:
+        """The boxes narrower or lower than `min_box_px`, in the camera's box order."""
         boxes = self.labelled.boxes
         size = np.minimum(boxes[:, 4] - boxes[:, 2], boxes[:, 5] - boxes[:, 3])
-        return np.asarray(size >= self.min_box_px)
+        return np.asarray(size < self.min_box_px)
+
+    @cached_property
+    def mine(self) -> NDArray[np.bool_]:
+        """The boxes of the camera's own vessel (none when `own` is 0)."""
+        return np.asarray((self.labelled.boxes[:, 0] == self.own) & (self.own > 0))
+
+    @property
+    def kept(self) -> NDArray[np.bool_]:
+        return ~self.small & ~self.mine
 
     @property
     def boxes(self) -> NDArray[np.float64]:
@@ -78,6 +92,7 @@ def camera_frames(
             f"{run.folder}: no labelled camera frames (the run needs a camera and "
             "recording.dataset: true; dataset/<vessel>.<camera>/labels.jsonl holds them)"
         )
+    own = {s.vessel: 0 if options.keep_own else run.world.body(s.vessel).row + 1 for s in found}
     pairs = [
         (f"{s.vessel}.{s.config.name}", f) for s in found for f in labelled_frames(run.folder, s)
     ]
@@ -91,9 +106,10 @@ def camera_frames(
     subsets = split([f.stamp_ns for _, f in pairs], seed=run.world.scenario.seed,
                     val_fraction=options.val_fraction, block_s=options.block_s)  # fmt: skip
     frames = [
-        Frame(f"{cam}_{f.tick:08d}", cam, f, subset, options.min_box_px)
+        Frame(f"{cam}_{f.tick:08d}", cam, f, subset, options.min_box_px,
+              own[cam.rsplit(".", 1)[0]])
         for (cam, f), subset in zip(pairs, subsets, strict=True)
-    ]
+    ]  # fmt: skip
     return frames, _note(frames, without, what, options.min_box_px)
 
 
@@ -101,7 +117,10 @@ def _note(frames: list[Frame], without: list[str], what: str, min_box_px: int) -
     note = ""
     if without:
         note += f"; left out {len(without)} frames without a {what} (first: {without[0]})"
-    small = sum(int((~f.kept).sum()) for f in frames)
+    small = sum(int((f.small & ~f.mine).sum()) for f in frames)
     if small:
         note += f"; left out {small} boxes under {min_box_px} px (--min-box-px)"
+    mine = sum(int(f.mine.sum()) for f in frames)
+    if mine:
+        note += f"; left out {mine} boxes of the cameras' own vessels (--keep-own keeps them)"
     return note

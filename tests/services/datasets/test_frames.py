@@ -1,0 +1,38 @@
+"""Which boxes of a frame an export keeps: not those below `--min-box-px`, and not those of
+the camera's own vessel (its bow in view) unless asked."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+from catabot.run.recorded_camera import LabelledFrame
+from services.datasets.frames import Frame, _note
+
+
+def _frame(*, own: int, min_box_px: int = 0) -> Frame:
+    objects = [  # the ego (instance 1) at the bottom edge, a boat, a distant buoy
+        {"instance": 1, "class": "vessel", "box": [202, 452, 438, 480]},
+        {"instance": 3, "class": "vessel", "box": [300, 200, 340, 230]},
+        {"instance": 4, "class": "buoy", "box": [100, 240, 103, 245]},
+    ]
+    for o in objects:
+        o |= {"truncated": False, "occluded": False}
+    record = {"tick": 0, "stamp_ns": 0, "width": 640, "height": 480, "objects": objects}
+    return Frame("ego.cam_00000000", "ego.cam", LabelledFrame(Path("."), record), "train",
+                 min_box_px, own)  # fmt: skip
+
+
+def test_the_cameras_own_vessel_is_left_out_and_said() -> None:
+    frame = _frame(own=1)
+    assert frame.boxes[:, 0].tolist() == [3, 4]
+    assert "left out 1 boxes of the cameras' own vessels (--keep-own keeps them)" in _note(
+        [frame], [], "colour image", 0
+    )
+
+
+def test_keep_own_keeps_it_and_small_boxes_are_counted_once() -> None:
+    assert _frame(own=0).boxes[:, 0].tolist() == [1, 3, 4]  # --keep-own: own is 0
+    frame = _frame(own=1, min_box_px=5)
+    assert frame.boxes[:, 0].tolist() == [3]
+    note = _note([frame], [], "colour image", 5)
+    assert "left out 1 boxes under 5 px" in note and "left out 1 boxes of the cameras'" in note
