@@ -250,7 +250,9 @@ def add_stack_args(parser: argparse.ArgumentParser) -> None:
     parser.add_argument(
         "--participant", help="lockstep name (default: the vessel's controller.participant)"
     )
-    parser.add_argument("--timeout", type=float, default=30.0, help="seconds to wait for the run")
+    parser.add_argument(
+        "--timeout", type=float, default=30.0, help="seconds to wait for the run (default: 30)"
+    )
 
 
 def _told(exc: BaseException) -> str:

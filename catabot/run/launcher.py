@@ -22,10 +22,11 @@ from catabot.config.scenario import Scenario
 from catabot.config.sensors import service_of
 from catabot.errors import CataBotError
 from catabot.run import programs
+from catabot.run.child import Child
 from catabot.run.companions import Viewer, after_run, start_viewer
 from catabot.run.progress import PlanningProgress, ProgressBar
 from catabot.run.summary import summarise
-from catabot.run.supervisor import Child, Stops, Supervisor
+from catabot.run.supervisor import Stops, Supervisor
 from catabot.world.mounts import check_mounts
 from catabot.world.world import World
 
@@ -258,6 +259,7 @@ def _watch(scenario: Scenario, run_dir: Path, supervisor: Supervisor, *, quiet: 
         supervisor.conductor.proc.returncode,
         codes,
         stopped=supervisor.stopped,
+        lingered=supervisor.lingered,
     )
 
 

@@ -18,6 +18,7 @@ from catabot.bus.clock import ender_of
 from catabot.config.scenario import Scenario
 from catabot.run.metrics_summary import metrics_lines
 from catabot.run.service import EXIT_CLOCK
+from catabot.run.supervisor import PROGRAM_REAP_S
 from catabot.run.usage import MEMORY, memory_mb, read_usage
 
 
@@ -87,6 +88,7 @@ def summarise(
     service_codes: Mapping[str, int | None],
     *,
     stopped: set[str] | frozenset[str] = frozenset(),
+    lingered: set[str] | frozenset[str] = frozenset(),
 ) -> int:
     ticks = int(result.get("ticks_done", 0))  # type: ignore[call-overload]
     wall = float(result.get("wall_s", 0.0))  # type: ignore[arg-type]
@@ -96,7 +98,8 @@ def summarise(
     unjoined: set[str] = set()  # an interrupted start: stopped while still starting, or
     if interrupted and not ticks:  # ended on seeing the stopped conductor go first
         unjoined = set(stopped) | {n for n, c in service_codes.items() if c == EXIT_CLOCK}
-    failed = {n: c for n, c in service_codes.items() if c not in (0, None) and n not in unjoined}
+    spared = unjoined | set(lingered)  # stopped by catabot run, not failed
+    failed = {n: c for n, c in service_codes.items() if c not in (0, None) and n not in spared}
     if not result:
         error = error or f"the conductor ended without a result ({describe_exit(conductor_code)})"
     elif not error and failed:
@@ -128,6 +131,12 @@ def summarise(
         print(f"  {name}: {_last_line(run_dir, name)}")  # what it wrote, as the CLI says it
     for name in sorted(unjoined):
         print(f"  {name}: stopped by catabot run before it joined", file=sys.stderr)
+    for name in sorted(lingered):
+        print(
+            f"  {name}: still running {PROGRAM_REAP_S:g} s after the run ended, so stopped "
+            "(a controller program should exit once run_lockstep returns)",
+            file=sys.stderr,
+        )
     for name, code in failed.items():
         log = run_dir / "log" / f"{name}.log"
         said = f": {_last_line(run_dir, name)}" if name.startswith("export-") else ""

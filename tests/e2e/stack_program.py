@@ -2,12 +2,14 @@
 the flags the launcher passes (catabot/run/programs.py), joins the lockstep as its
 participant and sends differential thrust toward a goal; `--crash-at T` raises at tick T,
 `--nan-at T` sends a NaN thrust for tick T and `--skip-at T` none (yet acks the tick): what
-a buggy stack in another language may do.
+a buggy stack in another language may do. `--leave` exits at once without joining, and
+`--linger` keeps running after the run (a ROS spin, a plot window).
 """
 
 import argparse
 import math
 import os
+import time
 
 from catabot.bus.inbox import Inputs
 from catabot.bus.messages import BodyStates, ThrustCmd, Tick
@@ -28,7 +30,11 @@ def main() -> None:
     p.add_argument("--crash-at", type=int, default=-1)
     p.add_argument("--nan-at", type=int, default=-1)
     p.add_argument("--skip-at", type=int, default=-1)
+    p.add_argument("--leave", action="store_true")
+    p.add_argument("--linger", action="store_true")
     args = p.parse_args()
+    if args.leave:
+        return
     world = World.resolve(load_scenario(os.environ["CATABOT_SCENARIO"]))
     assert world.scenario.name == args.world
     me = world.body(args.vessel)
@@ -57,7 +63,9 @@ def main() -> None:
             stack.publish(commands.key, ThrustCmd(thrust, tick=tick.tick, stamp_ns=tick.stamp_ns))
 
         end = stack.run(step)
-        print(f"stack ended at tick {end.tick} ({end.reason})")
+        print(f"stack ended at tick {end.tick} ({end.reason})", flush=True)
+    while args.linger:
+        time.sleep(1.0)
 
 
 if __name__ == "__main__":

@@ -81,3 +81,22 @@ def test_a_program_that_acks_a_tick_without_its_command_is_named(tmp_path: Path)
     cause = next(line for line in said.splitlines() if line.startswith("run failed:"))
     assert "missed the 2 s deadline of tick 101" in cause, cause
     assert "waited at tick 101 for catabot/program/vessel/ego/cmd/thrust from 'stack'" in cause
+
+
+def test_a_program_that_ends_before_joining_fails_the_run_at_once(tmp_path: Path) -> None:
+    """It exited 0, and the run waited out the 60 s start timeout for it."""
+    code, said, _ = _run(tmp_path, _scenario(tmp_path, "--leave"), "leave")
+    assert code == 1, said
+    cause = next(line for line in said.splitlines() if line.startswith("run failed:"))
+    assert "stack_program.py ended (exit code 0) before the run started" in cause, cause
+    assert "never joined" not in said
+
+
+def test_a_program_still_running_after_the_run_is_stopped_not_failed(tmp_path: Path) -> None:
+    """A stack that spins on after `run_lockstep` returned turned a completed run into a
+    failure (its SIGTERM exit code)."""
+    code, said, run = _run(tmp_path, _scenario(tmp_path, "--linger"), "linger")
+    assert code == 0 and run is not None, said
+    assert "stack: still running 5 s after the run ended, so stopped" in said
+    record = json.loads((run / "log" / "run.json").read_text())
+    assert record["error"] == "" and record["reason"] == "completed"
