@@ -30,7 +30,13 @@ from catabot.bus.session import (
 )
 from catabot.client.commands import Command
 from catabot.client.discover import find_world
-from catabot.client.errors import NotAParticipant, RunEnded, TooLate, UnknownVessel
+from catabot.client.errors import (
+    NotAParticipant,
+    RunEnded,
+    SeveralVessels,
+    TooLate,
+    UnknownVessel,
+)
 from catabot.client.free import run_free
 from catabot.client.info import SensorInfo, VesselInfo, WorldInfo
 from catabot.client.lockstep import Joined, Observation
@@ -125,6 +131,7 @@ class Client:
         controller's rate, else `rate_hz` (default every tick)."""
         info = find_world(self.session, self.info.name, self.timeout_s, self._where)  # fresh
         self._expected(info, name)
+        _one_vessel(info, name)
         target = self._target(info, name, vessel)
         mounted = [target.sensor(s) for s in sensors] if target is not None else []
         if sensors and target is None:
@@ -238,6 +245,18 @@ class Client:
         cause in its words, as `run_lockstep` tells it."""
         told = exc is not None and not isinstance(exc, RunEnded | KeyboardInterrupt | SystemExit)
         self.close(fault=_told(exc) if told and exc is not None else "")
+
+
+def _one_vessel(info: WorldInfo, name: str) -> None:
+    """A `Joined` commands one vessel: a participant the scenario gives two would leave the
+    second without commands, and physics waiting for them until the deadline."""
+    driven = [vid for vid, v in info.vessels.items()
+              if v.controller and v.controller.participant == name]  # fmt: skip
+    if len(driven) > 1:
+        raise SeveralVessels(
+            f"participant {name!r} controls vessels {', '.join(driven)} in world {info.name!r}, "
+            "and a joined client commands one: give each vessel its own controller.participant"
+        )
 
 
 def add_stack_args(parser: argparse.ArgumentParser) -> None:

@@ -35,6 +35,10 @@ class NotAParticipant(ClientError, ValueError):
     nor any vessel's `controller.participant`)."""
 
 
+class SeveralVessels(ClientError, ValueError):
+    """The participant controls more vessels than a `Joined` commands (one)."""
+
+
 class TooLate(ClientError, RuntimeError):
     """The run started without this participant, or another session holds its name."""
 

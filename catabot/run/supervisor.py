@@ -173,14 +173,16 @@ class Supervisor:
 
     def _kill_hung_participants(self) -> None:
         """Participants the conductor reports as gone or late, whose process still exists a
-        second later (one that is only closing its session is not hung)."""
+        second later (one that is only closing its session is not hung). One that said
+        whose data it waited for is not hung but starved: the cause is that data's sender."""
         error = str(self.result.get("error", ""))
         for name, child in self.services.items():
             if f"participant {name!r}" in error and not _exits(child.proc, within_s=1.0):
                 state = {"T": "stopped by a signal", "t": "stopped by a debugger"}.get(
                     child.state(), "alive but not stepping"
                 )
-                self._kill(child, f"participant {name!r} hung ({state}): {self._waited(error)}")
+                hung = "" if child.waited_line() else f"participant {name!r} hung ({state}): "
+                self._kill(child, hung + self._waited(error))
 
     def _reap(self) -> None:
         """Services end by themselves after the conductor's End (15 s allows the recorder's

@@ -6,6 +6,7 @@ from __future__ import annotations
 import json
 import time
 from collections.abc import Iterator
+from typing import Any
 
 import pytest
 import zenoh
@@ -18,6 +19,7 @@ from catabot.client import (
     CommandError,
     NoData,
     NotAParticipant,
+    SeveralVessels,
     SeveralWorlds,
     SimulatorNotFound,
     Thrust,
@@ -35,10 +37,10 @@ from tests.catabot.client.fixtures import ROSTER, scenario
 class Served:
     """A world's `world/info` desk on its own session, listening on its own port."""
 
-    def __init__(self, name: str) -> None:
+    def __init__(self, name: str, **top: Any) -> None:
         self.endpoint = f"tcp/127.0.0.1:{free_port()}"
         self.session = open_session(Connection(listen=(self.endpoint,)))
-        world = scenario(name)
+        world = scenario(name, **top)
         self.schedule = Schedule(ticks=world.ticks)
         self.desk = WorldInfoDesk(self.session, world, ROSTER, self.schedule)
         assert self.desk.served.wait(30)
@@ -97,6 +99,23 @@ def test_a_reply_for_another_worlds_key_or_not_json_is_ignored(served: Served) -
     finally:
         for fake in fakes:
             fake.undeclare()
+
+
+def test_a_participant_of_two_vessels_cannot_join_as_a_client_of_one() -> None:
+    """The second vessel would get no commands, and physics wait for them to the deadline."""
+    stack = {"participant": "stack", "rate_hz": 10.0}
+    vessels = [{"id": "ego", "controller": stack},
+               {"id": "ego2", "pose": {"x_m": 20.0, "y_m": 0.0}, "controller": stack}]  # fmt: skip
+    served = Served("pair", vessels=vessels, traffic={"count": 0})
+    said = "participant 'stack' controls vessels ego, ego2 in world 'pair', and a joined"
+    try:
+        with (
+            Client.connect([served.endpoint], timeout_s=10) as sim,
+            pytest.raises(SeveralVessels, match=said),
+        ):
+            sim.join("stack")
+    finally:
+        served.close()
 
 
 def test_unknown_vessels_sensors_and_participants(served: Served) -> None:
