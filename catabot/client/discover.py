@@ -26,6 +26,12 @@ def find_world(
     endpoints in the error."""
     selector = Keys(world).world_info() if world else world_infos()
     answers = until_answered(lambda left: _ask(session, selector, left), timeout_s)
+    others = sorted(_ask(session, world_infos(), 1.0)) if world and not answers else []
+    if others:  # a misspelt world beside a running one is not "is catabot run running?"
+        running = ", ".join(others)
+        raise SimulatorNotFound(
+            f"no simulation of world {world!r} answered ({where}); running there: {running}"
+        )
     if not answers:
         what = f"world {world!r}" if world else "any world"
         raise SimulatorNotFound(

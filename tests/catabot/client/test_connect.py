@@ -78,6 +78,9 @@ def test_the_one_world_is_found_and_several_must_be_chosen(served: Served) -> No
             Client.connect(both, timeout_s=10).close()
         with Client.connect(both, world="info2", timeout_s=10) as sim:
             assert sim.info.name == "info2"
+        with pytest.raises(SimulatorNotFound, match=r"world 'inf0' answered .*; running there: "
+                           "info, info2"):  # fmt: skip
+            Client.connect(both, world="inf0", timeout_s=1)
     finally:
         second.close()
 
