@@ -226,12 +226,20 @@ _PIXELS = {  # topic suffix -> the frame's array, with the encoding's dtype
 }
 
 
-def camera_info(names: Names, sensor: MountedSensor) -> bytes:
-    """sensor_msgs/CameraInfo of the pinhole at stamp 0: no distortion, K from the field of
-    view with ROS's pixel-centre convention (pixel u's centre at u, ours at u + 0.5)."""
+def camera_matrix(sensor: MountedSensor) -> np.ndarray:
+    """K (3 x 3) of a camera's pinhole from its field of view (square pixels, no
+    distortion), with ROS's and OpenCV's pixel-centre convention: pixel u's centre at u
+    (the camera's rays go through u + 0.5, services/sensors/camera.py)."""
     p = sensor.params
     f = (p.width / 2) / math.tan(math.radians(p.hfov_deg) / 2)
-    cx, cy = p.width / 2 - 0.5, p.height / 2 - 0.5
+    return np.array([[f, 0.0, p.width / 2 - 0.5], [0.0, f, p.height / 2 - 0.5], [0, 0, 1.0]])
+
+
+def camera_info(names: Names, sensor: MountedSensor) -> bytes:
+    """sensor_msgs/CameraInfo of the pinhole at stamp 0: no distortion, K of `camera_matrix`."""
+    p = sensor.params
+    k = camera_matrix(sensor)
+    f, cx, cy = k[0, 0], k[0, 2], k[1, 2]
     info = types.new(
         types.CAMERA_INFO,
         header=types.header(0, names.optical_frame(sensor)),

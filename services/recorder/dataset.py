@@ -9,7 +9,8 @@ Layout (one folder per sensor, `<vessel>.<sensor>`):
   (16-bit, a body's row + 1), for the outputs that are on, plus one `labels.jsonl` line per
   frame with its boxes, each naming its body;
   every frame, or with `recording.dataset_rate_hz` the first frame of each of its periods;
-- radars: `ppi_<tick>.png`, the north-up PPI (services/recorder/ppi.py) once per antenna turn.
+- radars: `ppi_<tick>.png`, the north-up PPI (services/recorder/ppi.py) once per antenna turn;
+- with cameras, `calibration.json`: every sensor's mount and each camera's K (calibration.py).
 PNGs are written with fixed settings and no time chunk, so the same run gives the same bytes.
 `catabot.run.recorded_camera` reads this layout back (dataset export, replay).
 """
@@ -26,6 +27,7 @@ from PIL import Image
 from catabot.bus.messages import LABEL_CLASSES, CameraFrame, Message, RadarSweep
 from catabot.config.sensors import RadarParams
 from catabot.world.world import World
+from services.recorder.calibration import write_calibration
 from services.recorder.ppi import Ppi
 
 PNG_LEVEL = 3  # zlib level: fast; fixed, so the same pixels give the same bytes
@@ -98,6 +100,8 @@ class Dataset:
             if s.config.type == "radar" and recording.ppi
         }
         self._ppi: dict[str, Ppi] = {}
+        if self.cameras and self.camera_period:
+            write_calibration(root, world)
 
     def folder(self, stream: str) -> Path:
         parts = stream.strip("/").split("/")

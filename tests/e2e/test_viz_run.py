@@ -283,3 +283,33 @@ def _boxes(out: Path, subset: str) -> list[tuple[float, float]]:
     lines = [x for f in sorted((out / "labels" / subset).glob("*.txt"))
              for x in f.read_text().splitlines()]  # fmt: skip
     return [(float(x.split()[3]), float(x.split()[4])) for x in lines]
+
+
+def test_calibration_projects_lidar_points_onto_the_camera_pixels_of_their_body(
+    run: Path,
+) -> None:
+    """dataset/calibration.json: LiDAR points of a body (KITTI export, sensor frame) taken
+    through the LiDAR's mount and the camera's, then K, land on that body's instance pixels
+    (within a pixel: a point on a silhouette's edge rounds either way)."""
+    calib = json.loads((run / "dataset" / "calibration.json").read_text())["sensors"]
+    cam, lidar = calib["ego.cam"], calib["ego.lidar"]
+    assert cam["vessel"] == lidar["vessel"] == "ego" and cam["width"] == 160
+    to_camera = np.linalg.inv(cam["body_from_optical"]) @ np.array(lidar["body_from_sensor"])
+    seq = run / "export" / "kitti" / "sequences" / "00"
+    times = [round(float(t) * 1e9) for t in (seq / "times.txt").read_text().split()]
+    frames = [json.loads(x) for x in (run / "dataset/ego.cam/labels.jsonl").read_text().split()]
+    hits = total = 0
+    for frame in frames:
+        n = times.index(frame["stamp_ns"])  # the camera's ticks are the LiDAR's too
+        points = np.fromfile(seq / "velodyne" / f"{n:06d}.bin", "<f4").reshape(-1, 4)[:, :3]
+        labels = np.fromfile(seq / "labels" / f"{n:06d}.label", "<u4")
+        body = np.isin(labels & 0xFFFF, (3, 4))  # vessels and buoys
+        xyz = (to_camera @ np.c_[points[body], np.ones(body.sum())].T)[:3]
+        u, v = np.rint((np.array(cam["K"]) @ xyz)[:2] / xyz[2]).astype(int)
+        seen = (xyz[2] > 0.5) & (u >= 0) & (u < 160) & (v >= 0) & (v < 120)
+        image = Image.open(run / "dataset/ego.cam" / frame["files"]["instance"])
+        painted, steps = np.pad(np.asarray(image), 1), (-1, 0, 1)
+        near = [painted[v[seen] + 1 + dv, u[seen] + 1 + du] for dv in steps for du in steps]
+        hits += int((np.array(near) == (labels[body] >> 16)[seen]).any(axis=0).sum())
+        total += int(seen.sum())
+    assert total > 10 and hits == total, (hits, total)
