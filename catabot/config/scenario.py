@@ -134,6 +134,11 @@ class VesselConfig(Strict):
     pose: Pose | None = Field(None, description="null: open water near the terrain centre")
     velocity: Velocity = Field(Velocity(), description="body-frame velocity at t = 0")
     script: list[ScriptStep] = []
+    command_timeout_s: float | None = Field(
+        None, gt=0, description="an outside (free) thrust or twist not renewed for this long "
+        "hands the vessel back to its script, or rest (a stack that died stops steering it); "
+        "null: it holds until a release",
+    )  # fmt: skip
     sensors: list[SensorConfig] = []
     controller: ControllerConfig | None = Field(
         None, description="a lockstep stack outside `catabot run` that commands this vessel"

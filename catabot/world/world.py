@@ -63,6 +63,7 @@ class Body:
     script: tuple[ScriptStep, ...] = ()  # in time order (the World sorts it once)
     controller: ControllerConfig | None = None
     velocity: Velocity = field(default_factory=Velocity)  # body frame, at t = 0
+    command_timeout_s: float | None = None  # an outside command's hold (catabot/world/orders.py)
 
     @property
     def instance(self) -> int:
@@ -258,11 +259,13 @@ def _bodies(scenario: Scenario, plan: TrafficPlan) -> tuple[Body, ...]:
 
 def _scenario_part(
     config: VesselConfig | None,
-) -> tuple[tuple[ScriptStep, ...], ControllerConfig | None, Velocity]:
-    """What only a scenario vessel has: its script, its controller, its start velocity."""
+) -> tuple[tuple[ScriptStep, ...], ControllerConfig | None, Velocity, float | None]:
+    """What only a scenario vessel has: its script, its controller, its start velocity, how
+    long an outside command holds it."""
     if config is None:
-        return (), None, Velocity()
-    return tuple(sorted(config.script, key=lambda s: s.t_s)), config.controller, config.velocity
+        return (), None, Velocity(), None
+    script = tuple(sorted(config.script, key=lambda s: s.t_s))
+    return script, config.controller, config.velocity, config.command_timeout_s
 
 
 def _check_script(vessel: VesselConfig, model: VesselModel, *, where: str) -> None:

@@ -22,7 +22,8 @@ from numpy.typing import NDArray
 
 from catabot.bus.messages import Message, ThrustCmd, TwistBatch, TwistCmd, WaypointsCmd
 from catabot.config.scenario import ScriptStep
-from catabot.world.orders import Orders, script_step
+from catabot.run.advice import advise
+from catabot.world.orders import Orders, command_timeouts, script_step
 from catabot.world.world import Body
 
 Array = NDArray[np.float64]
@@ -51,7 +52,7 @@ class CommandBook:
         self.times = {v.id: v.script_ns for v in vessels}
         self.scripted = [v.id for v in vessels if v.script]
         self.released: set[str] = set()  # handed back this tick (`take`)
-        self.book = Orders()  # who holds each vessel: outside commands, set-points
+        self.book = Orders(command_timeouts(vessels))  # who holds each: outside, set-points
         self.set_point = np.zeros((len(self.ids), 2))  # (surge m/s, yaw rate rad/s)
         self.has_set_point = np.zeros(len(self.ids), dtype=bool)
         self._batch_rows: dict[tuple[str, ...], NDArray[np.intp]] = {}  # a traffic shard's
@@ -72,6 +73,11 @@ class CommandBook:
     def orders(self, stamp_ns: int) -> tuple[dict[int, tuple[float, ...]], NDArray[np.intp], Array]:
         """Every vessel's order: thrust values by row, then the rows under velocity control
         and their (surge, yaw rate) targets, rows in `ids` order."""
+        for vid in self.book.expire(stamp_ns):  # outside commands gone stale: handed back
+            self.released.add(vid)
+            held_s = self.book.timeouts[vid] / 1e9
+            advise(log, f"{vid}: no outside command for {held_s:g} s (command_timeout_s): "
+                        "handed back to its script (rest without one)")  # fmt: skip
         target, follow = self.set_point.copy(), self.has_set_point.copy()
         thrust: dict[int, tuple[float, ...]] = {}
         for vid in self.scripted:
@@ -104,12 +110,12 @@ class CommandBook:
             rows = self._batch_rows[boats] = np.array([self.row[b] for b in boats], np.intp)
         return rows
 
-    def take(self, vessel: str, msgs: list[Message]) -> None:
+    def take(self, vessel: str, msgs: list[Message], stamp_ns: int = 0) -> None:
         """Adopt the newest command from the bus (checked on arrival: one finite value per
         thruster, a finite twist: catabot/bus/checks.py). A lockstep twist (tick >= 0) is a
         set-point; an outside command (tick -1) takes the vessel over."""
         for msg in msgs:
-            if self.book.heard(vessel, msg) and isinstance(msg, WaypointsCmd):
+            if self.book.heard(vessel, msg, stamp_ns) and isinstance(msg, WaypointsCmd):
                 self.released.add(vessel)
             if isinstance(msg, TwistCmd) and msg.tick >= 0:
                 self.set_point[self.row[vessel]] = (msg.surge, msg.yaw_rate)

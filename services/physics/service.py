@@ -81,7 +81,7 @@ class PhysicsService:
             if key in self.blocks:
                 self._take_twists(msgs[-1], self.blocks[key])
                 continue
-            self.book.take(self.vessel_of[key], msgs)
+            self.book.take(self.vessel_of[key], msgs, tick.stamp_ns)
             self.reach.heard(self.vessel_of[key], msgs)
             rel = self.keys.relative(key)
             taken += [entry(rel, m) for m in msgs if getattr(m, "tick", 0) == -1]

@@ -30,7 +30,7 @@ from catabot.bus.settings import changes_of
 from catabot.bus.taken import taken
 from catabot.ros2.convert import Converter
 from catabot.run.service import Built, ServiceContext, run_service
-from catabot.world.orders import Orders
+from catabot.world.orders import Orders, command_timeouts
 from services.recorder.batches import BatchFormatter, Block, without
 from services.recorder.csv_sink import CsvSink, RecorderError
 from services.recorder.dataset import Dataset
@@ -63,7 +63,7 @@ class Recorder:
         free = [*world.streams.commands, *world.streams.waypoints]
         self.free_kinds = {self.keys.relative(s.key): s.message for s in free}
         self.batches = BatchFormatter(convert)
-        self.orders = Orders()  # what physics follows, by its rule: what is written, metered
+        self.orders = Orders(command_timeouts(world.vessels))  # physics' rule: written, metered
         k = self.keys
         self.commanded = {
             key(v.id): v.id
@@ -132,18 +132,27 @@ class Recorder:
                 continue
             self._write(key, _stamped(msg, at))
             self._heard(f"{self.keys.prefix}/{key}", msg, at)
+        for vessel in self.orders.expire(at.stamp_ns):  # as physics, after that tick's takes
+            self._resume(vessel, at)
 
     def _heard(self, key: str, msg: Message, tick: Tick) -> None:
         """A command for a vessel: the order physics follows from now on, so an overridden
         script's steps are not written and the thrust metered is the one in force; after a
         release, the script's step (or rest) it follows again, written as a command."""
         vessel = self.commanded.get(key)
-        if vessel is not None and self.orders.heard(vessel, msg):
+        if vessel is not None and self.orders.heard(vessel, msg, tick.stamp_ns):
             self.metrics.order_changed(vessel)
             if isinstance(msg, WaypointsCmd):
-                resumed = self.scripts.resumed(vessel, tick.tick, tick.stamp_ns)
-                if resumed is not None:
-                    self._write(*resumed)
+                self._resume(vessel, tick, changed=False)
+
+    def _resume(self, vessel: str, tick: Tick, *, changed: bool = True) -> None:
+        """A vessel handed back (a release, a stale outside command): the order it follows
+        again, written as a command."""
+        if changed:
+            self.metrics.order_changed(vessel)
+        resumed = self.scripts.resumed(vessel, tick.tick, tick.stamp_ns)
+        if resumed is not None:
+            self._write(*resumed)
 
     def _twists(self, batch: TwistBatch) -> Block:
         """The set-points of the boats that follow them (not those an outside command holds)."""

@@ -38,3 +38,16 @@ def test_a_set_point_steers_for_good_and_other_messages_change_nothing() -> None
     state = VesselState(0, 0, zero, (0.0, 0.0, 0.0, 1.0), zero, zero, zero, zero)
     assert not orders.heard("ego", state)
     assert orders.follows_script("other")
+
+
+def test_a_stale_outside_command_expires_and_a_renewed_or_lockstep_one_does_not() -> None:
+    orders = Orders({"ego": 400_000_000})  # command_timeout_s 0.4
+    orders.heard("ego", ThrustCmd((0.5, 0.5)), stamp_ns=1_000_000_000)
+    orders.heard("other", ThrustCmd((0.5, 0.5)), stamp_ns=1_000_000_000)  # no timeout
+    assert orders.expire(1_390_000_000) == []
+    orders.heard("ego", ThrustCmd((0.6, 0.6)), stamp_ns=1_200_000_000)  # renewed
+    assert orders.expire(1_590_000_000) == []
+    assert orders.expire(1_600_000_000) == ["ego"] and orders.follows_script("ego")
+    assert orders.in_force("other") is not None  # held until a release
+    orders.heard("ego", ThrustCmd((0.5, 0.5), tick=3), stamp_ns=2_000_000_000)  # lockstep
+    assert orders.expire(9_000_000_000) == []
