@@ -197,7 +197,7 @@ class RecordingConfig(Strict):
     encounter_radius_m: float = Field(
         50.0, gt=0, description="metrics.json: two vessels this close are an encounter (CPA)"
     )
-    export: list[Literal["yolo", "coco", "kitti"]] = Field(
+    export: list[Literal["yolo", "coco", "kitti", "segmentation"]] = Field(
         [], description="datasets converted into export/<format>/ when the run ends"
     )
 
@@ -307,7 +307,10 @@ class Scenario(Strict):
         return ticks_for(self.duration_ns, self.dt_ns)
 
 
-EXPORT_OUTPUTS = {"yolo": ("color",), "coco": ("color", "segmentation")}  # camera outputs
+EXPORT_OUTPUTS = {  # the camera outputs each camera dataset is made from
+    "yolo": ("color",), "coco": ("color", "segmentation"),
+    "segmentation": ("color", "segmentation"),
+}  # fmt: skip
 SERVICE_NAMES = ("conductor", "physics", "sensors", "traffic", "recorder", GATEWAY, "viewer")
 
 

@@ -17,13 +17,14 @@ from pathlib import Path
 from catabot.errors import CataBotError
 from catabot.run.answer import OneLineParser, answered
 from catabot.run.recorded import RecordedRun
-from services.datasets import coco, kitti, yolo
+from services.datasets import coco, kitti, segmentation, yolo
 from services.datasets.frames import ExportOptions
 
 FORMATS: dict[str, Callable[[RecordedRun, Path, ExportOptions], str]] = {
     "yolo": yolo.export,
     "coco": coco.export,
     "kitti": kitti.export,
+    "segmentation": segmentation.export,
 }
 
 

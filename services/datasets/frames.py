@@ -18,7 +18,7 @@ from catabot.run.recorded import RecordedRun
 from catabot.run.recorded_camera import LabelledFrame, cameras, labelled_frames
 from services.datasets.split import split
 
-NAMES = {"color": "colour", "instance": "instance"}  # a frame's image outputs, as said
+NAMES = {"color": "colour", "class": "class", "instance": "instance"}  # as said
 
 
 class ExportError(CataBotError, ValueError):
@@ -81,7 +81,11 @@ class Frame:
 
 
 def camera_frames(
-    run: RecordedRun, options: ExportOptions, *, needs: tuple[str, ...] = ("color",)
+    run: RecordedRun,
+    options: ExportOptions,
+    *,
+    needs: tuple[str, ...] = ("color",),
+    boxes: bool = True,
 ) -> tuple[list[Frame], str]:
     """Every labelled frame with the outputs the format `needs`, split into train and val,
     and a note on the frames left out for want of one (a camera's output switched off for a
@@ -110,13 +114,16 @@ def camera_frames(
               own[cam.rsplit(".", 1)[0]])
         for (cam, f), subset in zip(pairs, subsets, strict=True)
     ]  # fmt: skip
-    return frames, _note(frames, without, what, options.min_box_px)
+    return frames, _note(frames, without, what, options.min_box_px if boxes else None)
 
 
-def _note(frames: list[Frame], without: list[str], what: str, min_box_px: int) -> str:
+def _note(frames: list[Frame], without: list[str], what: str, min_box_px: int | None) -> str:
+    """What was left out: frames, and (`min_box_px` given: a format of boxes) boxes."""
     note = ""
     if without:
         note += f"; left out {len(without)} frames without a {what} (first: {without[0]})"
+    if min_box_px is None:
+        return note
     small = sum(int((f.small & ~f.mine).sum()) for f in frames)
     if small:
         note += f"; left out {small} boxes under {min_box_px} px (--min-box-px)"

@@ -29,15 +29,14 @@ from catabot.bus.messages import LABEL_CLASSES, LidarScan
 from catabot.config.sensors import LidarParams
 from catabot.run.recorded import RecordedRun, StateTrack
 from catabot.world import rotations
+from catabot.world.label_colors import CLASS_COLORS, RAIN_COLOR
 from catabot.world.world import MountedSensor
 from services.datasets.frames import ExportError, ExportOptions
 
 KITTI_CLASSES = (*LABEL_CLASSES, "rain")
 RAIN = KITTI_CLASSES.index("rain")
-COLORS = {  # BGR, as semantic-kitti.yaml writes them
-    "none": (0, 0, 0), "water": (255, 150, 0), "terrain": (80, 240, 150),
-    "vessel": (0, 0, 255), "buoy": (0, 200, 255), "rain": (255, 0, 255),
-}  # fmt: skip
+COLORS = {name: rgb[::-1] for name, rgb in (CLASS_COLORS | {"rain": RAIN_COLOR}).items()}
+"""BGR, as semantic-kitti.yaml writes them."""
 
 
 def point_labels(scan: LidarScan) -> NDArray[np.uint32]:

@@ -11,13 +11,10 @@ import numpy as np
 from numpy.typing import NDArray
 
 from catabot.bus.messages import LABEL_CLASSES
+from catabot.world.label_colors import CLASS_COLORS
+from catabot.world.label_colors import RAIN_COLOR as RAIN
 
 U8 = NDArray[np.uint8]
-CLASS_COLORS = {  # RGB by LABEL_CLASSES name
-    "none": (0, 0, 0), "water": (40, 110, 200), "terrain": (120, 170, 90),
-    "vessel": (235, 60, 50), "buoy": (250, 200, 30),
-}  # fmt: skip
-RAIN = (255, 0, 255)
 EGO = (255, 140, 0)  # scenario vessels
 BOAT = (230, 230, 235)  # traffic boats
 BUOY = CLASS_COLORS["buoy"]

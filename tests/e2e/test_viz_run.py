@@ -43,7 +43,7 @@ def _scenario() -> dict[str, Any]:
     data["buoys"] = [{"id": "b1", "x_m": 25.0, "y_m": -6.0}]
     data["traffic"] = {"count": 2, "behaviour_mix": {"circle": 1.0}}
     data["rain"] = {"rate_mm_h": 20.0}
-    data["recording"] = {"rerun": True, "export": ["yolo", "coco", "kitti"]}
+    data["recording"] = {"rerun": True, "export": ["yolo", "coco", "kitti", "segmentation"]}
     return data
 
 
@@ -313,3 +313,21 @@ def test_calibration_projects_lidar_points_onto_the_camera_pixels_of_their_body(
         hits += int((np.array(near) == (labels[body] >> 16)[seen]).any(axis=0).sum())
         total += int(seen.sum())
     assert total > 10 and hits == total, (hits, total)
+
+
+def test_segmentation_export_is_the_class_images_split_with_a_legend(run: Path) -> None:
+    out = run / "export" / "segmentation"
+    legend = json.loads((out / "classes.json").read_text())
+    assert legend["classes"] == ["none", "water", "terrain", "vessel", "buoy"]
+    assert legend["ignore_index"] == 255 and len(legend["palette"]) == 5
+    subsets = ("train", "val")
+    names = {s: sorted(p.stem for p in (out / "ann_dir" / s).glob("*.png")) for s in subsets}
+    assert names == {s: legend[s] for s in subsets} and sum(map(len, names.values())) == 10
+    for subset, stems in names.items():
+        for stem in stems:
+            tick = stem.rsplit("_", 1)[1]
+            ann = np.asarray(Image.open(out / "ann_dir" / subset / f"{stem}.png"))
+            painted = np.asarray(Image.open(run / "dataset/ego.cam" / f"{tick}_class.png"))
+            assert ann.dtype == np.uint8 and (ann == painted).all()  # the ego is not in view
+            image = (out / "img_dir" / subset / f"{stem}.png").read_bytes()
+            assert image == (run / "dataset/ego.cam" / f"{tick}_color.png").read_bytes()

@@ -1,12 +1,17 @@
 """Which boxes of a frame an export keeps: not those below `--min-box-px`, and not those of
-the camera's own vessel (its bow in view) unless asked."""
+the camera's own vessel (its bow in view) unless asked; the segmentation export ignores its
+pixels alike."""
 
 from __future__ import annotations
 
 from pathlib import Path
 
+import numpy as np
+from PIL import Image
+
 from catabot.run.recorded_camera import LabelledFrame
 from services.datasets.frames import Frame, _note
+from services.datasets.segmentation import IGNORE, annotation
 
 
 def _frame(*, own: int, min_box_px: int = 0) -> Frame:
@@ -36,3 +41,17 @@ def test_keep_own_keeps_it_and_small_boxes_are_counted_once() -> None:
     assert frame.boxes[:, 0].tolist() == [3]
     note = _note([frame], [], "colour image", 5)
     assert "left out 1 boxes under 5 px" in note and "left out 1 boxes of the cameras'" in note
+
+
+def test_segmentation_ignores_the_cameras_own_vessel_unless_kept(tmp_path: Path) -> None:
+    classes = np.array([[1, 1, 3], [3, 3, 4]], np.uint8)  # water, then the ego's bow and a buoy
+    instance = np.array([[0, 0, 5], [1, 1, 7]], np.uint16)  # 1: the ego
+    Image.fromarray(classes).save(tmp_path / "c.png")
+    Image.fromarray(instance).save(tmp_path / "i.png")
+    record = {"tick": 0, "stamp_ns": 0, "width": 3, "height": 2, "objects": [],
+              "files": {"class": "c.png", "instance": "i.png"}}  # fmt: skip
+    labelled = LabelledFrame(tmp_path, record)
+    own = annotation(Frame("ego.cam_00000000", "ego.cam", labelled, "train", 0, 1))
+    assert own.tolist() == [[1, 1, 3], [IGNORE, IGNORE, 4]]
+    kept = annotation(Frame("ego.cam_00000000", "ego.cam", labelled, "train", 0, 0))
+    assert (kept == classes).all()
