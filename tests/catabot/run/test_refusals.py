@@ -1,8 +1,8 @@
 """What `catabot` refuses before anything starts, with one line naming why (exit 2): a
-script that does not fit its vessel's thrusters or gives one time two steps, a controller's missing program (validate
-says what run would), an output file in a folder that is not there, an endpoint nobody
-listens on or that cannot be listened on. And the line a run prints while it waits for a
-stack the user starts."""
+script that does not fit its vessel's thrusters or gives one time two steps, a controller's
+missing program (validate says what run would), an output file in a folder that is not
+there, an endpoint nobody listens on or that cannot be listened on. And the line a run
+prints while it waits for a stack the user starts."""
 
 from __future__ import annotations
 
