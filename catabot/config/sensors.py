@@ -87,7 +87,9 @@ class RadarParams(SensorParams):
         10.0, gt=0, description="nearest sea range of the fan: nearer low targets are unseen"
     )
     range_noise_sigma_m: float = Field(0.2, ge=0)
-    antenna_height_m: float = Field(3.0, description="above the body origin")
+    antenna_height_m: float = Field(
+        3.0, gt=0, description="above the body origin, and above the vessel's shape"
+    )
     sea_clutter: StrictBool = Field(False, description="keep returns from the water surface")
     ppi_size_px: int = Field(256, ge=16, le=2048)
     fade_s: float | None = Field(
@@ -188,9 +190,12 @@ class LidarParams(SensorParams):
     )
     range_noise_sigma_m: float = Field(0.01, ge=0)
     mount_xyz: Vec3 = (0.0, 0.0, 1.0)
-    mount_yaw_deg: float = 0.0
-    mount_pitch_deg: float = 0.0
-    drop_diameter_mm: float = Field(3.25, gt=0, le=10)
+    mount_yaw_deg: float = Field(0.0, ge=-360, le=360)
+    mount_pitch_deg: float = Field(0.0, ge=-90, le=90, description="+ nose down (FLU pitch)")
+    drop_diameter_mm: float = Field(
+        3.25, gt=0, le=10, description="the paper's text; the original's code used 2.75 "
+        "(2.5 x the drops a cubic metre: N(D) falls with D, eq. 1)",
+    )  # fmt: skip
     beam_radius_m: float = Field(0.02, gt=0)
     detection_threshold: float = Field(5e-6, gt=0)
     reflectivity: float = Field(PAPER_REFLECTIVITY, gt=0, le=1, description="s in rho = s / pi")

@@ -191,6 +191,19 @@ def test_unknown_sensor_type_lists_allowed() -> None:
     assert "'imu'" in msg and "'gps'" in msg and "'sonar'" in msg
 
 
+@pytest.mark.parametrize(
+    ("kind", "params", "said"),
+    [
+        ("lidar", {"mount_pitch_deg": 120}, "mount_pitch_deg: must be <= 90 (got 120)"),
+        ("radar", {"antenna_height_m": -1}, "antenna_height_m: must be > 0 (got -1)"),
+    ],
+)
+def test_a_mount_no_sensor_has_is_refused(kind: str, params: dict[str, Any], said: str) -> None:
+    data = _base()
+    data["vessels"][0]["sensors"][1] = {"name": "s", "type": kind, "rate_hz": 10, "params": params}
+    assert said in _error(data)
+
+
 def test_missing_vessels() -> None:
     data = _base()
     del data["vessels"]

@@ -73,8 +73,14 @@ def test_sees_a_boat_at_200_m_at_its_bearing_and_range(
     assert abs(float(np.median(rng)) - 198.0) < 3 * 0.2
 
 
-def test_range_noise_sigma() -> None:
-    params = RadarParams(sub_rays=1, elevations_deg=(0.0,), fan_target_height_m=0.0)
+@pytest.mark.parametrize(
+    "params",
+    [RadarParams(sub_rays=1, elevations_deg=(0.0,), fan_target_height_m=0.0), RadarParams()],
+    ids=["one ray a beam", "the default beam of many rays"],
+)
+def test_range_noise_sigma(params: RadarParams) -> None:
+    """The reading is N(true, sigma): with many rays a beam, the nearest of their noisy
+    ranges had been reported, 0.2 m short with a spread of 0.15 m."""
     errors = []
     for noise in (True, False):
         radar = RadarModel(
