@@ -184,29 +184,33 @@ class Gateway:
         earlier one: dropped. (Taken at the next controller tick, a late reply to /clock 0
         raced the reply to /clock 10, and two runs of one stack differed.)"""
         takes = self.takes_commands(tick)
+        until = time.monotonic() + self.ros.reply_timeout_s  # the whole wait of this tick
         if takes and tick.tick == 0:
-            self._await_stack()  # before the first /clock: a stack to answer it
+            self._await_stack(until)  # before the first /clock: a stack to answer it
         for cmd in self.inbound.take():
             self._route(cmd)
         for control in self.controls.values():
             if takes and tick.tick % (control.stream.period or 1) == 0:
                 control.fresh = None
         self.tick_clock(tick.tick, tick.stamp_ns, force=takes)
-        self.commands(tick)
+        self.commands(tick, until=until)
 
-    def commands(self, tick: Tick | None = None) -> None:
+    def commands(self, tick: Tick | None = None, *, until: float | None = None) -> None:
         """Route the commands received so far. At a tick where a vessel this gateway
         controls takes a command, publish it clocked, waiting for the ROS stack's reply to
-        this tick's /clock for up to `ros.reply_timeout_s`."""
+        this tick's /clock until `until` (`ros.reply_timeout_s` after the tick began, the
+        wait for a first subscriber included: the two had outlasted the clock's deadline);
+        with nobody subscribed to /clock, nobody can reply: the last command holds at once."""
         for cmd in self.inbound.take():
             self._route(cmd)
         if tick is None:
             return
+        until = time.monotonic() + self.ros.reply_timeout_s if until is None else until
         for vessel, control in self.controls.items():
             if tick.tick % (control.stream.period or 1):
                 continue
-            if control.fresh is None:
-                self._await(vessel, control, tick)
+            if control.fresh is None and self.clock.watched:
+                self._await(vessel, control, tick, until)
             msg = control.fresh or control.last
             control.last, control.fresh = msg, None
             assert self._publish is not None, "a lockstep gateway publishes its controls"
@@ -244,19 +248,18 @@ class Gateway:
             return False
         return True
 
-    def _await_stack(self) -> None:
+    def _await_stack(self, until: float) -> None:
         """Before the first command: wait for a /clock subscriber, the stack that answers
         (a clock sent before its subscription is known would reach nobody)."""
-        deadline = time.monotonic() + self.ros.reply_timeout_s
-        while not self.clock.watched and time.monotonic() < deadline:
+        while not self.clock.watched and time.monotonic() < until:
             time.sleep(0.01)
         if not self.clock.watched:
-            log.warning("nobody subscribes to /clock: the controlled vessels get no command")
+            log.warning("nobody subscribes to /clock: the controlled vessels hold their last "
+                        "command (at first: rest) until a stack does")  # fmt: skip
 
-    def _await(self, vessel: str, control: Control, tick: Tick) -> None:
-        deadline = time.monotonic() + self.ros.reply_timeout_s
+    def _await(self, vessel: str, control: Control, tick: Tick, until: float) -> None:
         while control.fresh is None:
-            left = deadline - time.monotonic()
+            left = until - time.monotonic()
             if left <= 0:
                 log.warning(
                     "no %s for %s at tick %d within %g s: the last one holds (this run is "

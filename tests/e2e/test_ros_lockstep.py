@@ -10,7 +10,7 @@ from pathlib import Path
 from typing import Any
 
 import zenoh
-from conftest import files_of, only_run_dir, scenario_file, start
+from conftest import catabot, files_of, only_run_dir, scenario_file, start
 from ros_client import ROSBAGS, RosClient, bridge_key, rmw_key, twist
 
 from catabot.bus.session import free_port
@@ -107,3 +107,19 @@ def test_the_same_commands_give_byte_identical_runs(tmp_path: Path) -> None:
         assert (m.decoded.linear.x, m.decoded.angular.z) == (surge(m.log_time), 0.05)
     log = (runs[0] / "log" / "ros.log").read_text()
     assert "no longer reproducible" not in log
+
+
+def test_with_no_stack_the_run_goes_on_with_the_vessel_at_rest(tmp_path: Path) -> None:
+    """The wait for a /clock subscriber and the wait for its reply had each a reply timeout
+    at tick 0: together past the deadline, so a ROS node started a few seconds late found
+    the run failed (blaming physics). Now they share one timeout, and with nobody on /clock
+    nobody can reply: the last command (at first: rest) holds at once, as documented."""
+    data = _scenario() | {"duration_s": 1.0, "clock": {"deadline_s": 2.0}}
+    data["ros"] = {"lockstep": True, "mode": "bridge", "reply_timeout_s": 1.5}
+    out = tmp_path / "runs"
+    result = catabot("run", str(scenario_file(tmp_path, data)), "--out", str(out), "--quiet")
+    assert result.returncode == 0, result.stderr
+    run = only_run_dir(out)
+    assert "nobody subscribes to /clock" in (run / "log" / "ros.log").read_text()
+    twist = (run / "vessel.ego.cmd.twist.csv").read_text().splitlines()
+    assert len(twist) == 1 + 10 and all(line.endswith(",0.0,0.0") for line in twist[1:])

@@ -114,8 +114,12 @@ def test_a_lockstep_controller_takes_the_reply_to_its_tick(sessions: Any) -> Non
     gateway = Gateway(world, world.scenario.ros, ours, lambda k, m: sent.append((k, m)),  # type: ignore[arg-type]
                       rejections=_refused())  # fmt: skip
     try:
-        gateway.commands(Tick("r", 0, 0, 10_000_000))  # nobody answers tick 0: neutral
+        gateway.commands(Tick("r", 0, 0, 10_000_000))  # nobody on /clock: neutral, at once
         assert sent == [(world.keys.cmd_thrust("other"), ThrustCmd((0.0, 0.0), 0, 0))]
+        clock = ros.declare_subscriber("clock", lambda _: None)  # the stack, on sim time
+        deadline = time.monotonic() + 10.0
+        while not gateway.clock.watched and time.monotonic() < deadline:
+            time.sleep(0.01)
         layout = ROSBAGS.types["std_msgs/msg/MultiArrayLayout"](dim=[], data_offset=0)
         msg = ROSBAGS.types["std_msgs/msg/Float64MultiArray"](
             layout=layout, data=np.array([0.5, -0.5])
@@ -127,6 +131,7 @@ def test_a_lockstep_controller_takes_the_reply_to_its_tick(sessions: Any) -> Non
         assert sent[-1] == (world.keys.cmd_thrust("other"), ThrustCmd((0.5, -0.5), 10, 100_000_000))
         gateway.commands(Tick("r", 20, 200_000_000, 10_000_000))  # silent: the last holds
         assert sent[-1][1] == ThrustCmd((0.5, -0.5), 20, 200_000_000)
+        clock.undeclare()
     finally:
         gateway.close()
 
