@@ -244,7 +244,7 @@ class Gateway:
             if check is not None:
                 check(cmd.message)
         except ValueError as exc:
-            self.inbound.refuse(f"{cmd.vessel}/{cmd.name}", exc)
+            self.inbound.refuse(self.convert.names.topic(cmd.vessel, cmd.name), exc)
             return False
         return True
 

@@ -174,8 +174,8 @@ def test_commands_the_bus_would_refuse_are_refused_here(
             assert _until(lambda: (gateway.commands(), bool(got))[1])
         assert got == [world.keys.cmd_waypoints("ego")]
         said = " ".join(r.getMessage() for r in caplog.records)
-        assert f"on ego/waypoints: {REFUSED}: 'ego' is a scenario vessel" in said
-        assert f"on other/cmd_vel: {REFUSED}: vessel 'other' is driven in lockstep by" in said
+        assert f"on /ego/waypoints: {REFUSED}: 'ego' is a scenario vessel" in said
+        assert f"on /other/cmd_vel: {REFUSED}: vessel 'other' is driven in lockstep by" in said
     finally:
         bus.undeclare()
         gateway.close()
