@@ -149,8 +149,9 @@ def _first_returns(
     ray's own noise. The nearest of the noisy ranges was biased short (0.2 m low at sigma
     0.2 over a beam's rays: a sensor check found the reading -0.215 +- 0.151 m, not
     N(0, 0.2) as the paper's "Gaussian noise on this distance reading" is)."""
+    nearest = np.full(beams, np.inf, dtype=clean.dtype)
+    np.minimum.at(nearest, beam, clean)
+    first = np.flatnonzero(clean == nearest[beam])[::-1]  # reversed: of ties, the first wins
     out = np.full(beams, np.inf)
-    order = np.lexsort((clean, beam))
-    first = order[np.unique(beam[order], return_index=True)[1]]
     out[beam[first]] = noisy[first]
     return out
