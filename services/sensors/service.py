@@ -19,6 +19,7 @@ from catabot.config.sensors import SENSOR_TYPES
 from catabot.run.service import Built, ServiceContext, run_service
 from catabot.world.waves import WaveField
 from catabot.world.world import World
+from services.sensors.own_view import OwnView
 from services.sensors.registry import Sensor, build_sensor
 from services.sensors.scene import Body, Scene
 from services.sensors.settings import SensorSettings
@@ -55,6 +56,8 @@ class SensorsService:
         self.states_key = ctx.keys.world_states()
         self.settings = SensorSettings(ctx.scenario, self.scene, ctx.keys.sensor)
         self.models = {m.key: m.sensor for m in self.mounted}
+        self.own_view = OwnView([(s.key, s.seed_name, world.body(s.vessel).instance)
+                                 for s in mine if SENSOR_TYPES[s.config.type].casts])  # fmt: skip
         self.participant = ctx.participant([world.streams.states])
 
     def step(self, tick: Tick, inputs: Inputs) -> None:
@@ -70,6 +73,7 @@ class SensorsService:
         for m in due:
             sample = m.sensor.sample(self.states[m.row], tick=tick.tick, stamp_ns=tick.stamp_ns)
             self.participant.publish(m.key, sample)
+            self.own_view.check(m.key, sample)
 
     def _pose_scene(self, tick: Tick) -> None:
         """Every body where it is at this tick; only on ticks a ray-casting sensor is due

@@ -1,5 +1,6 @@
 """`catabot run` tells on its console (stderr, with refusals) what a service advises: a
-twist beyond reach, a script step after the run's end."""
+twist beyond reach, a script step after the run's end, a LiDAR that mostly sees its own
+vessel."""
 
 from __future__ import annotations
 
@@ -15,7 +16,9 @@ def test_a_scripted_twist_beyond_reach_is_told_on_the_console(tmp_path: Path) ->
     data = {"name": "advice", "duration_s": 0.5, "vessels": [
         {"id": "fast", "script": twist(3.0)},
         {"id": "slow", "pose": {"x_m": 10.0, "y_m": 0.0},
-         "script": [*twist(1.0), {"t_s": 2.0, "thrust": [0.0, 0.0]}]},
+         "script": [*twist(1.0), {"t_s": 2.0, "thrust": [0.0, 0.0]}],
+         "sensors": [{"name": "low", "type": "lidar", "rate_hz": 10.0, "params": {
+             "channels": 8, "columns": 64, "mount_xyz": [0.0, 0.0, 0.2]}}]},
     ]}  # fmt: skip
     out = tmp_path / "runs"
     result = catabot("run", str(scenario_file(tmp_path, data)), "--out", str(out), "--quiet")
@@ -27,3 +30,5 @@ def test_a_scripted_twist_beyond_reach_is_told_on_the_console(tmp_path: Path) ->
     assert told[0].split("physics: ", 1)[1] in (only_run_dir(out) / "log/physics.log").read_text()
     late = "physics: slow: its script step at 2 s comes after the run's last tick (0.49 s), so it"
     assert late in result.stderr
+    assert "sensors: slow/low: " in result.stderr  # between its hulls: it sees them
+    assert "of its first sample's returns are its own vessel: mount it where" in result.stderr
