@@ -284,7 +284,7 @@ class CameraFrame(Message):
     times 127; `segmentation` (H, W) uint8 is the class (`LABEL_CLASSES`: 0 none, 1 water,
     2 terrain, 3 vessel, 4 buoy) and `instance` (H, W) uint16 the instance (0: none).
     `boxes` (K, 6) float32 rows are [instance, class, x0, y0, x1, y1] in pixels (x1, y1
-    exclusive) and `box_flags` (K, 2) uint8 [truncated, occluded].
+    exclusive) and `box_flags` (K, 3) uint8 [truncated, occluded, visible %].
     """
 
     TYPE: ClassVar[str] = "camera_frame"

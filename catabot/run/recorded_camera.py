@@ -69,9 +69,11 @@ class LabelledFrame:
 
     @cached_property
     def flags(self) -> NDArray[np.uint8]:
-        """(K, 2) [truncated, occluded] as the camera's `box_flags`."""
-        rows = [[o["truncated"], o["occluded"]] for o in self.record["objects"]]
-        return np.array(rows, dtype=np.uint8).reshape(len(rows), 2)
+        """(K, 3) [truncated, occluded, visible %] as the camera's `box_flags` (a run
+        recorded before the visible share was labelled: 100)."""
+        rows = [[o["truncated"], o["occluded"], round(100 * o.get("visible", 1.0))]
+                for o in self.record["objects"]]  # fmt: skip
+        return np.array(rows, dtype=np.uint8).reshape(len(rows), 3)
 
 
 def class_id(name: str) -> int:

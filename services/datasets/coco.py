@@ -6,7 +6,8 @@
 Each annotation is one visible body in one frame: `bbox` [x, y, width, height] (the visible
 box, which holds every pixel of the mask), `segmentation` its instance mask as compressed RLE
 (rle.py), `area` the mask's pixel count, `iscrowd` 0, plus CataBot's `instance` (the body's
-World row + 1), `truncated` and `occluded` flags. Category ids are the segmentation class
+World row + 1), `truncated` and `occluded` flags and `visible` (the share of the body's
+silhouette seen). Category ids are the segmentation class
 ids (3 vessel, 4 buoy), so a mask painted with its category id gives back the class image.
 pycocotools' `COCO(...)`, detectron2 and torchvision's CocoDetection read it as it is.
 """
@@ -52,6 +53,7 @@ def frame_annotations(frame: Frame, image_id: int, first_id: int) -> list[dict[s
             "instance": int(row[0]),
             "truncated": bool(flags[0]),
             "occluded": bool(flags[1]),
+            "visible": int(flags[2]) / 100,
         })  # fmt: skip
     return out
 

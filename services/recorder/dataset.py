@@ -58,6 +58,7 @@ def labels(frame: CameraFrame, files: dict[str, str], *, bodies: dict[int, str])
             "box": [int(v) for v in row[2:6]],
             "truncated": bool(flag[0]),
             "occluded": bool(flag[1]),
+            "visible": int(flag[2]) / 100,
         }
         for row, flag in zip(frame.boxes, frame.box_flags, strict=True)
     ]

@@ -157,11 +157,12 @@ class CameraModel:
     def _boxes(
         self, seg: NDArray[np.uint8], inst: NDArray[np.int32], origin: F64, rot: F64, hits: Hits
     ) -> tuple[F32, NDArray[np.uint8]]:
-        """(K, 6) [instance, class, x0, y0, x1, y1] and (K, 2) [truncated, occluded]. An
-        instance that is no body of the scene keeps its mask's box and is never occluded."""
+        """(K, 6) [instance, class, x0, y0, x1, y1] and (K, 3) [truncated, occluded,
+        visible %]. An instance that is no body of the scene keeps its mask's box and is
+        never occluded."""
         vis = cb.visible_boxes(inst, seg)
         if vis.ids.size == 0:
-            return np.empty((0, 6), np.float32), np.empty((0, 2), np.uint8)
+            return np.empty((0, 6), np.float32), np.empty((0, 3), np.uint8)
         if self._row_of is None:
             self._row_of = _rows_by_instance(self.scene.bodies)
         rows = self._row_of[np.minimum(vis.ids, self._row_of.size - 1)]

@@ -6,7 +6,8 @@ of occupied columns and rows, so a frame with many boats costs one pass over its
 pixels and no Python loop per pixel. The flags compare it with the WHOLE body:
 - truncated: the projected body leaves the image (or part of it is behind the camera): its
   box is the box of its shape's outline points (Scene.outlines) projected by the pinhole;
-- occluded: fewer visible pixels than `fraction` x its silhouette, the pixels whose rays
+- occluded: fewer visible pixels than `fraction` x its silhouette (their share is the third
+  flag, in percent), the pixels whose rays
   meet its shape above the waterline whatever is in front (Scene.cast(silhouettes=True)),
   counted within the image like the visible ones. A box's area would not do: a catamaran
   seen bow-on fills a third of its box, the gap between its hulls being water.
@@ -92,14 +93,16 @@ def flags(
     cam: Pinhole,
     fraction: float,
 ) -> NDArray[np.uint8]:
-    """(K, 2) uint8 [truncated, occluded] of the visible instances, given their full boxes
-    and silhouettes (pixels)."""
+    """(K, 3) uint8 [truncated, occluded, visible %] of the visible instances, given their
+    full boxes and silhouettes (pixels): the percentage is of the silhouette's pixels in the
+    image that are seen (a user filters by it, as nuScenes' visibility levels)."""
     out_of_image = (
         (full[:, 0] < 0) | (full[:, 1] < 0) | (full[:, 2] > cam.width) | (full[:, 3] > cam.height)
     )
     truncated = behind | out_of_image
     occluded = vis.count < fraction * silhouette
-    return np.stack([truncated, occluded], axis=1).astype(np.uint8)
+    seen = np.minimum(np.rint(100.0 * vis.count / np.maximum(silhouette, 1)), 100.0)
+    return np.stack([truncated, occluded, seen], axis=1).astype(np.uint8)
 
 
 EDGES = np.array([(a, a | bit) for a in range(8) for bit in (1, 2, 4) if not a & bit])

@@ -54,7 +54,7 @@ def frame(color: np.ndarray) -> CameraFrame:
     return CameraFrame(
         tick=42, stamp_ns=420_000_000, width=4, height=2, hfov_rad=1.0, objects=0, color=color,
         depth=empty, normals=empty, segmentation=empty, instance=empty,
-        boxes=np.empty((0, 6), np.float32), box_flags=np.empty((0, 2), np.uint8),
+        boxes=np.empty((0, 6), np.float32), box_flags=np.empty((0, 3), np.uint8),
     )  # fmt: skip
 
 

@@ -121,7 +121,7 @@ SAMPLES: dict[str, Message] = {
         segmentation=np.array([[0, 3, 3], [1, 1, 1]], dtype=np.uint8),
         instance=np.array([[0, 2, 2], [0, 0, 0]], dtype=np.uint16),
         boxes=np.array([[2, 3, 1, 0, 3, 1]], dtype=np.float32),
-        box_flags=np.array([[0, 1]], dtype=np.uint8),
+        box_flags=np.array([[0, 1, 40]], dtype=np.uint8),
     ),
 }
 

@@ -28,7 +28,8 @@ def _frame(tick: int) -> CameraFrame:
         tick=tick, stamp_ns=tick * 10_000_000, width=4, height=3, hfov_rad=1.0, objects=1,
         color=np.zeros((3, 4, 3), np.uint8), depth=depth, normals=np.zeros((3, 4, 3), np.int8),
         segmentation=np.full((3, 4), 3, np.uint8), instance=np.ones((3, 4), np.uint16),
-        boxes=np.array([[1, 3, 0, 0, 4, 3]], np.float32), box_flags=np.zeros((1, 2), np.uint8),
+        boxes=np.array([[1, 3, 0, 0, 4, 3]], np.float32),
+        box_flags=np.array([[0, 1, 40]], np.uint8),
     )  # fmt: skip
 
 
@@ -61,3 +62,11 @@ def test_depth_as_exact_float32_beside_the_png(tmp_path: Path) -> None:
     _record(again, 5.0)
     for name in ("00000020_depth.npy", "00000020_depth.png", "labels.jsonl"):
         assert (tmp_path / "ego.cam" / name).read_bytes() == (again / "ego.cam" / name).read_bytes()
+
+
+def test_each_object_says_how_much_of_it_is_seen(tmp_path: Path) -> None:
+    (first, *_) = _record(tmp_path, None)
+    assert first["objects"][0] | {"box": None} == {
+        "instance": 1, "body": "ego", "class": "vessel", "box": None,
+        "truncated": False, "occluded": True, "visible": 0.4,
+    }  # fmt: skip

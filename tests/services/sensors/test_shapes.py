@@ -218,7 +218,7 @@ def test_boxes_and_flags_follow_the_shape() -> None:
     params = {"width": 320, "height": 240, "mount_xyz": (0.0, 0.0, 1.5)}
     _, alone = _camera_frame(_scene({"w": (20.0, 0.0, 0.0)}, wamv), **params)
     row = np.flatnonzero(alone.boxes[:, 0] == 2)
-    assert row.size == 1 and alone.box_flags[row[0]].tolist() == [0, 0]
+    assert row.size == 1 and alone.box_flags[row[0]].tolist() == [0, 0, 100]  # all seen
     mask = np.argwhere(alone.instance == 2)
     x0, y0 = mask[:, 1].min(), mask[:, 0].min()
     x1, y1 = mask[:, 1].max() + 1, mask[:, 0].max() + 1
@@ -229,6 +229,8 @@ def test_boxes_and_flags_follow_the_shape() -> None:
     )
     row = np.flatnonzero(hidden.boxes[:, 0] == 2)
     assert row.size == 1 and hidden.box_flags[row[0], 1] == 1
+    seen = np.count_nonzero(hidden.instance == 2) / np.count_nonzero(alone.instance == 2)
+    assert abs(hidden.box_flags[row[0], 2] - 100 * seen) <= 1  # visible: its share, in %
     edge_y = 18.0 * math.tan(math.radians(40.0))  # the left edge of the view at 18 m
     _, edge = _camera_frame(_scene({"w": (20.0, edge_y, 0.0)}, wamv), **params)
     row = np.flatnonzero(edge.boxes[:, 0] == 2)
