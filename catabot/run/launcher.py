@@ -103,13 +103,21 @@ def _check_logins(opts: RunOptions, world: World) -> None:
 
 
 def make_run_dir(out: Path, scenario: Scenario) -> Path:
+    """`<name>-<time>`, or `-2`, `-3`, ... after it: the folder is taken by making it, so
+    runs started in one second beside each other (`xargs -P`) each get their own (a check
+    then a make had let two race, and the loser exit 2 as if its scenario were bad)."""
     stamp = datetime.now().strftime("%Y%m%d-%H%M%S")
     base = out / f"{scenario.name}-{stamp}"
+    out.mkdir(parents=True, exist_ok=True)
     run_dir, n = base, 1
-    while run_dir.exists():
-        n += 1
-        run_dir = Path(f"{base}-{n}")
-    (run_dir / "log").mkdir(parents=True)
+    while True:
+        try:
+            run_dir.mkdir()
+            break
+        except FileExistsError:
+            n += 1
+            run_dir = Path(f"{base}-{n}")
+    (run_dir / "log").mkdir()
     (run_dir / "scenario.json").write_text(scenario.model_dump_json(indent=2) + "\n")
     return run_dir
 
