@@ -36,6 +36,7 @@ from catabot.config import live
 from catabot.config.load import digest, load_scenario
 from catabot.config.scenario import Scenario, participants
 from catabot.errors import CataBotError
+from catabot.run.advice import advise
 from catabot.run.answer import OneLineParser
 from catabot.run.service import quiet_gc
 from catabot.run.settings_desk import SettingsDesk
@@ -63,6 +64,16 @@ def clock_spec(scenario: Scenario, start_timeout_s: float | None = None) -> Cloc
 
 _EMIT = threading.Lock()  # the heartbeat thread and the tick loop share stdout
 HEARTBEAT_S = 0.5
+
+
+def _tell_late_settings(scenario: Scenario) -> None:
+    """Advice on timeline entries after the run's last tick (taken, never applied)."""
+    last = scenario.ticks - 1
+    last_s = last * scenario.dt_ns / 1e9
+    for i, s in enumerate(scenario.settings):
+        if live.tick_at(s.t_s, scenario.dt_ns) > last:
+            advise(log, f"settings.{i} ({s.key} at {s.t_s:g} s) comes after the run's last "
+                        f"tick ({last_s:g} s), so it never applies")  # fmt: skip
 
 
 def emit(kind: str, **fields: object) -> bool:
@@ -117,6 +128,7 @@ def main(argv: list[str] | None = None) -> int:
         return 2
     keys = Keys(scenario.name)
     schedule = Schedule(live.timeline(scenario), ticks=scenario.ticks, grace_s=live.apply_grace_s)
+    _tell_late_settings(scenario)
     spec = clock_spec(scenario, args.start_timeout)
     try:
         conductor = Conductor(session, keys, spec, roster=args.roster, settings=schedule)

@@ -1,6 +1,6 @@
 """`catabot run` tells on its console (stderr, with refusals) what a service advises: a
-twist beyond reach, a script step after the run's end, a LiDAR that mostly sees its own
-vessel."""
+twist beyond reach, a script step or a setting after the run's end, a LiDAR that mostly
+sees its own vessel."""
 
 from __future__ import annotations
 
@@ -13,7 +13,8 @@ def test_a_scripted_twist_beyond_reach_is_told_on_the_console(tmp_path: Path) ->
     def twist(surge: float) -> list[dict[str, object]]:
         return [{"t_s": 0.0, "twist": {"surge_mps": surge, "yaw_rate_radps": 0.0}}]
 
-    data = {"name": "advice", "duration_s": 0.5, "vessels": [
+    data = {"name": "advice", "duration_s": 0.5,
+            "settings": [{"t_s": 2.0, "key": "rain", "value": 5}], "vessels": [
         {"id": "fast", "script": twist(3.0)},
         {"id": "slow", "pose": {"x_m": 10.0, "y_m": 0.0},
          "script": [*twist(1.0), {"t_s": 2.0, "thrust": [0.0, 0.0]}],
@@ -31,4 +32,5 @@ def test_a_scripted_twist_beyond_reach_is_told_on_the_console(tmp_path: Path) ->
     late = "physics: slow: its script step at 2 s comes after the run's last tick (0.49 s), so it"
     assert late in result.stderr
     assert "sensors: slow/low: " in result.stderr  # between its hulls: it sees them
+    assert "settings.0 (rain at 2 s) comes after the run's last tick (0.49 s)" in result.stderr
     assert "of its first sample's returns are its own vessel: mount it where" in result.stderr
