@@ -41,6 +41,10 @@ def check_rates(scenario: Scenario) -> None:
         scenario.ticks  # noqa: B018 - validates duration against dt
     except ClockError as exc:
         raise ScenarioError(f"duration_s: {exc}") from None
+    if scenario.duration_ns % scenario.dt_ns:  # cut to whole ticks, unsaid: a run looked short
+        dt_s, whole = scenario.dt_ns / NS_PER_S, scenario.ticks * scenario.dt_ns / NS_PER_S
+        raise ScenarioError(f"duration_s: {scenario.duration_s:g} s is not a whole number of "
+                            f"ticks of {dt_s:g} s (the run would end at {whole:g} s)")  # fmt: skip
 
 
 def rate_in_ticks(rate_hz: float, dt_ns: int, *, where: str) -> int:

@@ -174,7 +174,11 @@ class TrafficConfig(Strict):
 
     @model_validator(mode="after")
     def _overrides_in_range(self) -> TrafficConfig:
-        for b in self.boats:
+        seen: dict[int, int] = {}  # index: the entry that pins it
+        for i, b in enumerate(self.boats):
             if b.index >= self.count:
                 raise ValueError(f"boats: index {b.index} is not below count {self.count}")
+            if seen.setdefault(b.index, i) != i:  # the last had won, unsaid
+                raise ValueError(f"boats.{i}: index {b.index} is pinned by boats.{seen[b.index]} "
+                                 "already; one entry a boat")  # fmt: skip
         return self

@@ -66,12 +66,15 @@ def prepare(opts: RunOptions) -> World:
         check_listen(opts.listen)
     scenario = load_scenario(opts.scenario)
     source = opts.scenario or "default"
-    data = scenario.model_dump()
+    data, flags = scenario.model_dump(), []
     if opts.duration_s is not None:
         data["duration_s"] = opts.duration_s
+        flags.append(f"--duration {opts.duration_s:g}")
     if opts.realtime is not None:
         data["clock"]["realtime_factor"] = opts.realtime
-    parsed = parse_scenario(data, source="command line")
+        flags.append(f"--realtime {opts.realtime:g}")
+    changed = f"{source} with {' '.join(flags)}" if flags else source  # the file, the flags
+    parsed = parse_scenario(data, source=changed)
     try:
         world = World.resolve(parsed, progress=PlanningProgress())
     except ScenarioError as exc:  # which file, as the parser's own errors say

@@ -57,6 +57,15 @@ def test_two_script_steps_at_one_time_are_refused(
     assert "vessels.0.script.2.t_s: step 0 is also at 2 s; give each time one step" in err
 
 
+def test_a_flag_that_breaks_the_scenario_is_named_with_the_file(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    path = _scenario(tmp_path)
+    assert main(["run", path, "--duration", "1.005", "--out", str(tmp_path / "runs")]) == 2
+    err = capsys.readouterr().err
+    assert f"scenario {path} with --duration 1.005: duration_s: 1.005 s is not a whole" in err
+
+
 def test_validate_refuses_a_missing_program_as_run_does(
     tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
