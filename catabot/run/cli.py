@@ -36,6 +36,7 @@ def _run(args: argparse.Namespace) -> int:
     opts = launcher.RunOptions(
         scenario=args.scenario,
         duration_s=args.duration,
+        seed=args.seed,
         realtime=args.realtime,
         out=Path(args.out),
         connect=connect,
@@ -178,6 +179,7 @@ def parser() -> argparse.ArgumentParser:
     run = sub.add_parser("run", help="run a scenario: conductor and services as processes")
     run.add_argument("scenario", nargs="?", help="scenario file or bundled name (default: default)")
     run.add_argument("--duration", type=float, help="simulated seconds (overrides the scenario)")
+    run.add_argument("--seed", type=int, help="the scenario's seed (a sweep's runs, one file)")
     run.add_argument("--realtime", type=float, metavar="FACTOR", help="pace: 1.0 = wall clock")
     run.add_argument("--out", default="runs", help="folder for run folders (default: runs)")
     run.add_argument(

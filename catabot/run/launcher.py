@@ -47,6 +47,7 @@ class LaunchError(CataBotError, RuntimeError):
 class RunOptions:
     scenario: str | None = None
     duration_s: float | None = None
+    seed: int | None = None
     realtime: float | None = None
     out: Path = Path("runs")
     connect: tuple[str, ...] = ()
@@ -70,6 +71,9 @@ def prepare(opts: RunOptions) -> World:
     if opts.duration_s is not None:
         data["duration_s"] = opts.duration_s
         flags.append(f"--duration {opts.duration_s:g}")
+    if opts.seed is not None:
+        data["seed"] = opts.seed
+        flags.append(f"--seed {opts.seed}")
     if opts.realtime is not None:
         data["clock"]["realtime_factor"] = opts.realtime
         flags.append(f"--realtime {opts.realtime:g}")

@@ -64,6 +64,9 @@ def test_a_flag_that_breaks_the_scenario_is_named_with_the_file(
     assert main(["run", path, "--duration", "1.005", "--out", str(tmp_path / "runs")]) == 2
     err = capsys.readouterr().err
     assert f"scenario {path} with --duration 1.005: duration_s: 1.005 s is not a whole" in err
+    assert main(["run", path, "--seed", "-3", "--duration", "1", "--out", str(tmp_path)]) == 2
+    said = f"scenario {path} with --duration 1 --seed -3: seed: must be >= 0 (got -3)"
+    assert said in capsys.readouterr().err
 
 
 def test_validate_refuses_a_missing_program_as_run_does(
