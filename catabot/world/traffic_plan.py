@@ -327,7 +327,8 @@ class Planner:
                 raise ScenarioError(
                     f"traffic: no path of {w.count} waypoints clear of land, buoys and other "
                     f"boats' tracks for {base.id} in {PATH_DRAWS} draws: use fewer points or "
-                    "boats, or a larger traffic.waypoints.region"
+                    "boats, or a traffic.waypoints.region over more open water (beyond the "
+                    "terrain's edge there is none)"
                 )
             path = (
                 [(float(q[0]), float(q[1])) for q in given]
