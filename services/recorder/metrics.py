@@ -135,8 +135,8 @@ class Metrics:
             touching[a, b] = boxes_touch(position, np.asarray(batch.orientation), boxes, a, b)
         self.collisions.update(touching, stamp)
 
-    def write(self, path: Path) -> None:
-        write_metrics(self, path)
+    def write(self, path: Path, *, end_reason: str = "") -> None:
+        write_metrics(self, path, end_reason=end_reason)
 
 
 class _Nearest:

@@ -19,8 +19,11 @@ if TYPE_CHECKING:
     from services.recorder.metrics import Metrics
 
 
-def write_metrics(m: Metrics, path: Path) -> None:
-    path.write_text(json.dumps(record(m), indent=2, sort_keys=True) + "\n")
+def write_metrics(m: Metrics, path: Path, *, end_reason: str = "") -> None:
+    """`end_reason`: how the run ended (`completed`, `interrupted`, a fault, `ended by ...`),
+    so the file alone says whether its figures cover the whole run."""
+    data = record(m) | {"end_reason": end_reason}
+    path.write_text(json.dumps(data, indent=2, sort_keys=True) + "\n")
 
 
 def record(m: Metrics) -> dict[str, Any]:

@@ -204,7 +204,7 @@ class Recorder:
             self.csv.close()
         if self.mcap is not None:
             self.mcap.close()
-        self.metrics.write(self.run_dir / "metrics.json")
+        self.metrics.write(self.run_dir / "metrics.json", end_reason=end.reason)
         more = f" ({past} ticks stepped past the end left out)" if past else ""
         log.info("recorder closed its files after tick %d%s", end.tick, more)
 

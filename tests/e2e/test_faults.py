@@ -155,6 +155,7 @@ def test_ctrl_c_ends_every_process_with_complete_files(
     assert not [c for c in children if c.is_running() and c.status() != psutil.STATUS_ZOMBIE]
     run = only_run_dir(out)
     _assert_readable(run)
+    assert json.loads((run / "metrics.json").read_text())["end_reason"] == "interrupted"
     from mcap.reader import make_reader
 
     with (run / "run.mcap").open("rb") as f:
