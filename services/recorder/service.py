@@ -101,7 +101,11 @@ class Recorder:
             self._write(stream, cmd)
 
     def _inputs(self, tick: Tick, inputs: Inputs) -> None:
-        for key in sorted(inputs):
+        """The states first: their batch names the free commands physics took at its tick,
+        and a boat one took over does not follow that tick's traffic set-points (sorted by
+        key, `world/cmd/twist` came first and wrote a set-point row the boat ignored)."""
+        states = self.keys.world_states()
+        for key in sorted(inputs, key=lambda k: (k != states, k)):
             stream = self.keys.relative(key)
             for msg in inputs[key]:
                 if isinstance(msg, BodyStates):
