@@ -239,13 +239,12 @@ def camera_info(names: Names, sensor: MountedSensor) -> bytes:
     """sensor_msgs/CameraInfo of the pinhole at stamp 0: no distortion, K of `camera_matrix`."""
     p = sensor.params
     k = camera_matrix(sensor)
-    f, cx, cy = k[0, 0], k[0, 2], k[1, 2]
     info = types.new(
         types.CAMERA_INFO,
         header=types.header(0, names.optical_frame(sensor)),
         height=p.height, width=p.width, distortion_model="plumb_bob",
-        d=np.zeros(5), k=np.array([f, 0, cx, 0, f, cy, 0, 0, 1.0]), r=np.eye(3).ravel(),
-        p=np.array([f, 0, cx, 0, 0, f, cy, 0, 0, 0, 1.0, 0]), binning_x=0, binning_y=0,
+        d=np.zeros(5), k=k.ravel(), r=np.eye(3).ravel(),
+        p=np.hstack([k, np.zeros((3, 1))]).ravel(), binning_x=0, binning_y=0,
         roi=types.new("sensor_msgs/msg/RegionOfInterest", x_offset=0, y_offset=0, height=0,
                       width=0, do_rectify=False),
     )  # fmt: skip

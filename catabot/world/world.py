@@ -247,10 +247,12 @@ def _bodies(scenario: Scenario, plan: TrafficPlan) -> tuple[Body, ...]:
     rows += [(b.id, "buoy", BUOY_MODEL, Pose(x_m=b.x_m, y_m=b.y_m), None) for b in buoys]
     _unique([r[0] for r in rows])
     fields = {"vessel": "vessels.{}.model", "boat": "traffic.models", "buoy": "buoys"}
-    first = {ref: (fields[kind].format(i), bid) for i, (bid, kind, ref, _, _) in
-             reversed(list(enumerate(rows)))}  # each model's first body  # fmt: skip
-    for ref, (where, bid) in first.items():
-        _check_floats(f"{where} ({bid})", ref, model(ref), scenario.water.density_kg_m3)
+    checked: set[str] = set()  # each model once, named by its first body
+    for i, (bid, kind, ref, _, _) in enumerate(rows):
+        if ref not in checked:
+            checked.add(ref)
+            where = f"{fields[kind].format(i)} ({bid})"
+            _check_floats(where, ref, model(ref), scenario.water.density_kg_m3)
     return tuple(
         Body(bid, kind, ref, model(ref), pose, row, *_scenario_part(config))
         for row, (bid, kind, ref, pose, config) in enumerate(rows)

@@ -96,24 +96,25 @@ def camera_frames(
             f"{run.folder}: no labelled camera frames (the run needs a camera and "
             "recording.dataset: true; dataset/<vessel>.<camera>/labels.jsonl holds them)"
         )
-    own = {s.vessel: 0 if options.keep_own else run.world.body(s.vessel).row + 1 for s in found}
+    own = {s.vessel: 0 if options.keep_own else run.world.body(s.vessel).instance for s in found}
     pairs = [
-        (f"{s.vessel}.{s.config.name}", f) for s in found for f in labelled_frames(run.folder, s)
+        (f"{s.vessel}.{s.config.name}", f, own[s.vessel])
+        for s in found
+        for f in labelled_frames(run.folder, s)
     ]
-    whole = [all(f.path(n) is not None for n in needs) for _, f in pairs]
-    without = [f"{cam}@{f.tick}" for (cam, f), ok in zip(pairs, whole, strict=True) if not ok]
+    whole = [all(f.path(n) is not None for n in needs) for _, f, _ in pairs]
+    without = [f"{cam}@{f.tick}" for (cam, f, _), ok in zip(pairs, whole, strict=True) if not ok]
     pairs = [pair for pair, ok in zip(pairs, whole, strict=True) if ok]
     what = " or ".join(NAMES[n] for n in needs) + " image"
     if not pairs:
         raise ExportError(f"{run.folder}: no labelled frame has a {what} (the cameras' outputs "
                           f"were off: outputs.{', outputs.'.join(needs)})")  # fmt: skip
-    subsets = split([f.stamp_ns for _, f in pairs], seed=run.world.scenario.seed,
+    subsets = split([f.stamp_ns for _, f, _ in pairs], seed=run.world.scenario.seed,
                     val_fraction=options.val_fraction, block_s=options.block_s)  # fmt: skip
     frames = [
-        Frame(f"{cam}_{f.tick:08d}", cam, f, subset, options.min_box_px,
-              own[cam.rsplit(".", 1)[0]])
-        for (cam, f), subset in zip(pairs, subsets, strict=True)
-    ]  # fmt: skip
+        Frame(f"{cam}_{f.tick:08d}", cam, f, subset, options.min_box_px, mine)
+        for (cam, f, mine), subset in zip(pairs, subsets, strict=True)
+    ]
     return frames, _note(frames, without, what, options.min_box_px if boxes else None)
 
 

@@ -144,16 +144,17 @@ class Recorder:
         script's steps are not written and the thrust metered is the one in force; after a
         release, the script's step (or rest) it follows again, written as a command."""
         vessel = self.commanded.get(key)
-        if vessel is not None and self.orders.heard(vessel, msg, tick.stamp_ns):
+        if vessel is None or not self.orders.heard(vessel, msg, tick.stamp_ns):
+            return
+        if isinstance(msg, WaypointsCmd):
+            self._resume(vessel, tick)
+        else:
             self.metrics.order_changed(vessel)
-            if isinstance(msg, WaypointsCmd):
-                self._resume(vessel, tick, changed=False)
 
-    def _resume(self, vessel: str, tick: Tick, *, changed: bool = True) -> None:
+    def _resume(self, vessel: str, tick: Tick) -> None:
         """A vessel handed back (a release, a stale outside command): the order it follows
         again, written as a command."""
-        if changed:
-            self.metrics.order_changed(vessel)
+        self.metrics.order_changed(vessel)
         resumed = self.scripts.resumed(vessel, tick.tick, tick.stamp_ns)
         if resumed is not None:
             self._write(*resumed)

@@ -43,8 +43,4 @@ class OwnView:
 
 def _instances(sample: Message) -> np.ndarray | None:
     """What each return or pixel hit, by instance id (None: the sensor does not say)."""
-    if isinstance(sample, LidarScan):
-        return np.asarray(sample.instance)
-    if isinstance(sample, CameraFrame):
-        return np.asarray(sample.instance)
-    return None
+    return np.asarray(sample.instance) if isinstance(sample, LidarScan | CameraFrame) else None
