@@ -234,6 +234,16 @@ def tick_at(t_s: float, dt_ns: int) -> int:
     return -(-round(t_s * NS_PER_S) // dt_ns)
 
 
+def after_end(scenario: Scenario, t_s: float) -> bool:
+    """Whether a step at `t_s` (a script's, the timeline's) falls after the run's last tick:
+    taken, and never applied (a `--duration` shorter than the file's)."""
+    return tick_at(t_s, scenario.dt_ns) >= scenario.ticks
+
+
+def last_tick_s(scenario: Scenario) -> float:
+    return (scenario.ticks - 1) * scenario.dt_ns / NS_PER_S
+
+
 def timeline(scenario: Scenario) -> list[Change]:
     """The scenario's `settings`, checked and on the clock, in file order within a tick."""
     changes = [

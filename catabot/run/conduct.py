@@ -68,12 +68,11 @@ HEARTBEAT_S = 0.5
 
 def _tell_late_settings(scenario: Scenario) -> None:
     """Advice on timeline entries after the run's last tick (taken, never applied)."""
-    last = scenario.ticks - 1
-    last_s = last * scenario.dt_ns / 1e9
+    last = live.last_tick_s(scenario)
     for i, s in enumerate(scenario.settings):
-        if live.tick_at(s.t_s, scenario.dt_ns) > last:
+        if live.after_end(scenario, s.t_s):
             advise(log, f"settings.{i} ({s.key} at {s.t_s:g} s) comes after the run's last "
-                        f"tick ({last_s:g} s), so it never applies")  # fmt: skip
+                        f"tick ({last:g} s), so it never applies")  # fmt: skip
 
 
 def emit(kind: str, **fields: object) -> bool:

@@ -48,8 +48,7 @@ class PhysicsService:
         )
         self.book = CommandBook(world.vessels)
         self.reach = Reach(world.vessels, self.controllers.single)  # says a twist is too much
-        last_ns = (world.scenario.ticks - 1) * self.dt_ns
-        for text in never_applied(world.vessels, last_ns=last_ns):
+        for text in never_applied(world.vessels, world.scenario):
             advise(log, text)
         streams = world.streams
         self.streams = [*streams.commands, *streams.controls, *streams.waypoints]

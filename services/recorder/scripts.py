@@ -22,6 +22,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from catabot.bus.messages import Message, ThrustCmd, TwistCmd
+from catabot.config.live import tick_at
 from catabot.config.scenario import ScriptStep
 from catabot.world.orders import Orders, script_step
 from catabot.world.world import World
@@ -36,9 +37,8 @@ class ScriptedCommands:
         self._dt_ns = dt
         self._scenario_vessels = {v.id: v for v in world.vessels if v.kind == "vessel"}
         for vessel in world.vessels:
-            for step, t_ns in zip(vessel.script, vessel.script_ns, strict=True):
-                tick = -(-t_ns // dt)  # the first tick at or after the step's time
-                self._due.setdefault(tick, {})[vessel.id] = step
+            for step in vessel.script:
+                self._due.setdefault(tick_at(step.t_s, dt), {})[vessel.id] = step
         self._keys = world.keys
         self._orders = orders
 
