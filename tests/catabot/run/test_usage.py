@@ -41,13 +41,15 @@ def test_usage_files_round_trip(tmp_path: Path) -> None:
 
 def test_proportional_and_anonymous_memory_count_a_shared_library_once() -> None:
     """A big private allocation shows in all three figures; PSS and anonymous memory are
-    read as the process is now, so they do not exceed the peak."""
+    read as the process is now, so they do not exceed the peak. PSS also holds this
+    process's share of shared file pages, which falls meanwhile when another process (a
+    sibling test worker) maps the same libraries: CI saw 176 MB for the 200 MB block."""
     before = memory_mb()
     block = bytearray(200 * 2**20)  # touched (zeroed) pages of this process's own
     after = memory_mb()
     assert set(after) == {"peak_rss_mb", "pss_mb", "anon_mb"}
     assert after["anon_mb"] - before["anon_mb"] > 190.0
-    assert after["pss_mb"] - before["pss_mb"] > 190.0
+    assert after["pss_mb"] - before["pss_mb"] > 140.0
     assert after["anon_mb"] < after["pss_mb"] <= after["peak_rss_mb"]
     del block
 
