@@ -34,7 +34,7 @@ class Orders:
         self.timeouts = dict(timeouts or {})
         self.held_since: dict[str, int] = {}  # the stamp of the tick that took the last
 
-    def heard(self, vessel: str, msg: Message, stamp_ns: int = 0) -> bool:
+    def heard(self, vessel: str, msg: Message, *, stamp_ns: int) -> bool:
         """Take one command for `vessel`, taken at the tick stamped `stamp_ns`; whether the
         rule could have changed its order (a release of a vessel nobody held changes
         nothing)."""

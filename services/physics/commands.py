@@ -116,7 +116,7 @@ class CommandBook:
         thruster, a finite twist: catabot/bus/checks.py). A lockstep twist (tick >= 0) is a
         set-point; an outside command (tick -1) takes the vessel over."""
         for msg in msgs:
-            if self.book.heard(vessel, msg, stamp_ns) and isinstance(msg, WaypointsCmd):
+            if self.book.heard(vessel, msg, stamp_ns=stamp_ns) and isinstance(msg, WaypointsCmd):
                 self.released.add(vessel)
             if isinstance(msg, TwistCmd) and msg.tick >= 0:
                 self.set_point[self.row[vessel]] = (msg.surge, msg.yaw_rate)

@@ -144,7 +144,7 @@ class Recorder:
         script's steps are not written and the thrust metered is the one in force; after a
         release, the script's step (or rest) it follows again, written as a command."""
         vessel = self.commanded.get(key)
-        if vessel is None or not self.orders.heard(vessel, msg, tick.stamp_ns):
+        if vessel is None or not self.orders.heard(vessel, msg, stamp_ns=tick.stamp_ns):
             return
         if isinstance(msg, WaypointsCmd):
             self._resume(vessel, tick)

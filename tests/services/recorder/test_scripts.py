@@ -32,14 +32,14 @@ def test_a_vessel_taken_over_from_the_bus_is_not_written_as_following_its_script
     world = World.resolve(parse_scenario({"vessels": [{"id": "ego", "script": SCRIPT}]}))
     orders = Orders()
     scripts = ScriptedCommands(world, orders)
-    orders.heard("ego", ThrustCmd((0.9, 0.9)))  # from outside: tick -1
+    orders.heard("ego", ThrustCmd((0.9, 0.9)), stamp_ns=0)  # from outside: tick -1
     assert scripts.due(2, 20_000_000) == []
-    orders.heard("ego", WaypointsCmd((), 1.0, 1.0, "release"))
+    orders.heard("ego", WaypointsCmd((), 1.0, 1.0, "release"), stamp_ns=0)
     assert scripts.due(2, 20_000_000) == [
         ("vessel/ego/cmd/thrust", ThrustCmd((0.3, 0.3), 2, 20_000_000))
     ]
-    orders.heard("ego", TwistCmd(1.0, 0.0, 3, 30_000_000))  # lockstep
-    orders.heard("ego", WaypointsCmd((), 1.0, 1.0, "release"))
+    orders.heard("ego", TwistCmd(1.0, 0.0, 3, 30_000_000), stamp_ns=0)  # lockstep
+    orders.heard("ego", WaypointsCmd((), 1.0, 1.0, "release"), stamp_ns=0)
     assert scripts.due(5, 50_000_000) == []
 
 
@@ -47,9 +47,9 @@ def test_a_boat_an_outside_command_holds_is_marked_until_a_path_or_release() -> 
     world = World.resolve(parse_scenario({"vessels": [{"id": "ego"}], "traffic": {"count": 3}}))
     orders, boats = Orders(), world.boat_ids
     scripts = ScriptedCommands(world, orders)
-    orders.heard("boat_001", TwistCmd(0.0, 0.0))  # tick -1: from outside
+    orders.heard("boat_001", TwistCmd(0.0, 0.0), stamp_ns=0)  # tick -1: from outside
     assert scripts.taken(boats).tolist() == [False, True, False]
-    orders.heard("boat_001", WaypointsCmd((), 1.0, 1.0, "release"))
+    orders.heard("boat_001", WaypointsCmd((), 1.0, 1.0, "release"), stamp_ns=0)
     assert not scripts.taken(boats).any()
 
 
