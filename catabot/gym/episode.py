@@ -21,15 +21,16 @@ from catabot.config.load import load_scenario, parse_scenario
 from catabot.config.rates import rate_in_ticks
 from catabot.config.scenario import Pose, Scenario
 from catabot.config.terrain import TerrainError
-from catabot.config.vessel import VesselModel, load_vessel_model
 from catabot.gym.options import EnvOptions, EnvOptionsError
 from catabot.world import seeding
 from catabot.world.placement import (
     BUOY_MODEL,
     CLEARANCE_M,
+    Models,
     footprint_m,
     keel_depth_m,
     resolve_poses,
+    scenario_models,
 )
 from catabot.world.terrain import load_terrain
 
@@ -67,15 +68,16 @@ class Draw:
         except ScenarioError as exc:
             raise EnvOptionsError(str(exc)) from None
         self.terrain = load_terrain(base.terrain) if base.terrain is not None else None
-        self.base = resolve_poses(base, self.terrain)
+        models = scenario_models(base)
+        self.base = resolve_poses(base, self.terrain, models=models)
         self.index = ids.index(self.vessel)
         ego = self.base.vessels[self.index]
-        self.model = load_vessel_model(ego.model)
+        self.model = models[ego.model]
         self.radius = footprint_m(self.model)
         self.keel = keel_depth_m(self.model)
         assert ego.pose is not None, "resolve_poses placed every vessel"
         self.home = ego.pose
-        self.others = _others(self.base, self.index)
+        self.others = _others(self.base, self.index, models)
 
     def episode(self, seed: int, world: str) -> Episode:
         start = self._start(seed)
@@ -177,13 +179,13 @@ def _base(scenario: str | dict[str, Any]) -> Scenario:
     return load_scenario(Path(scenario) if scenario.endswith(".json") else scenario)
 
 
-def _others(scenario: Scenario, ego: int) -> np.ndarray:
+def _others(scenario: Scenario, ego: int, models: Models) -> np.ndarray:
     """(x, y, footprint radius) of every other scenario vessel and buoy at its start."""
     rows = []
     for i, v in enumerate(scenario.vessels):
         if i != ego and v.pose is not None:
-            rows.append((v.pose.x_m, v.pose.y_m, footprint_m(load_vessel_model(v.model))))
-    buoy: VesselModel = load_vessel_model(BUOY_MODEL)
+            rows.append((v.pose.x_m, v.pose.y_m, footprint_m(models[v.model])))
+    buoy = models[BUOY_MODEL]
     rows += [(b.x_m, b.y_m, footprint_m(buoy)) for b in scenario.buoys]
     return np.array(rows, dtype=np.float64).reshape(-1, 3)
 

@@ -8,7 +8,7 @@ reads, so all processes agree on them. Placement is a pure function of the scena
 from __future__ import annotations
 
 import math
-from collections.abc import Iterator
+from collections.abc import Iterator, Mapping
 from contextlib import contextmanager
 
 import numpy as np
@@ -16,7 +16,7 @@ import numpy as np
 from catabot.config.base import ScenarioError
 from catabot.config.scenario import Pose, Scenario
 from catabot.config.terrain import TerrainError
-from catabot.config.vessel import VesselModel, load_vessel_model
+from catabot.config.vessel import VesselModel, VesselModelError, load_vessel_model
 from catabot.world.hulls import box_gaps, footprints
 from catabot.world.rotations import turn_xy
 from catabot.world.terrain import Terrain
@@ -24,6 +24,25 @@ from catabot.world.terrain import Terrain
 CLEARANCE_M = 0.5  # a vessel's keel above the seabed at its start
 BUOY_CLEARANCE_M = 0.1  # a moored buoy's: a mark may lie in shallow water
 BUOY_MODEL = "buoy"  # every buoy's vessel model
+Models = Mapping[str, VesselModel]  # every model a scenario names, by its reference
+
+
+def scenario_models(scenario: Scenario) -> dict[str, VesselModel]:
+    """Each model the scenario names, read once (the placement, the traffic plan and the
+    bodies share them), and the buoy's; a model that does not load is named by the field
+    that named it."""
+    named: list[tuple[str, str | None]]
+    named = [(f"vessels.{i}.model", v.model) for i, v in enumerate(scenario.vessels)]
+    named += [(f"traffic.models.{i}.model", m.model) for i, m in enumerate(scenario.traffic.models)]
+    named += [(f"traffic.boats.{i}.model", b.model) for i, b in enumerate(scenario.traffic.boats)]
+    models: dict[str, VesselModel] = {}
+    for where, ref in [*named, ("buoys", BUOY_MODEL)]:
+        try:
+            if ref is not None and ref not in models:
+                models[ref] = load_vessel_model(ref)
+        except VesselModelError as exc:
+            raise ScenarioError(f"{where}: {exc}") from None
+    return models
 
 
 def keel_depth_m(model: VesselModel) -> float:
@@ -39,16 +58,16 @@ def footprint_m(model: VesselModel) -> float:
     )
 
 
-def resolve_poses(scenario: Scenario, terrain: Terrain | None) -> Scenario:
+def resolve_poses(scenario: Scenario, terrain: Terrain | None, *, models: Models) -> Scenario:
     """Every vessel with a pose: given ones checked, missing ones placed in open water."""
-    models = [load_vessel_model(v.model) for v in scenario.vessels]
+    chosen = [models[v.model] for v in scenario.vessels]
     placed = [  # given poses first: a vessel placed for you keeps clear of later ones too
         (v.pose.x_m, v.pose.y_m, footprint_m(m))
-        for v, m in zip(scenario.vessels, models, strict=True)
+        for v, m in zip(scenario.vessels, chosen, strict=True)
         if v.pose is not None
     ]
     vessels = []
-    for index, (vessel, model) in enumerate(zip(scenario.vessels, models, strict=True)):
+    for index, (vessel, model) in enumerate(zip(scenario.vessels, chosen, strict=True)):
         pose = vessel.pose
         if pose is None:
             pose = _choose(index, model, terrain, placed)
@@ -59,12 +78,12 @@ def resolve_poses(scenario: Scenario, terrain: Terrain | None) -> Scenario:
     return scenario.model_copy(update={"vessels": vessels})
 
 
-def check_marks(scenario: Scenario, terrain: Terrain | None) -> None:
+def check_marks(scenario: Scenario, terrain: Terrain | None, *, models: Models) -> None:
     """Buoys, goals and route points in water: a buoy given on land sat on the ground all
     run, and a goal on land is a task no vessel can meet, both accepted without a word."""
     if terrain is None:
         return
-    buoy = load_vessel_model(BUOY_MODEL)
+    buoy = models[BUOY_MODEL]
     draft, reach = keel_depth_m(buoy), footprint_m(buoy)
     for i, b in enumerate(scenario.buoys):
         with _as_field(f"buoys.{i} ({b.id})"):
@@ -80,7 +99,7 @@ def check_marks(scenario: Scenario, terrain: Terrain | None) -> None:
                 terrain.check_water(x, y, what="route point")
 
 
-def check_apart(scenario: Scenario) -> None:
+def check_apart(scenario: Scenario, *, models: Models) -> None:
     """No hull starts inside another or on a buoy (plan-view boxes, physics' collision
     shapes): two vessels given one pose collided at t = 0, and the run said nothing."""
     named = [
@@ -90,7 +109,7 @@ def check_apart(scenario: Scenario) -> None:
               for i, b in enumerate(scenario.buoys)]  # fmt: skip
     if len(named) < 2:
         return
-    offset, half = footprints([load_vessel_model(model) for _, model, _ in named])
+    offset, half = footprints([models[model] for _, model, _ in named])
     poses = [pose for _, _, pose in named if pose is not None]
     assert len(poses) == len(named), "resolve_poses placed every vessel"
     heading = np.array([p.yaw_rad for p in poses])

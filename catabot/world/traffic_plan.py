@@ -17,10 +17,9 @@ from catabot.config.base import ScenarioError
 from catabot.config.scenario import BuoyConfig, Pose, Scenario
 from catabot.config.terrain import TerrainError
 from catabot.config.traffic import BEHAVIOURS, BoatOverride, Point, Region, TrafficConfig, boat_id
-from catabot.config.vessel import VesselModel, load_vessel_model
 from catabot.world import seeding
 from catabot.world.clearance import Discs, Rows, clear, densify, off_rings
-from catabot.world.placement import BUOY_MODEL, CLEARANCE_M, footprint_m, keel_depth_m
+from catabot.world.placement import BUOY_MODEL, CLEARANCE_M, Models, footprint_m, keel_depth_m
 from catabot.world.terrain import Terrain
 
 TRIES = 2000
@@ -57,26 +56,31 @@ Progress = Callable[[int, int], None]  # (boats planned, boats in all)
 
 
 def plan_traffic(
-    scenario: Scenario, terrain: Terrain | None, progress: Progress | None = None
+    scenario: Scenario, terrain: Terrain | None, *, models: Models, progress: Progress | None = None
 ) -> TrafficPlan:
     """The plan of a scenario whose vessels all have poses (World.resolve calls it once)."""
     if scenario.traffic.count == 0:
         return TrafficPlan((), ())
-    return Planner(scenario, terrain, progress).plan()
+    return Planner(scenario, terrain, models=models, progress=progress).plan()
 
 
 class Planner:
     """Draws boats one by one; a boat that finds no free deep water in TRIES draws is an error."""
 
     def __init__(
-        self, scenario: Scenario, terrain: Terrain | None, progress: Progress | None = None
+        self,
+        scenario: Scenario,
+        terrain: Terrain | None,
+        *,
+        models: Models,
+        progress: Progress | None = None,
     ) -> None:
         self.cfg: TrafficConfig = scenario.traffic
         self.terrain, self.progress = terrain, progress
         self._path_draws = 0  # paths drawn for the current boat
         seed = scenario.seed if self.cfg.seed is None else self.cfg.seed
         self.rng = seeding.rng(seed, "traffic")
-        self._models: dict[str, VesselModel] = {}
+        self._model = models.__getitem__  # scenario_models: each model file read once
         self.placed, self.named = Discs(), []  # vessels' starts: x, y, footprint radius; ids
         for v in scenario.vessels:
             assert v.pose is not None
@@ -211,12 +215,6 @@ class Planner:
             )
         raise ScenarioError(f"traffic: no free open water for boat {index} in {TRIES} draws: "
                             "give a larger traffic.region or fewer boats")  # fmt: skip
-
-    def _model(self, ref: str) -> VesselModel:
-        """Each model file read once per plan (500 boats share a handful of models)."""
-        if ref not in self._models:
-            self._models[ref] = load_vessel_model(ref)
-        return self._models[ref]
 
     def _pick(self, names: list[str], weights: list[float]) -> str:
         p = np.asarray(weights, dtype=np.float64)

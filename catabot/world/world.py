@@ -36,10 +36,17 @@ from catabot.config.scenario import (
     services,
 )
 from catabot.config.sensors import shard_names
-from catabot.config.vessel import VesselModel, VesselModelError, load_vessel_model
+from catabot.config.vessel import VesselModel
 from catabot.world import rotations
 from catabot.world.environment.current import CurrentField
-from catabot.world.placement import BUOY_MODEL, check_apart, check_marks, resolve_poses
+from catabot.world.placement import (
+    BUOY_MODEL,
+    Models,
+    check_apart,
+    check_marks,
+    resolve_poses,
+    scenario_models,
+)
 from catabot.world.shapes import ShapeMesh, vessel_mesh
 from catabot.world.shards import blocks, sensor_owners
 from catabot.world.streams import Streams
@@ -116,14 +123,14 @@ class World:
         """Everything a run needs from its scenario; ScenarioError names what cannot run.
         `progress(k, n)` hears of each planned traffic boat (a long plan's progress)."""
         given = digest(scenario)  # as the conductor, which loads the same file, has it
-        _check_models(scenario)
+        models = scenario_models(scenario)
         terrain = _terrain(scenario)
         current = CurrentField.from_config(scenario.water.current)
-        scenario = resolve_poses(scenario, terrain)
-        check_marks(scenario, terrain)
-        check_apart(scenario)
-        plan = plan_traffic(scenario, terrain, progress)
-        bodies = _bodies(scenario, plan)
+        scenario = resolve_poses(scenario, terrain, models=models)
+        check_marks(scenario, terrain, models=models)
+        check_apart(scenario, models=models)
+        plan = plan_traffic(scenario, terrain, models=models, progress=progress)
+        bodies = _bodies(scenario, plan, models)
         keys = Keys(scenario.name)
         sensors = tuple(
             MountedSensor(v.id, s, keys.sensor(v.id, s.name), _period(scenario, v.id, s))
@@ -228,15 +235,9 @@ def _terrain(scenario: Scenario) -> Terrain | None:
     return load_terrain(scenario.terrain) if scenario.terrain is not None else None
 
 
-def _bodies(scenario: Scenario, plan: TrafficPlan) -> tuple[Body, ...]:
+def _bodies(scenario: Scenario, plan: TrafficPlan, models: Models) -> tuple[Body, ...]:
     """Every body in row order; two bodies with one id are refused (they share keys)."""
-    models: dict[str, VesselModel] = {}
-
-    def model(ref: str) -> VesselModel:
-        if ref not in models:
-            models[ref] = load_vessel_model(ref)
-        return models[ref]
-
+    model = models.__getitem__
     rows: list[tuple[str, BodyKind, str, Pose, VesselConfig | None]] = []
     for index, v in enumerate(scenario.vessels):
         assert v.pose is not None, "resolve_poses placed every vessel"
@@ -286,20 +287,6 @@ def _check_script(vessel: VesselConfig, model: VesselModel, *, where: str) -> No
                 f"{where}.script.{k}.thrust: {len(step.thrust)} value(s), but model "
                 f"{vessel.model!r} has {count} thruster(s) (one value each, in [-1, 1])"
             )
-
-
-def _check_models(scenario: Scenario) -> None:
-    """Each model a scenario names loads, or its error names the field that named it."""
-    named: list[tuple[str, str | None]]
-    named = [(f"vessels.{i}.model", v.model) for i, v in enumerate(scenario.vessels)]
-    named += [(f"traffic.models.{i}.model", m.model) for i, m in enumerate(scenario.traffic.models)]
-    named += [(f"traffic.boats.{i}.model", b.model) for i, b in enumerate(scenario.traffic.boats)]
-    for where, ref in named:
-        try:
-            if ref is not None:
-                load_vessel_model(ref)
-        except VesselModelError as exc:
-            raise ScenarioError(f"{where}: {exc}") from None
 
 
 def _check_floats(where: str, ref: str, model: VesselModel, density: float) -> None:

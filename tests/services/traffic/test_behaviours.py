@@ -11,7 +11,7 @@ from catabot.config.load import parse_scenario
 from catabot.config.scenario import Pose
 from catabot.config.traffic import TrafficConfig
 from catabot.config.vessel import load_vessel_model
-from catabot.world.placement import footprint_m
+from catabot.world.placement import footprint_m, scenario_models
 from catabot.world.terrain import Terrain
 from catabot.world.traffic_plan import Boat, Planner
 from catabot.world.world import World
@@ -144,7 +144,8 @@ def test_no_boat_starts_or_steers_on_land() -> None:
     terrain = Terrain(grid, 5.0)
     data = _scenario(80, region={"center_m": [500.0, 500.0], "size_m": [1000.0, 1000.0]})
     data["vessels"] = [{"id": "ego", "pose": {"x_m": 800.0, "y_m": 500.0}}]
-    plan = Planner(parse_scenario(data), terrain).plan()
+    scenario = parse_scenario(data)
+    plan = Planner(scenario, terrain, models=scenario_models(scenario)).plan()
     for b in plan.boats:
         assert terrain.depth(b.pose.x_m, b.pose.y_m) > 1.0, b
         if b.behaviour == "circle":
