@@ -69,12 +69,20 @@ class VesselModelError(ConfigError):
     """A vessel model file is missing, unreadable or invalid; the message names file and field."""
 
 
+COLUMNS = (
+    "buoyancy columns along (x) or across (y) the hull, at Gauss-Legendre points: a "
+    "box's waterplane area and moments are exact at any count; across: 2 for a box, "
+    "10 for a cylinder by default"
+)
+
+
 class Hull(Strict):
     """A parametric hull, discretised into vertical columns for buoyancy.
 
     `beam_m` is a box's width or a cylinder's diameter; a cylinder lies along body x.
     `columns_along` / `columns_across` set the buoyancy discretisation (None: a default per
-    shape, more across for cylinders because their cross-section is curved).
+    shape, more across for cylinders because their cross-section is curved;
+    services/physics/hydro.py places them).
     """
 
     shape: Literal["box", "cylinder"]
@@ -82,8 +90,8 @@ class Hull(Strict):
     length_m: PositiveFloat
     beam_m: PositiveFloat
     height_m: PositiveFloat | None = None
-    columns_along: Annotated[int, Field(ge=1, le=256)] = 16
-    columns_across: Annotated[int, Field(ge=1, le=64)] | None = None
+    columns_along: Annotated[int, Field(ge=1, le=256, description=COLUMNS)] = 16
+    columns_across: Annotated[int, Field(ge=1, le=64, description=COLUMNS)] | None = None
 
     @model_validator(mode="after")
     def _shape_fields(self) -> Hull:

@@ -2,11 +2,16 @@
 
 The model (Fossen 2011, §6.3, current irrotational and uniform):
     M_RB nu_dot + C_RB(nu) nu + M_A nu_r_dot + C_A(nu_r) nu_r = tau,   nu_r = nu - nu_c,
-with nu = [v, w] the body-frame twist at the body origin, nu_c = [R^T v_c, 0] the current,
-and nu_r_dot = nu_dot + [w x nu_c, 0] (the current is constant in the world, so its body
-components turn with the hull). M_A = diag(A11 .. A66) acts as inertia in all six DOF. DART
-integrates only M_RB and its own rigid-body Coriolis and centripetal terms C_RB(nu) nu (about
-the COG) and gravity; C_A is ours.
+with nu = [v, w] the body-frame twist at the body origin, nu_c = [R^T v_c, 0] the water's
+velocity there, and nu_r_dot = nu_dot + [w x nu_c, 0] (the water's velocity held as it is
+over a step, so its body components turn with the hull). In waves v_c is the current plus
+the orbital velocity: the Munk terms then see the flow past the hull, and a body that rides
+the orbit with the water feels none. With the current alone, a buoy in the medium swell
+felt a roll moment -A22 v w from its own orbit and tilted up to 0.46 rad from the surface
+normal in a sea no steeper than 0.11 rad (0.07 rad now). The water's acceleration (its
+Froude-Krylov force and the added mass's share of it) is not modelled. M_A = diag(A11 ..
+A66) acts as inertia in all six DOF. DART integrates only M_RB and its own rigid-body
+Coriolis and centripetal terms C_RB(nu) nu (about the COG) and gravity; C_A is ours.
 
 C_A: Fossen's eq. 6.43 for a diagonal M_A (Kirchhoff form, momenta pa1 = A_lin * v_r,
 pa2 = A_ang * w, C_A nu_r = [w x pa1, v_r x pa1 + w x pa2]) built from the MANOEUVRING added

@@ -103,10 +103,10 @@ def body_wrench(
     nu = kernels.body_twist(motion.rot, motion.vel_w)
     current_w = tables.loads.current_world(motion.pos)
     water = sea.sample(motion.pos, time_s)
-    water_w = current_w  # plus the waves' orbital velocity at each body origin:
-    if water.velocity_w is not None:  # damping acts on motion relative to the water
+    water_w = current_w  # plus the waves' orbital velocity at each body origin: damping
+    if water.velocity_w is not None:  # and added mass act on motion relative to the water
         water_w = water_w + water.velocity_w
-    current_b = kernels.to_body(motion.rot, np.ascontiguousarray(water_w))
+    water_b = kernels.to_body(motion.rot, np.ascontiguousarray(water_w))
     buoyancy = buoyancy_wrench(
         tables.columns,
         motion.rot,
@@ -117,14 +117,14 @@ def body_wrench(
         surface=water.surface,
     )
     wet = wetness(buoyancy, motion.rot, tables.weight_n)
-    damping = damping_wrench(nu, tables.linear, tables.quadratic, current_b)
+    damping = damping_wrench(nu, tables.linear, tables.quadratic, water_b)
     loads = {
         "buoyancy": buoyancy,
         "damping": damping if wet is None else damping * wet[:, None],
         "thrust": thrust.wrench(motion.rot, motion.pos, water.at_points, time_s),
     }
     base = loads["buoyancy"] + loads["damping"] + loads["thrust"]
-    total = tables.loads.total(motion.rot, motion.pos, nu, current_w, base, wet=wet)
+    total = tables.loads.total(motion.rot, motion.pos, nu, water_b, base, wet=wet)
     loads[OTHER] = total - base
     loads["total"] = total
     return loads, wet

@@ -80,28 +80,37 @@ class Columns:
 def hull_columns(hull: Hull) -> tuple[Array, Array, Array]:
     """Discretise one hull into columns: (bottom points (K, 3), heights (K,), areas (K,)).
 
-    A box column spans the full hull height. A cylinder (axis along body x) is cut into strips
-    across its diameter; each strip's height is its mean chord (strip area / strip width), so
-    the columns hold exactly the cylinder's volume and follow its circular bottom closely.
+    A box column spans the full hull height; its columns stand at Gauss-Legendre points
+    along and across (`_gauss`). A cylinder (axis along body x) is cut into even strips
+    across its diameter; each strip's height is its mean chord (strip area / strip width),
+    so the columns hold exactly the cylinder's volume and follow its circular bottom closely.
     """
     n_x, n_y = hull.columns_along, hull.across
-    dx, dy = hull.length_m / n_x, hull.beam_m / n_y
     cx, cy, cz = hull.center_m
-    xs = cx - hull.length_m / 2 + dx * (np.arange(n_x) + 0.5)
-    edges = -hull.beam_m / 2 + dy * np.arange(n_y + 1)
-    ys = (edges[:-1] + edges[1:]) / 2
+    xs, wx = _gauss(n_x, hull.length_m)
     if hull.shape == "box":
         assert hull.height_m is not None
+        ys, wy = _gauss(n_y, hull.beam_m)
         heights = np.full(n_y, hull.height_m)
     else:
-        r = hull.beam_m / 2
-        e = np.clip(edges, -r, r)
+        dy, r = hull.beam_m / n_y, hull.beam_m / 2
+        e = np.clip(-r + dy * np.arange(n_y + 1), -r, r)
+        ys, wy = (e[:-1] + e[1:]) / 2, np.full(n_y, dy)
         primitive = e * np.sqrt(np.maximum(r * r - e * e, 0.0)) + r * r * np.arcsin(e / r)
         heights = np.diff(primitive) / dy
-    gx, gi = np.meshgrid(xs, np.arange(n_y), indexing="ij")
+    gx, gi = np.meshgrid(np.arange(n_x), np.arange(n_y), indexing="ij")
     h = heights[gi].ravel()
-    bottom = np.stack([gx.ravel(), cy + ys[gi].ravel(), cz - h / 2], axis=1)
-    return bottom, h, np.full(h.shape, dx * dy)
+    bottom = np.stack([cx + xs[gx].ravel(), cy + ys[gi].ravel(), cz - h / 2], axis=1)
+    return bottom, h, (wx[gx] * wy[gi]).ravel()
+
+
+def _gauss(n: int, length_m: float) -> tuple[Array, Array]:
+    """n points over a length centred on 0 and the width each stands for: Gauss-Legendre,
+    so the waterplane's area and its first and second moments are exact for any n (even
+    spacing gives the second moment short by 1/n^2: two columns across a box had 3/4 of
+    its roll stiffness, and the monohull rolled 21% slower than its GM says)."""
+    t, w = np.polynomial.legendre.leggauss(n)
+    return t * length_m / 2, w * length_m / 2
 
 
 def build_columns(models: Sequence[VesselModel]) -> Columns:

@@ -21,7 +21,6 @@ from numpy.typing import NDArray
 
 from catabot.config.vessel import VesselModel
 from catabot.world.environment import CurrentField, WindField
-from services.physics import kernels
 from services.physics.added_mass import AddedMass
 from services.physics.hydro import Array
 from services.physics.wind import wind_gains, wind_wrench
@@ -81,14 +80,15 @@ class EnvironmentLoads:
         return out
 
     def total(
-        self, rot: Array, pos: Array, nu: Array, current_w: Array, base: Array, *,
+        self, rot: Array, pos: Array, nu: Array, water_b: Array, base: Array, *,
         wet: Array | None = None,
     ) -> Array:  # fmt: skip
         """base + wind + moorings + added mass, body frame (N, 6).
 
-        current_w is `current_world(pos)`: the steady current only (wave orbital velocity is
-        not a uniform current and stays out of the added-mass terms). `wet`: the added
-        mass's share for each body (forces.wetness; None: all of it).
+        water_b is the water's velocity at each body origin in the body frame: the current
+        and the waves' orbital velocity, so the added mass's Munk terms see the flow past
+        the hull (added_mass.py). `wet`: the added mass's share for each body
+        (forces.wetness; None: all of it).
         """
         total = base
         if self.wind is not None and self.wind_gains is not None:
@@ -100,8 +100,7 @@ class EnvironmentLoads:
         if self.moored.size:
             total = total + self._mooring(rot, pos)
         if self.added_mass.active:
-            current_b = kernels.to_body(rot, current_w)  # R^T v_c
-            total = total + self.added_mass.wrench(rot, nu, current_b, total, wet=wet)
+            total = total + self.added_mass.wrench(rot, nu, water_b, total, wet=wet)
         return total
 
     def advance(self, dt_s: float) -> None:
