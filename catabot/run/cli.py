@@ -17,7 +17,7 @@ from catabot.config.load import json_schema, model_schema
 from catabot.config.scenario import WaterConfig
 from catabot.config.vessel import VesselModelError, load_vessel_model
 from catabot.errors import CataBotError
-from catabot.run import compose, conduct, launcher, secure, settings_cli
+from catabot.run import compose, conduct, console, launcher, secure, settings_cli
 from catabot.run.answer import OneLineParser, answered, output_file
 from catabot.run.companions import VIEW_MODES
 from catabot.run.generate import add_arguments as add_generate_arguments
@@ -237,6 +237,17 @@ def parser() -> argparse.ArgumentParser:
 
 
 def main(argv: list[str] | None = None) -> int:
+    """Every command; Ctrl-C outside a run (which ends itself cleanly: supervisor.Stops)
+    is exit 130 without a traceback, and a closed terminal or pipe ends no command early."""
+    with console.lasting():
+        try:
+            return _command(argv)
+        except KeyboardInterrupt:
+            print(file=sys.stderr)  # past the ^C
+            return 130
+
+
+def _command(argv: list[str] | None) -> int:
     args, rest = parser().parse_known_args(argv)
     if args.command == "service":
         return _service(args, rest)

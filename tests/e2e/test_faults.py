@@ -5,6 +5,7 @@ from __future__ import annotations
 import json
 import math
 import os
+import pty
 import signal
 import subprocess
 import sys
@@ -160,6 +161,29 @@ def test_ctrl_c_ends_every_process_with_complete_files(
 
     with (run / "run.mcap").open("rb") as f:
         assert make_reader(f).get_summary() is not None, "MCAP closed with a summary"
+
+
+def test_a_closed_terminal_ends_the_run_with_its_files_and_run_json(
+    tmp_path: Path, out: Path
+) -> None:
+    """The terminal window closed under `catabot run`: SIGHUP to its process group, and every
+    write to the terminal fails with EIO from then on. The launcher died at its next progress
+    line, leaving no log/run.json; now the run ends as interrupted, as for Ctrl-C."""
+    main, terminal = pty.openpty()
+    proc = subprocess.Popen(
+        [sys.executable, "-m", "catabot", "run", str(_long(tmp_path)), "--out", str(out)],
+        stdin=terminal, stdout=terminal, stderr=terminal, cwd=REPO, start_new_session=True,
+    )  # fmt: skip
+    os.close(terminal)
+    try:
+        _wait_for_rows(out, 20)
+    finally:
+        os.close(main)  # the window closes: the progress bar's next write fails
+        os.killpg(proc.pid, signal.SIGHUP)
+    assert proc.wait(timeout=30) == 130
+    run = only_run_dir(out)
+    assert json.loads((run / "log" / "run.json").read_text())["reason"] == "interrupted"
+    _assert_readable(run)
 
 
 def _wait_for_rows(out: Path, rows: int, limit_s: float = 30.0) -> None:
