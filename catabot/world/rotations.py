@@ -44,6 +44,16 @@ def _stack(x: Array, y: Array, z: Array, w: Array) -> Array:
     return out
 
 
+def vertical(q: Array, v: Array) -> Array:
+    """The map-frame up component of body-frame vectors v (N, 3) turned by q (N, 4): the
+    third row of `matrices(q)` times v, without the other eight entries."""
+    x, y, z, w = q[:, 0], q[:, 1], q[:, 2], q[:, 3]
+    return np.asarray(
+        2 * (x * z - y * w) * v[:, 0] + 2 * (y * z + x * w) * v[:, 1]
+        + (1 - 2 * (x * x + y * y)) * v[:, 2]
+    )  # fmt: skip
+
+
 def cross(a: Array, b: Array) -> Array:
     """a x b over the last axis, with np.cross's operations (the same bits) but none of its
     axis handling, which costs more than the arithmetic for a few vectors: the one cross

@@ -2,15 +2,16 @@
 
 Computed by the recorder from the `BodyStates` every stack produces, so a stack is measured
 the same way whatever it is. Every vessel (scenario vessels and traffic boats): distance
-travelled, top speed, final position. Each scenario vessel (what a stack drives), against
-everything else: the nearest vessel, buoy and shore it came to (centre to centre; shore:
-the nearest land pixel), its goal and route (`tasks.py`), its thrust impulse, and episodes
-(`episodes.py`): encounters (another vessel within `recording.encounter_radius_m`, with the
-closest point of approach), collisions (plan-view hull boxes within `CONTACT_M`, the
-physics collision shapes; other vessels and buoys), groundings (`seabed.py`) and capsizes
-(its deck's normal below the horizon, with its largest tilt: a boat on its side or upside
-down floats on, and its states alone do not say so). The traffic's own collisions, boat
-with boat or buoy, are `fleet_contacts.py`'s.
+travelled and top speed over the ground (horizontal: a boat heaving in a swell, or dropped
+by a change of sea, goes nowhere), final position. Each scenario vessel (what a stack
+drives), against everything else: the nearest vessel, buoy and shore it came to (centre to
+centre; shore: the nearest land pixel), its goal and route (`tasks.py`), its thrust impulse,
+and episodes (`episodes.py`): encounters (another vessel within
+`recording.encounter_radius_m`, with the closest point of approach), collisions (plan-view
+hull boxes within `CONTACT_M`, the physics collision shapes; other vessels and buoys),
+groundings (`seabed.py`) and capsizes (its deck's normal below the horizon, with its largest
+tilt: a boat on its side or upside down floats on, and its states alone do not say so). The
+traffic's own collisions, boat with boat or buoy, are `fleet_contacts.py`'s.
 
 Cost: arrays of (scenario vessels x bodies) per tick, no loop over bodies (DESIGN.md §8).
 Written with `repr` floats and sorted keys so two runs of one seed give the same bytes.
@@ -25,6 +26,7 @@ import numpy as np
 from catabot.bus.clock import NS_PER_S
 from catabot.bus.messages import BodyStates
 from catabot.config.rates import traffic_record_period
+from catabot.world import rotations
 from catabot.world.hulls import CONTACT_M, boxes_touch, footprints
 from catabot.world.orders import Orders
 from catabot.world.world import World
@@ -88,12 +90,13 @@ class Metrics:
             return
         self.fleet.add(batch)
         pos = everything[:n]
-        if self.last is not None:
-            step = pos - self.last
+        if self.last is not None:  # over the ground: a boat heaving in waves travels no way
+            step = pos[:, :2] - self.last[:, :2]
             self.distance += np.sqrt(rowdot(step, step))
         self.last = pos.copy()
-        vel = np.asarray(batch.linear_velocity[:n])
-        np.maximum(self.max_speed2, rowdot(vel, vel), out=self.max_speed2)
+        vel = np.asarray(batch.linear_velocity[:n])  # body frame: less its map-up part
+        up = rotations.vertical(np.asarray(batch.orientation[:n]), vel)
+        np.maximum(self.max_speed2, rowdot(vel, vel) - up * up, out=self.max_speed2)
         self.stamp_ns = stamp
         gap = np.hypot(
             everything[None, :, 0] - pos[:s, None, 0], everything[None, :, 1] - pos[:s, None, 1]

@@ -25,3 +25,12 @@ def test_matrices_are_the_rotations_of_their_quaternions() -> None:
     for quat, r in zip(q, got, strict=True):
         np.testing.assert_allclose(r, rotations.matrix(quat), atol=1e-15)
         np.testing.assert_allclose(r @ r.T, np.eye(3), atol=1e-12)
+
+
+def test_vertical_is_the_map_up_row_of_the_rotation() -> None:
+    rng = np.random.default_rng(5)
+    q = rng.normal(size=(20, 4))
+    q /= np.linalg.norm(q, axis=1, keepdims=True)
+    v = rng.normal(size=(20, 3))
+    expected = np.einsum("nj,nj->n", rotations.matrices(q)[:, 2, :], v)
+    assert np.allclose(rotations.vertical(q, v), expected, atol=1e-12)

@@ -240,3 +240,22 @@ def test_a_vessel_over_on_its_side_capsized_and_righted(tmp_path: Path) -> None:
     assert (v0["capsizes"], v1["capsizes"]) == (1, 0)
     assert v0["max_tilt_rad"] == pytest.approx(math.pi)
     assert v1["max_tilt_rad"] == pytest.approx(math.radians(30))
+
+
+def test_distance_and_top_speed_are_over_the_ground(tmp_path: Path) -> None:
+    """v0 heaves 1 m up and down at 2 m/s while it moves 0.5 m east; v1, pitched 30 deg bow
+    up, makes 1 m/s along its deck: 0.87 m/s over the ground. A run's metrics had counted a
+    boat dropped by a change of sea, still in the water, at 3.19 m/s."""
+    world = _world()
+    metrics = Metrics(world, Orders())
+    half = math.radians(30) / 2
+    for tick in range(11):
+        batch = _states(world, tick, [(0.05 * tick, 0.0), (0.0, 10.0)])
+        pos = np.array(batch.position)
+        pos[0, 2] = 1.0 - abs(tick - 5) / 5  # up 1 m and down again
+        quat = np.array([[0.0, 0.0, 0.0, 1.0], [0.0, -math.sin(half), 0.0, math.cos(half)]])
+        vel = np.array([[0.0, 0.0, 2.0], [1.0, 0.0, 0.0]])
+        metrics.add(dataclasses.replace(batch, position=pos, orientation=quat, linear_velocity=vel))
+    v0, v1 = (_record(metrics, tmp_path)["vessels"][v] for v in ("v0", "v1"))
+    assert v0["distance_m"] == pytest.approx(0.5) and v0["max_speed_mps"] == pytest.approx(0.0)
+    assert v1["max_speed_mps"] == pytest.approx(math.cos(math.radians(30)))
