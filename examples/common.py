@@ -44,8 +44,10 @@ def keys(s: zenoh.Session, args: argparse.Namespace) -> Keys:
 @contextmanager
 def clear_errors(program: str) -> Iterator[None]:
     """A client's error (no simulation, no such vessel or sensor, the run ended...) ends the
-    program with its message, not a traceback."""
+    program with its message, and Ctrl-C with exit 130, not a traceback."""
     try:
         yield
     except ClientError as e:
         raise SystemExit(f"{program}: {e}") from None
+    except KeyboardInterrupt:
+        raise SystemExit(130) from None

@@ -91,8 +91,19 @@ def screenshot(ego: Vessel, camera: str, folder: Path) -> str:
 
 
 def drive(win: curses.window, ego: Vessel, camera: str, folder: Path, rate_hz: float) -> str:
-    """The key loop: a key, the command, the screen, `rate_hz` times a second, until Q (or
-    RunEnded from the state once the run is over)."""
+    """Keys until Q (or RunEnded from the state once the run is over); however it ends
+    (Ctrl-C too), the thrusters are stopped: a teleop that leaves must not leave the boat
+    running. A closed terminal sends nothing more: the scenario's `command_timeout_s`
+    (examples/teleop.json: 1 s) hands the boat back to rest, as a dead-man's switch."""
+    try:
+        return _keys(win, ego, camera, folder, rate_hz)
+    finally:
+        with contextlib.suppress(ClientError, OSError):
+            ego.send(Thrust([0.0] * ego.info.thrusters))
+
+
+def _keys(win: curses.window, ego: Vessel, camera: str, folder: Path, rate_hz: float) -> str:
+    """A key, the command, the screen, `rate_hz` times a second."""
     curses.curs_set(0)
     win.timeout(round(1000 / rate_hz))
     thrust, note = (0.0,) * ego.info.thrusters, ""
@@ -100,7 +111,6 @@ def drive(win: curses.window, ego: Vessel, camera: str, folder: Path, rate_hz: f
     while True:
         key = win.getch()
         if key in (ord("q"), ord("Q")):
-            ego.send(Thrust([0.0] * len(thrust)))
             return "quit"
         if key == ord(" "):
             note = screenshot(ego, camera, folder)
