@@ -146,7 +146,8 @@ def check_router(endpoint: str) -> None:
         except OSError as exc:
             raise SessionError(
                 f"nothing answers at {endpoint} ({exc.strerror or exc}): start a router there "
-                "first (catabot router --listen ENDPOINT)"
+                "first (catabot router --listen ENDPOINT), or the run that listens there "
+                "(catabot run --listen ENDPOINT)"
             ) from None
 
 

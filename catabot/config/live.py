@@ -12,6 +12,7 @@ reach every service as the same bytes.
 
 from __future__ import annotations
 
+import difflib
 import json
 import math
 from collections.abc import Mapping
@@ -108,8 +109,12 @@ def spec_of(scenario: Scenario, key: str) -> Spec:
     spec = keys_of(scenario).get(key) if isinstance(key, str) else None
     if spec is None:
         shown = repr(key) if len(repr(key)) <= 80 else repr(key)[:77] + "..."
+        near = (
+            difflib.get_close_matches(key, keys_of(scenario), n=1) if isinstance(key, str) else []
+        )
+        hint = f" (did you mean {near[0]!r}?)" if near else ""
         raise SettingError(
-            f"unknown setting {shown}; this run's settings: {allowed_keys(scenario)}"
+            f"unknown setting {shown}{hint}; this run's settings: {allowed_keys(scenario)}"
         )
     return spec
 
@@ -191,7 +196,9 @@ def parse_value(text: str) -> Any:
         return words[text.strip().lower()]
     try:
         return json.loads(text)
-    except ValueError:
+    except ValueError as exc:
+        if text.lstrip()[:1] in ("[", "{"):  # meant as JSON: say where it is not
+            raise SettingError(f"{text!r} is not JSON ({exc}); e.g. [0.3, 0.1]") from None
         return text
 
 
@@ -218,7 +225,7 @@ def _initial(scenario: Scenario, spec: Spec, overrides: Mapping[int, str | None]
     if kind == "current":
         return list(scenario.water.current.velocity_mps)
     if kind == "waves":
-        return scenario.water.waves.preset or "as in the scenario"
+        return _sea(scenario.water.waves)
     if kind == "enabled":
         return True
     if kind == "output":
@@ -227,6 +234,15 @@ def _initial(scenario: Scenario, spec: Spec, overrides: Mapping[int, str | None]
         return getattr(sensor.typed_params().outputs, spec.output)
     index = scenario.traffic.boat_ids.index(spec.owner)
     return overrides.get(index) or AS_PLANNED
+
+
+def _sea(waves: WaveConfig) -> str:
+    """The scenario's sea as `catabot get` shows it: its preset, or what its fields make."""
+    if waves.preset is not None:
+        return waves.preset
+    if waves.significant_height_m == 0.0:
+        return "calm"
+    return f"Hs {waves.significant_height_m:g} m, Tp {waves.peak_period_s:g} s (the scenario's)"
 
 
 def tick_at(t_s: float, dt_ns: int) -> int:

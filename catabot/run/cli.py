@@ -180,7 +180,11 @@ def parser() -> argparse.ArgumentParser:
     run.add_argument("scenario", nargs="?", help="scenario file or bundled name (default: default)")
     run.add_argument("--duration", type=float, help="simulated seconds (overrides the scenario)")
     run.add_argument("--seed", type=int, help="the scenario's seed (a sweep's runs, one file)")
-    run.add_argument("--realtime", type=float, metavar="FACTOR", help="pace: 1.0 = wall clock")
+    run.add_argument(
+        "--realtime", type=float, metavar="FACTOR",
+        help="pace: 1.0 = wall clock; 0 = as fast as possible (the default, unless the "
+        "scenario sets clock.realtime_factor)",
+    )  # fmt: skip
     run.add_argument("--out", default="runs", help="folder for run folders (default: runs)")
     run.add_argument(
         "--connect",

@@ -7,6 +7,7 @@ JSON lines, and turns the end of the run into a summary and an exit code.
 
 from __future__ import annotations
 
+import math
 import sys
 from dataclasses import dataclass
 from datetime import datetime
@@ -74,8 +75,9 @@ def prepare(opts: RunOptions) -> World:
     if opts.seed is not None:
         data["seed"] = opts.seed
         flags.append(f"--seed {opts.seed}")
-    if opts.realtime is not None:
-        data["clock"]["realtime_factor"] = opts.realtime
+    if opts.realtime is not None:  # 0 or inf: as fast as possible, a file's pace undone
+        fast = opts.realtime == 0.0 or opts.realtime == math.inf
+        data["clock"]["realtime_factor"] = None if fast else opts.realtime
         flags.append(f"--realtime {opts.realtime:g}")
     changed = f"{source} with {' '.join(flags)}" if flags else source  # the file, the flags
     parsed = parse_scenario(data, source=changed)

@@ -11,6 +11,7 @@ from __future__ import annotations
 import argparse
 import json
 import queue
+import sys
 import time
 from pathlib import Path
 from typing import Any
@@ -29,7 +30,7 @@ from catabot.bus.session import (
     open_session,
     until_answered,
 )
-from catabot.config.live import parse_value
+from catabot.config.live import SettingError, parse_value
 from catabot.errors import CataBotError
 from catabot.run.answer import OneLineParser, answered
 
@@ -123,12 +124,20 @@ def get_main(argv: list[str]) -> int:
 def set_main(argv: list[str]) -> int:
     parser = _parser("set")
     parser.add_argument("key", help="a setting (catabot get lists them)")
-    parser.add_argument("value", help="its value: a number, true/false (on/off), a word, JSON")
+    parser.add_argument(
+        "value", nargs="+", help="its value: a number, true/false (on/off), a word, JSON "
+        "([0.3, 0.1] needs no quotes: the words are joined)",
+    )  # fmt: skip
     args = parser.parse_args(argv)
+    try:  # before any session: a value that cannot be read is the typist's to fix
+        value = parse_value(" ".join(args.value))
+    except SettingError as exc:
+        print(f"catabot set: {exc}", file=sys.stderr)
+        return 2
 
     def ask(session: zenoh.Session) -> None:
         world = args.world or _settings(session, None, args.timeout)["world"]
-        request = json.dumps({"key": args.key, "value": parse_value(args.value)})
+        request = json.dumps({"key": args.key, "value": value})
         answers = _ask(session, Keys(world).config("set"), args.timeout, request)
         if not answers:
             raise AskError(f"world {world!r} did not answer within {args.timeout:g} s")

@@ -79,6 +79,10 @@ def test_no_simulation_is_a_clear_error(tmp_path: Path) -> None:
     assert refused.returncode == 2 and "Traceback" not in refused.stderr
     assert f"catabot set: nothing answers at {gone} (Connection refused)" in refused.stderr
     assert refused.stderr.count("\n") == 1  # one line, not Zenoh's error from orchestrator.rs
+    words = catabot("set", "current", "[0.1,", "0.0]", "-e", gone, "--timeout", "1")
+    assert words.returncode == 2 and "nothing answers" in words.stderr  # read as one value
+    bad = catabot("set", "current", "[nan, 0]", "--timeout", "1")
+    assert bad.returncode == 2 and "catabot set: '[nan, 0]' is not JSON" in bad.stderr
     alone = catabot("get", "--world", "nobody", "--timeout", "1")
     assert alone.returncode == 2 and "Traceback" not in alone.stderr
     assert "no running simulation of world 'nobody' answered within 1 s" in alone.stderr

@@ -92,6 +92,24 @@ def test_command_line_values() -> None:
     assert live.parse_value("25") == 25 and live.parse_value("off") is False
     assert live.parse_value("[0.5, 0]") == [0.5, 0] and live.parse_value("hold") == "hold"
     assert live.parse_value("true") is True and live.parse_value("ON") is True
+    with pytest.raises(live.SettingError, match=r"'\[nan,0\]' is not JSON \(Expecting value"):
+        live.parse_value("[nan,0]")  # was sent as the text "[nan,0]": "must be a list"
+
+
+def test_a_mistyped_key_is_told_the_key_it_is_near() -> None:
+    with pytest.raises(
+        live.SettingError, match=r"unknown setting 'rian' \(did you mean 'rain'\?\)"
+    ):
+        live.check(_scenario(), "rian", 1)
+
+
+@pytest.mark.parametrize(("waves", "shown"), [
+    ({}, "calm"), ({"preset": "medium"}, "medium"),
+    ({"significant_height_m": 0.5, "peak_period_s": 6.0}, "Hs 0.5 m, Tp 6 s (the scenario's)"),
+])  # fmt: skip
+def test_the_sea_is_shown_as_it_is(waves: dict[str, Any], shown: str) -> None:
+    values = live.initial_values(_scenario(water={"waves": waves}))
+    assert values["waves"] == shown  # was "as in the scenario"
 
 
 def test_the_timeline_is_checked_like_the_rest_of_the_scenario() -> None:

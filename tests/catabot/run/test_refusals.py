@@ -7,6 +7,7 @@ prints while it waits for a stack the user starts."""
 from __future__ import annotations
 
 import json
+import math
 import re
 import socket
 import subprocess
@@ -20,6 +21,7 @@ import pytest
 from catabot.config.vessel import BUNDLED_DIR as BUNDLED_VESSELS
 from catabot.config.vessel import bundled_vessel_names
 from catabot.run.cli import main
+from catabot.run.launcher import RunOptions, prepare
 
 
 def _scenario(folder: Path, **vessel: Any) -> str:
@@ -170,3 +172,20 @@ def test_validate_checks_a_vessel_model_file_as_one(
     (tmp_path / "typo.json").write_text(json.dumps(typo))
     assert main(["scenario", "validate", str(tmp_path / "typo.json")]) == 2
     assert "damping: required field missing; dampng: unknown field" in capsys.readouterr().err
+
+
+def test_realtime_zero_undoes_a_files_pace_and_a_negative_one_is_refused(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """`--realtime 0` (or inf) is as fast as possible, the default a scenario's
+    clock.realtime_factor replaces: it was refused as not > 0."""
+    data = {"name": "paced", "duration_s": 1.0, "clock": {"realtime_factor": 1.0},
+            "vessels": [{"id": "ego"}]}  # fmt: skip
+    path = tmp_path / "paced.json"
+    path.write_text(json.dumps(data))
+    for fast in (0.0, math.inf):
+        world = prepare(RunOptions(scenario=str(path), realtime=fast))
+        assert world.scenario.clock.realtime_factor is None
+    assert prepare(RunOptions(scenario=str(path), realtime=4.0)).scenario.clock.realtime_factor == 4
+    assert main(["run", str(path), "--realtime", "-1", "--out", str(tmp_path)]) == 2
+    assert f"scenario {path} with --realtime -1: clock.realtime_factor" in capsys.readouterr().err
