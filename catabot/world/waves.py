@@ -122,12 +122,35 @@ class WaveField:
             raise WaveError(f"gravity must be a finite number > 0 (got {gravity})")
         self.config, self.seed, self.gravity = config, int(seed), float(gravity)
         omega, theta, phase = _components(config, self.seed)
-        m = omega.size
+        amp = 0.0 if config.is_calm else config.significant_height_m / math.sqrt(8.0 * omega.size)
+        self._tables(omega, theta, phase, np.full(omega.size, amp))  # a = sqrt(2 m0 / M)
+        self._calm, self.sigma_m = config.is_calm, config.significant_height_m / 4.0
+
+    @classmethod
+    def blend(cls, old: WaveField, new: WaveField, share: float) -> WaveField:
+        """`old` fading and `new` building up: the components of both, the old ones'
+        amplitudes times 1 - share and the new ones' times share (a calm side has none).
+        A run-time change of sea part of the way (catabot/world/sea_change.py)."""
+        parts = [(f, w) for f, w in ((old, 1.0 - share), (new, share)) if w > 0 and not f.is_calm]
+        if not parts:
+            return new
+        field = cls.__new__(cls)
+        field.config, field.seed, field.gravity = new.config, new.seed, new.gravity
+        omega, theta, phase, amp = (
+            np.concatenate([getattr(f, name) for f, _ in parts])
+            for name in ("frequencies_radps", "directions_rad", "phases_rad", "amplitudes_m")
+        )
+        amp = amp * np.concatenate([np.full(f.amplitudes_m.size, w) for f, w in parts])
+        field._tables(omega, theta, phase, amp)
+        field._calm, field.sigma_m = False, float(np.sqrt(np.sum(amp**2) / 2.0))
+        return field
+
+    def _tables(self, omega: Array, theta: Array, phase: Array, amp: Array) -> None:
+        """The components' read-only tables and the float32 weights the sums use."""
         self.frequencies_radps = _frozen(omega)
         self.directions_rad = _frozen(theta)
         self.phases_rad = _frozen(phase)
-        amp = 0.0 if config.is_calm else config.significant_height_m / math.sqrt(8.0 * m)
-        self.amplitudes_m = _frozen(np.full(m, amp))  # a = sqrt(2 m0 / M), m0 = Hs^2/16
+        self.amplitudes_m = _frozen(amp)
         k = omega**2 / self.gravity
         self.wavenumbers_radpm = _frozen(k)
         kx, ky = k * np.cos(theta), k * np.sin(theta)
@@ -142,7 +165,7 @@ class WaveField:
 
     @property
     def is_calm(self) -> bool:
-        return self.config.is_calm
+        return self._calm
 
     def height(self, x: ArrayLike, y: ArrayLike, t: ArrayLike = 0.0) -> Array:
         """Surface elevation eta (m, world z) at horizontal points (x, y), time t (s)."""

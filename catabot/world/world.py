@@ -191,6 +191,11 @@ class World:
         return Streams.of(self)
 
     @cached_property
+    def waves(self) -> WaveField:
+        """The scenario's sea at the start (a run-time change: sea_change.py)."""
+        return WaveField(self.scenario.water.waves, self.scenario.seed)
+
+    @cached_property
     def clock_limits(self) -> ClockLimits:
         """What participants check every Tick against (catabot/bus/clock.py)."""
         s = self.scenario
@@ -222,7 +227,7 @@ class World:
         quat = np.array([rotations.from_rpy(*t) for t in turns]).reshape(n, 4)
         linear = np.array([b.velocity.linear for b in self.bodies]).reshape(n, 3)
         if not self.scenario.water.waves.is_calm and n:
-            sea = WaveField(self.scenario.water.waves, self.scenario.seed)
+            sea = self.waves
             p[:, 2] += sea.height(p[:, 0], p[:, 1])
             water = sea.velocity(p[:, 0], p[:, 1], p[:, 2])  # map frame, at the surface
             linear += np.einsum("nji,nj->ni", rotations.matrices(quat), water)  # R^T: body frame

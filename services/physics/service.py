@@ -20,6 +20,7 @@ from catabot.bus.taken import entry
 from catabot.config import live
 from catabot.run.advice import advise
 from catabot.run.service import Built, ServiceContext, run_service
+from catabot.world.sea_change import SeaChange
 from services.physics import settings
 from services.physics.commands import CommandBook, never_applied
 from services.physics.control import TwistControllerBank
@@ -62,6 +63,7 @@ class PhysicsService:
         guidance = streams.guidance_states  # the traffic's copy of the states, when it has one
         self.guidance = guidance if guidance.key != streams.states.key else None
         self.scenario, self.specs = world.scenario, live.keys_of(world.scenario)
+        self.sea = SeaChange(world.waves, dt_ns=self.dt_ns)
         self.participant = ctx.participant(self.streams)
         watch_strays(self.participant, ctx.keys.vessel_commands(), self._stray)
 
@@ -73,8 +75,8 @@ class PhysicsService:
         return f"no command {command!r} (a vessel takes thrust, twist, waypoints)"
 
     def step(self, tick: Tick, inputs: Inputs) -> None:
-        for change in changes_of(tick.settings):
-            settings.apply(self.world, self.scenario, self.specs, change)
+        changes = changes_of(tick.settings)
+        settings.take(self.world, self.scenario, self.specs, changes, tick=tick.tick, sea=self.sea)
         taken: list[str] = []  # free commands (tick -1), for the recorder (taken.py)
         for key, msgs in inputs.items():
             if key in self.blocks:

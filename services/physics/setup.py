@@ -6,7 +6,6 @@ import numpy as np
 
 from catabot.world import rotations
 from catabot.world.environment.wind import WindField
-from catabot.world.waves import WaveField
 from catabot.world.world import World
 from services.physics.world import PhysicsWorld
 
@@ -22,7 +21,7 @@ def build_world(world: World) -> PhysicsWorld:
         starts,
         dt_s=scenario.dt_ns / 1e9,
         water_density=scenario.water.density_kg_m3,
-        waves=WaveField(scenario.water.waves, scenario.seed),
+        waves=world.waves,
         terrain=world.terrain,
         current=world.current,
         wind=WindField(scenario.wind, seed=scenario.seed),

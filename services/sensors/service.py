@@ -17,7 +17,6 @@ from catabot.bus.messages import BodyStates, Message, Tick, VesselState
 from catabot.bus.settings import changes_of
 from catabot.config.sensors import SENSOR_TYPES
 from catabot.run.service import Built, ServiceContext, run_service
-from catabot.world.waves import WaveField
 from catabot.world.world import World
 from services.sensors.own_view import OwnView
 from services.sensors.registry import Sensor, build_sensor
@@ -54,7 +53,7 @@ class SensorsService:
         self.batch = world.start_states()
         self.states = self._carriers(self.batch)
         self.states_key = ctx.keys.world_states()
-        self.settings = SensorSettings(ctx.scenario, self.scene, ctx.keys.sensor)
+        self.settings = SensorSettings(world, self.scene, ctx.keys.sensor)
         self.models = {m.key: m.sensor for m in self.mounted}
         self.own_view = OwnView([(s.key, s.seed_name, world.body(s.vessel).instance)
                                  for s in mine if SENSOR_TYPES[s.config.type].casts])  # fmt: skip
@@ -63,6 +62,7 @@ class SensorsService:
     def step(self, tick: Tick, inputs: Inputs) -> None:
         for change in changes_of(tick.settings):
             self.settings.apply(change, self.models)
+        self.settings.waves(tick.tick)
         batches = inputs.get(self.states_key)
         if batches:
             self._take(batches[-1])
@@ -99,7 +99,7 @@ def build_scene(world: World) -> Scene:
     scenario = world.scenario
     return Scene(
         terrain=world.terrain,
-        waves=WaveField(scenario.water.waves, scenario.seed),
+        waves=world.waves,
         bodies=scene_bodies(world),
         rain_rate_mm_h=scenario.rain.rate_mm_h,
     )

@@ -71,7 +71,7 @@ class WaveCaster:
         self.spec: GridSpec | None = grid_spec(waves)
         if not waves.is_calm:
             warm_up()  # the kernels load (or compile) now, not inside the first cast
-        sigma = waves.config.significant_height_m / 4.0
+        sigma = waves.sigma_m
         self.guess = min(self.amplitude, BAND_SIGMAS * sigma)
         self.scratch = Scratch()
         self.last_plan = ""  # what the last cast did (benchmarks, tests)

@@ -24,7 +24,6 @@ import rerun as rr
 from catabot.bus.messages import LABEL_CLASSES, BodyStates, ImuSample, LidarScan, RadarSweep
 from catabot.world import rotations
 from catabot.world.terrain_grid import grid_triangles
-from catabot.world.waves import WaveField
 from catabot.world.world import MountedSensor, World
 from services.viewer import palette, paths
 from services.viewer.static import body_groups, log_static
@@ -40,7 +39,7 @@ class RunLogger:
         self.groups = body_groups(world)
         self.vessels = len(world.vessels)
         self.own = [world.body(v.id) for v in world.scenario.vessels]
-        self.waves = WaveField(world.scenario.water.waves, world.scenario.seed)
+        self.waves = world.waves
         self._last = {"trail": -math.inf, "water": -math.inf}
         self._closest = math.inf
         log_static(rec, world)

@@ -14,7 +14,9 @@ from catabot.config import live
 from catabot.config.load import parse_scenario
 from catabot.config.scenario import Pose
 from catabot.config.traffic import TrafficConfig
+from catabot.world.sea_change import SeaChange
 from catabot.world.traffic_plan import Boat
+from catabot.world.waves import WaveField
 from catabot.world.world import World
 from services.physics import settings as physics_settings
 from services.physics.setup import build_world
@@ -29,10 +31,9 @@ def _scenario(**top: Any) -> Any:
 
 def _drift(changes: list[Change], steps: int = 200) -> float:
     scenario = _scenario()
-    world = build_world(World.resolve(scenario))
-    specs = live.keys_of(scenario)
-    for change in changes:
-        physics_settings.apply(world, scenario, specs, change)
+    resolved = World.resolve(scenario)
+    world, sea = build_world(resolved), SeaChange(resolved.waves, dt_ns=scenario.dt_ns)
+    physics_settings.take(world, scenario, live.keys_of(scenario), changes, tick=0, sea=sea)
     for _ in range(steps):
         world.step()
     return float(world.state_arrays().position[0, 0])
@@ -46,18 +47,40 @@ def test_physics_takes_current_and_wind() -> None:
     assert _drift(west) < still
 
 
-def test_physics_and_sensors_take_the_sea() -> None:
-    scenario = _scenario()
-    world = build_world(World.resolve(scenario))
-    physics_settings.apply(world, scenario, live.keys_of(scenario), Change(0, "waves", '"heavy"'))
+def _heave_peak(*, ramp: bool) -> float:
+    """The ego's largest vertical acceleration over 14 s of a medium swell that turns heavy
+    at 2 s (tick 200), built up (catabot/world/sea_change.py) or replaced in one tick."""
+    scenario = _scenario(water={"waves": {"preset": "medium"}})
+    resolved = World.resolve(scenario)
+    world, sea = build_world(resolved), SeaChange(resolved.waves, dt_ns=scenario.dt_ns)
+    specs, peak = live.keys_of(scenario), 0.0
+    heavy = WaveField(live.wave_config(scenario, "heavy"), scenario.seed)
+    for tick in range(1400):
+        changes = [Change(tick, "waves", '"heavy"')] if tick == 200 else []
+        if ramp:
+            physics_settings.take(world, scenario, specs, changes, tick=tick, sea=sea)
+        elif changes:
+            world.set_waves(heavy)
+        world.step()
+        if tick >= 100:  # past the start's own settling
+            peak = max(peak, abs(float(world.state_arrays().linear_acceleration[0, 2])))
     assert world.sea_method.startswith("vessel expansions")  # a sea, no longer calm
+    return peak
+
+
+def test_a_new_sea_builds_up_without_dropping_the_boats() -> None:
+    """Replaced in one tick, the surface under a boat jumped by up to a wave: from medium to
+    heavy swell a boat fell and landed at 26 m/s^2 (a user's run)."""
+    built, sudden = _heave_peak(ramp=True), _heave_peak(ramp=False)
+    assert built < 3.0 < sudden, (built, sudden)
 
 
 def test_sensor_settings_switch_rain_sensors_and_outputs() -> None:
     scenario = _scenario()
     scene = SimpleNamespace(rain_rate_mm_h=0.0)
     camera = SimpleNamespace(params=scenario.vessels[0].sensors[0].typed_params())
-    switch = SensorSettings(scenario, scene, lambda v, s: f"sensor/{v}/{s}")  # type: ignore[arg-type]
+    world = World.resolve(scenario)
+    switch = SensorSettings(world, scene, lambda v, s: f"sensor/{v}/{s}")  # type: ignore[arg-type]
     models = {"sensor/ego/cam": camera}
     switch.apply(Change(3, "rain", "25.0"), models)
     assert scene.rain_rate_mm_h == 25.0
