@@ -79,6 +79,19 @@ class StateTrack:
         )  # fmt: skip
 
 
+def _check_ticked(folder: Path) -> None:
+    """A run stopped before its first tick recorded nothing: say so, not that its run.mcap
+    is cut off and has no /tf channel (`log/run.json`; a killed run's folder has none)."""
+    try:
+        record = json.loads((folder / "log" / "run.json").read_text())
+        ticks, reason = int(record["ticks"]), str(record["reason"])
+    except (OSError, ValueError, TypeError, KeyError):
+        return
+    if ticks == 0:
+        raise RunFolderError(f"{folder}: the run recorded no tick (it was {reason} before its "
+                             "first: log/run.json)")  # fmt: skip
+
+
 class RecordedRun:
     """One run folder: its world, and its streams read back on demand."""
 
@@ -90,6 +103,7 @@ class RecordedRun:
         scenario = self.folder / "scenario.json"
         if not scenario.is_file():
             raise RunFolderError(f"{self.folder}: not a run folder (it has no scenario.json)")
+        _check_ticked(self.folder)
         self.world = World.resolve(load_scenario(scenario))
         self.names = Names(self.world, self.world.scenario.ros or RosConfig())  # the recorder's
         self._ros2 = DecoderFactory()

@@ -149,7 +149,8 @@ def summarise(
         print(f"run failed: {error}", file=sys.stderr)
         return 1
     if interrupted:
-        print("run interrupted; files are complete up to the last tick", file=sys.stderr)
+        print("run interrupted; " + ("files are complete up to the last tick" if record["ticks"]
+              else "before its first tick: nothing was recorded"), file=sys.stderr)  # fmt: skip
         return 130
     return 0
 

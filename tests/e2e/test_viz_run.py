@@ -197,6 +197,7 @@ def test_plot_writes_figures_and_a_report(run: Path, tmp_path: Path) -> None:
         (("dataset", "export", "{run}", "-f", "yolo", "-o", "{run}"), "is not an empty folder"),
         (("dataset", "export", "{nocam}", "-f", "coco", "-o", "{tmp}/o"), "no labelled camera"),
         (("view", "{tmp}"), "not a run folder"),
+        (("plot", "{unticked}"), "the run recorded no tick (it was interrupted before its first"),
         (("view", "{run}", "--save", "{tmp}/no/x.rrd"), "does not exist"),
         (("view", "{run}", "--web", "--no-hold", "--web-port", "{taken}"), "Address already"),
     ],
@@ -211,11 +212,16 @@ def test_refusals_exit_2_with_one_clear_line(
                                          if s["type"] != "camera"]  # fmt: skip
     scenario["recording"]["export"] = []
     (nocam / "scenario.json").write_text(json.dumps(scenario))
+    unticked = tmp_path / "unticked"  # stopped before its first tick: plot named a cut-off run.mcap
+    (unticked / "log").mkdir(parents=True)
+    shutil.copy(nocam / "scenario.json", unticked)
+    (unticked / "log" / "run.json").write_text('{"ticks": 0, "reason": "interrupted"}')
     with socket.socket() as taken:  # a port in use: a second web viewer met rerun's 9090
         taken.bind(("0.0.0.0", 0))
         taken.listen()
         port = taken.getsockname()[1]
-        filled = [a.format(tmp=tmp_path, run=run, nocam=nocam, taken=port) for a in args]
+        folders = {"run": run, "nocam": nocam, "unticked": unticked}
+        filled = [a.format(tmp=tmp_path, taken=port, **folders) for a in args]
         result = catabot(*filled)
     assert result.returncode == 2, result.stdout + result.stderr
     assert message in result.stderr and "Traceback" not in result.stderr
