@@ -85,7 +85,7 @@ class Child:
         key, reason, detail = (_printable(part) for part in report)
         self._refusals.add(report)
         if len(self._refusals) > MAX_ECHOED:
-            self.notes.append(f"{self.name} refused more kinds of samples: see {self.log_path}")
+            self.notes.append(f"{self.name} refused more kinds of input: see {self.log_path}")
             return
         hint = " (messages: docs/MESSAGES.md)" if reason in HINTED else ""
         said = f"{reason}: {detail}" if detail else reason

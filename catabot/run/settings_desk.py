@@ -23,6 +23,7 @@ from catabot.bus.rejections import Rejected, Rejections
 from catabot.bus.settings import Schedule, SettingsError
 from catabot.config import live
 from catabot.config.scenario import Scenario
+from catabot.run.advice import tell
 
 log = logging.getLogger("catabot.run.settings")
 MAX_QUERY_BYTES = 4096  # a key and a value: anything bigger is not a setting
@@ -88,7 +89,7 @@ class SettingsDesk:
         text = live.check(self.scenario, request["key"], request["value"])
         change = self.schedule.propose(request["key"], text)
         t_s = change.tick * self.scenario.dt_ns / 1e9
-        log.info("setting %s = %s from tick %d (t = %g s)", change.key, text, change.tick, t_s)
+        tell(log, f"setting {change.key} = {text} from tick {change.tick} (t = {t_s:g} s)")
         return {"key": change.key, "value": change.decoded, "tick": change.tick, "t_s": t_s}
 
     def in_force(self) -> dict[str, Any]:

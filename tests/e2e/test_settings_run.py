@@ -97,11 +97,13 @@ def test_set_rain_mid_run_is_recorded_and_replays_to_the_same_bytes(tmp_path: Pa
         _wait_ticking(endpoint)
         effect = _set(endpoint)
         _while_it_runs(endpoint, tmp_path / "snap.png")
-        _, stderr = run.communicate(timeout=120)
+        stdout, stderr = run.communicate(timeout=120)
     finally:
         run.kill()
     assert run.returncode == 0, stderr
     assert "setting refused 2" in stderr  # counted like any refused input
+    told = f"conductor: setting rain = 25.0 from tick {effect} (t = {effect / 100:g} s)"
+    assert told in stdout + stderr  # the run's own console says what changed
     folder = only_run_dir(out)
     scans = [(int(r[1]), int(r[3])) for r in csv_rows(folder / "sensor.ego.lidar.csv")[1:]]
     assert len(scans) == 60 and 60 < effect < 600
