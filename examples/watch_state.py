@@ -1,14 +1,18 @@
-"""Print a vessel's state as the simulation publishes it (an observer never blocks the clock).
+"""Print a vessel's state as the simulation publishes it (an observer never blocks the clock),
+until the run ends or --count states are shown.
 
 catabot run --realtime 1 --listen tcp/127.0.0.1:7447 &
 python examples/watch_state.py --connect tcp/127.0.0.1:7447 --vessel ego --count 20
 """
 
+import itertools
+import queue
+
 import zenoh
-from common import keys, parser, session
+from common import clear_errors, keys, parser, session
 
 from catabot.bus import codec
-from catabot.bus.messages import VesselState
+from catabot.bus.messages import End, VesselState
 
 
 def show(state: VesselState) -> None:
@@ -22,17 +26,23 @@ def main() -> None:
     p.add_argument("--count", type=int, default=0, help="stop after this many states (0: never)")
     p.add_argument("--every", type=int, default=10, help="print one state in this many")
     args = p.parse_args()
-    with session(args) as s:
-        sub = s.declare_subscriber(
-            keys(s, args).vessel_state(args.vessel), zenoh.handlers.RingChannel(256)
-        )
+    with clear_errors("watch_state.py"), session(args) as s:
+        k = keys(s, args)
+        got: queue.Queue[zenoh.Sample] = queue.Queue()  # the states and the run's end, in order
+        s.declare_subscriber(k.vessel_state(args.vessel), got.put)
+        s.declare_subscriber(k.end(), got.put)
         shown = 0
-        for n, sample in enumerate(sub):
+        for n in itertools.count():
+            sample = got.get()
+            if str(sample.key_expr) == k.end():
+                end = codec.decode(sample.payload.to_bytes(), End)
+                print(f"the run ended at tick {end.tick} ({end.reason})")
+                return
             if n % args.every == 0:
                 show(codec.decode(sample.payload.to_bytes(), VesselState))
                 shown += 1
             if args.count and shown >= args.count:
-                break
+                return
 
 
 if __name__ == "__main__":

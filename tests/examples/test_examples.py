@@ -85,6 +85,9 @@ def test_watch_state_prints_the_vessel_moving(run: type[Run]) -> None:
     assert shown.returncode == 0, shown.stderr
     lines = [ln for ln in shown.stdout.splitlines() if ln.startswith("t=")]
     assert len(lines) == 5 and "x=" in lines[0] and "u=" in lines[0]
+    until_end = example("watch_state.py", "--connect", sim.endpoint, "--every", "100")
+    assert until_end.returncode == 0, until_end.stderr  # it hung on after the run's end
+    assert until_end.stdout.endswith("the run ended at tick 799 (completed)\n"), until_end.stdout
     sim.finish()
 
 
