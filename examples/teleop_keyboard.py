@@ -34,6 +34,7 @@ from catabot.client import (
 STEP = 0.1  # thrust per key press, of full (-1..1)
 KEYS = {"r": (0, STEP), "f": (0, -STEP), "u": (1, STEP), "j": (1, -STEP)}
 HELP = "R/F port up/down   U/J starboard up/down   Space screenshot   Q quit"
+STALE_S = 2.0  # a camera frame older than this (sim time) is not the view now
 
 
 def press(thrust: tuple[float, ...], key: str) -> tuple[float, ...]:
@@ -79,10 +80,15 @@ def save_png(frame: CameraFrame, folder: Path, name: str) -> Path:
     return path
 
 
-def screenshot(ego: Vessel, camera: str, folder: Path) -> str:
-    """Space: save the newest camera frame; the line to show either way."""
+def screenshot(ego: Vessel, camera: str, folder: Path, now_ns: int | None = None) -> str:
+    """Space: save the newest camera frame; the line to show either way. A frame older than
+    STALE_S of sim time at `now_ns` is not the view now: the camera was switched off."""
     try:
         frame = ego.sensor(camera).latest(timeout_s=2.0)
+        age = (now_ns - frame.stamp_ns) / 1e9 if now_ns is not None else 0.0
+        if age > STALE_S:
+            return (f"no screenshot: the camera's newest frame is {age:.1f} s old: is it "
+                    f"switched off? (catabot set sensor.{ego.id}.{camera}.enabled on)")  # fmt: skip
         path = save_png(frame, folder, f"{ego.id}_{camera}")
     except (ClientError, ValueError, OSError) as e:
         return f"no screenshot: {e}"
@@ -113,7 +119,7 @@ def _keys(win: curses.window, ego: Vessel, camera: str, folder: Path, rate_hz: f
         if key in (ord("q"), ord("Q")):
             return "quit"
         if key == ord(" "):
-            note = screenshot(ego, camera, folder)
+            note = screenshot(ego, camera, folder, state.stamp_ns if state else None)
         elif 0 <= key < 256:
             thrust = press(thrust, chr(key))
         ego.send(Thrust(list(thrust)))
@@ -134,6 +140,7 @@ def main() -> None:
     args = p.parse_args()
     with clear_errors("teleop_keyboard.py"), Client.from_args(args) as sim:
         ego = sim.vessel(args.vessel)
+        ego.sensor(args.camera)  # a camera it does not have is told now, not at Space
         try:
             why = curses.wrapper(drive, ego, args.camera, args.out, args.rate)
         except RunEnded as e:

@@ -11,11 +11,12 @@ import sys
 import time
 from collections.abc import Iterator
 from pathlib import Path
+from types import SimpleNamespace
 
 import numpy as np
 import pytest
 from PIL import Image
-from teleop_keyboard import HELP, press, save_png, screen
+from teleop_keyboard import HELP, press, save_png, screen, screenshot
 
 from catabot.bus.messages import CameraFrame, VesselState
 from catabot.bus.session import free_port
@@ -65,6 +66,19 @@ def test_save_png_writes_the_colour_image(tmp_path: Path) -> None:
     assert np.array_equal(np.asarray(Image.open(path)), color)
     with pytest.raises(ValueError, match="colour output is switched off"):
         save_png(frame(np.empty((0,), np.uint8)), tmp_path, "x")
+
+
+def test_a_screenshot_of_a_camera_switched_off_says_so(tmp_path: Path) -> None:
+    """The newest frame of a camera switched off is old: the teleop said its colour output
+    was off (that old frame's), or saved a view long gone."""
+    color = np.zeros((2, 4, 3), np.uint8)
+    camera = SimpleNamespace(latest=lambda timeout_s: frame(color))  # stamped 0.42 s
+    ego = SimpleNamespace(id="ego", sensor=lambda name: camera)
+    said = screenshot(ego, "cam", tmp_path, now_ns=5_000_000_000)  # type: ignore[arg-type]
+    assert said.startswith("no screenshot: the camera's newest frame is 4.6 s old")
+    assert "catabot set sensor.ego.cam.enabled on" in said and not list(tmp_path.iterdir())
+    fresh = screenshot(ego, "cam", tmp_path, now_ns=600_000_000)  # type: ignore[arg-type]
+    assert fresh.startswith("saved ego_cam_00000042.png")
 
 
 TMUX = shutil.which("tmux")
