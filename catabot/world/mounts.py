@@ -71,13 +71,23 @@ def inside(mesh: ShapeMesh, point: tuple[float, float, float]) -> bool:
 
 def check_mounts(world: World) -> None:
     """Refuse the first ray-casting sensor whose rays start inside its own vessel's shape,
-    and a radar below its shape's top: its level sweep would hit its own hull (at 0 m, 205
-    of 240 beams returned the catamaran's own hulls, 2-10 mm off)."""
+    a radar below its shape's top: its level sweep would hit its own hull (at 0 m, 205
+    of 240 beams returned the catamaran's own hulls, 2-10 mm off), and any below the water."""
     for i, vessel in enumerate(world.scenario.vessels):
         body = world.body(vessel.id)
         mesh = world.shapes[body.model_ref]
         for j, sensor in enumerate(s for s in world.sensors if s.vessel == vessel.id):
             origin = ray_origin(sensor)
+            if origin is not None and origin[2] < 0.0:
+                field = (
+                    "antenna_height_m" if isinstance(sensor.params, RadarParams) else "mount_xyz"
+                )
+                raise MountInsideError(
+                    f"vessels.{i}.sensors.{j} ({sensor.config.name}): its rays start at "
+                    f"{list(origin)} ({field}), under water: z is up from {vessel.id}'s "
+                    "waterline at rest, and the sensors model no view under the surface "
+                    "(a LiDAR 1 m down saw rain and the seabed); mount it above z = 0"
+                )
             if mesh is None or origin is None:
                 continue
             if isinstance(sensor.params, RadarParams) and origin[2] <= mesh.hi[2]:

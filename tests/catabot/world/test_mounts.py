@@ -78,3 +78,12 @@ def test_scenario_validate_refuses_it_in_one_line(
     assert main(["scenario", "validate", str(path)]) == 2
     err = capsys.readouterr().err
     assert err.count("\n") == 1 and "(l): its rays start at [0.0, 0.5, 0.1] (mount_xyz)" in err
+
+
+@pytest.mark.parametrize("kind", ["lidar", "camera"])
+def test_a_sensor_under_the_water_is_refused(kind: str) -> None:
+    """A LiDAR 1 m down was taken without a word: its scans held rain and the seabed."""
+    sensor = {"name": "s", "type": kind, "rate_hz": 5.0, "params": {"mount_xyz": [0, 0, -1.0]}}
+    with pytest.raises(MountInsideError, match=r"\(s\): its rays start at \[0.0, 0.0, -1.0\] "
+                                               r"\(mount_xyz\), under water"):  # fmt: skip
+        check_mounts(_world("catabot", sensor))
