@@ -28,6 +28,8 @@ def test_everything_asked_for_with_its_sources() -> None:
     rec = {"rerun": True, "export": ["yolo", "coco", "kitti"], "dataset_rate_hz": 2.0}
     parsed = parse_scenario(_scenario(rec, CAMERA, LIDAR)).recording
     assert parsed.export == ["yolo", "coco", "kitti"] and parsed.dataset_rate_hz == 2.0
+    camera_only = {"mcap": False, "export": ["yolo", "coco", "segmentation"]}  # from dataset/
+    assert parse_scenario(_scenario(camera_only, CAMERA)).recording.export[0] == "yolo"
 
 
 @pytest.mark.parametrize(
