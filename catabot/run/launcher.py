@@ -76,6 +76,9 @@ def prepare(opts: RunOptions) -> World:
         data["seed"] = opts.seed
         flags.append(f"--seed {opts.seed}")
     if opts.realtime is not None:  # 0 or inf: as fast as possible, a file's pace undone
+        if not opts.realtime >= 0.0:
+            raise ScenarioError(f"--realtime {opts.realtime:g}: a pace is 0 or more (1: the wall "
+                                "clock, 0: as fast as possible)")  # fmt: skip
         fast = opts.realtime == 0.0 or opts.realtime == math.inf
         data["clock"]["realtime_factor"] = None if fast else opts.realtime
         flags.append(f"--realtime {opts.realtime:g}")
