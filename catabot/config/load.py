@@ -7,6 +7,7 @@ original simulator's `SettingsConfig.json` format are mapped by `settings_config
 
 from __future__ import annotations
 
+import difflib
 import hashlib
 import json
 import os
@@ -54,11 +55,21 @@ def load_scenario(path: str | Path | None = None) -> Scenario:
             hint = f"; a run folder's scenario is {inside}" if inside.is_file() else ""
             raise ScenarioError(f"scenario file {str(file)!r} is a folder{hint}")
         else:
-            raise ScenarioError(f"scenario file {str(file)!r} does not exist")
+            raise ScenarioError(f"scenario file {str(file)!r} does not exist{_bundled_hint(path)}")
     data = read_json(file, what="scenario")
     if isinstance(data, dict) and is_settings_config(data):  # first: its paths are relative too
         data = map_settings_config(data, source=str(file))
     return parse_scenario(absolute_paths(data, file.parent.resolve()), source=str(file))
+
+
+def _bundled_hint(path: str | Path | None) -> str:
+    """A bare name is a bundled scenario's: name the one it is near, and all of them."""
+    if path is None or "/" in str(path) or str(path).endswith(".json"):
+        return ""
+    names = sorted(p.stem for p in BUNDLED.glob("*.json"))
+    near = difflib.get_close_matches(str(path), names, n=1)
+    ask = f"did you mean {near[0]!r}? " if near else ""
+    return f" ({ask}bundled scenarios: {', '.join(names)})"
 
 
 def absolute_paths(data: Any, base: Path) -> Any:

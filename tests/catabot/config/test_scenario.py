@@ -225,8 +225,10 @@ def test_missing_file(tmp_path: Path) -> None:
     with pytest.raises(ScenarioError, match="does not exist") as info:
         load_scenario(path)
     assert "nowhere.json" in str(info.value)
-    with pytest.raises(ScenarioError, match="does not exist"):
+    with pytest.raises(ScenarioError, match=r"does not exist \(bundled scenarios: default, "):
         load_scenario("no-such-bundled-scenario")
+    with pytest.raises(ScenarioError, match="'harbor' does not exist \\(did you mean 'harbour'"):
+        load_scenario("harbor")
 
 
 def test_file_errors_name_the_file(tmp_path: Path) -> None:
