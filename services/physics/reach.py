@@ -50,9 +50,11 @@ class Reach:
         around = _most(lambda x: not self.beyond(vessel, 0.0, x), MAX_YAW_RATE)
         reach = (f"about {ahead:.2f} m/s straight ahead, {astern:.2f} m/s astern, "
                  f"{around:.2f} rad/s turning in place")  # fmt: skip
+        alone = abs(surge) <= (ahead if surge >= 0 else astern) and abs(yaw_rate) <= around
+        both = " together: a turn takes thrust from the speed" if alone else ""
         advise(log, f"{vessel}: the {how} twist {surge:g} m/s at {yaw_rate:g} rad/s is beyond "
-                    f"its thrusters (they hold {reach}), so it settles short of it: compare the "
-                    "recorded state with the twist (said once a vessel)")  # fmt: skip
+                    f"its thrusters{both} (they hold {reach}), so it settles short of it: "
+                    "compare the recorded state with the twist (said once a vessel)")  # fmt: skip
 
     def beyond(self, vessel: str, surge: float, yaw_rate: float) -> bool:
         """Whether holding the set-point in steady state needs more than the thrusters give."""

@@ -69,3 +69,13 @@ def test_a_scripted_twist_beyond_reach_is_told_at_the_start(
         _reach(("ego", "catabot", steps))
     (said,) = _advice(caplog)
     assert said.startswith("ego: the scripted twist 4 m/s at 0.1 rad/s is beyond")
+
+
+def test_a_set_point_beyond_only_in_combination_says_so(caplog: pytest.LogCaptureFixture) -> None:
+    """1.42 m/s and 0.18 rad/s are each within the catamaran's reach, not both at once: the
+    advice read as a contradiction (examples/navigate.json's first order)."""
+    reach = _reach(("c", "catabot", ()))
+    with caplog.at_level(logging.WARNING):
+        reach.heard("c", [TwistCmd(surge=1.42, yaw_rate=-0.18)])
+    (said,) = _advice(caplog)
+    assert "is beyond its thrusters together: a turn takes thrust from the speed (" in said
