@@ -118,7 +118,7 @@ class RecordedRun:
         if not path.is_file():
             raise RunFolderError(
                 f"{self.folder}: no run.mcap (recorded with recording.mcap false?); "
-                "replay, export and plots read it"
+                "replay, plots and the KITTI export read it"
             )
         index = McapIndex(path)
         if not index.finished:  # what is there is read, and the reader is told so

@@ -157,18 +157,31 @@ def thrust(data: RunSeries) -> Figure | None:
     fig = _figure(len(owners), 1, size=(10, 2.8 * len(owners)))
     end = float(data.t[-1])
     for ax, vid in zip(_axes(fig), owners, strict=True):
-        for series, style in ((data.thrust.get(vid), "-"), (data.setpoint.get(vid), "--")):
+        kinds = (data.thrust.get(vid), data.setpoint.get(vid))
+        for series, other, style in ((*kinds, "-"), (*kinds[::-1], "--")):
             if series is None:
                 continue
-            t = np.append(series.t, end)  # hold the last command to the end of the run
+            t, held = _in_force(series.t, series.values, other.t if other else None, end)
             for c, name in enumerate(series.names):
-                values = np.append(series.values[:, c], series.values[-1, c])
-                ax.step(t, values, style, where="post", label=name)
+                ax.step(t, held[:, c], style, where="post", label=name)
         ax.set(title=f"{vid}: commands (solid: thrust, -1..1; dashed: twist set-points)",
                xlabel="simulated time [s]", xlim=(0, end))  # fmt: skip
         ax.grid(alpha=0.3)
         ax.legend(fontsize=8, loc="best")
     return fig
+
+
+def _in_force(
+    t: np.ndarray, values: np.ndarray, other: np.ndarray | None, end: float
+) -> tuple[np.ndarray, np.ndarray]:
+    """Each command held until the next, or until the other kind's next (NaN: a thrust
+    stops ruling when a twist comes, and back), the last to the run's end. The thrust plot
+    drew the last thrust on for 20 s while the twist controller drove."""
+    cut = np.asarray(other if other is not None else [], dtype=np.float64)
+    times = np.concatenate([t, cut])
+    rows = np.concatenate([values, np.full((cut.size, values.shape[1]), np.nan)])
+    order = np.argsort(times, kind="stable")
+    return np.append(times[order], end), np.vstack([rows[order], rows[order][-1:]])
 
 
 def imu(data: RunSeries) -> Figure | None:

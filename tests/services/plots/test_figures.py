@@ -9,7 +9,7 @@ from matplotlib.patches import Circle
 
 from catabot.config.load import parse_scenario
 from catabot.world.world import World
-from services.plots.figures import _boat_names, _task, _task_points, rain_steps
+from services.plots.figures import _boat_names, _in_force, _task, _task_points, rain_steps
 
 
 def test_the_rain_rate_follows_the_settings_timeline() -> None:
@@ -51,3 +51,14 @@ def test_trajectories_mark_the_task_and_number_the_boats() -> None:
     assert [line.get_label() for line in ax.lines] == ["ego route"]
     assert [t.get_text() for t in ax.texts] == [str(i) for i in range(12)]  # boat_000 -> "0"
     plt.close(fig)
+
+
+def test_a_thrust_is_drawn_until_a_twist_takes_over_and_back() -> None:
+    """The default run's thrust plot held 0.3/0.9 from 40 s to the end while its twist
+    controller drove (a newcomer's reading of plots/thrust.png)."""
+    thrust_t, thrust = np.array([0.0, 10.0]), np.array([[0.5, 0.5], [0.3, 0.9]])
+    t, held = _in_force(thrust_t, thrust, np.array([40.0]), 60.0)
+    assert t.tolist() == [0.0, 10.0, 40.0, 60.0]
+    assert held[:2].tolist() == thrust.tolist() and np.isnan(held[2:]).all()
+    t, held = _in_force(np.array([40.0]), np.array([[1.0, 0.0]]), thrust_t, 60.0)
+    assert t.tolist() == [0.0, 10.0, 40.0, 60.0] and held[2:].tolist() == [[1.0, 0.0]] * 2
