@@ -14,6 +14,7 @@ import sys
 import time
 from collections import deque
 from collections.abc import Callable
+from pathlib import Path
 from typing import Any
 
 from catabot.bus.inbox import Inputs
@@ -28,7 +29,9 @@ from catabot.bus.messages import (
 )
 from catabot.bus.settings import changes_of
 from catabot.bus.taken import taken
+from catabot.config.scenario import Scenario
 from catabot.ros2.convert import Converter
+from catabot.run.advice import advise
 from catabot.run.service import Built, ServiceContext, run_service
 from catabot.world.orders import Orders, command_timeouts
 from services.recorder.batches import BatchFormatter, Block, without
@@ -42,13 +45,29 @@ log = logging.getLogger("recorder")
 FLUSH_EVERY_S = 0.1
 
 
+def _own_scenario(run_dir: Path, scenario: Scenario) -> None:
+    """The run folder's scenario.json is this run's: `catabot run` wrote it; a split run has
+    none, or the last run's in a folder used again (a compose file's fixed one). That one
+    was kept, so `catabot plot` drew this run's states against another's scenario, or
+    refused it; now it is replaced and the console told of the files left beside it."""
+    own, text = run_dir / "scenario.json", scenario.model_dump_json(indent=2) + "\n"
+    before = own.read_text() if own.is_file() else None
+    if before == text:
+        return
+    if before is not None:
+        left = len([p for p in run_dir.iterdir() if p.suffix in (".csv", ".mcap")])
+        advise(log, f"{run_dir} held another run's scenario.json: replaced with this run's; "
+                    f"the {left} CSV and MCAP files there are replaced as this run writes its "
+                    "own, and any of streams it does not have stay: give each run its own "
+                    "--run-dir")  # fmt: skip
+    own.write_text(text)
+
+
 class Recorder:
     def __init__(self, ctx: ServiceContext) -> None:
         rec = ctx.scenario.recording
         ctx.run_dir.mkdir(parents=True, exist_ok=True)
-        own = ctx.run_dir / "scenario.json"  # `catabot run` wrote it; a split run has none
-        if not own.exists():  # without it, `catabot plot`, `view` and `dataset` refuse the run
-            own.write_text(ctx.scenario.model_dump_json(indent=1) + "\n")
+        _own_scenario(ctx.run_dir, ctx.scenario)
         self.keys = ctx.keys
         world = ctx.world
         convert = Converter(world, ctx.scenario.ros)  # the gateway's topics and frames

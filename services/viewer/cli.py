@@ -150,6 +150,10 @@ def _replay(args: argparse.Namespace) -> rr.RecordingStream:
 def _serve(args: argparse.Namespace, rec: rr.RecordingStream) -> None:
     """The web viewer lives in this process, its data in `rec`'s server (which closes with
     `rec`): keep both up until Ctrl-C or SIGTERM."""
+    if args.save:  # what a --save wrote, and where (it said nothing: `catabot run` names it)
+        rec.flush()
+        size = Path(args.save).stat().st_size / 1e6 if Path(args.save).is_file() else 0.0
+        print(f"saved {args.save} ({size:.1f} MB): rerun {args.save}", flush=True)
     if not args.web or args.save or args.no_hold:
         return
     print("serving the web viewer until Ctrl-C", flush=True)
