@@ -1,5 +1,5 @@
 """Print a vessel's state as the simulation publishes it (an observer never blocks the clock),
-until the run ends or --count states are shown.
+until the run ends (or its conductor dies) or --count states are shown.
 
 catabot run --realtime 1 --listen tcp/127.0.0.1:7447 &
 python examples/watch_state.py --connect tcp/127.0.0.1:7447 --vessel ego --count 20
@@ -12,6 +12,7 @@ import zenoh
 from common import clear_errors, keys, parser, session
 
 from catabot.bus import codec
+from catabot.bus.clock import CONDUCTOR
 from catabot.bus.messages import End, VesselState
 
 
@@ -31,9 +32,14 @@ def main() -> None:
         got: queue.Queue[zenoh.Sample] = queue.Queue()  # the states and the run's end, in order
         s.declare_subscriber(k.vessel_state(args.vessel), got.put)
         s.declare_subscriber(k.end(), got.put)
+        gone = k.live(CONDUCTOR, "*")  # its token goes when it dies without an end
+        s.liveliness().declare_subscriber(gone, got.put)
         shown = 0
         for n in itertools.count():
             sample = got.get()
+            if sample.kind == zenoh.SampleKind.DELETE:
+                print("the conductor left without ending the run")
+                return
             if str(sample.key_expr) == k.end():
                 end = codec.decode(sample.payload.to_bytes(), End)
                 print(f"the run ended at tick {end.tick} ({end.reason})")
