@@ -29,6 +29,7 @@ from catabot.bus.members import Members, claim
 from catabot.bus.messages import Ack, End, Tick
 from catabot.bus.outputs import Outputs
 from catabot.bus.rejections import Rejected, Rejections
+from catabot.bus.session import alone
 from catabot.bus.settings import from_wire, settings_problem
 
 log = logging.getLogger("catabot.bus.participant")
@@ -67,9 +68,8 @@ class Participant(Outputs):
         claim(session, keys, name, self.roster)  # NameTaken: a second physics stops
         self.members = Members(keys, self.roster)
         self.rejections = Rejections(log, name)
-        self.peers = set(peers) - {name}
+        self.peers, self.drain_s = set(peers) - {name}, drain_s
         self._everyone = self.peers | {name}  # the peers a tick may name as dropped
-        self.drain_s = drain_s
         self.next_tick = 0
         self._acked = -1  # the last tick acked
         self._ended = False  # asked the conductor to end the run: no more steps
@@ -79,8 +79,7 @@ class Participant(Outputs):
         self._held_clock: list[Event] = []  # until the conductor's session is known
         self._waiting_since = time.monotonic()  # for the warning about a long wait
         self.events: queue.SimpleQueue[Event] = queue.SimpleQueue()
-        self.run_id = ""
-        self._orphaned_at = 0.0
+        self.run_id, self._orphaned_at = "", 0.0
         self._warned_tick, self._met = -1, False  # _met: every peer seen present once
         self._notes = 0  # "no tick yet" lines logged
         self._subs = [
@@ -191,8 +190,9 @@ class Participant(Outputs):
         waited = time.monotonic() - self._waiting_since  # said nothing, however long
         if waited > NOTE_EVERY_S * (self._notes + 1):
             self._notes += 1
-            log.warning("%s: no tick from the conductor of world %r after %.0f s (present: %s)",
-                        self.name, self.keys.world, waited, sorted(self.present))  # fmt: skip
+            log.warning("%s: no tick from the conductor of world %r after %.0f s (present: %s)%s",
+                        self.name, self.keys.world, waited, sorted(self.present),
+                        alone(self.session))  # fmt: skip
 
     def _tick_of(self, grant: Tick, k: int) -> Tick:
         stamp = grant.stamp_ns - (grant.tick - k) * grant.dt_ns

@@ -192,6 +192,15 @@ def open_session(conn: Connection) -> zenoh.Session:
         ) from None
 
 
+def alone(session: zenoh.Session) -> str:
+    """A note for a process that waits for others while its session reaches no other Zenoh
+    node (a peer told to --connect where nobody listens retries quietly forever), else ""."""
+    if list(session.info.routers_zid()) or list(session.info.peers_zid()):
+        return ""
+    return ("; this process reaches no other Zenoh node: is anything listening where it "
+            "connects? (to a router, give --mode client: it then fails at once)")  # fmt: skip
+
+
 def free_port() -> int:
     """A TCP port that is free on loopback now (the embedded conductor listens on it)."""
     with socket.socket(socket.AF_INET, socket.SOCK_STREAM) as s:

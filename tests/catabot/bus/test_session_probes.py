@@ -4,10 +4,19 @@ Zenoh itself would fail only inside every process, after all of them had started
 from __future__ import annotations
 
 import socket
+import time
 
 import pytest
 
-from catabot.bus.session import SessionError, check_listen, check_router
+from catabot.bus.session import (
+    Connection,
+    SessionError,
+    alone,
+    check_listen,
+    check_router,
+    free_port,
+    open_session,
+)
 
 
 def test_a_free_loopback_port_can_be_listened_on() -> None:
@@ -42,3 +51,22 @@ def test_other_protocols_are_left_to_zenoh_but_their_syntax_is_checked() -> None
     check_listen("udp/192.0.2.1:7447")
     with pytest.raises(SessionError, match="use proto/host:port"):
         check_router("garbage")
+
+
+def test_a_session_that_reaches_nobody_is_told_so_and_one_that_does_is_not() -> None:
+    """A peer told to --connect where nobody listens retries quietly forever: its "no tick
+    yet" lines now say that it reaches no other node."""
+    port = free_port()
+    lonely = open_session(Connection(connect=(f"tcp/127.0.0.1:{port}",)))
+    try:
+        assert "reaches no other Zenoh node" in alone(lonely)
+        other = open_session(Connection(listen=(f"tcp/127.0.0.1:{port}",)))
+        try:
+            deadline = time.monotonic() + 10.0
+            while alone(lonely) and time.monotonic() < deadline:
+                time.sleep(0.1)  # it connects on its next retry (at most 1 s apart)
+            assert alone(lonely) == ""
+        finally:
+            other.close()
+    finally:
+        lonely.close()
