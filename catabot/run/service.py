@@ -102,7 +102,10 @@ BuildFn = Callable[[ServiceContext], Built]
 def service_parser(name: str) -> argparse.ArgumentParser:
     parser = OneLineParser(prog=f"catabot service {name}")
     parser.add_argument("--scenario", help="scenario file (default: the bundled default)")
-    parser.add_argument("--run-dir", default=".", help="run folder for outputs")
+    parser.add_argument(
+        "--run-dir", help="run folder for outputs, the same for every service of a run "
+        "(default: runs/<the scenario's name>, as `catabot deploy compose` lays it out)",
+    )  # fmt: skip
     add_connection_args(parser)
     add_roster_args(parser)
     return parser
@@ -198,7 +201,8 @@ def run_service(
         log.critical("%s", exc)
         return 2
     try:
-        return _serve(ServiceContext(name, world, session, Path(args.run_dir), args.roster), build)
+        run_dir = Path(args.run_dir or Path("runs") / world.scenario.name)  # not the cwd
+        return _serve(ServiceContext(name, world, session, run_dir, args.roster), build)
     finally:
         session.close()
 

@@ -22,6 +22,7 @@ from catabot.config.vessel import BUNDLED_DIR as BUNDLED_VESSELS
 from catabot.config.vessel import bundled_vessel_names
 from catabot.run.cli import main
 from catabot.run.launcher import RunOptions, prepare
+from catabot.run.service import service_parser
 
 
 def _scenario(folder: Path, **vessel: Any) -> str:
@@ -190,3 +191,11 @@ def test_realtime_zero_undoes_a_files_pace_and_a_negative_one_is_refused(
     assert main(["run", str(path), "--realtime", "-1", "--out", str(tmp_path)]) == 2
     said = "catabot run: --realtime -1: a pace is 0 or more (1: the wall clock, 0: as fast as"
     assert said in capsys.readouterr().err  # it said "must be > 0", while 0 is taken
+
+
+def test_a_service_without_a_run_dir_records_under_runs_not_where_it_was_started() -> None:
+    """`catabot service recorder` without --run-dir wrote its CSVs and MCAP into the current
+    folder, whatever it was."""
+    args = service_parser("recorder").parse_args(["--scenario", "harbour"])
+    assert args.run_dir is None  # resolved against the scenario: runs/<its name>
+    assert "runs/<the scenario's name>" in service_parser("recorder").format_help()
