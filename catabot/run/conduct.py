@@ -131,7 +131,8 @@ def main(argv: list[str] | None = None) -> int:
     spec = clock_spec(scenario, args.start_timeout)
     try:
         conductor = Conductor(session, keys, spec, roster=args.roster, settings=schedule)
-    except NameTaken as exc:  # a second conductor of this world
+    except NameTaken as exc:  # a second conductor of this world: said on stderr too
+        log.critical("%s", exc)
         emit("result", ticks_done=0, wall_s=0.0, error=str(exc), dropped=[])
         session.close()
         return 2

@@ -191,7 +191,7 @@ def run_service(
     setup_logging()
     single_thread_blas()  # idle BLAS threads spin on the cores other services need
     keep_heap()  # reuse freed arrays instead of faulting fresh pages in every tick
-    signal.signal(signal.SIGTERM, lambda *_: sys.exit(143))
+    signal.signal(signal.SIGTERM, _stopped)
     try:
         batch_scheduling()  # before Zenoh starts its threads, so that they inherit it
         world = World.resolve(load_scenario(args.scenario))  # the same in every process
@@ -205,6 +205,12 @@ def run_service(
         return _serve(ServiceContext(name, world, session, run_dir, args.roster), build)
     finally:
         session.close()
+
+
+def _stopped(*_: object) -> None:
+    """SIGTERM: exit 143, saying so (a stopped service left only "left the run" behind)."""
+    log.warning("stopped by SIGTERM (exit 143)")
+    sys.exit(143)
 
 
 def with_switches(ctx: ServiceContext, runner: Runner, step: StepFn) -> StepFn:

@@ -82,9 +82,11 @@ def test_a_second_physics_or_conductor_stops_and_the_run_goes_on(tmp_path: Path)
         procs += [again, rival]
         _, err = again.communicate(timeout=60)
         assert again.returncode == 2 and "another process already runs as 'physics'" in err
-        refused = _result(rival)
+        out, err = rival.communicate(timeout=120)
+        refused = json.loads([x for x in out.splitlines() if '"result"' in x][-1])
         assert rival.returncode == 2, refused
-        assert "another process already runs as 'conductor' in world 'split'" in refused["error"]
+        said = "another process already runs as 'conductor' in world 'split'"
+        assert said in refused["error"] and said in err  # its log says so too, not only stdout
         recorder = _service("recorder", scenario, endpoint, "--run-dir", str(run))
         procs.append(recorder)
         result = _result(conductor)
