@@ -20,7 +20,6 @@ if [[ $# -gt 0 ]]; then
     echo "$usage" >&2; exit 2; }
   fault=${1#--}; victim=$2; after=$3
 fi
-mkdir -p "$out"
 repo_py="$(cd "$(dirname "$0")/.." && pwd)/.venv/bin/python"  # sudo's python3 has no catabot
 py=${PYTHON:-$([[ -x $repo_py ]] && echo "$repo_py" || command -v python3)}
 "$py" -c "import catabot" 2>/dev/null || {
@@ -47,9 +46,13 @@ done
 hosts=(router conductor "${services[@]}")
 [[ -z $victim || " ${services[*]} " == *" $victim "* ]] || {
   echo "no service $victim in this scenario (it runs: ${services[*]})" >&2; exit 2; }
+mkdir -p "$out"   # only once the arguments are good: a refused call leaves no folder
 
 ns() { echo "cb${1//./}$tag" | cut -c1-15; }   # namespace names: <= 15 characters
-cleanup() {
+pids() { for h in "$@"; do ip netns pids "$(ns "$h")" 2>/dev/null || true; done; }
+cleanup() {  # stopped early (Ctrl-C, SIGTERM): the conductor ends the run, files whole
+  pids conductor | xargs -r kill -TERM 2>/dev/null || true
+  for _ in $(seq 100); do [[ -z $(pids "${hosts[@]:1}") ]] && break; sleep 0.1; done
   for h in "${hosts[@]}"; do
     ip netns pids "$(ns "$h")" 2>/dev/null | xargs -r kill -9 2>/dev/null || true
     ip netns del "$(ns "$h")" 2>/dev/null || true
@@ -57,6 +60,7 @@ cleanup() {
   ip netns del "$sw" 2>/dev/null || true
 }
 trap cleanup EXIT
+trap 'exit 130' INT; trap 'exit 143' TERM   # either way through cleanup
 ip netns add "$sw"
 ip -n "$sw" link add "$bridge" type bridge
 ip -n "$sw" link set "$bridge" up

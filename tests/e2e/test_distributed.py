@@ -113,3 +113,13 @@ def test_a_recorder_cut_off_from_the_clock_still_closes_its_files(tmp_path: Path
     assert (run / "metrics.json").is_file()
     log = next(run.glob("**/recorder.log")).read_text()
     assert "the conductor disappeared without ending the run (its files end at tick" in log
+
+
+def test_a_fault_on_no_service_of_the_scenario_is_refused_leaving_no_folder(
+    tmp_path: Path,
+) -> None:
+    """`--cut conductor 4` was refused after the output folder was made."""
+    out = tmp_path / "out"
+    refused = hosts(scenario_file(tmp_path, basic_scenario("nope")), out, "--cut", "conductor", "4")
+    assert refused.returncode == 2 and "no service conductor in this scenario" in refused.stderr
+    assert not out.exists()
