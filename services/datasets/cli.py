@@ -1,4 +1,4 @@
-"""`catabot dataset export RUN_FOLDER --format yolo|coco|kitti -o OUT_DIR`.
+"""`catabot dataset export RUN_FOLDER --format yolo|coco|segmentation|kitti -o OUT_DIR`.
 
 Converts a recorded run after the fact: camera datasets from the run's `dataset/` (labelled
 frames), LiDAR scans from its `run.mcap`. `catabot run` calls the same program when the
