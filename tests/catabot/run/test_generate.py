@@ -24,3 +24,13 @@ def test_generated_scenario_is_valid_and_has_the_traffic(tmp_path: Path) -> None
 def test_an_unknown_behaviour_is_refused(capsys: pytest.CaptureFixture[str]) -> None:
     assert main(["scenario", "generate", "--mix", "zigzag=1"]) == 2
     assert "unknown behaviour 'zigzag'" in capsys.readouterr().err
+
+
+def test_the_bundled_bay_comes_with_the_harbours_heights_and_scale(tmp_path: Path) -> None:
+    """A PNG has no scale: the defaults (5 m a pixel) made a bay 2.5 times the harbour's."""
+    out = tmp_path / "bay.json"
+    argv = ["scenario", "generate", "--boats", "2", "--terrain", "bay.png", "-o", str(out)]
+    assert main(argv) == 0
+    terrain, harbour = load_scenario(out).terrain, load_scenario("harbour").terrain
+    assert terrain is not None and harbour is not None
+    assert terrain.model_dump() == harbour.model_dump()
