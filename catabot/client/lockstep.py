@@ -13,11 +13,13 @@ stream, applied by physics from tick k+1 on every run.
 from __future__ import annotations
 
 import contextlib
+import math
 import queue
 import threading
 from dataclasses import dataclass, field
 from typing import Any
 
+import numpy as np
 import zenoh
 
 from catabot.bus.clock import EndRun, end_reason_problem, ender_of
@@ -29,6 +31,7 @@ from catabot.client.commands import Command, Thrust, Twist, kind_of, message
 from catabot.client.errors import ClientError, CommandError, NoData, RunEnded
 from catabot.client.info import SensorInfo, VesselInfo, WorldInfo
 from catabot.client.watch import Watch
+from catabot.world import rotations
 
 END_GRACE_S = 7.0  # longer than a participant's drain after an End (5 s)
 _LEAVE = object()  # put on the command queue by close(): the step gives up its wait
@@ -51,6 +54,15 @@ class Observation:
     @property
     def time_s(self) -> float:
         return self.stamp_ns / 1e9
+
+    @property
+    def yaw_rad(self) -> float:
+        """The vessel's heading (ENU: 0 east, counter-clockwise) from its quaternion, the
+        one rule (catabot/world/rotations.py) every stack had written itself; NaN without
+        a vessel."""
+        if self.state is None:
+            return math.nan
+        return float(rotations.yaw_of_quaternions(np.array([self.state.orientation]))[0])
 
 
 class Joined:

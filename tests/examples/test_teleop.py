@@ -136,7 +136,7 @@ def test_a_person_drives_with_the_keys_and_takes_a_screenshot(
 ) -> None:
     endpoint = f"tcp/127.0.0.1:{free_port()}"
     run = subprocess.Popen(
-        [sys.executable, "-m", "catabot", "run", "examples/teleop.json", "--duration", "25",
+        [sys.executable, "-m", "catabot", "run", "examples/teleop.json", "--duration", "16",
          "--quiet", "--out", str(tmp_path / "runs"), "--listen", endpoint],
         stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, cwd=REPO,
     )  # fmt: skip
