@@ -15,7 +15,8 @@ LAYERS = {  # what each part of the library may import from the project, besides
     "catabot.config": {"catabot.errors", "catabot.bus"},
     "catabot.world": {"catabot.errors", "catabot.bus", "catabot.config"},
     "catabot.ros2": {"catabot.errors", "catabot.bus", "catabot.config", "catabot.world"},
-    "catabot.client": {"catabot.errors", "catabot.bus"},  # a stack needs no scenario file
+    # a stack needs no scenario file; rotations is pure quaternion math, the one rule of it
+    "catabot.client": {"catabot.errors", "catabot.bus", "catabot.world.rotations"},
     "catabot.run": {
         "catabot.errors",
         "catabot.bus",

@@ -31,7 +31,7 @@ from catabot.client.commands import Command, Thrust, Twist, kind_of, message
 from catabot.client.errors import ClientError, CommandError, NoData, RunEnded
 from catabot.client.info import SensorInfo, VesselInfo, WorldInfo
 from catabot.client.watch import Watch
-from catabot.world import rotations
+from catabot.world.rotations import yaw_of_quaternions
 
 END_GRACE_S = 7.0  # longer than a participant's drain after an End (5 s)
 _LEAVE = object()  # put on the command queue by close(): the step gives up its wait
@@ -62,7 +62,7 @@ class Observation:
         a vessel."""
         if self.state is None:
             return math.nan
-        return float(rotations.yaw_of_quaternions(np.array([self.state.orientation]))[0])
+        return float(yaw_of_quaternions(np.array([self.state.orientation]))[0])
 
 
 class Joined:
