@@ -107,6 +107,17 @@ def wrap(angle: Array) -> Array:
     return np.asarray((angle + np.pi) % (2 * np.pi) - np.pi)
 
 
+def on_slopes(q: Array, normal: Array) -> Array:
+    """Quaternions (N, 4) turned so that a body level under `q` has its z along `normal`
+    (N, 3, unit): a roll and pitch given on calm water become ones relative to a sloping
+    surface, the heading kept."""
+    axis = np.column_stack([-normal[:, 1], normal[:, 0], np.zeros(len(normal))])  # z x n
+    size = np.linalg.norm(axis, axis=1)
+    unit = axis / np.where(size > 0.0, size, 1.0)[:, None]
+    turn = matrices(from_rotvec(unit * np.arctan2(size, normal[:, 2])[:, None]))
+    return np.array([quaternion_of_matrix(m) for m in turn @ matrices(q)]).reshape(-1, 4)
+
+
 def turn_xy(xy: Array, yaw: Array) -> Array:
     """Horizontal vectors (N, 2) turned by headings (N,): body-frame x, y in map axes (a
     boat's velocity over ground from its surge and sway)."""

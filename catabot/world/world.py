@@ -219,8 +219,9 @@ class World:
     def start_states(self) -> BodyStates:
         """Every body at its start pose and velocity (tick -1, t = 0): what physics starts
         from (services/physics/setup.py), velocities in the body frame. In waves `z_m` is
-        above the surface at the body's point, and the body moves with the water there: one
-        set at z = 0 in a trough fell freely, one under a crest was thrown up at 1 g."""
+        above the surface at the body's point, roll and pitch are from its slope, and the
+        body moves with the water there: one set at z = 0 in a trough fell freely, one under
+        a crest was thrown up at 1 g, and a level WAM-V pitched at 12 rad/s^2."""
         n = len(self.bodies)
         p = np.array([(b.pose.x_m, b.pose.y_m, b.pose.z_m) for b in self.bodies]).reshape(n, 3)
         turns = [(b.pose.roll_rad, b.pose.pitch_rad, b.pose.yaw_rad) for b in self.bodies]
@@ -229,6 +230,7 @@ class World:
         if not self.scenario.water.waves.is_calm and n:
             sea = self.waves
             p[:, 2] += sea.height(p[:, 0], p[:, 1])
+            quat = rotations.on_slopes(quat, sea.normal(p[:, 0], p[:, 1]))
             water = sea.velocity(p[:, 0], p[:, 1], p[:, 2])  # map frame, at the surface
             linear += np.einsum("nji,nj->ni", rotations.matrices(quat), water)  # R^T: body frame
         angular = np.array([b.velocity.angular for b in self.bodies]).reshape(n, 3)
