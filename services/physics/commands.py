@@ -23,7 +23,7 @@ from numpy.typing import NDArray
 from catabot.bus.messages import Message, ThrustCmd, TwistBatch, TwistCmd, WaypointsCmd
 from catabot.config import live
 from catabot.config.scenario import Scenario, ScriptStep
-from catabot.run.advice import advise
+from catabot.run.advice import advise, tell
 from catabot.world.orders import Orders, command_timeouts, script_step
 from catabot.world.world import Body
 
@@ -116,8 +116,14 @@ class CommandBook:
         thruster, a finite twist: catabot/bus/checks.py). A lockstep twist (tick >= 0) is a
         set-point; an outside command (tick -1) takes the vessel over."""
         for msg in msgs:
+            held = vessel in self.book.held
             if self.book.heard(vessel, msg, stamp_ns=stamp_ns) and isinstance(msg, WaypointsCmd):
                 self.released.add(vessel)
+            if not held and vessel in self.book.held:  # whose stack drives it? say when
+                kind = "thrust" if isinstance(msg, ThrustCmd) else "twist"
+                tell(log, f"{vessel}: taken over by an outside {kind} at t = {stamp_ns / 1e9:g} "
+                          "s; it holds the vessel until a release (waypoints) or its "
+                          "command_timeout_s")  # fmt: skip
             if isinstance(msg, TwistCmd) and msg.tick >= 0:
                 self.set_point[self.row[vessel]] = (msg.surge, msg.yaw_rate)
                 self.has_set_point[self.row[vessel]] = True

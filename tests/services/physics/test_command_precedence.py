@@ -2,7 +2,12 @@
 
 from __future__ import annotations
 
+import logging
+
+import pytest
+
 from catabot.bus.messages import ThrustCmd, TwistCmd, WaypointsCmd
+from catabot.run.advice import advice_of
 from services.physics.commands import CommandBook, Order
 from tests.services.physics.helpers import vessels
 
@@ -43,3 +48,24 @@ def test_a_released_vessel_rests_until_its_script_says_otherwise() -> None:
     assert book.orders(10_000_000)[0] == {0: (0.0, 0.0), 1: (0.0, 0.0)}
     assert book.orders(20_000_000)[0] == {1: (0.0, 0.0)}  # plain: set once, then left
     assert book.orders(1_000_000_000)[0] == {1: (0.4, 0.4)}
+
+
+def test_a_takeover_from_outside_is_told_once_until_the_vessel_is_handed_back(
+    caplog: pytest.LogCaptureFixture,
+) -> None:
+    """A client on the run's endpoint (another stack, a forgotten teleop) steered a vessel
+    and nothing said so: only its recorded commands showed it afterwards."""
+    book = _book()
+    release = WaypointsCmd(points=(), speed=0.0, tolerance=0.0, mode="release")
+    with caplog.at_level(logging.INFO, logger="physics.commands"):
+        book.take("boat_000", [TwistCmd(5.0, 0.26, tick=3)], stamp_ns=30_000_000)  # lockstep
+        book.take("boat_000", [ThrustCmd((0.2, 0.2))], stamp_ns=1_230_000_000)
+        book.take("boat_000", [ThrustCmd((0.3, 0.3))], stamp_ns=1_240_000_000)  # still held
+        book.take("boat_000", [release, TwistCmd(1.0, 0.0)], stamp_ns=2_000_000_000)
+    told = [advice_of(f" INFO {r.getMessage()}") for r in caplog.records]
+    assert told == [
+        "boat_000: taken over by an outside thrust at t = 1.23 s; it holds the vessel until a "
+        "release (waypoints) or its command_timeout_s",
+        "boat_000: taken over by an outside twist at t = 2 s; it holds the vessel until a "
+        "release (waypoints) or its command_timeout_s",
+    ]
