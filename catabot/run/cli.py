@@ -242,7 +242,11 @@ def parser() -> argparse.ArgumentParser:
 
 def main(argv: list[str] | None = None) -> int:
     """Every command; Ctrl-C outside a run (which ends itself cleanly: supervisor.Stops)
-    is exit 130 without a traceback, and a closed terminal or pipe ends no command early."""
+    is exit 130 without a traceback, and a closed terminal or pipe ends no command early.
+    A service is left as it is: its stdout is its launcher's pipe, and a conductor ends the
+    run once nobody reads it (conduct.emit)."""
+    if (sys.argv[1:] if argv is None else argv)[:1] == ["service"]:
+        return _command(argv)
     with console.lasting():
         try:
             return _command(argv)

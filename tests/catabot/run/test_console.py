@@ -8,6 +8,7 @@ import sys
 
 import pytest
 
+from catabot.run import cli
 from catabot.run.cli import main
 from catabot.run.console import _Lasting
 
@@ -40,3 +41,12 @@ def test_a_reader_that_leaves_early_ends_no_command_with_an_error(
     said "catabot get: Broken pipe" and failed (exit 2)."""
     monkeypatch.setattr(sys, "stdout", _Closed())
     assert main(["scenario", "schema"]) == 0
+
+
+def test_a_service_keeps_its_own_stdout(monkeypatch: pytest.MonkeyPatch) -> None:
+    """A conductor ends its run once nobody reads its stdout (its launcher gone): a stream
+    that cannot fail would have kept it ticking, an orphan."""
+    seen: list[object] = []
+    monkeypatch.setattr(cli, "_command", lambda argv: seen.append(sys.stdout) or 0)
+    assert cli.main(["service", "conductor"]) == 0 and cli.main(["get"]) == 0
+    assert seen[0] is sys.stdout and isinstance(seen[1], _Lasting)
