@@ -8,8 +8,10 @@ errors into one line per problem naming the dotted field, the rule and the value
 
 from __future__ import annotations
 
+import difflib
 import json
 import math
+from collections.abc import Iterable
 from functools import cache, partial
 from pathlib import Path
 from types import UnionType
@@ -54,6 +56,12 @@ BuoyId = Annotated[str, AfterValidator(partial(check_name, "buoy"))]
 SensorName = Annotated[str, AfterValidator(partial(check_name, "sensor"))]
 ParticipantName = Annotated[str, AfterValidator(partial(check_name, "participant"))]
 """Names that become one chunk of a key expression (and part of file names)."""
+
+
+def did_you_mean(word: str, choices: Iterable[str]) -> str:
+    """ "did you mean 'x'?" for the choice a typo is nearest, or "" when none is near."""
+    near = difflib.get_close_matches(word, list(choices), n=1)
+    return f"did you mean {near[0]!r}?" if near else ""
 
 
 def unique(items: list[Any], *, attr: str, what: str) -> list[Any]:

@@ -12,7 +12,6 @@ reach every service as the same bytes.
 
 from __future__ import annotations
 
-import difflib
 import json
 import math
 from collections.abc import Mapping
@@ -23,7 +22,7 @@ from pydantic import BaseModel, Field, JsonValue, ValidationError
 
 from catabot.bus.clock import NS_PER_S
 from catabot.bus.settings import Change
-from catabot.config.base import ConfigError, FieldProblem, Strict, describe
+from catabot.config.base import ConfigError, FieldProblem, Strict, describe, did_you_mean
 from catabot.config.environment import CurrentConfig, RainConfig, WindConfig
 from catabot.config.sensors import CameraOutputs
 from catabot.config.traffic import BEHAVIOURS, Behaviour
@@ -109,10 +108,8 @@ def spec_of(scenario: Scenario, key: str) -> Spec:
     spec = keys_of(scenario).get(key) if isinstance(key, str) else None
     if spec is None:
         shown = repr(key) if len(repr(key)) <= 80 else repr(key)[:77] + "..."
-        near = (
-            difflib.get_close_matches(key, keys_of(scenario), n=1) if isinstance(key, str) else []
-        )
-        hint = f" (did you mean {near[0]!r}?)" if near else ""
+        near = did_you_mean(key, keys_of(scenario)) if isinstance(key, str) else ""
+        hint = f" ({near})" if near else ""
         raise SettingError(
             f"unknown setting {shown}{hint}; this run's settings: {allowed_keys(scenario)}"
         )

@@ -7,7 +7,6 @@ original simulator's `SettingsConfig.json` format are mapped by `settings_config
 
 from __future__ import annotations
 
-import difflib
 import hashlib
 import json
 import os
@@ -16,7 +15,7 @@ from typing import Any
 
 from pydantic import ValidationError
 
-from catabot.config.base import ScenarioError, explain, read_json
+from catabot.config.base import ScenarioError, did_you_mean, explain, read_json
 from catabot.config.rates import check_rates
 from catabot.config.scenario import Scenario
 from catabot.config.sensors import SENSOR_TYPES
@@ -67,9 +66,14 @@ def _bundled_hint(path: str | Path | None) -> str:
     if path is None or "/" in str(path) or str(path).endswith(".json"):
         return ""
     names = sorted(p.stem for p in BUNDLED.glob("*.json"))
-    near = difflib.get_close_matches(str(path), names, n=1)
-    ask = f"did you mean {near[0]!r}? " if near else ""
-    return f" ({ask}bundled scenarios: {', '.join(names)})"
+    ask = did_you_mean(str(path), names)
+    return f" ({ask + ' ' if ask else ''}bundled scenarios: {', '.join(names)})"
+
+
+def scenario_json(scenario: Scenario) -> str:
+    """A run folder's scenario.json text: `catabot run` writes it, the recorder compares a
+    folder's with it, and the applied settings are written back in it (one format)."""
+    return scenario.model_dump_json(indent=2) + "\n"
 
 
 def absolute_paths(data: Any, base: Path) -> Any:

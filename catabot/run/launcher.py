@@ -18,7 +18,7 @@ from catabot.bus.identity import Roster, new_zid
 from catabot.bus.scheduling import requested_policy
 from catabot.bus.session import check_listen, check_router, free_port
 from catabot.config.base import ScenarioError
-from catabot.config.load import load_scenario, parse_scenario
+from catabot.config.load import load_scenario, parse_scenario, scenario_json
 from catabot.config.scenario import Scenario
 from catabot.config.sensors import service_of
 from catabot.errors import CataBotError
@@ -130,7 +130,7 @@ def make_run_dir(out: Path, scenario: Scenario) -> Path:
             n += 1
             run_dir = Path(f"{base}-{n}")
     (run_dir / "log").mkdir()
-    (run_dir / "scenario.json").write_text(scenario.model_dump_json(indent=2) + "\n")
+    (run_dir / "scenario.json").write_text(scenario_json(scenario))
     return run_dir
 
 
@@ -292,6 +292,6 @@ def record_settings(scenario: Scenario, run_dir: Path, applied: object) -> None:
     data = scenario.model_dump(mode="json") | {"settings": applied}
     try:
         resolved = parse_scenario(data, source="the run's settings")
-        (run_dir / "scenario.json").write_text(resolved.model_dump_json(indent=2) + "\n")
+        (run_dir / "scenario.json").write_text(scenario_json(resolved))
     except (CataBotError, OSError) as exc:
         print(f"catabot run: the settings timeline was not recorded: {exc}", file=sys.stderr)

@@ -114,8 +114,21 @@ def on_slopes(q: Array, normal: Array) -> Array:
     axis = np.column_stack([-normal[:, 1], normal[:, 0], np.zeros(len(normal))])  # z x n
     size = np.linalg.norm(axis, axis=1)
     unit = axis / np.where(size > 0.0, size, 1.0)[:, None]
-    turn = matrices(from_rotvec(unit * np.arctan2(size, normal[:, 2])[:, None]))
-    return np.array([quaternion_of_matrix(m) for m in turn @ matrices(q)]).reshape(-1, 4)
+    return product(from_rotvec(unit * np.arctan2(size, normal[:, 2])[:, None]), q)
+
+
+def product(a: Array, b: Array) -> Array:
+    """Hamilton products a b of quaternions (N, 4): b's turn, then a's; w >= 0 (the sign
+    `quaternion_of_matrix` gives)."""
+    ax, ay, az, aw = a.T
+    bx, by, bz, bw = b.T
+    out = np.column_stack([
+        aw * bx + ax * bw + ay * bz - az * by,
+        aw * by - ax * bz + ay * bw + az * bx,
+        aw * bz + ax * by - ay * bx + az * bw,
+        aw * bw - ax * bx - ay * by - az * bz,
+    ])  # fmt: skip
+    return np.where(out[:, 3:] < 0.0, -out, out)
 
 
 def turn_xy(xy: Array, yaw: Array) -> Array:

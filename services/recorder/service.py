@@ -29,6 +29,7 @@ from catabot.bus.messages import (
 )
 from catabot.bus.settings import changes_of
 from catabot.bus.taken import taken
+from catabot.config.load import scenario_json
 from catabot.config.scenario import Scenario
 from catabot.ros2.convert import Converter
 from catabot.run.advice import advise
@@ -50,7 +51,7 @@ def _own_scenario(run_dir: Path, scenario: Scenario) -> None:
     none, or the last run's in a folder used again (a compose file's fixed one). That one
     was kept, so `catabot plot` drew this run's states against another's scenario, or
     refused it; now it is replaced and the console told of the files left beside it."""
-    own, text = run_dir / "scenario.json", scenario.model_dump_json(indent=2) + "\n"
+    own, text = run_dir / "scenario.json", scenario_json(scenario)
     before = own.read_text() if own.is_file() else None
     if before == text:
         return

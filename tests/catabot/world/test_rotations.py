@@ -34,3 +34,11 @@ def test_vertical_is_the_map_up_row_of_the_rotation() -> None:
     v = rng.normal(size=(20, 3))
     expected = np.einsum("nj,nj->n", rotations.matrices(q)[:, 2, :], v)
     assert np.allclose(rotations.vertical(q, v), expected, atol=1e-12)
+
+
+def test_a_product_turns_as_its_matrices_do() -> None:
+    rng = np.random.default_rng(6)
+    a, b = (q / np.linalg.norm(q, axis=1, keepdims=True) for q in rng.normal(size=(2, 30, 4)))
+    turned = rotations.product(a, b)
+    assert np.allclose(rotations.matrices(turned), rotations.matrices(a) @ rotations.matrices(b))
+    assert (turned[:, 3] >= 0).all()
