@@ -162,6 +162,7 @@ class RunResult:
     dropped: list[str] = field(default_factory=list)
     reason: str = "completed"
     join_s: float = 0.0
+    why_dropped: dict[str, str] = field(default_factory=dict)  # name: the fault (policy drop)
 
 
 @dataclass(frozen=True)
@@ -204,6 +205,27 @@ class ClockLimits:
         if tick.tick >= next_tick + self.window:  # nobody may run a window ahead of us
             return f"grant {tick.tick} is past the window ({next_tick} + {self.window})"
         return ""
+
+
+class Drops:
+    """From which tick each dropped participant counts as dropped: the same tick on every
+    participant. Why: a grant that names a newly dropped participant may reach a participant
+    that still has ticks of the previous grant to step, and what a step does about the drop
+    (physics hands the vessels the dropped stack drove back to their scripts, the recorder
+    writes it) must happen at one tick everywhere. Nobody can have stepped past the last
+    grant that did not name it (grants arrive in order), so it counts from the tick after."""
+
+    def __init__(self) -> None:
+        self.since: dict[str, int] = {}
+
+    def heard(self, dropped: tuple[str, ...], *, granted: int) -> tuple[str, ...]:
+        """A grant's dropped list, heard while `granted` was the last tick granted."""
+        for name in dropped:
+            self.since.setdefault(name, granted + 1)
+        return dropped
+
+    def at(self, tick: int) -> tuple[str, ...]:
+        return tuple(name for name, since in self.since.items() if since <= tick)
 
 
 class WorldMismatch(CataBotError):

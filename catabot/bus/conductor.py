@@ -60,7 +60,7 @@ class Conductor:
         claim(session, keys, CONDUCTOR, roster)  # NameTaken: a second conductor stops
         self._members = Members(keys, roster)
         self.rejections = Rejections(log, CONDUCTOR)
-        self.dropped: list[str] = []
+        self.dropped: dict[str, str] = {}  # name: why (policy drop)
         self._stop_reason = ""
         self._end_at: int | None = None  # the last tick, when a participant ended the run
         self._told = ""  # the fault a participant told (Ack.fault): the run's error
@@ -121,8 +121,8 @@ class Conductor:
         done = self._done  # complete ticks, also when a fault or a stop cut the run short
         reason = self._stop_reason or ("completed" if not error else "fault")
         self._out.publish(self.keys.end(), End(self.run_id, done - 1, reason, error))
-        wall = time.monotonic() - start
-        return RunResult(done, wall, error, list(self.dropped), reason, joined - self._created)
+        wall, dropped = time.monotonic() - start, self.dropped
+        return RunResult(done, wall, error, [*dropped], reason, joined - self._created, dropped)
 
     def _await_members(self) -> None:
         expected = set(self.spec.participants)
@@ -149,13 +149,13 @@ class Conductor:
         After a stop no more ticks are granted, but every granted tick completes, so every
         participant ends on the same last tick.
         """
-        last_report = self._t0 = start
+        last_report, self._t0 = start - 1.0, start  # the first at once: the clock started
         self._deadline = None
         while self._done < self.spec.ticks and not self._stop_reason:
             self._grant(self._horizon())
             self._await_progress()
             now = time.monotonic()
-            if on_progress and now - last_report >= 0.25:
+            if on_progress and self._done and now - last_report >= 0.25:
                 on_progress(self._progress(self._done - 1, now - start))
                 last_report = now
         while self._done <= (self._granted if self._end_at is None else self._end_at):
@@ -321,7 +321,7 @@ class Conductor:
         if self.spec.policy is Policy.ABORT:
             raise ClockError(message)
         log.error("%s; dropping it and going on (policy drop)", message)
-        self.dropped.append(name)
+        self.dropped[name] = message
         self._advance()
         self._grant(self._horizon(), again=True)  # tell the others to stop waiting for it
 

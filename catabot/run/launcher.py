@@ -233,7 +233,8 @@ def _start(
             program=True,
             env=programs.environment(run_dir),
         )
-    return Supervisor(conductor, services, stops), viewer
+    goes_on = world.scenario.clock.policy == "drop"
+    return Supervisor(conductor, services, stops, goes_on=goes_on), viewer
 
 
 def _viewer(opts: RunOptions, run_dir: Path, svc_flags: list[str]) -> Viewer | None:
@@ -266,6 +267,8 @@ def _watch(scenario: Scenario, run_dir: Path, supervisor: Supervisor, *, quiet: 
     supervisor.wait(bar.update, bar.note)
     bar.close()
     result, cause = dict(supervisor.result), supervisor.cause()
+    if supervisor.dropped():  # with a program's own words (a result may be absent)
+        result["why_dropped"] = supervisor.dropped()
     if cause:
         result["error"] = cause
     record_settings(scenario, run_dir, result.get("settings"))

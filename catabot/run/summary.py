@@ -98,7 +98,8 @@ def summarise(
     unjoined: set[str] = set()  # an interrupted start: stopped while still starting, or
     if interrupted and not ticks:  # ended on seeing the stopped conductor go first
         unjoined = set(stopped) | {n for n, c in service_codes.items() if c == EXIT_CLOCK}
-    spared = unjoined | set(lingered)  # stopped by catabot run, not failed
+    dropped = dict(result.get("why_dropped") or {})  # type: ignore[call-overload]
+    spared = unjoined | set(lingered) | set(dropped)  # stopped, or gone on without: not failed
     failed = {n: c for n, c in service_codes.items() if c not in (0, None) and n not in spared}
     if not result:
         error = error or f"the conductor ended without a result ({describe_exit(conductor_code)})"
@@ -114,6 +115,7 @@ def summarise(
         "cpu_s": read_usage(run_dir, service_codes, "cpu_s"),
         **_memory(run_dir, service_codes, result),
         "rejected": _rejected(run_dir, service_codes, result),
+        "dropped": dropped,
     }
     try:
         (run_dir / "log" / "run.json").write_text(json.dumps(record, indent=2) + "\n")
@@ -131,6 +133,9 @@ def summarise(
         print(f"  {name}: {_last_line(run_dir, name)}")  # what it wrote, as the CLI says it
     for name in sorted(unjoined):
         print(f"  {name}: stopped by catabot run before it joined", file=sys.stderr)
+    for name, why in dropped.items():
+        print(f"  {name}: dropped, the run went on without it (clock.policy drop): {why}",
+              file=sys.stderr)  # fmt: skip
     for name in sorted(lingered):
         print(
             f"  {name}: still running {PROGRAM_REAP_S:g} s after the run ended, so stopped "

@@ -72,8 +72,13 @@ class Stops:
 class Supervisor:
     """Follows the conductor's lines, watches every process, ends hung ones, finds the cause."""
 
-    def __init__(self, conductor: Child, services: dict[str, Child], stops: Stops) -> None:
+    def __init__(
+        self, conductor: Child, services: dict[str, Child], stops: Stops, *, goes_on: bool = False
+    ) -> None:
+        """`goes_on`: the scenario's clock.policy is drop, so a process that dies once the
+        clock has started is the conductor's to drop, and the run goes on without it."""
         self.conductor, self.services, self.stops = conductor, services, stops
+        self.goes_on = goes_on
         self.result: dict[str, object] = {}
         self.progress: dict[str, object] = {}
         self.stopped: set[str] = set()  # services stopped before they joined an interrupted run
@@ -99,8 +104,9 @@ class Supervisor:
             if died and not asked_to_stop and self.conductor.proc.poll() is None:
                 for child in died:
                     child.crashed()
-                self.conductor.proc.send_signal(signal.SIGTERM)
-                asked_to_stop = True
+                if not (self.goes_on and self._ticking):
+                    self.conductor.proc.send_signal(signal.SIGTERM)
+                    asked_to_stop = True
             silent = self._silent()
             if silent and self.conductor.proc.poll() is None:
                 self._kill(self.conductor, f"the conductor hung (nothing from it for {silent:g} s)")
@@ -207,13 +213,24 @@ class Supervisor:
 
     def cause(self) -> str:
         """The first fault: a process's own fatal error, a hung process, else the conductor's."""
-        fatal = [c for c in (self.conductor, *self.services.values()) if c.fatal]
+        gone_on = self.dropped()  # the run went on without them: their faults end nothing
+        fatal = [c for c in (self.conductor, *self.services.values())
+                 if c.fatal and c.name not in gone_on]  # fmt: skip
         if fatal:
             first = min(fatal, key=lambda c: c.fatal_at)
             return f"{first.name}: {first.fatal}"
         if self.hung:
             return self.hung[0]
         return self._waited(str(self.result.get("error", "") or ""))
+
+    def dropped(self) -> dict[str, str]:
+        """Participants the conductor dropped (clock.policy drop), each with why: the
+        conductor's words, and a program's own last words when it died."""
+        why = dict(self.result.get("why_dropped") or {})  # type: ignore[call-overload]
+        for name, child in self.services.items():
+            if name in why and child.fatal:
+                why[name] = f"{why[name]}; {child.fatal}"
+        return why
 
     def _waited(self, error: str) -> str:
         """The conductor's fault, and whose data the participant it names waited for."""

@@ -49,6 +49,14 @@ class Orders:
             return False
         return True
 
+    def drop(self, vessel: str) -> None:
+        """Its controller left the run and the run goes on without it (clock.policy drop):
+        its last lockstep command or set-point no longer holds it (a crashed stack's boat
+        sailed on at its last speed to the end); an outside command still does."""
+        self.steered.pop(vessel, None)
+        if vessel in self.held and self.held[vessel].tick >= 0:
+            del self.held[vessel]
+
     def expire(self, stamp_ns: int) -> list[str]:
         """At the tick stamped `stamp_ns`, after its commands were heard: hand back every
         vessel whose outside command (tick -1; a lockstep one is renewed by the clock) is

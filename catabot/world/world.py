@@ -13,6 +13,7 @@ the traffic plan's waypoint buoys). A body's label instance is its row + 1 (0: n
 
 from __future__ import annotations
 
+from collections.abc import Collection
 from dataclasses import dataclass, field
 from functools import cached_property
 from typing import Any, Literal
@@ -185,6 +186,15 @@ class World:
             return {}
         names = shard_names("traffic", self.scenario.traffic.shards)
         return dict(zip(names, blocks(self.boat_ids, len(names)), strict=True))
+
+    def driven_by(self, participants: Collection[str]) -> list[str]:
+        """The vessels these participants command, in row order (a controller's vessel, a
+        traffic shard's boats): what their drop hands back (clock.policy drop)."""
+        boats = {b for name in participants for b in self.traffic_blocks.get(name, ())}
+        boats |= {
+            v.id for v in self.vessels if v.controller and v.controller.participant in participants
+        }
+        return [v.id for v in self.vessels if v.id in boats]
 
     @cached_property
     def streams(self) -> Streams:

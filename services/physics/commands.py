@@ -93,6 +93,18 @@ class CommandBook:
         rows = np.flatnonzero(follow)
         return thrust, rows, target[rows]
 
+    def drop(self, participant: str, vessels: Sequence[str], stamp_ns: int) -> None:
+        """`participant` left the run, which goes on without it (clock.policy drop): the
+        vessels it drove no longer hold its last command or set-point (a crashed stack's boat
+        sailed on to the end, and only conductor.log said why), back to script or rest."""
+        for vessel in vessels:
+            self.book.drop(vessel)
+            self.has_set_point[self.row[vessel]] = False
+            self.released.add(vessel)
+        if vessels:
+            tell(log, f"{participant} left the run at t = {stamp_ns / 1e9:g} s (clock.policy "
+                      f"drop): {some(vessels)} back to script (rest without one)")  # fmt: skip
+
     def take_batch(self, batch: TwistBatch, expected: tuple[str, ...]) -> None:
         """The traffic service's set-points (rows and shapes checked on arrival): every boat
         with finite values adopts its own, the others keep their previous order."""
@@ -116,10 +128,11 @@ class CommandBook:
         thruster, a finite twist: catabot/bus/checks.py). A lockstep twist (tick >= 0) is a
         set-point; an outside command (tick -1) takes the vessel over."""
         for msg in msgs:
-            held = vessel in self.book.held
+            was = self.book.held.get(vessel)
             if self.book.heard(vessel, msg, stamp_ns=stamp_ns) and isinstance(msg, WaypointsCmd):
                 self.released.add(vessel)
-            if not held and vessel in self.book.held:  # whose stack drives it? say when
+            now = self.book.held.get(vessel)
+            if _outside(now) and not _outside(was):  # another stack drives it: say when
                 kind = "thrust" if isinstance(msg, ThrustCmd) else "twist"
                 tell(log, f"{vessel}: taken over by an outside {kind} at t = {stamp_ns / 1e9:g} "
                           "s; it holds the vessel until a release (waypoints) or its "
@@ -161,3 +174,14 @@ def _from_step(step: ScriptStep) -> Order:
         return Order(thrust=tuple(step.thrust))
     assert step.twist is not None
     return Order(twist=(step.twist.surge_mps, step.twist.yaw_rate_radps))
+
+
+def some(ids: Sequence[str], shown: int = 5) -> str:
+    """A list of ids short enough for one console line."""
+    more = f" and {len(ids) - shown} more" if len(ids) > shown else ""
+    return ", ".join(ids[:shown]) + more
+
+
+def _outside(held: Message | None) -> bool:
+    """An outside command (tick -1), not the vessel's own lockstep thrust controller's."""
+    return held is not None and getattr(held, "tick", 0) < 0

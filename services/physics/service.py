@@ -22,7 +22,7 @@ from catabot.run.advice import advise
 from catabot.run.service import Built, ServiceContext, run_service
 from catabot.world.sea_change import SeaChange
 from services.physics import settings
-from services.physics.commands import CommandBook, never_applied
+from services.physics.commands import CommandBook, never_applied, some
 from services.physics.control import TwistControllerBank
 from services.physics.reach import Reach
 from services.physics.setup import build_world
@@ -48,6 +48,7 @@ class PhysicsService:
             [v.model for v in world.vessels], dt_s=self.dt_ns / 1e9
         )
         self.book = CommandBook(world.vessels)
+        self.driven_by, self.dropped = world.driven_by, set[str]()  # clock.policy drop
         self.reach = Reach(world.vessels, self.controllers.single)  # says a twist is too much
         for text in never_applied(world.vessels, world.scenario):
             advise(log, text)
@@ -71,12 +72,15 @@ class PhysicsService:
         """Why a command key physics does not take is none: no such vessel, or command."""
         _, vessel, _, command = self.keys.relative(key).split("/")
         if vessel not in self.book.row:
-            return f"no vessel {vessel!r} in this world ({_some(self.book.ids)})"
+            return f"no vessel {vessel!r} in this world (its vessels: {some(self.book.ids)})"
         return f"no command {command!r} (a vessel takes thrust, twist, waypoints)"
 
     def step(self, tick: Tick, inputs: Inputs) -> None:
         changes = changes_of(tick.settings)
         settings.take(self.world, self.scenario, self.specs, changes, tick=tick.tick, sea=self.sea)
+        for name in (n for n in tick.dropped if n not in self.dropped):  # the same tick as the
+            self.dropped.add(name)  # recorder's (clock.Drops)
+            self.book.drop(name, self.driven_by([name]), tick.stamp_ns)
         taken: list[str] = []  # free commands (tick -1), for the recorder (taken.py)
         for key, msgs in inputs.items():
             if key in self.blocks:
@@ -124,11 +128,6 @@ class PhysicsService:
         for i in self.participant.watched_among(self.state_keys):
             row = (tuple(getattr(v, f)[i].tolist()) for f in FIELDS)
             self.participant.publish(self.state_keys[i], VesselState(tick.tick, stamp, *row))
-
-
-def _some(ids: tuple[str, ...], shown: int = 5) -> str:
-    head = ", ".join(ids[:shown])
-    return f"its vessels: {head}" + (f" and {len(ids) - shown} more" if len(ids) > shown else "")
 
 
 def build(ctx: ServiceContext) -> Built:

@@ -51,6 +51,7 @@ class Metrics:
         self.last: np.ndarray | None = None
         self.stamp_ns = 0
         self.skipped = 0  # state batches with a non-finite position, left out
+        self.dropped: dict[str, float] = {}  # participant: from when (s), clock.policy drop
         self.offset, self.half = footprints([b.model for b in world.bodies])
         self.reach = np.hypot(*self.offset.T) + np.hypot(*self.half.T)  # the box within it
         self.nearest = {kind: _Nearest(s) for kind in ("vessel", "buoy", "shore")}

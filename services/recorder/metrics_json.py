@@ -21,8 +21,9 @@ if TYPE_CHECKING:
 
 def write_metrics(m: Metrics, path: Path, *, end_reason: str = "") -> None:
     """`end_reason`: how the run ended (`completed`, `interrupted`, a fault, `ended by ...`),
-    so the file alone says whether its figures cover the whole run."""
-    data = record(m) | {"end_reason": end_reason}
+    so the file alone says whether its figures cover the whole run; `dropped`, only when a
+    participant was (clock.policy drop): from when the run went on without it."""
+    data = record(m) | {"end_reason": end_reason} | ({"dropped": m.dropped} if m.dropped else {})
     path.write_text(json.dumps(data, indent=2, sort_keys=True) + "\n")
 
 

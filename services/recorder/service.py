@@ -17,6 +17,7 @@ from collections.abc import Callable
 from pathlib import Path
 from typing import Any
 
+from catabot.bus.clock import NS_PER_S
 from catabot.bus.inbox import Inputs
 from catabot.bus.messages import (
     BodyStates,
@@ -84,6 +85,7 @@ class Recorder:
         self.free_kinds = {self.keys.relative(s.key): s.message for s in free}
         self.batches = BatchFormatter(convert)
         self.orders = Orders(command_timeouts(world.vessels))  # physics' rule: written, metered
+        self.driven_by = world.driven_by  # the vessels a dropped participant drove
         k = self.keys
         self.commanded = {
             key(v.id): v.id
@@ -148,6 +150,7 @@ class Recorder:
         """The free commands physics took at the start of the batch's tick k: written as
         heard before tick k (k - 1, stamped k dt), the order physics follows from k on."""
         at = dataclasses.replace(tick, tick=batch.tick, stamp_ns=batch.stamp_ns - self.dt_ns)
+        self._drops(at)
         for text in batch.commands:
             try:
                 key, msg = taken(text, self.free_kinds)
@@ -158,6 +161,18 @@ class Recorder:
             self._heard(f"{self.keys.prefix}/{key}", msg, at)
         for vessel in self.orders.expire(at.stamp_ns):  # as physics, after that tick's takes
             self._resume(vessel, at)
+
+    def _drops(self, at: Tick) -> None:
+        """Participants dropped from this batch's tick on (clock.policy drop): physics handed
+        the vessels they drove back at that tick (participant.drops, the same tick on every
+        participant), so their script's step, or rest, is written as a command from there."""
+        since = self.participant.drops.since
+        dropped = self.metrics.dropped
+        for name in sorted(n for n in since if since[n] <= at.tick and n not in dropped):
+            dropped[name] = at.stamp_ns / NS_PER_S
+            for vessel in self.driven_by([name]):
+                self.orders.drop(vessel)
+                self._resume(vessel, at)
 
     def _heard(self, key: str, msg: Message, tick: Tick) -> None:
         """A command for a vessel: the order physics follows from now on, so an overridden

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import json
+import re
 from pathlib import Path
 from typing import Any
 
@@ -100,3 +101,31 @@ def test_a_program_still_running_after_the_run_is_stopped_not_failed(tmp_path: P
     assert "stack: still running 5 s after the run ended, so stopped" in said
     record = json.loads((run / "log" / "run.json").read_text())
     assert record["error"] == "" and record["reason"] == "completed"
+
+
+def test_under_policy_drop_a_crashed_programs_vessel_is_handed_back(tmp_path: Path) -> None:
+    """Under `clock.policy: drop` a crashed stack's boat sailed on at its last thrust to the
+    end, and only conductor.log said anything: the recording read as if the stack had
+    steered it. Now physics and the recorder hand it back (rest without a script) at one
+    tick, the console says so, and run.json and metrics.json name the participant."""
+    scenario = _scenario(tmp_path, "--crash-at", "120", clock={"policy": "drop"})
+    code, said, run = _run(tmp_path, scenario, "drop")
+    assert code == 0 and run is not None, said
+    told = re.search(r"stack left the run at t = ([\d.]+) s \(clock.policy drop\): ego back", said)
+    assert told is not None, said
+    since_s = float(told[1])  # the first tick no participant had been granted at the drop
+    assert 1.2 <= since_s < 2.0
+    assert "stack: dropped, the run went on without it" in said and "ZeroDivisionError" in said
+    assert "taken over" not in said  # its own lockstep thrust was never an outsider's
+    assert json.loads((run / "metrics.json").read_text())["dropped"] == {"stack": since_s}
+    assert (
+        "ZeroDivisionError"
+        in json.loads((run / "log" / "run.json").read_text())["dropped"]["stack"]
+    )
+    rows = csv_rows(run / "vessel.ego.cmd.thrust.csv")
+    stamp, *values = rows[-1][0], *rows[-1][2:]
+    assert int(stamp) == round(since_s * 1e9) and [float(v) for v in values] == [0.0, 0.0]
+    states = csv_rows(run / "vessel.ego.state.csv")
+    surge = states[0].index("linear_velocity_x[m/s]")
+    at_drop, last = (float(states[round(since_s * 100)][surge]), float(states[-1][surge]))
+    assert int(states[-1][1]) == 299 and last < 0.7 * at_drop, (at_drop, last)

@@ -6,7 +6,7 @@ import pytest
 
 from catabot.bus import checks, codec
 from catabot.bus import inbox as inbox_module
-from catabot.bus.clock import ClockError, Policy, Stream, period_in_ticks, ticks_for
+from catabot.bus.clock import ClockError, Drops, Policy, Stream, period_in_ticks, ticks_for
 from catabot.bus.identity import Roster
 from catabot.bus.inbox import Inbox
 from catabot.bus.keys import Keys
@@ -244,6 +244,18 @@ def test_dropped_producers_are_not_waited_for() -> None:
     assert inbox.missing(1) == [STATE]
     inbox.drop_producers(("physics",))
     assert inbox.missing(100) == []
+
+
+def test_a_drop_counts_from_the_first_tick_nobody_was_granted_when_it_was_heard() -> None:
+    """Every participant hears the grants in one order, so each finds the same tick, however
+    far it has stepped (physics and the recorder hand a dropped stack's vessel back there)."""
+    drops = Drops()
+    assert drops.heard((), granted=40) == () and drops.at(1000) == ()
+    assert drops.heard(("stack",), granted=52) == ("stack",)
+    drops.heard(("stack", "radar"), granted=60)  # a later grant: stack's tick is kept
+    assert (drops.at(52), drops.at(53), drops.at(60), drops.at(61)) == (
+        (), ("stack",), ("stack",), ("stack", "radar"),
+    )  # fmt: skip
 
 
 def test_malformed_payloads_raise_and_leave_the_inbox_unchanged() -> None:

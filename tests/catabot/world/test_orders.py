@@ -53,3 +53,15 @@ def test_a_stale_outside_command_expires_and_a_renewed_or_lockstep_one_does_not(
     assert orders.in_force("other") is not None  # held until a release
     orders.heard("ego", ThrustCmd((0.5, 0.5), tick=3), stamp_ns=2_000_000_000)  # lockstep
     assert orders.expire(9_000_000_000) == []
+
+
+def test_a_dropped_controller_no_longer_holds_its_vessel_but_an_outside_command_does() -> None:
+    """clock.policy drop: a crashed stack's last command held its boat to the end."""
+    orders = Orders()
+    orders.heard("thrust", ThrustCmd((0.6, 0.6), tick=7), stamp_ns=0)  # lockstep thrust
+    orders.heard("twist", TwistCmd(1.0, 0.0, 7, 70_000_000), stamp_ns=0)  # a set-point
+    orders.heard("outside", ThrustCmd((0.2, 0.2)), stamp_ns=0)  # tick -1
+    for vessel in ("thrust", "twist", "outside"):
+        orders.drop(vessel)
+    assert orders.follows_script("thrust") and orders.follows_script("twist")
+    assert orders.in_force("outside") == ThrustCmd((0.2, 0.2))

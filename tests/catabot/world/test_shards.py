@@ -88,3 +88,13 @@ def test_more_traffic_shards_than_boats_is_refused_by_name() -> None:
     data = {"name": "w", "vessels": [{"id": "ego"}], "traffic": {"count": 2, "shards": 3}}
     with pytest.raises(ScenarioError, match=r"traffic\.shards: 3 shards for 2 boat"):
         parse_scenario(data)
+
+
+def test_the_vessels_a_participant_drives_are_its_controllers_and_its_shards_boats() -> None:
+    """What a drop hands back (clock.policy drop), in row order."""
+    stack = {"participant": "stack", "rate_hz": 10.0}
+    vessels = [{"id": "ego", "controller": stack}, {"id": "b", "pose": {"x_m": 20.0}}]
+    data = {"name": "w", "vessels": vessels, "traffic": {"count": 4, "shards": 2}}
+    world = World.resolve(parse_scenario(data))
+    assert world.driven_by(["traffic.1", "stack"]) == ["ego", "boat_002", "boat_003"]
+    assert world.driven_by(["recorder"]) == []

@@ -54,11 +54,14 @@ def test_a_takeover_from_outside_is_told_once_until_the_vessel_is_handed_back(
     caplog: pytest.LogCaptureFixture,
 ) -> None:
     """A client on the run's endpoint (another stack, a forgotten teleop) steered a vessel
-    and nothing said so: only its recorded commands showed it afterwards."""
+    and nothing said so: only its recorded commands showed it afterwards. The vessel's own
+    lockstep thrust controller is not an outsider (every thrust stack was told it was)."""
     book = _book()
     release = WaypointsCmd(points=(), speed=0.0, tolerance=0.0, mode="release")
     with caplog.at_level(logging.INFO, logger="physics.commands"):
         book.take("boat_000", [TwistCmd(5.0, 0.26, tick=3)], stamp_ns=30_000_000)  # lockstep
+        book.take("boat_000", [ThrustCmd((0.1, 0.1), tick=4)], stamp_ns=40_000_000)  # its own
+        book.take("boat_000", [release], stamp_ns=50_000_000)
         book.take("boat_000", [ThrustCmd((0.2, 0.2))], stamp_ns=1_230_000_000)
         book.take("boat_000", [ThrustCmd((0.3, 0.3))], stamp_ns=1_240_000_000)  # still held
         book.take("boat_000", [release, TwistCmd(1.0, 0.0)], stamp_ns=2_000_000_000)
@@ -68,4 +71,20 @@ def test_a_takeover_from_outside_is_told_once_until_the_vessel_is_handed_back(
         "release (waypoints) or its command_timeout_s",
         "boat_000: taken over by an outside twist at t = 2 s; it holds the vessel until a "
         "release (waypoints) or its command_timeout_s",
+    ]
+
+
+def test_a_dropped_stacks_vessel_is_handed_back_and_the_console_told(
+    caplog: pytest.LogCaptureFixture,
+) -> None:
+    """clock.policy drop: the boat of a crashed stack sailed on at its last thrust."""
+    book = CommandBook(vessels({"id": "a"}, {"id": "b", "pose": {"x_m": 20.0}}))
+    book.take("a", [ThrustCmd((0.6, 0.6), tick=7)], stamp_ns=70_000_000)
+    book.take("b", [TwistCmd(1.0, 0.1, tick=7)], stamp_ns=70_000_000)
+    with caplog.at_level(logging.INFO, logger="physics.commands"):
+        book.drop("stack", ["a", "b"], 1_400_000_000)
+    assert book.orders(1_400_000_000)[0] == {0: (0.0, 0.0), 1: (0.0, 0.0)}  # rest: no script
+    assert [advice_of(f" INFO {r.getMessage()}") for r in caplog.records] == [
+        "stack left the run at t = 1.4 s (clock.policy drop): a, b back to script (rest "
+        "without one)"
     ]
