@@ -32,6 +32,7 @@ from catabot.client.commands import Command
 from catabot.client.discover import find_world
 from catabot.client.errors import (
     NotAParticipant,
+    NotItsVessel,
     RunEnded,
     SeveralVessels,
     TooLate,
@@ -131,8 +132,8 @@ class Client:
         controller's rate, else `rate_hz` (default every tick)."""
         info = find_world(self.session, self.info.name, self.timeout_s, self._where)  # fresh
         self._expected(info, name)
-        _one_vessel(info, name)
-        target = self._target(info, name, vessel)
+        target = self._target(info, name, vessel)  # UnknownVessel
+        _one_vessel(info, name, vessel)
         mounted = [target.sensor(s) for s in sensors] if target is not None else []
         if sensors and target is None:
             raise UnknownVessel(f"sensors {list(sensors)} asked for without a vessel")
@@ -247,9 +248,10 @@ class Client:
         self.close(fault=_told(exc) if told and exc is not None else "")
 
 
-def _one_vessel(info: WorldInfo, name: str) -> None:
-    """A `Joined` commands one vessel: a participant the scenario gives two would leave the
-    second without commands, and physics waiting for them until the deadline."""
+def _one_vessel(info: WorldInfo, name: str, vessel: str | None) -> None:
+    """A `Joined` commands one vessel, its own: a participant the scenario gives two would
+    leave the second without commands, one joined to another vessel its own, and physics
+    waiting for them until the deadline (which then blamed physics)."""
     driven = [vid for vid, v in info.vessels.items()
               if v.controller and v.controller.participant == name]  # fmt: skip
     if len(driven) > 1:
@@ -257,6 +259,13 @@ def _one_vessel(info: WorldInfo, name: str) -> None:
             f"participant {name!r} controls vessels {', '.join(driven)} in world {info.name!r}, "
             "and a joined client commands one: give each vessel its own controller.participant"
         )
+    if driven and vessel is not None and vessel != driven[0]:
+        other = info.vessels.get(vessel)
+        theirs = other.controller.participant if other and other.controller else None
+        hint = f"; {theirs!r} controls {vessel!r}" if theirs else ""
+        raise NotItsVessel(f"participant {name!r} controls vessel {driven[0]!r}, not "
+                           f"{vessel!r}: join with vessel={driven[0]!r} (--vessel "
+                           f"{driven[0]}){hint}")  # fmt: skip
 
 
 def add_stack_args(parser: argparse.ArgumentParser) -> None:

@@ -39,6 +39,11 @@ class SeveralVessels(ClientError, ValueError):
     """The participant controls more vessels than a `Joined` commands (one)."""
 
 
+class NotItsVessel(ClientError, ValueError):
+    """A join naming a vessel other than the one the participant controls: nothing would
+    command its own, and the run would stop at the deadline blaming physics."""
+
+
 class TooLate(ClientError, RuntimeError):
     """The run started without this participant, or another session holds its name."""
 

@@ -17,7 +17,7 @@ from catabot.config.load import json_schema, model_schema
 from catabot.config.scenario import WaterConfig
 from catabot.config.vessel import VesselModelError, load_vessel_model
 from catabot.errors import CataBotError
-from catabot.run import compose, conduct, console, launcher, secure, settings_cli
+from catabot.run import compose, conduct, console, launcher, programs, secure, settings_cli
 from catabot.run.answer import OneLineParser, answered, output_file
 from catabot.run.companions import VIEW_MODES
 from catabot.run.generate import add_arguments as add_generate_arguments
@@ -151,6 +151,8 @@ def _scenario(args: argparse.Namespace) -> int:
         f"{len(world.buoys)} buoy(s), {len(world.sensors)} sensor(s), {s.ticks} ticks"
     )
     print(f"{args.file or 'default'}: valid ({counts})")
+    for note in programs.shared_notes(s):
+        print(note)
     return 0
 
 

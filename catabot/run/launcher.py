@@ -185,6 +185,8 @@ def run(opts: RunOptions) -> int:
 def _tell_external(world: World, opts: RunOptions, endpoint: str) -> None:
     """The clock starts only once the participants started outside the run have joined:
     say so, or the console shows a progress bar standing at zero until the start timeout."""
+    for note in programs.shared_notes(world.scenario):
+        print(note, flush=True)
     launched = {p.participant for p in programs.programs(world.scenario, opts.scenario)}
     outside = [p for p in world.participants if p not in {*world.services, *launched}]
     if outside:
@@ -193,6 +195,11 @@ def _tell_external(world: World, opts: RunOptions, endpoint: str) -> None:
             f"{endpoint}); the run gives up after {world.scenario.clock.start_timeout_s:g} s",
             flush=True,
         )
+    for vessel in world.scenario.vessels:  # the flags of the README's stack (add_stack_args)
+        c = vessel.controller
+        if c is not None and c.participant in outside:
+            print(f"  {c.participant}: e.g. python my_stack.py --connect {endpoint} "
+                  f"--participant {c.participant} --vessel {vessel.id}", flush=True)  # fmt: skip
 
 
 def _start(

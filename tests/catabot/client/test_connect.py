@@ -4,6 +4,7 @@ this process (no run): the errors a stack meets before it steps, each naming wha
 from __future__ import annotations
 
 import json
+import re
 import time
 from collections.abc import Iterator
 from typing import Any
@@ -19,6 +20,7 @@ from catabot.client import (
     CommandError,
     NoData,
     NotAParticipant,
+    NotItsVessel,
     SeveralVessels,
     SeveralWorlds,
     SimulatorNotFound,
@@ -117,6 +119,27 @@ def test_a_participant_of_two_vessels_cannot_join_as_a_client_of_one() -> None:
             pytest.raises(SeveralVessels, match=said),
         ):
             sim.join("stack")
+    finally:
+        served.close()
+
+
+def test_a_controller_joined_to_another_vessel_than_its_own_is_refused_at_join() -> None:
+    """It was taken, its own vessel got no commands, and the run stopped at tick 0 with
+    "drives no vessel's commands" and advice to send free commands (which are refused)."""
+    vessels = [{"id": "alpha", "controller": {"participant": "stack_a", "rate_hz": 10.0}},
+               {"id": "bravo", "pose": {"x_m": 20.0, "y_m": 0.0},
+                "controller": {"participant": "stack_b", "rate_hz": 10.0}}]  # fmt: skip
+    served = Served("two", vessels=vessels, traffic={"count": 0})
+    said = (
+        "participant 'stack_a' controls vessel 'alpha', not 'bravo': join with "
+        "vessel='alpha' (--vessel alpha); 'stack_b' controls 'bravo'"
+    )
+    try:
+        with Client.connect([served.endpoint], timeout_s=10) as sim:
+            with pytest.raises(NotItsVessel, match=re.escape(said)):
+                sim.join("stack_a", vessel="bravo")
+            with pytest.raises(UnknownVessel, match="no vessel 'zulu'"):
+                sim.join("stack_a", vessel="zulu")
     finally:
         served.close()
 

@@ -142,9 +142,26 @@ def test_a_run_says_it_waits_for_a_stack_started_outside_it(tmp_path: Path) -> N
     )
     assert "waiting for stack to join (started by you, connecting to tcp/" in done.stdout
     assert "the run gives up after 4 s" in done.stdout
+    assert re.search(r"stack: e\.g\. python my_stack\.py --connect tcp/[\d.:]+ --participant "
+                     r"stack --vessel ego\n", done.stdout), done.stdout  # fmt: skip
     assert done.returncode == 1  # under load a service may be late as well: named with it
     assert re.search(r"never joined within 4 s: (\w+, )*stack\n", done.stderr), done.stderr
     assert "0 ticks" in done.stdout and "ego:" not in done.stdout  # no metrics of 0 ticks
+
+
+def test_validate_notes_a_participant_given_two_vessels(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """Allowed (a stack on the bus may drive both), but a catabot.client stack cannot join
+    it: validate said "valid" and the run waited out its start timeout."""
+    stack = {"participant": "pair", "rate_hz": 10.0}
+    vessels = [{"id": "a", "controller": stack},
+               {"id": "b", "pose": {"x_m": 20.0, "y_m": 0.0}, "controller": stack}]  # fmt: skip
+    path = tmp_path / "pair.json"
+    path.write_text(json.dumps({"name": "pair", "vessels": vessels}))
+    assert main(["scenario", "validate", str(path)]) == 0
+    out = capsys.readouterr().out
+    assert "valid" in out and "note: participant 'pair' controls vessels a, b: a " in out
 
 
 def test_the_vessel_model_schema_checks_every_bundled_model(tmp_path: Path) -> None:
