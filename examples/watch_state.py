@@ -42,7 +42,7 @@ def main() -> None:
                 return
             if str(sample.key_expr) == k.end():
                 end = codec.decode(sample.payload.to_bytes(), End)
-                print(f"the run ended at tick {end.tick} ({end.reason})")
+                print(f"the run ended at tick {end.tick} ({end.error or end.reason})")
                 return
             if n % args.every == 0:
                 show(codec.decode(sample.payload.to_bytes(), VesselState))

@@ -45,13 +45,35 @@ def _color(k: int) -> str:
 def trajectories(data: RunSeries) -> Figure:
     """Every vessel's track over the terrain (cropped to the tracks, the tasks and the
     scenario's buoys: the traffic's waypoint buoys may lie far off), buoys, starts and ends."""
+    return _trajectories(data, *_view(data, everyone=True), "Trajectories")
+
+
+def trajectories_own(data: RunSeries) -> Figure | None:
+    """The scenario's own vessels close up, when the traffic spreads the full view over more
+    than four times their area (a fleet of three filled a corner of a 300 m frame)."""
+    lo, hi = _view(data, everyone=True)
+    own_lo, own_hi = _view(data, everyone=False)
+    if not data.run.world.boat_ids or 4 * np.prod(own_hi - own_lo) > np.prod(hi - lo):
+        return None
+    return _trajectories(data, own_lo, own_hi, "Own vessels' trajectories")
+
+
+def _view(data: RunSeries, *, everyone: bool) -> tuple[np.ndarray, np.ndarray]:
+    """The corners of a view holding the tracks (every vessel's, or the scenario's own) and
+    the tasks, and for every vessel's the scenario's buoys, with a margin."""
+    world, xy = data.run.world, data.states.position[:, :, :2]
+    rows = len(world.vessels) if everyone else len(world.scenario.vessels)
+    moored = [(b.x_m, b.y_m) for b in world.scenario.buoys] if everyone else []
+    seen = np.concatenate([xy[:, :rows].reshape(-1, 2), _task_points(world, data.own),
+                           np.array(moored, dtype=np.float64).reshape(-1, 2)])  # fmt: skip
+    margin = MARGIN_M if everyone else MARGIN_M / 4
+    return np.nanmin(seen, axis=0) - margin, np.nanmax(seen, axis=0) + margin
+
+
+def _trajectories(data: RunSeries, lo: np.ndarray, hi: np.ndarray, title: str) -> Figure:
     world, pos = data.run.world, data.states.position
     vessels = len(world.vessels)
     xy = pos[:, :, :2]
-    moored = [(b.x_m, b.y_m) for b in world.scenario.buoys]  # not the traffic's far waypoints
-    seen = np.concatenate([xy[:, :vessels].reshape(-1, 2), _task_points(world, data.own),
-                           np.array(moored, dtype=np.float64).reshape(-1, 2)])  # fmt: skip
-    lo, hi = np.nanmin(seen, axis=0) - MARGIN_M, np.nanmax(seen, axis=0) + MARGIN_M
     fig = _figure(size=(8.5, 8))
     ax = _axes(fig)[0]
     _terrain(ax, data, lo, hi)
@@ -72,7 +94,7 @@ def trajectories(data: RunSeries) -> Figure:
         ax.scatter(b[:, 0], b[:, 1], s=14, c="#fac81e", edgecolors="black", lw=0.4,
                    label=f"buoys ({len(b)})", zorder=3)  # fmt: skip
     ax.set(xlim=(lo[0], hi[0]), ylim=(lo[1], hi[1]), xlabel="east x [m]", ylabel="north y [m]",
-           title=f"Trajectories, {data.t[-1]:.1f} s (o start, ■ end)", aspect="equal")  # fmt: skip
+           title=f"{title}, {data.t[-1]:.1f} s (o start, ■ end)", aspect="equal")  # fmt: skip
     ax.legend(loc="upper right", fontsize=8, framealpha=0.9, facecolor="#9fb0c0")  # white shows
     return fig
 
@@ -255,6 +277,9 @@ def metrics(data: RunSeries) -> Figure | None:
         gap.plot(data.t[k], data.closest[k], "v", color="red",
                  label=f"minimum {data.closest[k]:.2f} m at {data.t[k]:.1f} s")  # fmt: skip
         gap.legend(fontsize=8)
+    else:  # one vessel alone: an empty 0..1 panel read as a plot gone wrong
+        gap.text(0.5, 0.5, "one vessel: no pair to measure", ha="center", va="center",
+                 transform=gap.transAxes, color="gray")  # fmt: skip
     gap.set(title="Closest approach between two vessels", xlabel="simulated time [s]",
             ylabel="distance [m]")  # fmt: skip
     gap.grid(alpha=0.3)
@@ -279,6 +304,7 @@ def metrics(data: RunSeries) -> Figure | None:
 
 FIGURES = {
     "trajectories": trajectories,
+    "trajectories_own": trajectories_own,
     "speed_heading": speed_heading,
     "thrust": thrust,
     "imu": imu,

@@ -14,6 +14,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
+from catabot.config.vessel import Thruster
 from catabot.run.recorded import RecordedRun, StateTrack
 from catabot.world import rotations
 
@@ -90,7 +91,7 @@ def _commands(run: RecordedRun, out: RunSeries) -> None:
         if both:
             n = max(len(v) for _, v in both)
             values = np.array([[*v, *[np.nan] * (n - len(v))] for _, v in both])
-            names = tuple(f"thruster {i}" for i in range(n))
+            names = _thruster_names(body.model.thrusters, n)
             out.thrust[vid] = Series(np.array([t for t, _ in both]), values, names)
         scripted = [(s.t_s, (s.twist.surge_mps, s.twist.yaw_rate_radps))
                     for s in body.script if s.twist is not None]  # fmt: skip
@@ -118,3 +119,10 @@ def _sensors(run: RecordedRun, out: RunSeries) -> None:
             if counts:
                 table = np.array(counts, dtype=np.float64)
                 out.lidar[owner] = Series(table[:, 0], table[:, 1:], ("returns", "rain returns"))
+
+
+def _thruster_names(thrusters: Sequence[Thruster], n: int) -> tuple[str, ...]:
+    """ "thruster 0 (port)": which side each is on, from its y (FLU: + is port)."""
+    sides = ["port" if t.position_m[1] > 0 else "starboard" if t.position_m[1] < 0 else "centre"
+             for t in thrusters]  # fmt: skip
+    return tuple(f"thruster {i}" + (f" ({sides[i]})" if i < len(sides) else "") for i in range(n))

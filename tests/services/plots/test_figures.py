@@ -3,13 +3,23 @@ vessels' tasks, the boats' numbers."""
 
 from __future__ import annotations
 
+from types import SimpleNamespace
+
 import matplotlib.pyplot as plt
 import numpy as np
 from matplotlib.patches import Circle
 
 from catabot.config.load import parse_scenario
 from catabot.world.world import World
-from services.plots.figures import _boat_names, _in_force, _task, _task_points, rain_steps
+from services.plots.figures import (
+    _boat_names,
+    _in_force,
+    _task,
+    _task_points,
+    _view,
+    rain_steps,
+)
+from services.plots.series import _thruster_names
 
 
 def test_the_rain_rate_follows_the_settings_timeline() -> None:
@@ -62,3 +72,29 @@ def test_a_thrust_is_drawn_until_a_twist_takes_over_and_back() -> None:
     assert held[:2].tolist() == thrust.tolist() and np.isnan(held[2:]).all()
     t, held = _in_force(np.array([40.0]), np.array([[1.0, 0.0]]), thrust_t, 60.0)
     assert t.tolist() == [0.0, 10.0, 40.0, 60.0] and held[2:].tolist() == [[1.0, 0.0]] * 2
+
+
+def test_the_own_view_holds_the_scenario_vessels_and_the_full_view_the_traffic() -> None:
+    """A fleet of three filled a corner of a 300 m frame spread by the traffic: the own
+    vessels get a figure of their own, cropped to their tracks and tasks."""
+    world = World.resolve(parse_scenario({
+        "name": "fleet", "vessels": [{"id": "a"}, {"id": "b", "pose": {"x_m": 20.0}}],
+        "traffic": {"count": 2, "region": {"center_m": [0.0, 300.0], "size_m": [100.0, 100.0]}},
+    }))  # fmt: skip
+    position = np.zeros((2, len(world.bodies), 3))
+    position[:, 1, 0] = 20.0
+    position[:, 2:4, :2] = [[-50.0, 250.0], [50.0, 350.0]]
+    data = SimpleNamespace(run=SimpleNamespace(world=world), own=["a", "b"],
+                           states=SimpleNamespace(position=position))  # fmt: skip
+    lo, hi = _view(data, everyone=True)  # type: ignore[arg-type]
+    assert lo.tolist() == [-90.0, -40.0] and hi.tolist() == [90.0, 390.0]
+    lo, hi = _view(data, everyone=False)  # type: ignore[arg-type]
+    assert lo.tolist() == [-10.0, -10.0] and hi.tolist() == [30.0, 10.0]
+
+
+def test_thrusters_are_named_by_their_side() -> None:
+    """ "thruster 0" left a student to find in the model file which one is port."""
+    world = World.resolve(parse_scenario({"name": "t", "vessels": [{"id": "ego"}]}))
+    thrusters = world.body("ego").model.thrusters
+    assert _thruster_names(thrusters, 2) == ("thruster 0 (port)", "thruster 1 (starboard)")
+    assert _thruster_names(thrusters, 3)[2] == "thruster 2"  # more values than thrusters
