@@ -8,6 +8,7 @@ free-running (tick -1) and is applied at the next tick boundary after it arrives
 
 from __future__ import annotations
 
+import logging
 import threading
 import time
 from collections.abc import Callable, Sequence
@@ -23,6 +24,7 @@ from catabot.client.lockstep import Observation
 from catabot.client.vessel import Vessel
 from catabot.client.watch import Latest, Watch
 
+log = logging.getLogger("catabot.client")
 FIRST_STATE_S = 10.0  # a lockstep run may wait for its external participants first
 
 
@@ -64,6 +66,8 @@ def run_free(
 ) -> End | None:
     if not rate_hz > 0:
         raise ValueError(f"rate_hz must be > 0 (got {rate_hz})")
+    if unpaced(info):
+        log.warning(unpaced(info))
     states = Latest(watch, Stream(info.states_key, BodyStates, info.states_producer, None,
                                   check=info.states_stream().check), "world state")  # fmt: skip
     samples = _Samples(watch, sensors)
@@ -72,6 +76,18 @@ def run_free(
     finally:  # a stack may run free again: leave no subscription behind
         for sub in [states.sub, *samples.subs]:
             watch.unsubscribe(sub)
+
+
+def unpaced(info: WorldInfo) -> str:
+    """Why a free stack would see little of a run not paced to the wall clock (a 10 Hz stack
+    beside a run at 7.6x real time sent 34 commands in 30 simulated seconds), else ""."""
+    if (info.scenario.get("clock") or {}).get("realtime_factor") is not None:
+        return ""
+    return (
+        f"world {info.name!r} runs as fast as it can (no clock.realtime_factor): a free "
+        "stack's rate is of the wall clock, so it sees the run only now and then; start "
+        "the run with --realtime 1, or join the lockstep (run_lockstep) for every period"
+    )
 
 
 def _loop(

@@ -10,6 +10,7 @@ import pytest
 
 from catabot.bus.messages import LidarScan, TwistCmd
 from catabot.client import ClientError, UnknownSensor
+from catabot.client.free import unpaced
 from catabot.client.info import parse
 from catabot.config.load import parse_scenario
 from catabot.run.world_info import describe
@@ -114,3 +115,13 @@ def test_start_states_off_rest_and_sharded_producers_are_the_worlds() -> None:
         "sensors.0",
         "sensors.1",
     }
+
+
+def test_a_free_stack_is_told_when_the_run_is_not_paced_to_the_wall_clock() -> None:
+    """A 10 Hz free stack beside a run at 7.6x real time sent 34 commands in 30 simulated
+    seconds and took its boat over late, and nothing said why."""
+    fast = parse(answer(), "test")
+    assert "runs as fast as it can (no clock.realtime_factor)" in unpaced(fast)
+    assert "--realtime 1" in unpaced(fast)
+    paced = parse(describe(World.resolve(scenario(clock={"realtime_factor": 1.0})), ROSTER), "t")
+    assert unpaced(paced) == ""
