@@ -23,7 +23,7 @@ def metrics_lines(run_dir: Path) -> list[str]:
     if not isinstance(record, dict) or not isinstance(record.get("vessels"), dict):
         return []
     lines = [
-        f"  {vid}: " + "; ".join(filter(None, _parts(m)))
+        f"  {vid}: " + "; ".join(filter(None, vessel_parts(m)))
         for vid, m in record["vessels"].items()
         if isinstance(m, dict) and "nearest_vessel" in m
     ]
@@ -44,7 +44,8 @@ def _traffic(record: dict[str, Any]) -> list[str]:
     return [f"  traffic: {len(hits)} collisions among its boats and buoys"]
 
 
-def _parts(m: dict[str, Any]) -> list[str]:
+def vessel_parts(m: dict[str, Any]) -> list[str]:
+    """A scenario vessel's figures, as the console's summary line and the report give them."""
     goal, route = m.get("goal"), m.get("route")
     near = [
         f"{kind} {n['distance_m']:.2f} m" + (f" ({n['id']})" if "id" in n else "")

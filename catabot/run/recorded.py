@@ -88,8 +88,9 @@ def _check_ticked(folder: Path) -> None:
     except (OSError, ValueError, TypeError, KeyError):
         return
     if ticks == 0:
-        raise RunFolderError(f"{folder}: the run recorded no tick (it was {reason} before its "
-                             "first: log/run.json)")  # fmt: skip
+        how = {"fault": "ended by a fault", "interrupted": "was interrupted"}.get(reason, reason)
+        raise RunFolderError(f"{folder}: the run recorded no tick (it {how} before its first; "
+                             "log/run.json says why)")  # fmt: skip
 
 
 class RecordedRun:

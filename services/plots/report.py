@@ -11,6 +11,7 @@ import json
 from pathlib import Path
 from typing import Any
 
+from catabot.run.metrics_summary import vessel_parts
 from services.plots.series import RunSeries
 
 STYLE = (
@@ -49,17 +50,19 @@ def _metrics(data: RunSeries) -> str:
     vessels = m.get("vessels", {})
     rows = "".join(
         f"<tr><td>{html.escape(v)}</td><td>{vessels[v]['distance_m']:.1f}</td>"
-        f"<td>{vessels[v]['max_speed_mps']:.2f}</td></tr>"
+        f"<td>{vessels[v]['max_speed_mps']:.2f}</td>"
+        f"<td>{html.escape('; '.join(filter(None, vessel_parts(vessels[v]))))}</td></tr>"
         for v in data.own
         if v in vessels
-    )
+    )  # the last column: the console summary's goal, nearest bodies, contacts, thrust
     close = m.get("closest_approach")
     line = (
         f"<p>Closest approach: <b>{close['distance_m']:.2f} m</b> between "
         f"{html.escape(' and '.join(close['vessels']))} at {close['stamp_ns'] / 1e9:.2f} s</p>"
         if close else "<p>No closest approach (fewer than two vessels).</p>"
     )  # fmt: skip
-    head = "<tr><th>vessel</th><th>distance [m]</th><th>top speed [m/s]</th></tr>"
+    head = ("<tr><th>vessel</th><th>distance [m]</th><th>top speed [m/s]</th>"
+            "<th>goal, nearest, contacts, thrust</th></tr>")  # fmt: skip
     return f"<table>{head}{rows}</table>{line}" if rows else line
 
 

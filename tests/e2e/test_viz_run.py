@@ -189,6 +189,7 @@ def test_plot_writes_figures_and_a_report(run: Path, tmp_path: Path) -> None:
         assert pixels.std() > 5, f"{png.name} is blank"
     report = (tmp_path / "plots" / "report.html").read_text()
     assert all(f'src="{p.name}"' in report for p in pngs) and "Closest approach" in report
+    assert "<th>goal, nearest, contacts, thrust</th>" in report and "collisions 0" in report
     again = catabot("plot", str(run), "-o", str(tmp_path / "again"))
     assert again.returncode == 0
     assert files_of(tmp_path / "plots", ("*",)) == files_of(tmp_path / "again", ("*",))
@@ -205,7 +206,7 @@ def test_plot_writes_figures_and_a_report(run: Path, tmp_path: Path) -> None:
         (("dataset", "export", "{run}", "-f", "yolo", "-o", "{run}"), "is not an empty folder"),
         (("dataset", "export", "{nocam}", "-f", "coco", "-o", "{tmp}/o"), "no labelled camera"),
         (("view", "{tmp}"), "not a run folder"),
-        (("plot", "{unticked}"), "the run recorded no tick (it was interrupted before its first"),
+        (("plot", "{unticked}"), "the run recorded no tick (it was interrupted before its first;"),
         (("view", "{run}", "--save", "{tmp}/no/x.rrd"), "does not exist"),
         (("view", "{run}", "--web", "--no-hold", "--web-port", "{taken}"), "Address already"),
     ],
