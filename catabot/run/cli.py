@@ -44,6 +44,7 @@ def _run(args: argparse.Namespace) -> int:
         quiet=args.quiet,
         zenoh_configs=configs,
         view=args.view,
+        sets=tuple(args.set),
     )
     return launcher.run(opts)
 
@@ -182,6 +183,11 @@ def parser() -> argparse.ArgumentParser:
     run.add_argument("scenario", nargs="?", help="scenario file or bundled name (default: default)")
     run.add_argument("--duration", type=float, help="simulated seconds (overrides the scenario)")
     run.add_argument("--seed", type=int, help="the scenario's seed (a sweep's runs, one file)")
+    run.add_argument(
+        "--set", action="append", default=[], metavar="FIELD=VALUE",
+        help="change one scenario field for this run (JSON value; repeatable), e.g. --set "
+        "water.current.velocity_mps=[0.5,0] --set name=lab3",
+    )  # fmt: skip
     run.add_argument(
         "--realtime", type=float, metavar="FACTOR",
         help="pace: 1.0 = wall clock; 0 = as fast as possible (the default, unless the "

@@ -17,6 +17,7 @@ from catabot.bus.clock import CONDUCTOR
 from catabot.bus.identity import Roster, new_zid
 from catabot.bus.scheduling import requested_policy
 from catabot.bus.session import check_listen, check_router, free_port
+from catabot.config import overrides
 from catabot.config.base import ScenarioError
 from catabot.config.load import load_scenario, parse_scenario, scenario_json
 from catabot.config.scenario import Scenario
@@ -56,6 +57,7 @@ class RunOptions:
     quiet: bool = False
     zenoh_configs: Path | None = None  # a folder of <process>.json5 (the secure profile)
     view: str | None = None  # one of VIEW_MODES: the live rerun viewer beside the run
+    sets: tuple[str, ...] = ()  # --set FIELD=VALUE, in order (catabot/config/overrides.py)
 
 
 def prepare(opts: RunOptions) -> World:
@@ -82,6 +84,7 @@ def prepare(opts: RunOptions) -> World:
         fast = opts.realtime == 0.0 or opts.realtime == math.inf
         data["clock"]["realtime_factor"] = None if fast else opts.realtime
         flags.append(f"--realtime {opts.realtime:g}")
+    flags += overrides.apply(data, list(opts.sets))
     changed = f"{source} with {' '.join(flags)}" if flags else source  # the file, the flags
     parsed = parse_scenario(data, source=changed)
     try:
