@@ -7,6 +7,7 @@ nothing for it (no IMU, no thrust command), and the report says so.
 
 from __future__ import annotations
 
+import json
 from typing import Any
 
 import numpy as np
@@ -164,12 +165,26 @@ def speed_heading(data: RunSeries) -> Figure | None:
         speed.plot(data.t, data.speed[vid], color=_color(k), label=vid)
         heading.plot(data.t, data.heading[vid], ".", ms=2, color=_color(k), label=vid)
     speed.set(ylabel="speed over ground [m/s]", title="Speed and heading")
-    heading.set(ylabel="heading [deg from north]", xlabel="simulated time [s]", ylim=(0, 360),
-                yticks=range(0, 361, 90))  # fmt: skip
+    heading.set(ylabel="heading [deg from north, clockwise]", xlabel="simulated time [s]",
+                ylim=(0, 360), yticks=range(0, 361, 90))  # fmt: skip
     for ax in (speed, heading):
         ax.grid(alpha=0.3)
         ax.legend(fontsize=8)
+    _changes(speed, data.run.world.scenario)
+    _changes(heading, data.run.world.scenario, labelled=False)
     return fig
+
+
+def _changes(ax: Axes, scenario: Scenario, *, labelled: bool = True) -> None:
+    """Each setting change of the run (its `settings` timeline, `catabot set` included) as a
+    dotted line, named on top: why a track bends when the current was set mid-run."""
+    for change in scenario.settings:
+        ax.axvline(change.t_s, ls=":", lw=1.0, color="dimgray")
+        if labelled:
+            text = f"{change.key} = {json.dumps(change.value)}"[:40]
+            ax.annotate(text, (change.t_s, 0.97), xycoords=("data", "axes fraction"),
+                        xytext=(2, 0), textcoords="offset points", fontsize=7, va="top",
+                        color="dimgray", rotation=90)  # fmt: skip
 
 
 def thrust(data: RunSeries) -> Figure | None:

@@ -13,6 +13,7 @@ from catabot.config.load import parse_scenario
 from catabot.world.world import World
 from services.plots.figures import (
     _boat_names,
+    _changes,
     _in_force,
     _task,
     _task_points,
@@ -98,3 +99,17 @@ def test_thrusters_are_named_by_their_side() -> None:
     thrusters = world.body("ego").model.thrusters
     assert _thruster_names(thrusters, 2) == ("thruster 0 (port)", "thruster 1 (starboard)")
     assert _thruster_names(thrusters, 3)[2] == "thruster 2"  # more values than thrusters
+
+
+def test_setting_changes_are_marked_where_they_took_effect() -> None:
+    """A current set mid-run bent the track, and the plots did not say when."""
+    scenario = parse_scenario({
+        "name": "set", "duration_s": 10.0, "vessels": [{"id": "ego"}],
+        "settings": [{"t_s": 5.5, "key": "current", "value": [0.0, -1.0]}],
+    })  # fmt: skip
+    fig, ax = plt.subplots()
+    _changes(ax, scenario)
+    (line,) = ax.lines
+    assert list(line.get_xdata()) == [5.5, 5.5]
+    assert [t.get_text() for t in ax.texts] == ["current = [0.0, -1.0]"]
+    plt.close(fig)
