@@ -3,10 +3,11 @@ program `catabot run` starts as that participant (catabot/run/programs.py)."""
 
 from __future__ import annotations
 
+import json
 from collections.abc import Sequence
 from typing import Literal
 
-from pydantic import Field, model_validator
+from pydantic import Field, field_validator, model_validator
 
 from catabot.config.base import FieldProblem, ParticipantName, Strict
 
@@ -27,7 +28,21 @@ class ControllerConfig(Strict):
         description="a Python file `catabot run` starts as this participant (relative to the "
         "scenario file's folder, else to the current directory)",
     )
-    args: list[str] = Field([], description="the program's own arguments, after CataBot's flags")
+    args: list[str] = Field(
+        [],
+        description="the program's own arguments, after CataBot's flags (a number is taken as "
+        "its JSON text: a command line holds only text)",
+    )
+
+    @field_validator("args", mode="before")
+    @classmethod
+    def _numbers_as_text(cls, value: object) -> object:
+        """A sweep over a gain wrote `["--gain", 2]` and was refused: a number here can only
+        mean its text. A bool is no number a command line would hold."""
+        if not isinstance(value, list):
+            return value
+        return [json.dumps(a) if isinstance(a, int | float) and not isinstance(a, bool) else a
+                for a in value]  # fmt: skip
 
     @model_validator(mode="after")
     def _args_need_program(self) -> ControllerConfig:

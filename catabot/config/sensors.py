@@ -70,7 +70,7 @@ class GpsParams(SensorParams):
 class RadarParams(SensorParams):
     """Marine radar (paper III-B.2.b: 250 m, one turn in 2 s, range noise sigma 0.2 m)."""
 
-    range_m: float = Field(250.0, gt=0)
+    range_m: float = Field(250.0, gt=0, le=100_000, description="out to this slant range")
     rotation_period_s: float = Field(
         2.0, ge=0.25, le=60, description="one antenna turn, clockwise (marine: 1-2.5 s)"
     )
@@ -78,7 +78,9 @@ class RadarParams(SensorParams):
     beam_width_deg: float = Field(1.5, gt=0, le=20, description="horizontal; beams at half")
     sub_rays: int = Field(3, ge=1, le=16, description="rays across one beam's width")
     elevations_deg: tuple[float, ...] = Field(
-        (0.0, 1.0, 3.0), description="rays at or above the horizon (shores, tall ships)"
+        (0.0, 1.0, 3.0),
+        min_length=1,
+        description="rays at or above the horizon (shores, tall ships), 0-60 deg",
     )
     fan_target_height_m: float = Field(
         0.3, ge=0, description="down-looking fan sees targets this tall at any range; 0: no fan"
@@ -95,6 +97,24 @@ class RadarParams(SensorParams):
     fade_s: float | None = Field(
         None, gt=0, description="PPI returns fade to nothing in this time; null: 1.5 turns"
     )
+
+    @model_validator(mode="after")
+    def _geometry(self) -> RadarParams:
+        """Limits the fields' descriptions gave and nothing checked: a ray below the horizon
+        is the fan's, a fan aimed above the antenna is none, a blind zone past the range
+        leaves nothing to see."""
+        low = [e for e in self.elevations_deg if not 0.0 <= e <= 60.0]
+        if low:
+            raise FieldProblem("elevations_deg", f"{low[0]:g} is not 0-60 deg (rays at or "
+                               "above the horizon; the fan sees down)")  # fmt: skip
+        if self.fan_target_height_m >= self.antenna_height_m:
+            raise FieldProblem("fan_target_height_m", f"{self.fan_target_height_m:g} m is not "
+                               f"below the antenna ({self.antenna_height_m:g} m); 0: no "
+                               "fan")  # fmt: skip
+        if self.fan_min_range_m >= self.range_m:
+            raise FieldProblem("fan_min_range_m", f"{self.fan_min_range_m:g} m is not within "
+                               f"range_m ({self.range_m:g} m)")  # fmt: skip
+        return self
 
     @property
     def fade(self) -> float:

@@ -123,7 +123,7 @@ def main(argv: list[str] | None = None) -> int:
         scenario = load_scenario(args.scenario)
         session = open_session(connection_from_args(args))
     except CataBotError as exc:
-        emit("result", ticks_done=0, wall_s=0.0, error=str(exc), dropped=[])
+        emit("result", ticks_done=0, wall_s=0.0, error=str(exc), dropped=[], reason="fault")
         return 2
     keys = Keys(scenario.name)
     schedule = Schedule(live.timeline(scenario), ticks=scenario.ticks, grace_s=live.apply_grace_s)
@@ -133,7 +133,7 @@ def main(argv: list[str] | None = None) -> int:
         conductor = Conductor(session, keys, spec, roster=args.roster, settings=schedule)
     except NameTaken as exc:  # a second conductor of this world: said on stderr too
         log.critical("%s", exc)
-        emit("result", ticks_done=0, wall_s=0.0, error=str(exc), dropped=[])
+        emit("result", ticks_done=0, wall_s=0.0, error=str(exc), dropped=[], reason="fault")
         session.close()
         return 2
     info = WorldInfoDesk(session, scenario, args.roster, schedule)  # for stacks: catabot.client

@@ -84,7 +84,7 @@ def prepare(opts: RunOptions) -> World:
         fast = opts.realtime == 0.0 or opts.realtime == math.inf
         data["clock"]["realtime_factor"] = None if fast else opts.realtime
         flags.append(f"--realtime {opts.realtime:g}")
-    flags += overrides.apply(data, list(opts.sets))
+    flags += overrides.apply(data, list(opts.sets), flagged=_flagged(opts))
     changed = f"{source} with {' '.join(flags)}" if flags else source  # the file, the flags
     parsed = parse_scenario(data, source=changed)
     try:
@@ -99,6 +99,14 @@ def prepare(opts: RunOptions) -> World:
     programs.programs(world.scenario, opts.scenario)  # each controller's program is a file
     _check_logins(opts, world)
     return world
+
+
+def _flagged(opts: RunOptions) -> dict[str, str]:
+    """The fields a flag of their own gives (a `--set` of them as well is refused)."""
+    given = {"duration_s": opts.duration_s, "seed": opts.seed,
+             "clock.realtime_factor": opts.realtime}  # fmt: skip
+    names = {"duration_s": "--duration", "seed": "--seed", "clock.realtime_factor": "--realtime"}
+    return {field: names[field] for field, value in given.items() if value is not None}
 
 
 def _check_logins(opts: RunOptions, world: World) -> None:
@@ -293,6 +301,7 @@ def _watch(scenario: Scenario, run_dir: Path, supervisor: Supervisor, *, quiet: 
         codes,
         stopped=supervisor.stopped,
         lingered=supervisor.lingered,
+        after_fault=supervisor.after_fault,
     )
 
 

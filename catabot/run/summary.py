@@ -17,6 +17,7 @@ from pathlib import Path
 from catabot.bus.clock import ender_of
 from catabot.config.scenario import Scenario
 from catabot.run.metrics_summary import metrics_lines
+from catabot.run.provenance import provenance
 from catabot.run.service import EXIT_CLOCK
 from catabot.run.supervisor import PROGRAM_REAP_S
 from catabot.run.usage import MEMORY, memory_mb, read_usage
@@ -89,7 +90,11 @@ def summarise(
     *,
     stopped: set[str] | frozenset[str] = frozenset(),
     lingered: set[str] | frozenset[str] = frozenset(),
+    after_fault: set[str] | frozenset[str] = frozenset(),
 ) -> int:
+    """`stopped`: services stopped before they joined an interrupted run; `lingered`:
+    programs still running after a clean end; `after_fault`: services still running after a
+    fault had ended the run (SIGTERM, exit 143): none of them is a failure of its own."""
     ticks = int(result.get("ticks_done", 0))  # type: ignore[call-overload]
     wall = float(result.get("wall_s", 0.0))  # type: ignore[arg-type]
     sim_s = ticks * scenario.dt_ns / 1e9
@@ -99,7 +104,7 @@ def summarise(
     if interrupted and not ticks:  # ended on seeing the stopped conductor go first
         unjoined = set(stopped) | {n for n, c in service_codes.items() if c == EXIT_CLOCK}
     dropped = dict(result.get("why_dropped") or {})  # type: ignore[call-overload]
-    spared = unjoined | set(lingered) | set(dropped)  # stopped, or gone on without: not failed
+    spared = unjoined | set(lingered) | set(dropped) | set(after_fault)  # not failures
     failed = {n: c for n, c in service_codes.items() if c not in (0, None) and n not in spared}
     if not result:
         error = error or f"the conductor ended without a result ({describe_exit(conductor_code)})"
@@ -110,12 +115,13 @@ def summarise(
         "sim_s": sim_s,
         "wall_s": wall,
         "error": error,
-        "reason": result.get("reason", ""),
+        "reason": result.get("reason") or _reason(error, interrupted=interrupted),
         "services": dict(service_codes),
         "cpu_s": read_usage(run_dir, service_codes, "cpu_s"),
         **_memory(run_dir, service_codes, result),
         "rejected": _rejected(run_dir, service_codes, result),
         "dropped": dropped,
+        **provenance(scenario),
     }
     try:
         (run_dir / "log" / "run.json").write_text(json.dumps(record, indent=2) + "\n")
@@ -136,6 +142,8 @@ def summarise(
     for name, why in dropped.items():
         print(f"  {name}: dropped, the run went on without it (clock.policy drop): {why}",
               file=sys.stderr)  # fmt: skip
+    for name in sorted(after_fault):
+        print(f"  {name}: stopped by catabot run after the fault", file=sys.stderr)
     for name in sorted(lingered):
         print(
             f"  {name}: still running {PROGRAM_REAP_S:g} s after the run ended, so stopped "
@@ -167,3 +175,9 @@ def _last_line(run_dir: Path, name: str) -> str:
     except OSError:
         return "(no log)"
     return next((x.strip() for x in reversed(lines) if x.strip()), "(empty log)")[:300]
+
+
+def _reason(error: str, *, interrupted: bool) -> str:
+    """How a run ended when the conductor said nothing (it failed, or was stopped, before
+    its first tick): run.json's `reason` is never empty for a script to test."""
+    return "interrupted" if interrupted else "fault" if error else "completed"

@@ -84,6 +84,7 @@ class Supervisor:
         self.stopped: set[str] = set()  # services stopped before they joined an interrupted run
         self.hung: list[str] = []  # processes found hung and killed
         self.lingered: set[str] = set()  # programs stopped, still running after a clean end
+        self.after_fault: set[str] = set()  # services stopped, still running after a fault
         self._ticking = False  # a progress line came: the run's clock has started
         self._gone: dict[str, float] = {}  # programs that exited 0 before it had, and when
         self._started = time.monotonic()
@@ -209,6 +210,8 @@ class Supervisor:
                     self.stopped.add(name)
                 elif child.program and not faulted:  # its own loop (a spin, a plot window)
                     self.lingered.add(name)
+                elif faulted and child.proc.poll() is None:
+                    self.after_fault.add(name)
                 ended(child.proc, grace_s=1.0)
 
     def cause(self) -> str:

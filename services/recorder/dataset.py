@@ -10,7 +10,8 @@ Layout (one folder per sensor, `<vessel>.<sensor>`):
   frame with its boxes, each naming its body;
   every frame, or with `recording.dataset_rate_hz` the first frame of each of its periods;
 - radars: `ppi_<tick>.png`, the north-up PPI (services/recorder/ppi.py) once per antenna turn;
-- with cameras, `calibration.json`: every sensor's mount and each camera's K (calibration.py).
+- with cameras or PPIs, `calibration.json`: every sensor's mount and each camera's K
+  (calibration.py): a radar-only run's mounts were in `/tf_static` alone.
 PNGs are written with fixed settings and no time chunk, so the same run gives the same bytes.
 `catabot.run.recorded_camera` reads this layout back (dataset export, replay).
 """
@@ -101,7 +102,7 @@ class Dataset:
             if s.config.type == "radar" and recording.ppi
         }
         self._ppi: dict[str, Ppi] = {}
-        if self.cameras and self.camera_period:
+        if (self.cameras and self.camera_period) or self.radar:  # dataset/ has sensor data
             write_calibration(root, world)
 
     def folder(self, stream: str) -> Path:

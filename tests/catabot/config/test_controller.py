@@ -93,3 +93,13 @@ def test_external_participants_are_named_once_and_not_as_a_service(
     with pytest.raises(ScenarioError) as info:
         parse_scenario({"clock": {"external_participants": names}, "vessels": [{"id": "ego"}]})
     assert message in str(info.value)
+
+
+def test_numbers_in_args_are_taken_as_their_text() -> None:
+    """A sweep over a gain wrote ["--gain", 2]: refused as "must be a string"."""
+    program = {"participant": "s", "program": "x.py", "args": ["--gain", 2, 0.5]}
+    scenario = parse_scenario({"vessels": [{"id": "ego", "controller": program}]})
+    assert scenario.vessels[0].controller is not None
+    assert scenario.vessels[0].controller.args == ["--gain", "2", "0.5"]
+    with pytest.raises(ScenarioError, match="must be a string"):
+        parse_scenario({"vessels": [{"id": "ego", "controller": {**program, "args": [True]}}]})

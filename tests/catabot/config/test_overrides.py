@@ -42,9 +42,42 @@ def test_a_mistake_is_named_with_its_flag(item: str, said: str) -> None:
     assert said in str(err.value)
 
 
+def test_a_string_field_takes_the_text_as_it_is() -> None:
+    """A run named after a swept value: `name=2024-lab` had been malformed JSON, `name=0.5`
+    a number where a string belongs."""
+    data = {"name": "x", "seed": 0}
+    apply(data, ["name=2024-lab"])
+    assert data["name"] == "2024-lab"
+    apply(data, ["name=0.5", "seed=7"])
+    assert data == {"name": "0.5", "seed": 7}
+
+
+def test_a_field_its_own_flag_gives_is_refused() -> None:
+    with pytest.raises(OverrideError, match=r"--set seed=3: seed is given by --seed too"):
+        apply({"seed": 0}, ["seed=3"], flagged={"seed": "--seed"})
+    with pytest.raises(OverrideError, match=r"--duration too"):
+        prepare(RunOptions(duration_s=2.0, sets=("duration_s=3",)))
+
+
 def test_a_run_takes_the_changed_scenario_and_checks_it_whole() -> None:
     world = prepare(RunOptions(sets=("water.current.velocity_mps=[0.5,0]", "name=lab3")))
     assert world.scenario.name == "lab3"
     assert world.scenario.water.current.velocity_mps == (0.5, 0.0)
     with pytest.raises(ScenarioError, match=r"with --set water\.current=fast: water\.current"):
         prepare(RunOptions(sets=("water.current=fast",)))
+
+
+def test_a_sensor_param_the_file_left_to_its_default_can_be_set() -> None:
+    """A radar sweep over range_m was refused ("its fields: ") unless the file listed it:
+    params hold only what the file gave; the sensor type's model checks the key."""
+    radar = {"name": "radar", "type": "radar", "rate_hz": 10.0, "params": {}}
+    camera = {"name": "cam", "type": "camera", "rate_hz": 10.0, "params": {}}
+    data = {"vessels": [{"id": "ego", "sensors": [radar, camera]}]}
+    apply(data, ["vessels.0.sensors.0.params.range_m=300",
+                 "vessels.0.sensors.1.params.outputs.depth=false"])  # fmt: skip
+    assert data["vessels"][0]["sensors"][0]["params"] == {"range_m": 300}
+    assert data["vessels"][0]["sensors"][1]["params"] == {"outputs": {"depth": False}}
+    gps = prepare(RunOptions(sets=("vessels.0.sensors.1.params.horizontal_sigma=2.5",)))
+    assert gps.scenario.vessels[0].sensors[1].typed_params().horizontal_sigma == 2.5
+    with pytest.raises(ScenarioError, match=r"params\.horizontal_sigm: unknown field \(allowed"):
+        prepare(RunOptions(sets=("vessels.0.sensors.1.params.horizontal_sigm=1",)))

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import re
 from typing import Any
 
 import pytest
@@ -38,3 +39,21 @@ def test_the_ppi_persists_a_turn_and_a_half_unless_told() -> None:
     assert radar.typed_params().fade == 3.75
     (radar,) = parse_scenario(_radar(10.0, fade_s=0.5)).vessels[0].sensors
     assert radar.typed_params().fade == 0.5
+
+
+@pytest.mark.parametrize(
+    ("params", "message"),
+    [
+        ({"elevations_deg": [-5, 0]}, "elevations_deg: -5 is not 0-60 deg"),
+        ({"elevations_deg": []}, "elevations_deg: needs at least 1 item"),
+        ({"fan_target_height_m": 5}, "fan_target_height_m: 5 m is not below the antenna (3 m)"),
+        ({"fan_min_range_m": 300}, "fan_min_range_m: 300 m is not within range_m (250 m)"),
+        ({"range_m": 1e9}, "range_m: must be <= 100000"),
+    ],
+)
+def test_radar_geometry_the_descriptions_gave_is_checked(
+    params: dict[str, Any], message: str
+) -> None:
+    """Each had run without a word (a fan above the antenna silently turned the fan off)."""
+    with pytest.raises(ScenarioError, match=re.escape(message)):
+        parse_scenario(_radar(10.0, **params))

@@ -33,3 +33,35 @@ def test_a_service_that_lost_the_stopped_conductor_is_not_blamed(
 def test_a_real_failure_or_a_lost_clock_once_ticking_is_still_blamed(tmp_path: Path) -> None:
     assert _end(tmp_path, {"recorder": 2}) == 1  # its own error, not the interrupt
     assert _end(tmp_path, {"recorder": EXIT_CLOCK}, ticks_done=40) == 1  # the run had started
+
+
+def test_a_start_that_failed_is_a_fault_and_the_services_stopped_after_it_are_not_blamed(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """A stack that died before tick 0: run.json's reason was "" (a sweep testing for
+    "fault" missed it) and every service stopped after it read as failed with 143."""
+    (tmp_path / "log").mkdir()
+    codes = {"physics": 143, "recorder": 143, "stack": 2}
+    result = {"error": "stack: the program my.py ended (exit code 2)"}
+    assert summarise(SCENARIO, tmp_path, result, 1, codes, after_fault={"physics", "recorder"})
+    err = capsys.readouterr().err
+    assert "physics: stopped by catabot run after the fault" in err
+    assert "physics: exit code" not in err and "stack: exit code 2" in err
+    assert json.loads((tmp_path / "log" / "run.json").read_text())["reason"] == "fault"
+
+
+def test_run_json_says_what_produced_the_run(tmp_path: Path) -> None:
+    """A sweep's table had to join three files to label a row with its seed, and nothing
+    said which code or program produced the bytes."""
+    program = tmp_path / "stack.py"
+    program.write_text("print('hi')\n")
+    scenario = parse_scenario({"name": "p", "seed": 7, "vessels": [{"id": "ego", "controller": {
+        "participant": "stack", "program": str(program)}}]})  # fmt: skip
+    (tmp_path / "log").mkdir()
+    summarise(scenario, tmp_path, {"reason": "completed", "ticks_done": 1}, 0, {})
+    record = json.loads((tmp_path / "log" / "run.json").read_text())
+    assert (record["scenario"], record["seed"], record["command"][0]) == ("p", 7, "catabot")
+    assert record["catabot_version"] == "0.1.0" and len(record["git_commit"]) in (0, 40, 46)
+    digest = "2e4f7bf0a6ac1f19b2ba0a2dbfcaec4b7c6d3fe2f8a1b2a04b0bf3bb16b0c5b0"
+    assert record["programs"]["stack"]["path"] == str(program)
+    assert len(record["programs"]["stack"]["sha256"]) == len(digest)

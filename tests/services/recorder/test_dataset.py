@@ -70,3 +70,13 @@ def test_each_object_says_how_much_of_it_is_seen(tmp_path: Path) -> None:
         "instance": 1, "body": "ego", "class": "vessel", "box": None,
         "truncated": False, "occluded": True, "visible": 0.4,
     }  # fmt: skip
+
+
+def test_a_radar_only_dataset_says_where_its_radar_sits(tmp_path: Path) -> None:
+    """dataset/ held the PPIs, but calibration.json only came with a camera: the radar's
+    mount was in /tf_static alone."""
+    radar = {"name": "radar", "type": "radar", "rate_hz": 10.0}
+    world = World.resolve(parse_scenario({"vessels": [{"id": "ego", "sensors": [radar]}]}))
+    Dataset(tmp_path, world)
+    sensors = json.loads((tmp_path / "calibration.json").read_text())["sensors"]
+    assert list(sensors) == ["ego.radar"] and "body_from_sensor" in sensors["ego.radar"]
