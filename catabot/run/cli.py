@@ -142,7 +142,7 @@ def _scenario(args: argparse.Namespace) -> int:
     if args.file is not None and _is_model(Path(args.file)):
         return answered("scenario validate", lambda: _valid_model(args.file))
     try:  # what `catabot run` checks before it starts anything, no less
-        world = launcher.prepare(launcher.RunOptions(scenario=args.file))
+        world = launcher.prepare(launcher.RunOptions(scenario=args.file, sets=tuple(args.set)))
     except CataBotError as exc:
         print(f"catabot scenario validate: {exc}", file=sys.stderr)
         return 2
@@ -242,6 +242,8 @@ def parser() -> argparse.ArgumentParser:
     scen.add_argument("action", choices=["schema", "model-schema", "validate", "generate"])
     scen.add_argument("file", nargs="?", help="scenario to validate")
     scen.add_argument("--output", "-o", help="write the schema (or generated scenario) here")
+    scen.add_argument("--set", action="append", default=[], metavar="FIELD=VALUE",
+                      help="validate: with these changes, as catabot run --set")  # fmt: skip
     add_generate_arguments(scen)
     for name, (_, text) in [*TOOLS.items(), *LIVE.items(), *DEPLOY.items()]:
         sub.add_parser(name, help=text, add_help=False)

@@ -149,6 +149,15 @@ def test_a_run_says_it_waits_for_a_stack_started_outside_it(tmp_path: Path) -> N
     assert "0 ticks" in done.stdout and "ego:" not in done.stdout  # no metrics of 0 ticks
 
 
+def test_validate_checks_a_sweeps_changes_before_any_run(
+    capsys: pytest.CaptureFixture[str],
+) -> None:
+    """A sweep's grid, checked whole before its first run starts."""
+    assert main(["scenario", "validate", "--set", "seed=3", "--set", "name=lab3"]) == 0
+    assert main(["scenario", "validate", "--set", "water.current=3"]) == 2
+    assert "with --set water.current=3: water.current: must be an object" in capsys.readouterr().err
+
+
 def test_validate_notes_a_participant_given_two_vessels(
     tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
