@@ -1,4 +1,5 @@
-"""`catabot plot RUN_FOLDER [-o OUT_DIR]`: PNG figures and `report.html` of a recorded run.
+"""`catabot plot RUN_FOLDER [-o OUT_DIR]`: PNG figures and `report.html` of a recorded run;
+`catabot plot RUN RUN ...`: their scenario vessels compared (compare.py).
 
 Trajectories over the terrain with the traffic and buoys, speed and heading, thrust and
 twist commands, IMU series, LiDAR returns and rain returns against the rain rate, and the
@@ -14,7 +15,7 @@ from pathlib import Path
 
 from catabot.run.answer import OneLineParser, answered
 from catabot.run.recorded import RecordedRun
-from services.plots import report, series
+from services.plots import compare, report, series
 from services.plots.figures import FIGURES
 
 PNG = {"Software": None}  # no version string: the same run gives the same bytes
@@ -22,8 +23,10 @@ PNG = {"Software": None}  # no version string: the same run gives the same bytes
 
 def parser() -> argparse.ArgumentParser:
     p = OneLineParser(prog="catabot plot", description=__doc__.split("\n")[0])
-    p.add_argument("run", help="the run folder (runs/<world>-<time>)")
-    p.add_argument("--output", "-o", help="folder for the PNGs and report.html")
+    p.add_argument("run", nargs="+", help="the run folder (runs/<world>-<time>); several: "
+                   "their scenario vessels compared on one set of axes")  # fmt: skip
+    p.add_argument("--output", "-o", help="folder for the PNGs and report.html (compared: "
+                   "compare.html; default RUN/plots, or the first RUN's compare/)")  # fmt: skip
     return p
 
 
@@ -41,9 +44,25 @@ def plot(run_folder: str, out: Path | None) -> Path:
     return out
 
 
+def plot_compared(folders: list[str], out: Path | None) -> Path:
+    runs = [series.read(RecordedRun(f), full=False) for f in folders]
+    out = out or runs[0].run.folder / "compare"
+    out.mkdir(parents=True, exist_ok=True)
+    files = {}
+    for name, fig in compare.figures(runs).items():
+        fig.savefig(out / f"{name}.png", metadata=PNG)
+        files[name] = f"{name}.png"
+    compare.report(out / "compare.html", runs, files)
+    return out
+
+
 def main(argv: list[str] | None = None) -> int:
     args = parser().parse_args(argv)
-    return answered("plot", lambda: f"plots and report.html in {plot(args.run, _out(args.output))}")
+    out = _out(args.output)
+    if len(args.run) > 1:
+        where = lambda: f"{len(args.run)} runs compared in {plot_compared(args.run, out)}"  # noqa: E731
+        return answered("plot", where)
+    return answered("plot", lambda: f"plots and report.html in {plot(args.run[0], out)}")
 
 
 def _out(output: str | None) -> Path | None:

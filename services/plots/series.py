@@ -46,7 +46,9 @@ class RunSeries:
     metrics: dict[str, Any] | None = None
 
 
-def read(run: RecordedRun) -> RunSeries:
+def read(run: RecordedRun, *, full: bool = True) -> RunSeries:
+    """`full`: the commands and sensors too (one run's plots); without, the states alone
+    (runs compared)."""
     states = run.states()
     own = [v.id for v in run.world.scenario.vessels]
     out = RunSeries(run, states, states.stamp_ns / 1e9, own, metrics=run.metrics())
@@ -57,8 +59,9 @@ def read(run: RecordedRun) -> RunSeries:
         out.speed[vid] = np.hypot(states.twist[:, row, 0], states.twist[:, row, 1])
         out.heading[vid] = (90.0 - np.degrees(yaw[:, k])) % 360.0
     out.closest = closest_approach(states.position[:, : len(run.world.vessels), :2])
-    _commands(run, out)
-    _sensors(run, out)
+    if full:
+        _commands(run, out)
+        _sensors(run, out)
     return out
 
 

@@ -174,15 +174,8 @@ def test_plot_writes_figures_and_a_report(run: Path, tmp_path: Path) -> None:
     assert result.returncode == 0, result.stderr
     pngs = sorted((tmp_path / "plots").glob("*.png"))
     names = {p.stem for p in pngs}
-    assert names == {
-        "trajectories",
-        "trajectories_own",
-        "speed_heading",
-        "thrust",
-        "imu",
-        "lidar_rain",
-        "metrics",
-    }  # fmt: skip (own: the traffic spreads the view)
+    figures = "trajectories trajectories_own speed_heading thrust imu lidar_rain metrics"
+    assert names == set(figures.split())  # _own: the traffic spreads the first view
     for png in pngs:
         with Image.open(png) as image:
             pixels = np.asarray(image.convert("L"))
@@ -193,6 +186,10 @@ def test_plot_writes_figures_and_a_report(run: Path, tmp_path: Path) -> None:
     again = catabot("plot", str(run), "-o", str(tmp_path / "again"))
     assert again.returncode == 0
     assert files_of(tmp_path / "plots", ("*",)) == files_of(tmp_path / "again", ("*",))
+    both = catabot("plot", str(run), str(run), "-o", str(tmp_path / "cmp"))  # runs compared
+    assert both.returncode == 0 and "2 runs compared in" in both.stdout, both.stderr
+    page = (tmp_path / "cmp" / "compare.html").read_text()
+    assert page.count(f"<td>{run.name}</td><td>ego</td>") == 2 and "compare_trajectories" in page
 
 
 @pytest.mark.parametrize(

@@ -59,7 +59,7 @@ def test_a_radar_antenna_below_its_shapes_top_is_refused_and_an_imu_is_not(
 ) -> None:
     """Inside the cabin, or between a catamaran's hulls (not inside the shape, yet 205 of
     240 beams hit its own hulls there)."""
-    params = {"antenna_height_m": height}
+    params = {"antenna_height_m": height, "fan_target_height_m": 0.0}  # no fan: a mount test
     radar = {"name": "r", "type": "radar", "rate_hz": 10.0, "params": params}
     said = f"antenna_height_m {height:g} is not above ego's own shape \\(model '{model}'"
     with pytest.raises(MountInsideError, match=said):

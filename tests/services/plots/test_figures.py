@@ -3,6 +3,7 @@ vessels' tasks, the boats' numbers."""
 
 from __future__ import annotations
 
+from pathlib import Path
 from types import SimpleNamespace
 
 import matplotlib.pyplot as plt
@@ -11,6 +12,7 @@ from matplotlib.patches import Circle
 
 from catabot.config.load import parse_scenario
 from catabot.world.world import World
+from services.plots.compare import run_labels
 from services.plots.figures import (
     _boat_names,
     _changes,
@@ -113,3 +115,13 @@ def test_setting_changes_are_marked_where_they_took_effect() -> None:
     assert list(line.get_xdata()) == [5.5, 5.5]
     assert [t.get_text() for t in ax.texts] == ["current = [0.0, -1.0]"]
     plt.close(fig)
+
+
+def test_compared_runs_are_named_by_what_differs_from_the_first() -> None:
+    """Two lab runs differ in their current: the legend says so, not only their folders."""
+    calm = {"name": "lab", "vessels": [{"id": "ego", "script": [{"t_s": 0, "thrust": [1, 1]}]}]}
+    drift = {**calm, "water": {"current": {"velocity_mps": [0.0, 0.5]}}}
+    runs = [SimpleNamespace(run=SimpleNamespace(folder=Path(f"runs/{n}"),
+                                                world=World.resolve(parse_scenario(d))))
+            for n, d in (("a", calm), ("b", drift))]  # fmt: skip
+    assert run_labels(runs) == ["a", "b (water.current.velocity_mps=[0.0, 0.5])"]  # type: ignore[arg-type]
