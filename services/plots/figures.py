@@ -287,16 +287,18 @@ def metrics(data: RunSeries) -> Figure | None:
     gap, bars = _axes(fig)
     finite = np.isfinite(data.closest)
     if finite.any():
-        gap.plot(data.t, data.closest, color="#1f77b4")
+        gap.plot(data.t, data.closest, color="#1f77b4", label="any two vessels")
         k = int(np.nanargmin(np.where(finite, data.closest, np.nan)))
         gap.plot(data.t[k], data.closest[k], "v", color="red",
                  label=f"minimum {data.closest[k]:.2f} m at {data.t[k]:.1f} s")  # fmt: skip
+        for k, (pair, apart) in enumerate(data.pairs.items()):
+            gap.plot(data.t, apart, lw=0.9, ls="--", color=_color(k), label=pair)
         gap.legend(fontsize=8)
     else:  # one vessel alone: an empty 0..1 panel read as a plot gone wrong
         gap.text(0.5, 0.5, "one vessel: no pair to measure", ha="center", va="center",
                  transform=gap.transAxes, color="gray")  # fmt: skip
-    gap.set(title="Closest approach between two vessels", xlabel="simulated time [s]",
-            ylabel="distance [m]")  # fmt: skip
+    gap.set(title="Closest approach between two vessels (dashed: own pairs)",
+            xlabel="simulated time [s]", ylabel="distance [m]")  # fmt: skip
     gap.grid(alpha=0.3)
     vessels = (data.metrics or {}).get("vessels", {})
     shown = [v for v in data.own if v in vessels]

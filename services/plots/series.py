@@ -39,6 +39,7 @@ class RunSeries:
     speed: dict[str, F64] = field(default_factory=dict)
     heading: dict[str, F64] = field(default_factory=dict)
     closest: F64 = field(default_factory=lambda: np.empty(0))
+    pairs: dict[str, F64] = field(default_factory=dict)  # "a-b": two own vessels' distance
     thrust: dict[str, Series] = field(default_factory=dict)
     setpoint: dict[str, Series] = field(default_factory=dict)
     imu: dict[str, Series] = field(default_factory=dict)
@@ -59,10 +60,21 @@ def read(run: RecordedRun, *, full: bool = True) -> RunSeries:
         out.speed[vid] = np.hypot(states.twist[:, row, 0], states.twist[:, row, 1])
         out.heading[vid] = (90.0 - np.degrees(yaw[:, k])) % 360.0
     out.closest = closest_approach(states.position[:, : len(run.world.vessels), :2])
+    out.pairs = own_pairs(states.position[:, rows, :2], own)
     if full:
         _commands(run, out)
         _sensors(run, out)
     return out
+
+
+def own_pairs(xy: F64, own: list[str], most: int = 6) -> dict[str, F64]:
+    """Each pair of the scenario's own vessels (a fleet of up to `most`): their distance over
+    time, beside the closest approach of any two, which flattens after one pile-up."""
+    if not 2 <= len(own) <= most:
+        return {}
+    i, j = np.triu_indices(len(own), k=1)
+    gaps = np.linalg.norm(xy[:, i] - xy[:, j], axis=-1)  # (T, pairs)
+    return {f"{own[a]}-{own[b]}": gaps[:, k] for k, (a, b) in enumerate(zip(i, j, strict=True))}
 
 
 def closest_approach(xy: F64) -> F64:

@@ -22,7 +22,7 @@ from services.plots.figures import (
     _view,
     rain_steps,
 )
-from services.plots.series import _thruster_names
+from services.plots.series import _thruster_names, own_pairs
 
 
 def test_the_rain_rate_follows_the_settings_timeline() -> None:
@@ -125,3 +125,15 @@ def test_compared_runs_are_named_by_what_differs_from_the_first() -> None:
                                                 world=World.resolve(parse_scenario(d))))
             for n, d in (("a", calm), ("b", drift))]  # fmt: skip
     assert run_labels(runs) == ["a", "b (water.current.velocity_mps=[0.0, 0.5])"]  # type: ignore[arg-type]
+
+
+def test_each_pair_of_own_vessels_has_its_distance() -> None:
+    """The closest approach of any two flattened after a pile-up: a fleet's pairs apart."""
+    xy = np.zeros((2, 3, 2))
+    xy[:, 1, 0], xy[:, 2, 1] = [3.0, 6.0], [4.0, 8.0]
+    pairs = own_pairs(xy, ["a", "b", "c"])
+    assert {k: v.tolist() for k, v in pairs.items()} == {
+        "a-b": [3.0, 6.0], "a-c": [4.0, 8.0], "b-c": [5.0, 10.0]}  # fmt: skip
+    assert (
+        own_pairs(xy[:, :1], ["a"]) == {} and own_pairs(np.zeros((2, 7, 2)), list("abcdefg")) == {}
+    )
