@@ -172,7 +172,30 @@ _TYPES = {
 
 def explain(exc: ValidationError, *, model: type[BaseModel], where: str = "") -> str:
     """One line per problem, joined by '; ': `path.to.field: rule (got value)`."""
-    return "; ".join(describe(err, model=model, where=where) for err in exc.errors())
+    lines = [describe(err, model=model, where=where) for err in _short_tuples(exc.errors())]
+    return "; ".join(dict.fromkeys(lines))
+
+
+def _short_tuples(errors: list[Any]) -> list[Any]:
+    """A vector given too few values is one problem ("needs 3 values, got 2"), not one
+    "required field missing" per absent index (`antenna_offset.2`)."""
+    out: list[Any] = []
+    wanted: dict[tuple[Any, ...], int] = {}
+    for err in errors:
+        loc, got = err["loc"], err.get("input")
+        if (
+            err["type"] == "missing"
+            and loc
+            and isinstance(loc[-1], int)
+            and isinstance(got, list | tuple)
+        ):
+            wanted[loc[:-1]] = max(wanted.get(loc[:-1], 0), loc[-1] + 1)
+            err = {**err, "loc": loc[:-1], "type": "short_vector", "ctx": {"got": len(got)}}
+        out.append(err)
+    for err in out:
+        if err["type"] == "short_vector":
+            err["ctx"]["wanted"] = wanted[err["loc"]]
+    return out
 
 
 def describe(err: Any, *, model: type[BaseModel], where: str = "") -> str:
@@ -185,6 +208,8 @@ def describe(err: Any, *, model: type[BaseModel], where: str = "") -> str:
     shown = "" if isinstance(got, dict | list) else f" (got {_short(got)})"
     if kind == "missing":
         return f"{path}: required field missing"
+    if kind == "short_vector":
+        return f"{path}: needs {ctx['wanted']} values, got {ctx['got']}"
     if kind == "extra_forbidden":
         allowed = ctx.get("allowed") or ", ".join(_allowed_fields(model, err["loc"][:-1]))
         return f"{path}: unknown field (allowed: {allowed})"

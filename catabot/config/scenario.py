@@ -97,7 +97,12 @@ class SensorConfig(Strict):
         json_schema_extra={"enum": list(SENSOR_TYPES)},
     )
     rate_hz: float = Field(gt=0)
-    noise: StrictBool = True
+    noise: StrictBool = Field(
+        True,
+        description="false: an ideal sensor, without its random noise and biases (IMU noise and "
+        "bias, GPS noise, LiDAR and radar range noise); the world's effects stay (rain, "
+        "occlusion, the blind zones)",
+    )
     params: dict[str, Any] = Field({}, description="the type's parameters (defaults if empty)")
 
     @field_validator("type")

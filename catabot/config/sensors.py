@@ -42,16 +42,20 @@ class ImuParams(SensorParams):
     accel_sigma: float = Field(0.021, ge=0, description="m/s^2, white noise per sample")
     gyro_bias_instability: float = Field(0.0008, ge=0, description="rad/s, Gauss-Markov bias")
     accel_bias_instability: float = Field(0.004, ge=0, description="m/s^2, Gauss-Markov bias")
-    bias_tau_s: float = Field(300.0, gt=0)
+    bias_tau_s: float = Field(300.0, gt=0, description="s, the biases' correlation time")
     gyro_random_walk: float = Field(0.0, ge=0, description="rad/s/sqrt(s)")
     accel_random_walk: float = Field(0.0, ge=0, description="m/s^2/sqrt(s)")
-    lever_arm: Vec3 = (0.0, 0.0, 0.0)
+    lever_arm: Vec3 = Field(
+        (0.0, 0.0, 0.0), description="m, the IMU from the body origin (body frame, FLU)"
+    )
 
 
 class GpsParams(SensorParams):
     horizontal_sigma: float = Field(0.5, ge=0, description="m, per axis")
     vertical_sigma: float = Field(1.0, ge=0, description="m")
-    antenna_offset: Vec3 = (0.0, 0.0, 0.0)
+    antenna_offset: Vec3 = Field(
+        (0.0, 0.0, 0.0), description="m, the antenna from the body origin (body frame, FLU)"
+    )
     method: Literal["wgs84", "paper_table"] = "wgs84"
     altitude: Literal["local", "ellipsoid"] = Field(
         "local",

@@ -57,3 +57,11 @@ def test_radar_geometry_the_descriptions_gave_is_checked(
     """Each had run without a word (a fan above the antenna silently turned the fan off)."""
     with pytest.raises(ScenarioError, match=re.escape(message)):
         parse_scenario(_radar(10.0, **params))
+
+
+def test_a_vector_given_too_few_values_is_one_problem() -> None:
+    """`antenna_offset.2: required field missing` read as a missing field named 2."""
+    gps = {"name": "gps", "type": "gps", "rate_hz": 10.0, "params": {"antenna_offset": [1.0]}}
+    with pytest.raises(ScenarioError) as info:
+        parse_scenario({"vessels": [{"id": "ego", "sensors": [gps]}]})
+    assert str(info.value).endswith("params.antenna_offset: needs 3 values, got 1")
