@@ -97,12 +97,8 @@ class SensorConfig(Strict):
         json_schema_extra={"enum": list(SENSOR_TYPES)},
     )
     rate_hz: float = Field(gt=0)
-    noise: StrictBool = Field(
-        True,
-        description="false: an ideal sensor, without its random noise and biases (IMU noise and "
-        "bias, GPS noise, LiDAR and radar range noise); the world's effects stay (rain, "
-        "occlusion, the blind zones)",
-    )
+    noise: StrictBool = Field(True, description="false: ideal, without its random noise and "
+                              "biases; the world's effects stay (rain, occlusion)")  # fmt: skip
     params: dict[str, Any] = Field({}, description="the type's parameters (defaults if empty)")
 
     @field_validator("type")

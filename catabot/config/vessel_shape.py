@@ -3,7 +3,7 @@ see of the vessel, as opposed to its buoyancy hulls (what floats it) and its hul
 physics collides).
 
 A model names its shape in one of two ways:
-- `{"mesh": {"file": "boat.obj", "scale": 0.01, "rpy_deg": [90, 0, 0], "offset_m": [0, 0, -0.2]}}`:
+- `{"mesh": {"file": "boat.obj", "scale": 0.01, "rpy_deg": [90, 0, 90], "offset_m": [0, 0, -0.2]}}`:
   a triangle mesh file (OBJ, STL or glTF, read by open3d), its path relative to the model
   file; a vertex v of the file is placed at R(rpy) (scale * v) + offset in the body frame
   (FLU); R turns by roll about x, then pitch about y, then yaw about z, in degrees. glTF
@@ -24,7 +24,7 @@ from __future__ import annotations
 
 from typing import Annotated, Any, Literal
 
-from pydantic import BeforeValidator, Field, field_validator, model_validator
+from pydantic import BeforeValidator, Field, WithJsonSchema, field_validator, model_validator
 from pydantic.types import FiniteFloat
 
 from catabot.config.base import FieldProblem, Strict
@@ -53,9 +53,15 @@ Vec3 = Annotated[tuple[FiniteFloat, FiniteFloat, FiniteFloat], _three("[x, y, z]
 Size3 = Annotated[
     tuple[PositiveFloat, PositiveFloat, PositiveFloat], _three("[length x, width y, height z]")
 ]
+_POSITIVE = {"type": "number", "exclusiveMinimum": 0}
 Scale3 = Annotated[
-    tuple[PositiveFloat, PositiveFloat, PositiveFloat], _three("[x, y, z]", number_ok=True)
-]
+    tuple[PositiveFloat, PositiveFloat, PositiveFloat],
+    _three("[x, y, z]", number_ok=True),
+    WithJsonSchema({  # the schema said array only, and flagged the README's own example
+        "anyOf": [_POSITIVE, {"type": "array", "items": _POSITIVE, "minItems": 3, "maxItems": 3}],
+        "description": "one factor for every axis (0.001: a file in millimetres), or [x, y, z]",
+    }),
+]  # fmt: skip
 Rpy3 = Annotated[tuple[FiniteFloat, FiniteFloat, FiniteFloat], _three("[roll, pitch, yaw]")]
 
 

@@ -22,6 +22,7 @@ from catabot.run.answer import OneLineParser, answered, output_file
 from catabot.run.companions import VIEW_MODES
 from catabot.run.generate import add_arguments as add_generate_arguments
 from catabot.run.generate import generate
+from catabot.world.model_checks import displacement, model_notes
 
 
 def _run(args: argparse.Namespace) -> int:
@@ -168,12 +169,17 @@ def _is_model(path: Path) -> bool:
 
 
 def _valid_model(file: str) -> str:
+    """Valid, with what its figures imply (model_checks.py): a designer's unit slips pass
+    every field's own limit."""
     model = load_vessel_model(str(Path(file).resolve()))
-    sinks = model.sinks_in(WaterConfig().density_kg_m3)  # a scenario's water: with it
+    density = WaterConfig().density_kg_m3  # a scenario's water: with it
+    sinks = model.sinks_in(density)
     if sinks:
         raise VesselModelError(f"vessel model {file!r} {sinks}")
+    notes = "".join(f"\nnote: {n}" for n in model_notes(model, source=file))
     return (f"{file}: a valid vessel model {model.name!r} ({model.mass_kg:g} kg, "
-            f"{len(model.hulls)} hull(s), {len(model.thrusters)} thruster(s))")  # fmt: skip
+            f"{len(model.hulls)} hull(s), {len(model.thrusters)} thruster(s)); "
+            f"{displacement(model, density)}{notes}")  # fmt: skip
 
 
 def parser() -> argparse.ArgumentParser:

@@ -57,9 +57,14 @@ class Reach:
                     "compare the recorded state with the twist (said once a vessel)")  # fmt: skip
 
     def beyond(self, vessel: str, surge: float, yaw_rate: float) -> bool:
-        """Whether holding the set-point in steady state needs more than the thrusters give."""
+        """Whether holding the set-point in steady state needs more than the thrusters give:
+        more force than they have, or a force they cannot make at all (one thruster on the
+        centreline turns nothing: its yaw request had vanished without a word)."""
         control = self.control[vessel]
-        return control.allocate(control.feed_forward(np.array([surge, yaw_rate])))[1]
+        wrench = control.feed_forward(np.array([surge, yaw_rate]))
+        forces, scaled = control.allocate(wrench)
+        made = control.alloc @ forces
+        return scaled or not np.allclose(made, wrench, rtol=1e-6, atol=1e-6)
 
 
 def _most(holds: Callable[[float], bool], goal: float) -> float:

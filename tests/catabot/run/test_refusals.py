@@ -181,6 +181,11 @@ def test_the_vessel_model_schema_checks_every_bundled_model(tmp_path: Path) -> N
         jsonschema.validate(json.loads((BUNDLED_VESSELS / f"{name}.json").read_text()), schema)
     with pytest.raises(jsonschema.ValidationError, match="mass_kg"):
         jsonschema.validate({"name": "x", "hulls": []}, schema)
+    shape = {"mesh": {"file": "boat.obj", "scale": 0.01}}  # the README's: one factor
+    model = json.loads((BUNDLED_VESSELS / "catabot.json").read_text()) | {"shape": shape}
+    jsonschema.validate(model, schema)
+    with pytest.raises(jsonschema.ValidationError):
+        jsonschema.validate(model | {"shape": {"mesh": {"file": "b.obj", "scale": [1, 2]}}}, schema)
 
 
 def test_validate_checks_a_vessel_model_file_as_one(

@@ -79,3 +79,19 @@ def test_a_set_point_beyond_only_in_combination_says_so(caplog: pytest.LogCaptur
         reach.heard("c", [TwistCmd(surge=1.42, yaw_rate=-0.18)])
     (said,) = _advice(caplog)
     assert "is beyond its thrusters together: a turn takes thrust from the speed (" in said
+
+
+def test_a_turn_a_single_centreline_thruster_cannot_make_is_told(
+    caplog: pytest.LogCaptureFixture,
+) -> None:
+    """One outboard on the centreline: a twist's yaw rate vanished in the allocation, the
+    boat went straight, and nothing was said (the request was never scaled, only lost)."""
+    model = load_vessel_model("catabot")
+    one = model.thrusters[0].model_copy(update={"position_m": (-0.9, 0.0, -0.1)})
+    body = SimpleNamespace(id="ego", model=model.model_copy(update={"thrusters": [one]}), script=())
+    reach = Reach([body], [TwistController(body.model, dt_s=0.01)])  # type: ignore[list-item]
+    assert not reach.beyond("ego", 0.5, 0.0) and reach.beyond("ego", 0.5, 0.1)
+    with caplog.at_level(logging.WARNING):
+        reach.heard("ego", [TwistCmd(surge=0.5, yaw_rate=0.1)])
+    (said,) = _advice(caplog)
+    assert "is beyond its thrusters" in said and "0.00 rad/s turning in place" in said
