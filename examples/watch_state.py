@@ -7,6 +7,7 @@ python examples/watch_state.py --connect tcp/127.0.0.1:7447 --vessel ego --count
 
 import itertools
 import queue
+import time
 
 import zenoh
 from common import clear_errors, keys, parser, session
@@ -14,6 +15,8 @@ from common import clear_errors, keys, parser, session
 from catabot.bus import codec
 from catabot.bus.clock import CONDUCTOR
 from catabot.bus.messages import End, VesselState
+
+GRACE_S = 2.0  # the conductor's End may come after its token has gone: wait for it this long
 
 
 def show(state: VesselState) -> None:
@@ -34,12 +37,17 @@ def main() -> None:
         s.declare_subscriber(k.end(), got.put)
         gone = k.live(CONDUCTOR, "*")  # its token goes when it dies without an end
         s.liveliness().declare_subscriber(gone, got.put)
-        shown = 0
+        shown, gone_at = 0, None
         for n in itertools.count():
-            sample = got.get()
-            if sample.kind == zenoh.SampleKind.DELETE:
+            try:
+                wait = None if gone_at is None else max(gone_at + GRACE_S - time.monotonic(), 0)
+                sample = got.get(timeout=wait)
+            except queue.Empty:
                 print("the conductor left without ending the run")
                 return
+            if sample.kind == zenoh.SampleKind.DELETE:
+                gone_at = time.monotonic()
+                continue
             if str(sample.key_expr) == k.end():
                 end = codec.decode(sample.payload.to_bytes(), End)
                 print(f"the run ended at tick {end.tick} ({end.error or end.reason})")
