@@ -15,6 +15,7 @@ from typing import Any
 from matplotlib.figure import Figure
 
 from catabot.run.metrics_summary import vessel_parts
+from services.plots.figures import speed_heading_axes
 from services.plots.series import RunSeries
 
 STYLES = ["-", "--", ":", "-."]
@@ -76,12 +77,7 @@ def _speed_heading(runs: list[RunSeries], labels: list[str]) -> Figure:
             style = dict(color=COLORS[k % len(COLORS)], label=f"{label}: {vid}")
             speed.plot(data.t, data.speed[vid], STYLES[j % len(STYLES)], **style)
             heading.plot(data.t, data.heading[vid], ".", ms=1.5, **style)
-    speed.set(ylabel="speed over ground [m/s]", title="Speed and heading")
-    heading.set(ylabel="heading [deg from north, clockwise]", xlabel="simulated time [s]",
-                ylim=(0, 360), yticks=range(0, 361, 90))  # fmt: skip
-    for ax in (speed, heading):
-        ax.grid(alpha=0.3)
-    speed.legend(fontsize=7)
+    speed_heading_axes(speed, heading)
     return fig
 
 

@@ -164,15 +164,21 @@ def speed_heading(data: RunSeries) -> Figure | None:
     for k, vid in enumerate(data.own):
         speed.plot(data.t, data.speed[vid], color=_color(k), label=vid)
         heading.plot(data.t, data.heading[vid], ".", ms=2, color=_color(k), label=vid)
+    speed_heading_axes(speed, heading)
+    heading.legend(fontsize=8)
+    _changes(speed, data.run.world.scenario)
+    _changes(heading, data.run.world.scenario, labelled=False)
+    return fig
+
+
+def speed_heading_axes(speed: Axes, heading: Axes) -> None:
+    """The speed and heading panels' labels (one run's, or runs compared)."""
     speed.set(ylabel="speed over ground [m/s]", title="Speed and heading")
     heading.set(ylabel="heading [deg from north, clockwise]", xlabel="simulated time [s]",
                 ylim=(0, 360), yticks=range(0, 361, 90))  # fmt: skip
     for ax in (speed, heading):
         ax.grid(alpha=0.3)
-        ax.legend(fontsize=8)
-    _changes(speed, data.run.world.scenario)
-    _changes(heading, data.run.world.scenario, labelled=False)
-    return fig
+    speed.legend(fontsize=8)
 
 
 def _changes(ax: Axes, scenario: Scenario, *, labelled: bool = True) -> None:
