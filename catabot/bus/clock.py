@@ -207,27 +207,6 @@ class ClockLimits:
         return ""
 
 
-class Drops:
-    """From which tick each dropped participant counts as dropped: the same tick on every
-    participant. Why: a grant that names a newly dropped participant may reach a participant
-    that still has ticks of the previous grant to step, and what a step does about the drop
-    (physics hands the vessels the dropped stack drove back to their scripts, the recorder
-    writes it) must happen at one tick everywhere. Nobody can have stepped past the last
-    grant that did not name it (grants arrive in order), so it counts from the tick after."""
-
-    def __init__(self) -> None:
-        self.since: dict[str, int] = {}
-
-    def heard(self, dropped: tuple[str, ...], *, granted: int) -> tuple[str, ...]:
-        """A grant's dropped list, heard while `granted` was the last tick granted."""
-        for name in dropped:
-            self.since.setdefault(name, granted + 1)
-        return dropped
-
-    def at(self, tick: int) -> tuple[str, ...]:
-        return tuple(name for name, since in self.since.items() if since <= tick)
-
-
 class WorldMismatch(CataBotError):
     """This process and the conductor were started on different scenarios."""
 

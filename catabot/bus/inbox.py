@@ -141,6 +141,16 @@ class Inbox:
         """Stop waiting for streams of participants the conductor dropped."""
         self.dropped.update(names)
 
+    def stalled(self, producer: str) -> int | None:
+        """The first tick whose step waited for a sample of `producer` that never came (its
+        next due tag after the last one heard, through this consumer's lag); None if none of
+        its streams is clocked here. Why: a dropped stack's vessel is handed back from there,
+        a tick every run agrees on when the stack failed at one, where the grant the drop
+        came with depended on how fast the others had acked (5.2 or 5.4 s on two runs)."""
+        ticks = [_next_tag(s, self.latest[s.key]) + 1 + s.lag for s in self._clocked
+                 if s.producer == producer]  # fmt: skip
+        return min(ticks) if ticks else None
+
     def switch(self, key: str, tick: int, *, on: bool) -> None:
         """A stream's producer stops (or starts again) producing from tag `tick` on: a sensor
         switched at run time. Every participant learns it with the Tick of `tick`, before any
@@ -204,6 +214,14 @@ def _check_content(stream: Stream, msg: Message) -> None:
         stream.check(msg)
     except (ValueError, CataBotError) as exc:
         raise Rejected("invalid content", str(exc)) from None
+
+
+def _next_tag(s: Stream, last: int) -> int:
+    """The first tag after `last` at which `s` is due."""
+    assert s.period is not None
+    if last < s.phase:
+        return s.phase
+    return s.phase + ((last - s.phase) // s.period + 1) * s.period
 
 
 def _tick_of(msg: Message) -> int:

@@ -21,7 +21,7 @@ from collections.abc import Callable, Sequence
 import zenoh
 
 from catabot.bus import codec
-from catabot.bus.clock import CONDUCTOR, ClockError, ClockLimits, Drops, EndRun, Stream, end_reason
+from catabot.bus.clock import CONDUCTOR, ClockError, ClockLimits, EndRun, Stream, end_reason
 from catabot.bus.identity import Roster, sender_of
 from catabot.bus.inbox import Inbox, Inputs
 from catabot.bus.keys import Keys
@@ -70,8 +70,8 @@ class Participant(Outputs):
         self.rejections = Rejections(log, name)
         self.peers, self.drain_s = set(peers) - {name}, drain_s
         self._everyone = self.peers | {name}  # the peers a tick may name as dropped
-        self.next_tick, self._acked = 0, -1  # the next tick to step, the last tick acked
-        self.drops = Drops()  # who is dropped from which tick, the same on every participant
+        self.next_tick = 0
+        self._acked = -1  # the last tick acked
         self._ended = False  # asked the conductor to end the run: no more steps
         self._asked = False  # a repeated grant: ack progress as it comes from then on
         self._grant: Tick | None = None
@@ -197,7 +197,7 @@ class Participant(Outputs):
     def _tick_of(self, grant: Tick, k: int) -> Tick:
         stamp = grant.stamp_ns - (grant.tick - k) * grant.dt_ns
         changes = tuple(self._settings.pop(k, ()))
-        return Tick(grant.run, k, stamp, grant.dt_ns, self.drops.at(k), grant.ack_every, changes)
+        return Tick(grant.run, k, stamp, grant.dt_ns, grant.dropped, grant.ack_every, changes)
 
     def _next(self) -> Event:
         """The next event; an End may trail the conductor's token, so allow it a grace."""
@@ -271,7 +271,7 @@ class Participant(Outputs):
             raise Rejected("tick the clock cannot send", problem)
         for text in tick.settings:
             self._settings.setdefault(from_wire(text).tick, []).append(text)
-        self.inbox.drop_producers(self.drops.heard(tick.dropped, granted=self.granted))
+        self.inbox.drop_producers(tick.dropped)
         self.peers -= set(tick.dropped)  # a dropped peer that crashed will never be present
         if self._grant is None or self.next_tick > self._grant.tick:
             self._waiting_since = time.monotonic()  # it had run dry: a wait begins

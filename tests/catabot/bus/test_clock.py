@@ -6,7 +6,7 @@ import pytest
 
 from catabot.bus import checks, codec
 from catabot.bus import inbox as inbox_module
-from catabot.bus.clock import ClockError, Drops, Policy, Stream, period_in_ticks, ticks_for
+from catabot.bus.clock import ClockError, Policy, Stream, period_in_ticks, ticks_for
 from catabot.bus.identity import Roster
 from catabot.bus.inbox import Inbox
 from catabot.bus.keys import Keys
@@ -246,16 +246,19 @@ def test_dropped_producers_are_not_waited_for() -> None:
     assert inbox.missing(100) == []
 
 
-def test_a_drop_counts_from_the_first_tick_nobody_was_granted_when_it_was_heard() -> None:
-    """Every participant hears the grants in one order, so each finds the same tick, however
-    far it has stepped (physics and the recorder hand a dropped stack's vessel back there)."""
-    drops = Drops()
-    assert drops.heard((), granted=40) == () and drops.at(1000) == ()
-    assert drops.heard(("stack",), granted=52) == ("stack",)
-    drops.heard(("stack", "radar"), granted=60)  # a later grant: stack's tick is kept
-    assert (drops.at(52), drops.at(53), drops.at(60), drops.at(61)) == (
-        (), ("stack",), ("stack",), ("stack", "radar"),
-    )  # fmt: skip
+def test_a_dropped_producer_stalled_at_the_first_tick_that_waited_for_it() -> None:
+    """Where a dropped stack's vessel is handed back: a tick the samples alone decide, so a
+    stack failing at one tick is handed back at one tick on every run (the grant naming the
+    drop came at 5.2 s on one run and 5.4 s on another)."""
+    inbox = _inbox()
+    assert inbox.stalled("sensors") == 1  # nothing heard: tag 0 is due, tick 1 waits for it
+    _add(inbox, GPS, _gps(0))
+    _add(inbox, GPS, _gps(10))
+    assert inbox.stalled("sensors") == 21  # the next due tag is 20
+    lagged = Inbox([Stream(GPS, GpsFix, "sensors", 10, lag=3)], roster=Roster(ZIDS))
+    _add(lagged, GPS, _gps(0))
+    assert lagged.stalled("sensors") == 14  # read 3 ticks later
+    assert inbox.stalled("external") is None and inbox.stalled("nobody") is None  # not clocked
 
 
 def test_malformed_payloads_raise_and_leave_the_inbox_unchanged() -> None:
