@@ -28,6 +28,18 @@ class SettingsError(CataBotError, ValueError):
     """A change the clock cannot schedule (the run is ending, too many changes)."""
 
 
+def switch_key(vessel: str, sensor: str) -> str:
+    """The live key that switches a sensor off or on (ids and names hold no '.')."""
+    return f"sensor.{vessel}.{sensor}.enabled"
+
+
+def sensor_switch(key: str) -> tuple[str, str] | None:
+    """(vessel, sensor) a change of `key` switches; None for any other key."""
+    parts = key.split(".")
+    ok = len(parts) == 4 and parts[0] == "sensor" and parts[3] == "enabled"
+    return (parts[1], parts[2]) if ok else None
+
+
 @dataclass(frozen=True)
 class Change:
     tick: int

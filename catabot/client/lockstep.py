@@ -27,6 +27,7 @@ from catabot.bus.inbox import Inputs
 from catabot.bus.keys import Keys
 from catabot.bus.messages import BodyStates, End, Message, ThrustCmd, Tick, TwistCmd, VesselState
 from catabot.bus.participant import Participant, Stopped
+from catabot.bus.settings import changes_of, sensor_switch
 from catabot.client.commands import Command, Thrust, Twist, kind_of, message
 from catabot.client.errors import ClientError, CommandError, NoData, RunEnded
 from catabot.client.info import SensorInfo, VesselInfo, WorldInfo
@@ -82,6 +83,8 @@ class Joined:
         self.name, self.info, self.vessel, self.period = name, info, vessel, period
         self._watch = watch
         self._sensors = {s.key: s.name for s in sensors}
+        owner = vessel.id if vessel is not None else ""
+        self._switchable = {(owner, s.name): s.key for s in sensors}  # catabot set ... enabled
         self._control = vessel.control_stream() if vessel is not None else None
         if self._control is not None and self._control.producer != name:
             self._control = None  # another participant drives this vessel: observe only
@@ -115,6 +118,7 @@ class Joined:
 
     def _step(self, tick: Tick, inputs: Inputs) -> None:
         self._watch.ticking = True  # Vessel.send need not wait for a state (vessel.py)
+        self._switch(tick)
         for msg in inputs.get(self.info.states_key, ()):
             assert isinstance(msg, BodyStates)
             self._bodies = msg  # the state at the start of this tick (tagged tick - 1)
@@ -133,6 +137,16 @@ class Joined:
             raise command
         if self._control is not None:
             self.participant.publish(self._control.key, command)
+
+    def _switch(self, tick: Tick) -> None:
+        """Sensors switched off or on at this tick (`catabot set sensor.<vessel>.<sensor>.
+        enabled`): one that is off is not waited for (a stack reading it held the run to
+        its deadline, as the services, told of switches, did not)."""
+        for change in changes_of(tick.settings):
+            named = sensor_switch(change.key)
+            key = self._switchable.get(named) if named is not None else None
+            if key is not None:
+                self.participant.inbox.switch(key, tick.tick, on=bool(change.decoded))
 
     def _observation(self, tick: Tick) -> Observation:
         since, self._since = self._since, {name: [] for name in self._since}

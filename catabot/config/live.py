@@ -21,7 +21,7 @@ from typing import TYPE_CHECKING, Annotated, Any
 from pydantic import BaseModel, Field, JsonValue, ValidationError
 
 from catabot.bus.clock import NS_PER_S
-from catabot.bus.settings import Change
+from catabot.bus.settings import Change, switch_key
 from catabot.config.base import ConfigError, FieldProblem, Strict, describe, did_you_mean
 from catabot.config.environment import CurrentConfig, RainConfig, WindConfig
 from catabot.config.sensors import CameraOutputs
@@ -90,8 +90,10 @@ def keys_of(scenario: Scenario) -> dict[str, Spec]:
     keys = dict(GLOBAL)
     for vessel in scenario.vessels:
         for sensor in vessel.sensors:
-            base = f"sensor.{vessel.id}.{sensor.name}"
-            keys[f"{base}.enabled"] = Spec("enabled", ON_OFF, vessel.id, sensor.name)
+            base = f"sensor.{vessel.id}.{sensor.name}"  # its outputs; switch_key: on and off
+            keys[switch_key(vessel.id, sensor.name)] = Spec(
+                "enabled", ON_OFF, vessel.id, sensor.name
+            )
             if sensor.type == "camera":
                 for out in OUTPUTS:
                     keys[f"{base}.outputs.{out}"] = Spec(

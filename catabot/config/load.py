@@ -44,6 +44,13 @@ def parse_scenario(data: Any, *, source: str = "<data>") -> Scenario:
 
 def load_scenario(path: str | Path | None = None) -> Scenario:
     """Load a scenario file, or the bundled default when `path` is None."""
+    data, file = scenario_data(path)
+    return parse_scenario(data, source=str(file))
+
+
+def scenario_data(path: str | Path | None = None) -> tuple[Any, Path]:
+    """A scenario file's own data, its paths made absolute, and the file (`--set` changes
+    the data before it is parsed: catabot/config/overrides.py)."""
     file = BUNDLED / "default.json" if path is None else Path(path)
     if not file.is_file():
         bundled = BUNDLED / f"{file.name}.json"
@@ -58,7 +65,7 @@ def load_scenario(path: str | Path | None = None) -> Scenario:
     data = read_json(file, what="scenario")
     if isinstance(data, dict) and is_settings_config(data):  # first: its paths are relative too
         data = map_settings_config(data, source=str(file))
-    return parse_scenario(absolute_paths(data, file.parent.resolve()), source=str(file))
+    return absolute_paths(data, file.parent.resolve()), file
 
 
 def _bundled_hint(path: str | Path | None) -> str:

@@ -19,7 +19,7 @@ from catabot.bus.scheduling import requested_policy
 from catabot.bus.session import check_listen, check_router, free_port
 from catabot.config import overrides
 from catabot.config.base import ScenarioError
-from catabot.config.load import load_scenario, parse_scenario, scenario_json
+from catabot.config.load import load_scenario, parse_scenario, scenario_data, scenario_json
 from catabot.config.scenario import Scenario
 from catabot.config.sensors import service_of
 from catabot.errors import CataBotError
@@ -68,9 +68,8 @@ def prepare(opts: RunOptions) -> World:
         check_router(endpoint)
     if opts.listen and not opts.connect:  # the embedded mesh: the conductor listens there
         check_listen(opts.listen)
-    scenario = load_scenario(opts.scenario)
-    source = opts.scenario or "default"
-    data, flags = scenario.model_dump(), []
+    scenario, source = _with_sets(opts), opts.scenario or "default"
+    data, flags = scenario.model_dump(), [f"--set {item}" for item in opts.sets]
     if opts.duration_s is not None:
         data["duration_s"] = opts.duration_s
         flags.append(f"--duration {opts.duration_s:g}")
@@ -84,7 +83,6 @@ def prepare(opts: RunOptions) -> World:
         fast = opts.realtime == 0.0 or opts.realtime == math.inf
         data["clock"]["realtime_factor"] = None if fast else opts.realtime
         flags.append(f"--realtime {opts.realtime:g}")
-    flags += overrides.apply(data, list(opts.sets), flagged=_flagged(opts))
     changed = f"{source} with {' '.join(flags)}" if flags else source  # the file, the flags
     parsed = parse_scenario(data, source=changed)
     try:
@@ -99,6 +97,16 @@ def prepare(opts: RunOptions) -> World:
     programs.programs(world.scenario, opts.scenario)  # each controller's program is a file
     _check_logins(opts, world)
     return world
+
+
+def _with_sets(opts: RunOptions) -> Scenario:
+    """The scenario, with `--set`'s changes made to the file's own data (overrides.py)."""
+    if not opts.sets:
+        return load_scenario(opts.scenario)
+    data, file = scenario_data(opts.scenario)
+    resolved = parse_scenario(data, source=str(file)).model_dump(mode="json")
+    flags = overrides.apply(data, list(opts.sets), resolved=resolved, flagged=_flagged(opts))
+    return parse_scenario(data, source=f"{opts.scenario or 'default'} with {' '.join(flags)}")
 
 
 def _flagged(opts: RunOptions) -> dict[str, str]:

@@ -56,3 +56,37 @@ def _stamps(path: Path) -> dict[str, list[int]]:
     for m in read_mcap_messages(path):
         out.setdefault(m.topic, []).append(m.log_time)
     return out
+
+
+STACK = """
+from catabot.client import Client, Thrust, add_stack_args
+import argparse
+p = argparse.ArgumentParser()
+add_stack_args(p)
+args = p.parse_args()
+seen = []
+def step(obs):
+    seen.append(obs.sensors["gps"] is not None and obs.sensors["gps"].tick)
+    return Thrust([0.3, 0.3])
+with Client.from_args(args) as sim:
+    end = sim.run_lockstep(args.participant, step, vessel=args.vessel, sensors=["gps"])
+print("gps ticks", sorted(set(seen) - {False}), end.reason)
+"""
+
+
+def test_a_lockstep_stack_reading_a_sensor_switched_off_is_not_held(tmp_path: Path) -> None:
+    """The services were told of a switch and the client was not: a stack that read the GPS
+    waited for samples that never came, and the run ended at the deadline, blaming it."""
+    (tmp_path / "stack.py").write_text(STACK)
+    off_on = [{"t_s": 0.5, "key": "sensor.ego.gps.enabled", "value": False},
+              {"t_s": 1.0, "key": "sensor.ego.gps.enabled", "value": True}]  # fmt: skip
+    data = basic_scenario("switch", duration_s=1.5, settings=off_on)
+    data["clock"] = {"deadline_s": 3.0}
+    gps = {"name": "gps", "type": "gps", "rate_hz": 10.0}
+    data["vessels"][0] |= {"controller": {"participant": "stack", "program": "stack.py"},
+                           "sensors": [gps]}  # fmt: skip
+    result = catabot("run", str(scenario_file(tmp_path, data)), "--out", str(tmp_path / "o"),
+                     "--quiet")  # fmt: skip
+    assert result.returncode == 0, result.stderr
+    said = (only_run_dir(tmp_path / "o") / "log" / "stack.log").read_text()
+    assert "gps ticks [10, 20, 30, 40, 100, 110, 120, 130] completed" in said, said  # off 50-99

@@ -3,11 +3,20 @@ is, and every mistake named with the flag that made it."""
 
 from __future__ import annotations
 
+import copy
+from typing import Any
+
 import pytest
 
 from catabot.config.base import ScenarioError
-from catabot.config.overrides import OverrideError, apply
+from catabot.config.overrides import OverrideError
+from catabot.config.overrides import apply as apply_to
 from catabot.run.launcher import RunOptions, prepare
+
+
+def apply(data: dict[str, Any], items: list[str], **kw: Any) -> list[str]:
+    """A file's data whose resolved form has the same shape (these tests' own)."""
+    return apply_to(data, items, resolved=copy.deepcopy(data), **kw)
 
 
 def test_fields_lists_and_bare_words_are_set_in_order() -> None:
@@ -27,6 +36,7 @@ def test_fields_lists_and_bare_words_are_set_in_order() -> None:
         ("zzz=1", "no field zzz (its fields: name, vessels, water)"),
         ("water.current.velocity_mps=[0.5", "the value is not JSON (Expecting ',' delimiter"),
         ("vessels.3.id=x", "vessels.3: a list of 1, so an index from 0 to 0"),
+        ("vessels.ego.id=x", "a list of 1, so an index from 0 to 0: 'ego' is vessels.0"),
         ("vessels.0.task.goal=1", "vessels.0.task is not set in the scenario: set it whole"),
         ("name.first=x", "name is a value, not a section"),
         ("seed", "give FIELD=VALUE"),
@@ -57,6 +67,16 @@ def test_a_field_its_own_flag_gives_is_refused() -> None:
         apply({"seed": 0}, ["seed=3"], flagged={"seed": "--seed"})
     with pytest.raises(OverrideError, match=r"--duration too"):
         prepare(RunOptions(duration_s=2.0, sets=("duration_s=3",)))
+
+
+def test_a_preset_set_fills_what_the_file_left_to_it() -> None:
+    """`--set water.waves.preset=medium` gave flat water (the resolved calm sea's height,
+    filled in, beat the preset) while scenario.json and the report said "medium"."""
+    waves = prepare(RunOptions(sets=("water.waves.preset=medium",))).scenario.water.waves
+    assert (waves.preset, waves.significant_height_m) == ("medium", 1.24)
+    task = ('vessels.0.task={"route": [[0, 0], [30, 5]]}', "vessels.0.task.route.1.0=40")
+    route = prepare(RunOptions(sets=task)).scenario.vessels[0].task
+    assert route is not None and route.route is not None and list(route.route[1]) == [40.0, 5.0]
 
 
 def test_a_run_takes_the_changed_scenario_and_checks_it_whole() -> None:
