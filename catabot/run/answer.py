@@ -40,6 +40,15 @@ def output_file(path: str, *, flag: str) -> Path:
     return file
 
 
+def output_folder(path: str, *, flag: str) -> Path:
+    """`path` as a folder this command may write into (made if missing); OutputPathError
+    names the flag when it is a file ("File exists" had been all it said)."""
+    folder = Path(path)
+    if folder.exists() and not folder.is_dir():
+        raise OutputPathError(f"{flag} {path}: is a file; give a folder")
+    return folder
+
+
 def answered(prog: str, work: Callable[[], str | None]) -> int:
     """Run `work`; print what it says and return 0, or one line on stderr and return 2."""
     try:

@@ -124,8 +124,9 @@ class RecordedRun:
         index = McapIndex(path)
         if not index.finished:  # what is there is read, and the reader is told so
             count = sum(len(c) for c in index.channels.values())
-            log.warning("%s: cut off (no end: the run was killed or the file truncated); read "
-                        "to its last whole record, %d messages", path, count)  # fmt: skip
+            log.warning("%s: no end yet (the run is still going, or was killed, or the file "
+                        "was cut short); read to its last whole record, %d messages", path,
+                        count)  # fmt: skip
         return index
 
     @cached_property

@@ -13,8 +13,9 @@ import argparse
 import sys
 from pathlib import Path
 
-from catabot.run.answer import OneLineParser, answered
-from catabot.run.recorded import RecordedRun
+from catabot.errors import CataBotError
+from catabot.run.answer import OneLineParser, answered, output_folder
+from catabot.run.recorded import RecordedRun, RunFolderError
 from services.plots import compare, report, series
 from services.plots.figures import FIGURES
 
@@ -44,8 +45,15 @@ def plot(run_folder: str, out: Path | None) -> Path:
     return out
 
 
-def plot_compared(folders: list[str], out: Path | None) -> Path:
-    runs = [series.read(RecordedRun(f), full=False) for f in folders]
+def plot_compared(folders: list[str], out: Path | None) -> str:
+    runs = []
+    for folder in folders:  # one unusable folder (no tick, not a run) need not stop the rest
+        try:
+            runs.append(series.read(RecordedRun(folder), full=False))
+        except CataBotError as exc:
+            print(f"catabot plot: left out: {exc}", file=sys.stderr)
+    if not runs:
+        raise RunFolderError("no run to compare: every folder given was left out (above)")
     out = out or runs[0].run.folder / "compare"
     out.mkdir(parents=True, exist_ok=True)
     files = {}
@@ -53,20 +61,23 @@ def plot_compared(folders: list[str], out: Path | None) -> Path:
         fig.savefig(out / f"{name}.png", metadata=PNG)
         files[name] = f"{name}.png"
     compare.report(out / "compare.html", runs, files)
-    return out
+    return f"{len(runs)} runs compared in {out}"
 
 
 def main(argv: list[str] | None = None) -> int:
     args = parser().parse_args(argv)
-    out = _out(args.output)
+    try:
+        out = _out(args.output)
+    except CataBotError as exc:
+        print(f"catabot plot: {exc}", file=sys.stderr)
+        return 2
     if len(args.run) > 1:
-        where = lambda: f"{len(args.run)} runs compared in {plot_compared(args.run, out)}"  # noqa: E731
-        return answered("plot", where)
+        return answered("plot", lambda: plot_compared(args.run, out))
     return answered("plot", lambda: f"plots and report.html in {plot(args.run[0], out)}")
 
 
 def _out(output: str | None) -> Path | None:
-    return Path(output) if output else None
+    return output_folder(output, flag="-o") if output is not None else None
 
 
 if __name__ == "__main__":

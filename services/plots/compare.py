@@ -9,17 +9,22 @@ vessel of a run by its line style; `compare.html` has every run's figures in one
 from __future__ import annotations
 
 import html
+import json
 from pathlib import Path
 from typing import Any
 
+import numpy as np
+from matplotlib import colormaps
 from matplotlib.figure import Figure
 
+from catabot.config.scenario import Scenario
 from catabot.run.metrics_summary import vessel_parts
-from services.plots.figures import speed_heading_axes
+from services.plots.figures import draw_task, speed_heading_axes
 from services.plots.series import RunSeries
 
 STYLES = ["-", "--", ":", "-."]
-COLORS = ["#1f77b4", "#ff7f0e", "#2ca02c", "#d62728", "#9467bd", "#8c564b", "#e377c2"]
+MANY = 6  # a run differing from the first in more fields than this is named by its scenario
+COLORS = colormaps["tab20"]  # 20 runs apart by colour
 
 
 def figures(runs: list[RunSeries]) -> dict[str, Figure]:
@@ -29,14 +34,33 @@ def figures(runs: list[RunSeries]) -> dict[str, Figure]:
 
 
 def run_labels(runs: list[RunSeries]) -> list[str]:
-    """Each run's folder name, and the scenario fields in which it differs from the first."""
-    first = _flat(runs[0].run.world.scenario.model_dump(mode="json"))
-    labels = []
-    for data in runs:
-        mine = _flat(data.run.world.scenario.model_dump(mode="json"))
-        differ = [f"{k}={mine[k]}" for k in sorted(mine) if k != "name" and mine[k] != first.get(k)]
-        labels.append(data.run.folder.name + (f" ({', '.join(differ)[:90]})" if differ else ""))
-    return labels
+    """Each run's folder name, what in its scenario differs from the first's (another
+    scenario: its name), its setting changes, and how it ended unless it completed."""
+    first = runs[0].run.world.scenario
+    return [data.run.folder.name + _about(data, first) for data in runs]
+
+
+def _about(data: RunSeries, first: Scenario) -> str:
+    mine = data.run.world.scenario
+    base, own = (_flat(s.model_dump(mode="json", exclude={"name", "settings"}))
+                 for s in (first, mine))  # fmt: skip
+    parts = [f"{k}={json.dumps(own[k])}" for k in sorted(own) if own[k] != base.get(k)]
+    if len(parts) > MANY and mine.name != first.name:  # another scenario: its name says more
+        parts = [f"scenario {mine.name}"]
+    parts += [f"{c.key}={json.dumps(c.value)} at {c.t_s:g} s" for c in mine.settings]
+    ended = (data.metrics or {}).get("end_reason", "completed")
+    parts += [] if ended == "completed" else [f"ended: {ended}"[:40]]
+    return f" ({_short(parts)})" if parts else ""
+
+
+def _short(parts: list[str], budget: int = 100) -> str:
+    """Whole entries while they fit, then how many more (a value was cut mid-list)."""
+    shown: list[str] = []
+    for k, part in enumerate(parts):
+        if len(", ".join([*shown, part])) > budget and shown:
+            return ", ".join(shown) + f", and {len(parts) - k} more"
+        shown.append(part)
+    return ", ".join(shown)
 
 
 def _flat(tree: Any, prefix: str = "") -> dict[str, Any]:
@@ -53,31 +77,58 @@ def _flat(tree: Any, prefix: str = "") -> dict[str, Any]:
 
 
 def _tracks(runs: list[RunSeries], labels: list[str]) -> Figure:
-    fig = Figure(figsize=(9, 8), dpi=110, layout="constrained")
+    fig = Figure(figsize=(9, 9 + 0.18 * len(labels)), dpi=110, layout="constrained")
     ax = fig.subplots()
+    seen = []
     for k, (data, label) in enumerate(zip(runs, labels, strict=True)):
         xy = data.states.position[:, :, :2]
         for j, vid in enumerate(data.own):
             row = data.run.world.body(vid).row
-            ax.plot(xy[:, row, 0], xy[:, row, 1], STYLES[j % len(STYLES)], lw=1.8,
-                    color=COLORS[k % len(COLORS)], label=f"{label}: {vid}")  # fmt: skip
-            ax.plot(*xy[-1, row], "s", color=COLORS[k % len(COLORS)], ms=6, mec="black")
+            ax.plot(xy[:, row, 0], xy[:, row, 1], lw=1.8, label=f"{label}: {vid}",
+                    **_style(k, j))  # fmt: skip
+            ax.plot(*xy[-1, row], "s", color=_style(k, j)["color"], ms=6, mec="black")
+            seen.append(xy[:, row])
+            draw_task(ax, data.run.world.scenario.vessels[row].task, _style(k, j)["color"], vid)
+    _square(ax, np.concatenate(seen))
     ax.set(xlabel="east x [m]", ylabel="north y [m]", aspect="equal",
-           title="Trajectories of the scenario vessels (■ end)")  # fmt: skip
+           title="Trajectories of the scenario vessels (■ end; tasks dashed, dotted)")  # fmt: skip
     ax.grid(alpha=0.3)
-    ax.legend(fontsize=7, loc="best")
+    fig.legend(*_own_entries(ax), fontsize=7, loc="outside lower left")
     return fig
 
 
+def _own_entries(ax: Any) -> tuple[list[Any], list[str]]:
+    """The tracks' legend entries, not every run's goal and route again."""
+    pairs = [(h, t) for h, t in zip(*ax.get_legend_handles_labels(), strict=True)
+             if not t.endswith((" goal", " route"))]  # fmt: skip
+    return [h for h, _ in pairs], [t for _, t in pairs]
+
+
+def _square(ax: Any, xy: np.ndarray) -> None:
+    """A square view around the tracks: a near-straight one collapsed an equal-aspect plot to
+    a strip."""
+    lo, hi = np.nanmin(xy, axis=0), np.nanmax(xy, axis=0)
+    centre, half = (lo + hi) / 2, max(float(np.max(hi - lo)) / 2, 1.0) * 1.1
+    ax.set(xlim=(centre[0] - half, centre[0] + half), ylim=(centre[1] - half, centre[1] + half))
+
+
+def _style(run: int, vessel: int) -> dict[str, Any]:
+    """Run k's colour (20 apart, then the line style too), vessel j's line style."""
+    color = COLORS(run % 20)
+    return {"color": color, "ls": STYLES[(vessel + run // 20) % len(STYLES)]}
+
+
 def _speed_heading(runs: list[RunSeries], labels: list[str]) -> Figure:
-    fig = Figure(figsize=(10, 6), dpi=110, layout="constrained")
+    fig = Figure(figsize=(10, 6 + 0.18 * len(labels)), dpi=110, layout="constrained")
     speed, heading = fig.subplots(2, 1)
     for k, (data, label) in enumerate(zip(runs, labels, strict=True)):
         for j, vid in enumerate(data.own):
-            style = dict(color=COLORS[k % len(COLORS)], label=f"{label}: {vid}")
-            speed.plot(data.t, data.speed[vid], STYLES[j % len(STYLES)], **style)
-            heading.plot(data.t, data.heading[vid], ".", ms=1.5, **style)
+            style = _style(k, j)
+            speed.plot(data.t, data.speed[vid], label=f"{label}: {vid}", **style)
+            heading.plot(data.t, data.heading[vid], ".", ms=1.5, color=style["color"])
     speed_heading_axes(speed, heading)
+    speed.get_legend().remove()
+    fig.legend(fontsize=7, loc="outside lower left")
     return fig
 
 
@@ -86,9 +137,10 @@ def report(path: Path, runs: list[RunSeries], files: dict[str, str]) -> None:
     rows = []
     for data, label in zip(runs, run_labels(runs), strict=True):
         vessels = (data.metrics or {}).get("vessels", {})
-        rows += [_row(label, vid, vessels[vid]) for vid in data.own if vid in vessels]
+        ended = str((data.metrics or {}).get("end_reason", "?"))
+        rows += [_row(label, vid, vessels[vid], ended) for vid in data.own if vid in vessels]
     head = ("<tr><th>run</th><th>vessel</th><th>distance [m]</th><th>top speed [m/s]</th>"
-            "<th>goal, nearest, contacts, thrust</th></tr>")  # fmt: skip
+            "<th>goal, nearest, contacts, thrust</th><th>ended</th></tr>")  # fmt: skip
     images = "".join(f'<img src="{f}" alt="{n}" style="max-width:100%">' for n, f in files.items())
     table = f"<table border=1>{head}{''.join(rows)}</table>"
     path.write_text("<!DOCTYPE html>\n<html><head><meta charset='utf-8'><title>CataBot runs "
@@ -96,8 +148,8 @@ def report(path: Path, runs: list[RunSeries], files: dict[str, str]) -> None:
                     f"{table}\n{images}\n</body></html>\n")  # fmt: skip
 
 
-def _row(label: str, vid: str, m: dict[str, Any]) -> str:
+def _row(label: str, vid: str, m: dict[str, Any], ended: str) -> str:
     parts = html.escape("; ".join(filter(None, vessel_parts(m))))
     cells = [html.escape(label), html.escape(vid), f"{m['distance_m']:.1f}",
-             f"{m['max_speed_mps']:.2f}", parts]  # fmt: skip
+             f"{m['max_speed_mps']:.2f}", parts, html.escape(ended)]  # fmt: skip
     return "<tr>" + "".join(f"<td>{c}</td>" for c in cells) + "</tr>"

@@ -89,7 +89,7 @@ def _trajectories(data: RunSeries, lo: np.ndarray, hi: np.ndarray, title: str) -
         ax.plot(xy[:, row, 0], xy[:, row, 1], color=_color(k), lw=2.2, label=vid)
         ax.plot(*xy[0, row], "o", color=_color(k), ms=7, mec="black")
         ax.plot(*xy[-1, row], "s", color=_color(k), ms=7, mec="black")
-        _task(ax, world.scenario.vessels[row].task, _color(k), vid)
+        draw_task(ax, world.scenario.vessels[row].task, _color(k), vid)
     if world.buoys:
         b = xy[-1, vessels:]
         ax.scatter(b[:, 0], b[:, 1], s=14, c="#fac81e", edgecolors="black", lw=0.4,
@@ -124,7 +124,7 @@ def _task_points(world: World, own: Any) -> np.ndarray:
     return np.array(points, dtype=np.float64).reshape(-1, 2)
 
 
-def _task(ax: Axes, task: TaskConfig | None, color: str, vid: str) -> None:
+def draw_task(ax: Axes, task: TaskConfig | None, color: str, vid: str) -> None:
     """A vessel's goal region (dashed circle) and route (dotted line), as metrics.json
     measures them."""
     if task is None:

@@ -198,6 +198,7 @@ def test_plot_writes_figures_and_a_report(run: Path, tmp_path: Path) -> None:
         (("view", "{tmp}/nowhere", "--save", "{tmp}/x.rrd"), "no such run folder"),
         (("plot", "{tmp}/nowhere"), "no such run folder"),
         (("plot", "{run}/scenario.json"), "scenario.json: a file, not a run folder"),
+        (("plot", "{run}", "{run}", "-o", "{run}/scenario.json"), "is a file; give a folder"),
         (("dataset", "export", "{tmp}/nowhere", "-f", "yolo", "-o", "{tmp}/o"), "no such run"),
         (("dataset", "export", "{run}", "-f", "voc", "-o", "{tmp}/o"), "invalid choice: 'voc'"),
         (("dataset", "export", "{run}", "-f", "yolo", "-o", "{run}"), "is not an empty folder"),

@@ -10,15 +10,15 @@ from catabot.config.base import ScenarioError
 from catabot.config.load import json_schema, parse_scenario
 
 
-def _task(task: Any) -> Any:
+def draw_task(task: Any) -> Any:
     return parse_scenario({"vessels": [{"id": "ego", "task": task}]}).vessels[0].task
 
 
 def test_goal_and_route() -> None:
-    task = _task({"goal": {"x_m": 1, "y_m": 2, "radius_m": 3}, "route": [[0, 0], [1, 1.5]]})
+    task = draw_task({"goal": {"x_m": 1, "y_m": 2, "radius_m": 3}, "route": [[0, 0], [1, 1.5]]})
     assert (task.goal.x_m, task.goal.radius_m) == (1.0, 3.0)
     assert task.route == [(0.0, 0.0), (1.0, 1.5)]
-    assert _task({"route": [[0, 0], [5, 0]]}).goal is None
+    assert draw_task({"route": [[0, 0], [5, 0]]}).goal is None
 
 
 @pytest.mark.parametrize(
@@ -41,7 +41,7 @@ def test_goal_and_route() -> None:
 )
 def test_bad_tasks_name_the_field(task: Any, message: str) -> None:
     with pytest.raises(ScenarioError) as err:
-        _task(task)
+        draw_task(task)
     assert message in str(err.value)
 
 

@@ -34,14 +34,14 @@ def _refusal(**top: Any) -> str:
     return str(caught.value)
 
 
-def _task(**task: Any) -> list[dict[str, Any]]:
+def draw_task(**task: Any) -> list[dict[str, Any]]:
     return [{"id": "ego", "pose": {"x_m": 300.0, "y_m": 200.0}, "task": task}]
 
 
 def test_marks_in_open_water_are_accepted() -> None:
     world = _resolve(
         buoys=[{"id": "b", "x_m": 350.0, "y_m": 260.0}],
-        vessels=_task(
+        vessels=draw_task(
             goal={"x_m": 550.0, "y_m": 200.0, "radius_m": 2.0},
             route=[[300.0, 200.0], [550.0, 200.0]],
         ),
@@ -70,11 +70,11 @@ def test_marks_in_open_water_are_accepted() -> None:
             "buoys.0 (beach): buoy (300.0, 465.0): water depth",
         ),
         (
-            {"vessels": _task(goal={"x_m": ISLAND[0], "y_m": ISLAND[1], "radius_m": 2.0})},
+            {"vessels": draw_task(goal={"x_m": ISLAND[0], "y_m": ISLAND[1], "radius_m": 2.0})},
             "vessels.0.task.goal (ego): goal (440.0, 260.0) is on land",
         ),
         (
-            {"vessels": _task(route=[[300.0, 200.0], [-5.0, 3.0]])},
+            {"vessels": draw_task(route=[[300.0, 200.0], [-5.0, 3.0]])},
             "vessels.0.task.route.1 (ego): route point (-5.0, 3.0) is outside the terrain",
         ),
     ],

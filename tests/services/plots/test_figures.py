@@ -17,9 +17,9 @@ from services.plots.figures import (
     _boat_names,
     _changes,
     _in_force,
-    _task,
     _task_points,
     _view,
+    draw_task,
     rain_steps,
 )
 from services.plots.series import _thruster_names, own_pairs
@@ -56,7 +56,7 @@ def test_trajectories_mark_the_task_and_number_the_boats() -> None:
     }))  # fmt: skip
     assert _task_points(world, ["ego"]).tolist() == [[60.0, 20.0], [0.0, 0.0], [30.0, 5.0]]
     fig, ax = plt.subplots()
-    _task(ax, world.scenario.vessels[0].task, "#ff8c00", "ego")
+    draw_task(ax, world.scenario.vessels[0].task, "#ff8c00", "ego")
     xy = np.zeros((2, len(world.bodies), 2))
     _boat_names(ax, world, xy)
     (goal,) = [p for p in ax.patches if isinstance(p, Circle)]
@@ -118,13 +118,28 @@ def test_setting_changes_are_marked_where_they_took_effect() -> None:
 
 
 def test_compared_runs_are_named_by_what_differs_from_the_first() -> None:
-    """Two lab runs differ in their current: the legend says so, not only their folders."""
+    """Two lab runs differ in their current: the legend says so, not only their folders; a
+    change made while it ran is named with its time, whole, and a run that did not
+    complete says how it ended (a value had been cut mid-list, an end left out)."""
     calm = {"name": "lab", "vessels": [{"id": "ego", "script": [{"t_s": 0, "thrust": [1, 1]}]}]}
     drift = {**calm, "water": {"current": {"velocity_mps": [0.0, 0.5]}}}
+    live = {**calm, "settings": [{"t_s": 1.26, "key": "current", "value": [0.3, 0.0]}]}
+    other = {
+        "name": "harbour",
+        "vessels": [{"id": "boat", "model": "wamv"}],
+        "seed": 3,
+        "duration_s": 9.0,
+        "traffic": {"count": 2},
+        "buoys": [{"id": "b", "x_m": 30, "y_m": 0}],
+    }
+    ends = ("completed", "completed", "fault", "completed")
     runs = [SimpleNamespace(run=SimpleNamespace(folder=Path(f"runs/{n}"),
-                                                world=World.resolve(parse_scenario(d))))
-            for n, d in (("a", calm), ("b", drift))]  # fmt: skip
-    assert run_labels(runs) == ["a", "b (water.current.velocity_mps=[0.0, 0.5])"]  # type: ignore[arg-type]
+                                                world=World.resolve(parse_scenario(d))),
+                            metrics={"end_reason": e})
+            for n, d, e in zip("abcd", (calm, drift, live, other), ends, strict=True)]  # fmt: skip
+    assert run_labels(runs) == [  # type: ignore[arg-type]
+        "a", "b (water.current.velocity_mps=[0.0, 0.5])",
+        "c (current=[0.3, 0.0] at 1.26 s, ended: fault)", "d (scenario harbour)"]  # fmt: skip
 
 
 def test_each_pair_of_own_vessels_has_its_distance() -> None:
