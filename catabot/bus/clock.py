@@ -207,6 +207,11 @@ class ClockLimits:
         return ""
 
 
+# A stop for a fault (SIGUSR1: `catabot run` saw a process of the run die) is one: two
+# programs failing at one tick had ended the run "interrupted", as Ctrl-C does.
+FAULT_STOP = "stopped by its launcher: a process of the run ended"
+
+
 class WorldMismatch(CataBotError):
     """This process and the conductor were started on different scenarios."""
 

@@ -19,6 +19,7 @@ import zenoh
 from catabot.bus import codec
 from catabot.bus.clock import (
     CONDUCTOR,
+    FAULT_STOP,
     ClockError,
     ClockSpec,
     Policy,
@@ -64,8 +65,7 @@ class Conductor:
         self._stop_reason = ""
         self._end_at: int | None = None  # the last tick, when a participant ended the run
         self._told = ""  # the fault a participant told (Ack.fault): the run's error
-        self._done = 0  # ticks every active participant has acked
-        self._granted = -1  # the last tick granted
+        self._done, self._granted = 0, -1  # ticks every active one acked; the last granted
         self._acked = {name: -1 for name in spec.participants}
         self._t0 = self._created
         self._out = Outputs(session)  # ticks and ends, signed with this session's id
@@ -117,9 +117,9 @@ class Conductor:
             error = ""
         except ClockError as exc:
             error = str(exc)
-        error = self._told or error  # the cause, though another fault followed it
+        error = self._told or error or (FAULT_STOP if self._stop_reason == "fault" else "")
         done = self._done  # complete ticks, also when a fault or a stop cut the run short
-        reason = self._stop_reason or ("completed" if not error else "fault")
+        reason = "fault" if error else (self._stop_reason or "completed")
         self._out.publish(self.keys.end(), End(self.run_id, done - 1, reason, error))
         wall, dropped = time.monotonic() - start, self.dropped
         return RunResult(done, wall, error, [*dropped], reason, joined - self._created, dropped)

@@ -141,6 +141,7 @@ def main(argv: list[str] | None = None) -> int:
     quiet_gc()
     for sig in (signal.SIGINT, signal.SIGTERM):
         signal.signal(sig, lambda *_: conductor.stop("interrupted"))
+    signal.signal(signal.SIGUSR1, lambda *_: conductor.stop("fault"))  # a process of it died
     emit("ready")  # from now on a stop ends the run cleanly (the launcher holds one till then)
 
     def progress(p: Progress) -> None:

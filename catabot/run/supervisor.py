@@ -106,7 +106,7 @@ class Supervisor:
                 for child in died:
                     child.crashed()
                 if not (self.goes_on and self._ticking):
-                    self.conductor.proc.send_signal(signal.SIGTERM)
+                    self.conductor.proc.send_signal(signal.SIGUSR1)  # a stop for a fault
                     asked_to_stop = True
             silent = self._silent()
             if silent and self.conductor.proc.poll() is None:

@@ -52,6 +52,9 @@ def test_a_program_crashing_mid_run_is_named_as_the_cause(tmp_path: Path) -> Non
     cause = next(line for line in said.splitlines() if line.startswith("run failed:"))
     assert "stack" in cause and "stack_program.py" in cause, cause
     assert "ZeroDivisionError: the stack fell over at tick 120" in cause
+    assert (
+        run is not None and json.loads((run / "metrics.json").read_text())["end_reason"] == "fault"
+    )
     assert run is not None and "Traceback" in (run / "log" / "stack.log").read_text()
 
 
@@ -86,11 +89,13 @@ def test_a_program_that_acks_a_tick_without_its_command_is_named(tmp_path: Path)
 
 def test_a_program_that_ends_before_joining_fails_the_run_at_once(tmp_path: Path) -> None:
     """It exited 0, and the run waited out the 60 s start timeout for it."""
-    code, said, _ = _run(tmp_path, _scenario(tmp_path, "--leave"), "leave")
+    code, said, run = _run(tmp_path, _scenario(tmp_path, "--leave"), "leave")
     assert code == 1, said
     cause = next(line for line in said.splitlines() if line.startswith("run failed:"))
     assert "stack_program.py ended (exit code 0) before the run started" in cause, cause
     assert "never joined" not in said
+    assert run is not None  # a fault, not "interrupted" as Ctrl-C (a sweep tests for it)
+    assert json.loads((run / "log" / "run.json").read_text())["reason"] == "fault"
 
 
 def test_a_program_still_running_after_the_run_is_stopped_not_failed(tmp_path: Path) -> None:
