@@ -7,6 +7,7 @@ N s. Keys are sorted and floats written by `repr`, so one seed gives the same by
 from __future__ import annotations
 
 import json
+import math
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
@@ -24,7 +25,20 @@ def write_metrics(m: Metrics, path: Path, *, end_reason: str = "") -> None:
     so the file alone says whether its figures cover the whole run; `dropped`, only when a
     participant was (clock.policy drop): from when the run went on without it."""
     data = record(m) | {"end_reason": end_reason} | ({"dropped": m.dropped} if m.dropped else {})
-    path.write_text(json.dumps(data, indent=2, sort_keys=True) + "\n")
+    text = json.dumps(_finite(data), indent=2, sort_keys=True, allow_nan=False)
+    path.write_text(text + "\n")
+
+
+def _finite(value: Any) -> Any:
+    """null for a figure never measured (a run ended before its first tick had written
+    `Infinity`, which JSON has not: Node and strict parsers refused the file)."""
+    if isinstance(value, float) and not math.isfinite(value):
+        return None
+    if isinstance(value, dict):
+        return {k: _finite(v) for k, v in value.items()}
+    if isinstance(value, list):
+        return [_finite(v) for v in value]
+    return value
 
 
 def record(m: Metrics) -> dict[str, Any]:
@@ -85,14 +99,14 @@ def _subject(m: Metrics, k: int) -> dict[str, Any]:
         "max_tilt_rad": float(m.max_tilt[k]),
     }
     goals, last = m.goals, m.last
-    if k in goals.rows and last is not None:
+    if k in goals.rows:  # its keys in every run, also one that ended before its first tick
         g = int(list(goals.rows).index(k))
         reached = int(goals.reached_ns[g])
         out["goal"] = {
             "reached": reached >= 0,
             "time_to_goal_s": reached / NS_PER_S if reached >= 0 else None,
             "path_length_m": float(goals.path_m[g]) if reached >= 0 else None,
-            "final_distance_m": float(goals.final_distance(last)[g]),
+            "final_distance_m": None if last is None else float(goals.final_distance(last)[g]),
         }
     if k in m.routes.rows:
         r = int(list(m.routes.rows).index(k))

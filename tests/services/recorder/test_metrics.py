@@ -259,3 +259,17 @@ def test_distance_and_top_speed_are_over_the_ground(tmp_path: Path) -> None:
     v0, v1 = (_record(metrics, tmp_path)["vessels"][v] for v in ("v0", "v1"))
     assert v0["distance_m"] == pytest.approx(0.5) and v0["max_speed_mps"] == pytest.approx(0.0)
     assert v1["max_speed_mps"] == pytest.approx(math.cos(math.radians(30)))
+
+
+def test_a_run_with_no_tick_writes_strict_json_with_every_key(tmp_path: Path) -> None:
+    """A heat that ended at tick 0 wrote `"b1": Infinity` (Node refused the file) and left
+    the `goal` key out, which a results script read in every other run."""
+    goal = {"goal": {"x_m": 30.0, "y_m": 0.0, "radius_m": 2.0}}
+    world = _world(vessels=[{"id": "v0", "task": goal}], buoys=[{"id": "b1", "x_m": 5, "y_m": 5}])
+    metrics = Metrics(world, Orders())
+    metrics.write(tmp_path / "metrics.json")
+    text = (tmp_path / "metrics.json").read_text()
+    data = json.loads(text, parse_constant=lambda c: pytest.fail(f"not JSON: {c}"))
+    v0 = data["vessels"]["v0"]
+    assert v0["min_distance_m"] == {"b1": None} and v0["goal"]["reached"] is False
+    assert v0["goal"]["final_distance_m"] is None
