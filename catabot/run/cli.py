@@ -46,6 +46,7 @@ def _run(args: argparse.Namespace) -> int:
         zenoh_configs=configs,
         view=args.view,
         sets=tuple(args.set),
+        run_dir=Path(args.run_dir) if args.run_dir else None,
     )
     return launcher.run(opts)
 
@@ -200,6 +201,8 @@ def parser() -> argparse.ArgumentParser:
         "scenario sets clock.realtime_factor)",
     )  # fmt: skip
     run.add_argument("--out", default="runs", help="folder for run folders (default: runs)")
+    run.add_argument("--run-dir", help="this run's folder itself, new or empty (instead of "
+                     "--out's <name>-<time>): a script names its runs")  # fmt: skip
     run.add_argument(
         "--connect",
         action="append",

@@ -58,6 +58,7 @@ class RunOptions:
     zenoh_configs: Path | None = None  # a folder of <process>.json5 (the secure profile)
     view: str | None = None  # one of VIEW_MODES: the live rerun viewer beside the run
     sets: tuple[str, ...] = ()  # --set FIELD=VALUE, in order (catabot/config/overrides.py)
+    run_dir: Path | None = None  # --run-dir: this folder, not <out>/<name>-<time>
 
 
 def prepare(opts: RunOptions) -> World:
@@ -95,6 +96,7 @@ def prepare(opts: RunOptions) -> World:
         if service_of(name, world.services)[0] not in SERVICE_MODULES:
             raise LaunchError(f"scenario needs service {name!r}, which this version does not have")
     programs.programs(world.scenario, opts.scenario)  # each controller's program is a file
+    _check_run_dir(opts.run_dir)
     _check_logins(opts, world)
     return world
 
@@ -107,6 +109,16 @@ def _with_sets(opts: RunOptions) -> Scenario:
     resolved = parse_scenario(data, source=str(file)).model_dump(mode="json")
     flags = overrides.apply(data, list(opts.sets), resolved=resolved, flagged=_flagged(opts))
     return parse_scenario(data, source=f"{opts.scenario or 'default'} with {' '.join(flags)}")
+
+
+def _check_run_dir(folder: Path | None) -> None:
+    """`--run-dir`: a new or empty folder (a run folder holds one run's files)."""
+    if folder is None or not folder.exists():
+        return
+    if not folder.is_dir():
+        raise LaunchError(f"--run-dir {folder}: a file, not a folder")
+    if any(folder.iterdir()):
+        raise LaunchError(f"--run-dir {folder}: not empty; a run folder holds one run")
 
 
 def _flagged(opts: RunOptions) -> dict[str, str]:
@@ -133,10 +145,14 @@ def _check_logins(opts: RunOptions, world: World) -> None:
         )
 
 
-def make_run_dir(out: Path, scenario: Scenario) -> Path:
+def make_run_dir(out: Path, scenario: Scenario, *, exact: Path | None = None) -> Path:
     """`<name>-<time>`, or `-2`, `-3`, ... after it: the folder is taken by making it, so
     runs started in one second beside each other (`xargs -P`) each get their own (a check
-    then a make had let two race, and the loser exit 2 as if its scenario were bad)."""
+    then a make had let two race, and the loser exit 2 as if its scenario were bad).
+    `exact` (`--run-dir`): that folder, new or empty (a sweep's script names its runs)."""
+    if exact is not None:
+        exact.mkdir(parents=True, exist_ok=True)
+        return _filled(exact, scenario)
     stamp = datetime.now().strftime("%Y%m%d-%H%M%S")
     base = out / f"{scenario.name}-{stamp}"
     out.mkdir(parents=True, exist_ok=True)
@@ -148,6 +164,10 @@ def make_run_dir(out: Path, scenario: Scenario) -> Path:
         except FileExistsError:
             n += 1
             run_dir = Path(f"{base}-{n}")
+    return _filled(run_dir, scenario)
+
+
+def _filled(run_dir: Path, scenario: Scenario) -> Path:
     (run_dir / "log").mkdir()
     (run_dir / "scenario.json").write_text(scenario_json(scenario))
     return run_dir
@@ -183,10 +203,10 @@ def run(opts: RunOptions) -> int:
     stops = Stops()
     with stops.installed():  # from before the first process starts
         try:
-            run_dir = make_run_dir(opts.out, scenario)
+            run_dir = make_run_dir(opts.out, scenario, exact=opts.run_dir)
         except OSError as exc:
-            print(f"catabot run: cannot make a run folder in {opts.out}: {exc.strerror}",
-                  file=sys.stderr)  # fmt: skip
+            where = opts.run_dir or f"a run folder in {opts.out}"
+            print(f"catabot run: cannot make {where}: {exc.strerror}", file=sys.stderr)
             return 2
         cond_flags, svc_flags = _endpoints(opts)
         print(

@@ -5,8 +5,10 @@ from __future__ import annotations
 from concurrent.futures import ThreadPoolExecutor
 from pathlib import Path
 
+import pytest
+
 from catabot.config.load import parse_scenario
-from catabot.run.launcher import make_run_dir
+from catabot.run.launcher import LaunchError, RunOptions, make_run_dir, prepare
 
 
 def test_runs_started_together_each_get_their_own_folder(tmp_path: Path) -> None:
@@ -17,3 +19,16 @@ def test_runs_started_together_each_get_their_own_folder(tmp_path: Path) -> None
         made = list(pool.map(lambda _: make_run_dir(out, scenario), range(16)))
     assert len(set(made)) == 16 and all((d / "scenario.json").is_file() for d in made)
     assert all(d.name.startswith("race-") for d in made)
+
+
+def test_a_run_dir_given_is_the_run_folder_itself_new_or_empty(tmp_path: Path) -> None:
+    """A sweep's script read the folder from stdout: --run-dir names it."""
+    scenario = parse_scenario({"name": "exact", "vessels": [{"id": "ego"}]})
+    made = make_run_dir(tmp_path / "runs", scenario, exact=tmp_path / "sweep" / "gain2")
+    assert made == tmp_path / "sweep" / "gain2" and (made / "scenario.json").is_file()
+    with pytest.raises(LaunchError, match=r"--run-dir .*gain2: not empty; a run folder holds"):
+        prepare(RunOptions(run_dir=made))
+    (tmp_path / "file").write_text("x")
+    with pytest.raises(LaunchError, match=r"--run-dir .*file: a file, not a folder"):
+        prepare(RunOptions(run_dir=tmp_path / "file"))
+    prepare(RunOptions(run_dir=tmp_path / "empty"))  # new: made when the run starts
