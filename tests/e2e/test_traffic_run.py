@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import math
+import os
 import time
 from dataclasses import replace
 from pathlib import Path
@@ -96,9 +97,11 @@ def test_external_twist_takes_over_a_boat_and_release_restores_it(
 
 
 def test_a_hundred_boats_stay_afloat_in_the_bay(tmp_path: Path, out: Path) -> None:
-    """100 boats and their waypoint buoys with the terrain, 60 s simulated (the issue's
-    figure; ~30 s wall on the 2-core machine with the CSV recorder)."""
-    data = _traffic("hundred", 100, duration_s=60.0, recording={"csv": True, "mcap": False})
+    """100 boats and their waypoint buoys with the terrain: 30 s simulated in CI, the
+    issue's 60 s with `CATABOT_SLOW=1` (~45 s wall on the 2-core machine: CI's 15 minutes
+    were near)."""
+    seconds = 60.0 if os.environ.get("CATABOT_SLOW") else 30.0
+    data = _traffic("hundred", 100, duration_s=seconds, recording={"csv": True, "mcap": False})
     data["terrain"] = {"elevation_image": str(BAY)}
     data["vessels"] = [{"id": "ego"}]
     result = catabot("run", str(scenario_file(tmp_path, data)), "--out", str(out), "--quiet")
