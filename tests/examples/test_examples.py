@@ -4,6 +4,7 @@ a real `catabot run` listening on loopback, the example as its own process conne
 from __future__ import annotations
 
 import json
+import os
 import subprocess
 import sys
 from collections.abc import Iterator
@@ -181,10 +182,12 @@ GOAL = (90.0, 0.0)  # examples/navigate.json's task.goal
 
 @pytest.fixture(scope="module")
 def navigated(tmp_path_factory: pytest.TempPathFactory) -> list[Path]:
-    """examples/navigate.json run twice: `catabot run` starts the navigator (its controller's
-    program) as a lockstep participant; 75 s simulated, 20 boats."""
+    """examples/navigate.json run (twice with `CATABOT_SLOW=1`, for the byte comparison):
+    `catabot run` starts the navigator (its controller's program) as a lockstep participant;
+    75 s simulated, 20 boats. Once in CI, whose 15 minutes were near: lockstep programs'
+    bytes are compared by the lockstep stack's test and the controller program's."""
     folders = []
-    for i in range(2):
+    for i in range(2 if os.environ.get("CATABOT_SLOW") else 1):
         out = tmp_path_factory.mktemp(f"navigate{i}")
         cmd = [sys.executable, "-m", "catabot", "run", "examples/navigate.json", "--quiet",
                "--out", str(out)]  # fmt: skip
@@ -232,6 +235,8 @@ def test_navigate_reaches_its_goal_through_traffic_without_touching_a_boat(
 
 
 def test_navigate_in_lockstep_records_the_same_bytes_twice(navigated: list[Path]) -> None:
+    if len(navigated) < 2:
+        pytest.skip("set CATABOT_SLOW=1 (a second 75 s run)")
     first, second = ({p.name: p.read_bytes() for p in sorted(f.glob("*.csv"))} for f in navigated)
     assert first.keys() == second.keys() and len(first) > 40
     assert first == second
