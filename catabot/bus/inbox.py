@@ -50,6 +50,7 @@ class Inbox:
         self.latest = {key: -1 for key in self.streams}
         self.held: dict[str, list[Message]] = {key: [] for key in self.streams}
         self.dropped: set[str] = set()
+        self.handed: set[str] = set()  # dropped producers past their stall (stalled_by)
         self.pending: list[tuple[str, bytes, str]] = []
         self._pending_bytes = 0
         # Only clocked streams can be due (physics has ~300 free-running command keys with
@@ -150,6 +151,14 @@ class Inbox:
         ticks = [_next_tag(s, self.latest[s.key]) + 1 + s.lag for s in self._clocked
                  if s.producer == producer]  # fmt: skip
         return min(ticks) if ticks else None
+
+    def stalled_by(self, tick: int) -> list[str]:
+        """Dropped producers stalled at `tick` or before, each once (the tick their vessels
+        are handed back: physics and the recorder ask alike); `handed` holds them after."""
+        due = [n for n in sorted(self.dropped - self.handed)
+               if (stall := self.stalled(n)) is None or tick >= stall]  # fmt: skip
+        self.handed.update(due)
+        return due
 
     def switch(self, key: str, tick: int, *, on: bool) -> None:
         """A stream's producer stops (or starts again) producing from tag `tick` on: a sensor

@@ -313,8 +313,9 @@ def _watch(scenario: Scenario, run_dir: Path, supervisor: Supervisor, *, quiet: 
     supervisor.wait(bar.update, bar.note)
     bar.close()
     result, cause = dict(supervisor.result), supervisor.cause()
-    if supervisor.dropped():  # with a program's own words (a result may be absent)
-        result["why_dropped"] = supervisor.dropped()
+    dropped = supervisor.dropped()  # with a program's own words (a result may be absent)
+    if dropped:
+        result["why_dropped"] = dropped
     if cause:
         result["error"] = cause
     record_settings(scenario, run_dir, result.get("settings"))

@@ -49,7 +49,6 @@ class PhysicsService:
         )
         self.book = CommandBook(world.vessels)
         self.driven_by = world.driven_by  # clock.policy drop: the vessels a participant drove
-        self.dropped: dict[str, bool] = {}  # heard of, handed back yet
         self.reach = Reach(world.vessels, self.controllers.single)  # says a twist is too much
         for text in never_applied(world.vessels, world.scenario):
             advise(log, text)
@@ -79,10 +78,12 @@ class PhysicsService:
     def step(self, tick: Tick, inputs: Inputs) -> None:
         changes = changes_of(tick.settings)
         settings.take(self.world, self.scenario, self.specs, changes, tick=tick.tick, sea=self.sea)
-        self._drops(tick)
+        inbox = self.participant.inbox
+        for name in inbox.stalled_by(tick.tick):  # a dropped stack's vessels handed back
+            self.book.drop(name, self.driven_by([name]), tick.stamp_ns)
         taken: list[str] = []  # free commands (tick -1), for the recorder (taken.py)
         for key, msgs in inputs.items():
-            if self.dropped.get(self.participant.inbox.streams[key].producer):
+            if inbox.streams[key].producer in inbox.handed:
                 continue  # a dropped stack's late sample: its vessel was handed back
             if key in self.blocks:
                 self._take_twists(msgs[-1], self.blocks[key])
@@ -94,17 +95,6 @@ class PhysicsService:
         self._apply_orders(tick.stamp_ns)
         self.world.step()
         self._publish(tick, tuple(taken))
-
-    def _drops(self, tick: Tick) -> None:
-        """Hand a dropped participant's vessels back from the first tick that waited for its
-        commands (Inbox.stalled): the tick the recorder writes it at, on every run."""
-        for name in tick.dropped:
-            self.dropped.setdefault(name, False)
-        for name in [n for n, done in self.dropped.items() if not done]:
-            stall = self.participant.inbox.stalled(name)
-            if stall is None or tick.tick >= stall:
-                self.dropped[name] = True
-                self.book.drop(name, self.driven_by([name]), tick.stamp_ns)
 
     def _take_twists(self, batch: Message, boats: tuple[str, ...]) -> None:
         assert isinstance(batch, TwistBatch)  # the inbox decodes each stream as its type

@@ -150,7 +150,7 @@ class Recorder:
         """The free commands physics took at the start of the batch's tick k: written as
         heard before tick k (k - 1, stamped k dt), the order physics follows from k on."""
         at = dataclasses.replace(tick, tick=batch.tick, stamp_ns=batch.stamp_ns - self.dt_ns)
-        self._drops(at, tick.dropped)
+        self._drops(at)
         for text in batch.commands:
             try:
                 key, msg = taken(text, self.free_kinds)
@@ -162,16 +162,12 @@ class Recorder:
         for vessel in self.orders.expire(at.stamp_ns):  # as physics, after that tick's takes
             self._resume(vessel, at)
 
-    def _drops(self, at: Tick, heard: tuple[str, ...]) -> None:
+    def _drops(self, at: Tick) -> None:
         """Participants dropped (clock.policy drop) whose vessels physics handed back at this
-        batch's tick: the first that waited for their commands (Inbox.stalled, the same
-        streams and samples here), so their script's step, or rest, is written from there."""
-        dropped = self.metrics.dropped
-        for name in sorted(n for n in heard if n not in dropped):
-            stall = self.participant.inbox.stalled(name)
-            if stall is not None and at.tick < stall:
-                continue
-            dropped[name] = at.stamp_ns / NS_PER_S
+        batch's tick (Inbox.stalled_by: the same streams and samples here), so their
+        script's step, or rest, is written from there."""
+        for name in self.participant.inbox.stalled_by(at.tick):
+            self.metrics.dropped[name] = at.stamp_ns / NS_PER_S
             for vessel in self.driven_by([name]):
                 self.orders.drop(vessel)
                 self._resume(vessel, at)

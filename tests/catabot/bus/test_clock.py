@@ -259,6 +259,9 @@ def test_a_dropped_producer_stalled_at_the_first_tick_that_waited_for_it() -> No
     _add(lagged, GPS, _gps(0))
     assert lagged.stalled("sensors") == 14  # read 3 ticks later
     assert inbox.stalled("external") is None and inbox.stalled("nobody") is None  # not clocked
+    inbox.drop_producers(["sensors"])
+    assert inbox.stalled_by(20) == [] and inbox.stalled_by(21) == ["sensors"]  # once
+    assert inbox.stalled_by(30) == [] and inbox.handed == {"sensors"}
 
 
 def test_malformed_payloads_raise_and_leave_the_inbox_unchanged() -> None:
