@@ -8,7 +8,6 @@ vessel of a run by its line style; `compare.html` has every run's figures in one
 
 from __future__ import annotations
 
-import html
 import json
 from pathlib import Path
 from typing import Any
@@ -18,8 +17,8 @@ from matplotlib import colormaps
 from matplotlib.figure import Figure
 
 from catabot.config.scenario import Scenario
-from catabot.run.metrics_summary import vessel_parts
 from services.plots.figures import draw_task, speed_heading_axes
+from services.plots.report import table_row, vessel_cells
 from services.plots.series import RunSeries
 
 STYLES = ["-", "--", ":", "-."]
@@ -149,7 +148,4 @@ def report(path: Path, runs: list[RunSeries], files: dict[str, str]) -> None:
 
 
 def _row(label: str, vid: str, m: dict[str, Any], ended: str) -> str:
-    parts = html.escape("; ".join(filter(None, vessel_parts(m))))
-    cells = [html.escape(label), html.escape(vid), f"{m['distance_m']:.1f}",
-             f"{m['max_speed_mps']:.2f}", parts, html.escape(ended)]  # fmt: skip
-    return "<tr>" + "".join(f"<td>{c}</td>" for c in cells) + "</tr>"
+    return table_row([label, vid, *vessel_cells(m), ended])

@@ -45,16 +45,21 @@ def summary(data: RunSeries) -> list[tuple[str, Any]]:
     ]  # fmt: skip
 
 
+def vessel_cells(m: dict[str, Any]) -> list[str]:
+    """A vessel's figures in metrics.json as table cells: distance, top speed, and the
+    console summary's goal, nearest bodies, contacts and thrust (one run, or runs compared)."""
+    return [f"{m['distance_m']:.1f}", f"{m['max_speed_mps']:.2f}",
+            "; ".join(filter(None, vessel_parts(m)))]  # fmt: skip
+
+
+def table_row(cells: list[str]) -> str:
+    return "<tr>" + "".join(f"<td>{html.escape(c)}</td>" for c in cells) + "</tr>"
+
+
 def _metrics(data: RunSeries) -> str:
     m = data.metrics or {}
     vessels = m.get("vessels", {})
-    rows = "".join(
-        f"<tr><td>{html.escape(v)}</td><td>{vessels[v]['distance_m']:.1f}</td>"
-        f"<td>{vessels[v]['max_speed_mps']:.2f}</td>"
-        f"<td>{html.escape('; '.join(filter(None, vessel_parts(vessels[v]))))}</td></tr>"
-        for v in data.own
-        if v in vessels
-    )  # the last column: the console summary's goal, nearest bodies, contacts, thrust
+    rows = "".join(table_row([v, *vessel_cells(vessels[v])]) for v in data.own if v in vessels)
     close = m.get("closest_approach")
     line = (
         f"<p>Closest approach: <b>{close['distance_m']:.2f} m</b> between "
