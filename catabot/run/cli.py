@@ -1,5 +1,5 @@
 """The `catabot` command: run, service, router, scenario, secure, deploy, and the tools over
-run folders (view, dataset, plot)."""
+run folders (view, dataset, plot, results)."""
 
 from __future__ import annotations
 
@@ -96,6 +96,7 @@ TOOLS = {  # `catabot <tool> ...`: programs over a run folder, each in its own s
     "view": ("services.viewer.cli", "replay a run or attach to one in the rerun viewer"),
     "dataset": ("services.datasets.cli", "export a run as a YOLO, COCO or KITTI dataset"),
     "plot": ("services.plots.cli", "plot a run: PNG figures and report.html"),
+    "results": ("services.results.cli", "many runs in one table (a sweep): CSV for pandas"),
 }
 LIVE = {  # `catabot <command> ...` against a running simulation (its own flags and --help)
     "get": (settings_cli.get_main, "the settings of a running simulation"),

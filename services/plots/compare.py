@@ -16,6 +16,7 @@ import numpy as np
 from matplotlib import colormaps
 from matplotlib.figure import Figure
 
+from catabot.config.differences import differences
 from catabot.config.scenario import Scenario
 from services.plots.figures import draw_task, speed_heading_axes
 from services.plots.report import table_row, vessel_cells
@@ -41,9 +42,7 @@ def run_labels(runs: list[RunSeries]) -> list[str]:
 
 def _about(data: RunSeries, first: Scenario) -> str:
     mine = data.run.world.scenario
-    base, own = (_flat(s.model_dump(mode="json", exclude={"name", "settings"}))
-                 for s in (first, mine))  # fmt: skip
-    parts = [f"{k}={json.dumps(own[k])}" for k in sorted(own) if own[k] != base.get(k)]
+    parts = [f"{k}={json.dumps(v)}" for k, v in differences(first, mine).items()]
     if len(parts) > MANY and mine.name != first.name:  # another scenario: its name says more
         parts = [f"scenario {mine.name}"]
     parts += [f"{c.key}={json.dumps(c.value)} at {c.t_s:g} s" for c in mine.settings]
@@ -60,19 +59,6 @@ def _short(parts: list[str], budget: int = 100) -> str:
             return ", ".join(shown) + f", and {len(parts) - k} more"
         shown.append(part)
     return ", ".join(shown)
-
-
-def _flat(tree: Any, prefix: str = "") -> dict[str, Any]:
-    """A nested scenario as `a.b.0.c: value` leaves (a list of plain values is one value: a
-    current's [east, north])."""
-    if isinstance(tree, list) and any(isinstance(v, dict | list) for v in tree):
-        tree = dict(enumerate(tree))
-    if not isinstance(tree, dict):
-        return {prefix: tree}
-    out: dict[str, Any] = {}
-    for key, value in tree.items():
-        out |= _flat(value, f"{prefix}.{key}" if prefix else str(key))
-    return out
 
 
 def _tracks(runs: list[RunSeries], labels: list[str]) -> Figure:

@@ -1,0 +1,5 @@
+import sys
+
+from services.results.cli import main
+
+sys.exit(main())

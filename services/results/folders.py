@@ -1,0 +1,47 @@
+"""Which folders are runs: the ones named, or the runs inside a folder of runs.
+
+A sweep writes its runs into one folder (`catabot run --out runs/sweep`, a run each in
+`runs/sweep/<name>-<time>`), so naming that folder names them all, in name order (the
+order they were started in, since the time is in the name).
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+from catabot.errors import CataBotError
+
+
+class ResultsError(CataBotError, ValueError):
+    """A folder that is neither a run nor holds any."""
+
+
+def is_run(folder: Path) -> bool:
+    """A run folder: its scenario, and what `catabot run` wrote as it ended (log/run.json)
+    or the recorder (metrics.json)."""
+    has_end = (folder / "log" / "run.json").is_file() or (folder / "metrics.json").is_file()
+    return (folder / "scenario.json").is_file() and has_end
+
+
+def run_folders(paths: list[str]) -> list[Path]:
+    """Each path as the runs it names, once each, in the order given."""
+    found: list[Path] = []
+    for path in paths:
+        found += [f for f in _runs_in(Path(path)) if f not in found]
+    return found
+
+
+def _runs_in(path: Path) -> list[Path]:
+    if not path.exists():
+        raise ResultsError(f"{path}: no such folder")
+    if not path.is_dir():
+        raise ResultsError(f"{path}: a file; give a run folder or a folder of runs")
+    if is_run(path):
+        return [path]
+    inside = sorted(f for f in path.iterdir() if f.is_dir() and is_run(f))
+    if not inside:
+        raise ResultsError(
+            f"{path}: not a run folder (no scenario.json with log/run.json or metrics.json), "
+            "and no run folder in it"
+        )
+    return inside

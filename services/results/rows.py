@@ -1,0 +1,122 @@
+"""A row per run and scenario vessel: the swept fields, how the run ended, the vessel's metrics.
+
+Read from each run folder's `scenario.json` (the fields, `--set` included), `log/run.json`
+(how it ended, its times) and `metrics.json` (the recorder's figures). A run whose recorder
+wrote no metrics (it failed before its first tick) still has its row, blank where nothing
+was measured, so a sweep's table shows every run it started.
+"""
+
+from __future__ import annotations
+
+import json
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+from catabot.config.differences import flat_fields, swept_fields
+from catabot.config.load import load_scenario
+from catabot.config.scenario import Scenario
+
+# The measured columns: name -> (where in a vessel's metrics, or the run's), in table order.
+RUN_COLUMNS = ("seed", "reason", "error", "sim_s", "wall_s")
+VESSEL_COLUMNS = (
+    "goal_reached", "time_to_goal_s", "path_length_m", "final_distance_m",
+    "max_cross_track_m", "rms_cross_track_m", "nearest_vessel_m", "nearest_vessel",
+    "nearest_buoy_m", "nearest_shore_m", "collisions", "groundings", "capsizes",
+    "thrust_impulse_Ns", "distance_m", "max_speed_mps",
+)  # fmt: skip
+AFTER = ("closest_approach_m", "traffic_collisions")
+
+
+@dataclass(frozen=True)
+class RunRecord:
+    """One run folder as read: its scenario and its two result files (None where absent)."""
+
+    folder: Path
+    scenario: Scenario
+    run: dict[str, Any] | None
+    metrics: dict[str, Any] | None
+
+
+def read(folder: Path) -> RunRecord:
+    """A run folder's record; an unreadable scenario raises its ConfigError."""
+    return RunRecord(
+        folder, load_scenario(folder / "scenario.json"),
+        _json(folder / "log" / "run.json"), _json(folder / "metrics.json"),
+    )  # fmt: skip
+
+
+def _json(path: Path) -> dict[str, Any] | None:
+    try:
+        value = json.loads(path.read_text())
+    except (OSError, ValueError):
+        return None
+    return value if isinstance(value, dict) else None
+
+
+def table(records: list[RunRecord]) -> tuple[list[str], list[dict[str, Any]]]:
+    """The header (run, vessel, the swept fields, then the measured columns) and the rows."""
+    swept = [k for k in swept_fields([r.scenario for r in records]) if k not in RUN_COLUMNS]
+    header = ["run", "vessel", *swept, *RUN_COLUMNS, *VESSEL_COLUMNS, *AFTER]
+    return header, [row for r in records for row in _rows(r, swept)]
+
+
+def _rows(record: RunRecord, swept: list[str]) -> list[dict[str, Any]]:
+    fields = flat_fields(record.scenario)
+    common = {"run": record.folder.name, **{k: fields.get(k) for k in swept}}
+    common |= _run_cells(record) | _after(record.metrics)
+    vessels = own_vessels(record.metrics)
+    if not vessels:  # nothing measured: the run's row alone
+        return [common | {"vessel": None}]
+    return [common | {"vessel": vid} | vessel_cells(m) for vid, m in vessels.items()]
+
+
+def own_vessels(metrics: dict[str, Any] | None) -> dict[str, dict[str, Any]]:
+    """The scenario vessels' metrics (measured against everything else: `nearest_vessel`),
+    not the traffic boats'."""
+    vessels = (metrics or {}).get("vessels")
+    if not isinstance(vessels, dict):
+        return {}
+    return {v: m for v, m in vessels.items() if isinstance(m, dict) and "nearest_vessel" in m}
+
+
+def _run_cells(record: RunRecord) -> dict[str, Any]:
+    run = record.run or {}
+    reason = run.get("reason") or (record.metrics or {}).get("end_reason")
+    return {
+        "seed": record.scenario.seed,
+        "reason": reason or "unknown (no log/run.json)",
+        "error": run.get("error") or None,
+        "sim_s": run.get("sim_s", (record.metrics or {}).get("sim_time_s")),
+        "wall_s": run.get("wall_s"),
+    }
+
+
+def _after(metrics: dict[str, Any] | None) -> dict[str, Any]:
+    m = metrics or {}
+    close, hits = m.get("closest_approach"), m.get("traffic_collisions")
+    return {
+        "closest_approach_m": close.get("distance_m") if isinstance(close, dict) else None,
+        "traffic_collisions": len(hits) if isinstance(hits, list) else None,
+    }
+
+
+def vessel_cells(m: dict[str, Any]) -> dict[str, Any]:
+    """A scenario vessel's figures in metrics.json as flat cells (blank where it has none:
+    no goal, no route, no buoy in the scenario)."""
+    goal, route = m.get("goal") or {}, m.get("route") or {}
+    nearest = {k: m.get(f"nearest_{k}") or {} for k in ("vessel", "buoy", "shore")}
+    return {
+        "goal_reached": goal.get("reached"),
+        "time_to_goal_s": goal.get("time_to_goal_s"),
+        "path_length_m": goal.get("path_length_m"),
+        "final_distance_m": goal.get("final_distance_m"),
+        "max_cross_track_m": route.get("max_cross_track_m"),
+        "rms_cross_track_m": route.get("rms_cross_track_m"),
+        "nearest_vessel_m": nearest["vessel"].get("distance_m"),
+        "nearest_vessel": nearest["vessel"].get("id"),
+        "nearest_buoy_m": nearest["buoy"].get("distance_m"),
+        "nearest_shore_m": nearest["shore"].get("distance_m"),
+        **{k: m.get(k) for k in ("collisions", "groundings", "capsizes", "thrust_impulse_Ns")},
+        **{k: m.get(k) for k in ("distance_m", "max_speed_mps")},
+    }
