@@ -125,6 +125,27 @@ def check_apart(scenario: Scenario, *, models: Models) -> None:
         )
 
 
+Hull = tuple[str, Pose, VesselModel]  # a body already placed: its name, pose and model
+
+
+def hull_clash(pose: Pose, model: VesselModel, placed: list[Hull]) -> str:
+    """Why a hull given its start cannot start there ("" if it can): it overlaps a placed
+    hull, their plan-view boxes (physics' collision shapes) as `check_apart` sees them, so
+    boats may be given starts alongside each other, as scenario vessels may."""
+    if not placed:
+        return ""
+    poses = [pose, *(p for _, p, _ in placed)]
+    offset, half = footprints([model, *(m for _, _, m in placed)])
+    heading = np.array([p.yaw_rad for p in poses])
+    xy = np.array([(p.x_m, p.y_m) for p in poses])
+    others = np.arange(1, len(poses))
+    gaps = box_gaps(xy + turn_xy(offset, heading), heading, half, np.zeros_like(others), others)
+    k = int(np.argmin(gaps))
+    if gaps[k] >= 0.0:
+        return ""
+    return f"its hull overlaps {placed[k][0]}'s by {-gaps[k]:.2f} m (seen from above)"
+
+
 @contextmanager
 def _as_field(field: str) -> Iterator[None]:
     """A terrain check's refusal as the scenario's, naming the field."""

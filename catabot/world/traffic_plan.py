@@ -19,14 +19,21 @@ from catabot.config.terrain import TerrainError
 from catabot.config.traffic import BEHAVIOURS, BoatOverride, Point, Region, TrafficConfig, boat_id
 from catabot.world import seeding
 from catabot.world.clearance import Discs, Rows, clear, densify, off_rings
-from catabot.world.placement import BUOY_MODEL, CLEARANCE_M, Models, footprint_m, keel_depth_m
+from catabot.world.placement import (
+    BUOY_MODEL,
+    CLEARANCE_M,
+    Hull,
+    Models,
+    footprint_m,
+    hull_clash,
+    keel_depth_m,
+)
 from catabot.world.terrain import Terrain
+from catabot.world.traffic_checks import TRACK_DEPTH_M, check_given, check_room
 
 TRIES = 2000
 START_ROOM_M = 10.0  # more water between a drawn start and every vessel's: see README § traffic
 PATH_DRAWS = 5000  # random paths per boat before the plan is refused
-MAX_BUOY_COVER = 0.05
-TRACK_DEPTH_M = 2.0  # water under every point of a boat's track: boats must not run aground
 
 
 @dataclass(frozen=True)
@@ -82,10 +89,12 @@ class Planner:
         self.rng = seeding.rng(seed, "traffic")
         self._model = models.__getitem__  # scenario_models: each model file read once
         self.placed, self.named = Discs(), []  # vessels' starts: x, y, footprint radius; ids
+        self.hulls: list[Hull] = []  # the same, as hulls: a start given beside one (hull_clash)
         for v in scenario.vessels:
             assert v.pose is not None
             self.named.append(v.id)
             self.placed.add(v.pose.x_m, v.pose.y_m, footprint_m(self._model(v.model)))
+            self.hulls.append((v.id, v.pose, self._model(v.model)))
         self.buoy_r = footprint_m(self._model(BUOY_MODEL))
         # Buoys are moored: a boat must not start on one, nor circle through one every lap.
         self.marks = Discs()  # buoys: x, y, footprint radius
@@ -94,56 +103,8 @@ class Planner:
         self.rings = Rows(4)  # circling boats: centre x, y, radius, hull footprint
         self.footprints: dict[str, float] = {}  # by model, as drawn
         self.overrides = {b.index: b for b in self.cfg.boats}
-        self._check_room()
-        self._check_given()
-
-    def _check_room(self) -> None:
-        """Refuse at once a traffic whose waypoint buoys cannot all be laid clear of each
-        other: each buoy keeps others out of a disc of radius 2 r + clearance, and once
-        those discs cover 5% of the region a path of many points almost never lands clear
-        (planning would run for minutes, then fail)."""
-        w, mix = self.cfg.waypoints, self.cfg.behaviour_mix
-        if w.points is not None or not w.buoys:
-            return
-        share = mix.get("waypoints", 0.0) / sum(mix.values())
-        buoys = self.cfg.count * share * w.count
-        width, height = w.region.size_m
-        covered = buoys * math.pi * (2 * self.buoy_r + CLEARANCE_M) ** 2 / (width * height)
-        if covered > MAX_BUOY_COVER:
-            raise ScenarioError(
-                f"traffic: about {buoys:.0f} waypoint buoys ({self.cfg.count} boats x "
-                f"{share:.0%} on waypoints x {w.count} points) in a {width:g} x {height:g} m "
-                f"region would keep {covered:.0%} of it; at most {MAX_BUOY_COVER:.0%}: use "
-                "fewer points or boats, a larger traffic.waypoints.region, or buoys: false"
-            )
-
-    def _check_given(self) -> None:
-        """Given waypoints, and the legs between them, in water `TRACK_DEPTH_M` deep, each
-        refusal naming its field: a point on land used to end 2000 start draws later in
-        "no free open water for boat 1", which named neither."""
-        if self.terrain is None:
-            return
-        loop = self.cfg.waypoints.mode == "loop"
-        given = [("traffic.waypoints.points", self.cfg.waypoints.points)]
-        given += [(f"traffic.boats.{j}.points", b.points) for j, b in enumerate(self.cfg.boats)]
-        for field, points in given:
-            for k, (x, y) in enumerate(points or ()):
-                try:
-                    self.terrain.check_water(x, y, what="waypoint", depth_m=TRACK_DEPTH_M)
-                except TerrainError as exc:
-                    raise ScenarioError(f"{field}.{k}: {exc}") from None
-            if points and len(points) > 1:
-                self._check_legs(field, np.array(points, dtype=np.float64), loop=loop)
-
-    def _check_legs(self, field: str, points: np.ndarray, *, loop: bool) -> None:
-        closed = np.vstack([points, points[:1]]) if loop else points
-        for k in range(len(closed) - 1):
-            if not self._wet(*densify(closed[k : k + 2], loop=False)):
-                a, b = closed[k].tolist(), closed[k + 1].tolist()
-                raise ScenarioError(
-                    f"{field}: the leg from ({a[0]:g}, {a[1]:g}) to ({b[0]:g}, {b[1]:g}) "
-                    f"crosses land or water under {TRACK_DEPTH_M:g} m deep"
-                )
+        check_room(self.cfg, self.buoy_r)
+        check_given(self.cfg, self.terrain, self._wet)
 
     def plan(self) -> TrafficPlan:
         boats = tuple(self._planned(i) for i in range(self.cfg.count))
@@ -197,15 +158,20 @@ class Planner:
             x, y = over.x_m if over.x_m is not None else x, over.y_m if over.y_m is not None else y
             yaw = over.yaw_rad if over.yaw_rad is not None else self.rng.uniform(-math.pi, math.pi)
             fixed = over.x_m is not None and over.y_m is not None  # the user's spot: as given
-            blocked = self._blocked(x, y, radius, draft, room=0.0 if fixed else START_ROOM_M)
+            pose = Pose(x_m=x, y_m=y, yaw_rad=yaw)
+            blocked = hull_clash(pose, hull, self.hulls) if fixed else ""
+            blocked = blocked or self._blocked(
+                x, y, radius, draft, room=None if fixed else START_ROOM_M
+            )
             if blocked:
                 if fixed:
                     raise ScenarioError(f"traffic.boats: boat {index} at ({x}, {y}): {blocked}")
                 continue
-            boat = self._behave(index, model, Pose(x_m=x, y_m=y, yaw_rad=yaw), behaviour, over)
+            boat = self._behave(index, model, pose, behaviour, over)
             if boat is not None:
                 self.placed.add(x, y, radius)
                 self.named.append(boat.id)
+                self.hulls.append((boat.id, pose, hull))
                 return boat
         if behaviour == "waypoints" and (over.points or self.cfg.waypoints.points):
             raise ScenarioError(
@@ -247,14 +213,18 @@ class Planner:
         disc = self.placed.array
         return self.named[int(np.argmin(np.hypot(disc[:, 0] - x, disc[:, 1] - y) - disc[:, 2]))]
 
-    def _blocked(self, x: float, y: float, radius: float, draft: float, *, room: float) -> str:
-        """Why a start is not free ("" if it is): clear of every vessel (by `room` more) and
-        buoy placed so far, and in water deep enough for the hull."""
+    def _blocked(
+        self, x: float, y: float, radius: float, draft: float, *, room: float | None
+    ) -> str:
+        """Why a start is not free ("" if it is): clear of every vessel placed so far by
+        `room` more than their footprints (None: not tested here, a given start's hull is)
+        and of every buoy, and in water deep enough for the hull."""
         here = np.array([(x, y)])
-        if not self.placed.clear_of(here, radius + room):
+        if room is not None and not self.placed.clear_of(here, radius + room):
             return f"its {radius:.2f} m footprint overlaps {self._nearest(x, y)}'s (or its room)"
         if not self.marks.clear_of(here, radius):
-            return f"its {radius:.2f} m footprint overlaps a buoy (scenario or waypoint)"
+            where = "(scenario or waypoint)"
+            return f"its footprint ({radius:.2f} m about its origin) overlaps a buoy {where}"
         if self.terrain is None:
             return ""
         try:

@@ -83,13 +83,29 @@ def test_a_given_waypoint_where_a_boat_starts_is_refused_naming_both() -> None:
 
 def test_a_start_that_is_not_free_says_what_it_overlaps() -> None:
     on_mark = {"index": 0, "x_m": 40.0, "y_m": 0.5}
-    with pytest.raises(ScenarioError, match=r"boat 0 at \(40.0, 0.5\): its .* m footprint "
-                       r"overlaps a buoy \(scenario or waypoint\)"):  # fmt: skip
+    with pytest.raises(ScenarioError, match=r"boat 0 at \(40.0, 0.5\): its footprint \(.* m "
+                       r"about its origin\) overlaps a buoy \(scenario or waypoint\)"):  # fmt: skip
         _plan(1, boats=[on_mark])
     on_ego = {"index": 1, "x_m": 1.0, "y_m": 0.0}  # boat_000 is drawn far from the ego
-    with pytest.raises(ScenarioError, match=r"boat 1 at \(1.0, 0.0\): its .* m footprint "
-                       r"overlaps ego's \(or its room\)"):  # fmt: skip
+    with pytest.raises(ScenarioError, match=r"boat 1 at \(1.0, 0.0\): its hull overlaps ego's "
+                       r"by .* m \(seen from above\)"):  # fmt: skip
         _plan(2, boats=[on_ego])
     with pytest.raises(ScenarioError, match=r"no free open water for boat .* give a larger "
                        r"traffic.region or fewer boats"):  # fmt: skip
         _plan(40, region={"size_m": [30.0, 30.0]})
+
+
+def test_given_starts_may_lie_alongside_each_other_but_not_overlap() -> None:
+    """A harbour's boats moored side by side (3 m apart, 1.3 m beams): a disc around each
+    whole hull had refused them, where scenario vessels alongside each other are fine."""
+    side = [{"index": 0, "x_m": 14.0, "y_m": 0.0, "yaw_rad": 0.0, "behaviour": "hold"},
+            {"index": 1, "x_m": 14.0, "y_m": 3.0, "yaw_rad": 0.0, "behaviour": "hold"}]  # fmt: skip
+    plan = _plan(2, boats=side)
+    assert [(b.pose.x_m, b.pose.y_m) for b in plan.boats] == [(14.0, 0.0), (14.0, 3.0)]
+    side[1]["y_m"] = 1.0
+    with pytest.raises(ScenarioError, match=r"boat 1 at \(14.0, 1.0\): its hull overlaps "
+                       r"boat_000's by 0\.\d\d m"):  # fmt: skip
+        _plan(2, boats=side)
+    side[1] |= {"y_m": 2.5, "yaw_rad": 1.5708}  # turned across the first: stern into its side
+    with pytest.raises(ScenarioError, match="its hull overlaps boat_000's"):
+        _plan(2, boats=side)
