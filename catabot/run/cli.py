@@ -94,7 +94,7 @@ def _service(args: argparse.Namespace, rest: list[str]) -> int:
 
 TOOLS = {  # `catabot <tool> ...`: programs over a run folder, each in its own service folder
     "view": ("services.viewer.cli", "replay a run or attach to one in the rerun viewer"),
-    "dataset": ("services.datasets.cli", "export a run as a YOLO, COCO or KITTI dataset"),
+    "dataset": ("services.datasets.cli", "export a run: YOLO, COCO, SemanticKITTI, segmentation"),
     "plot": ("services.plots.cli", "plot a run: PNG figures and report.html"),
     "results": ("services.results.cli", "many runs in one table (a sweep): CSV for pandas"),
 }

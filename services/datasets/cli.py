@@ -68,7 +68,9 @@ def _check(args: argparse.Namespace) -> Path:
     if args.min_box_px < 0:
         raise ExportOptionError(f"--min-box-px must be >= 0 (got {args.min_box_px})")
     out = Path(args.output)
-    if out.exists() and (not out.is_dir() or any(out.iterdir())):
+    if out.exists() and not out.is_dir():
+        raise ExportOptionError(f"--output {out} is a file; give a folder (new or empty)")
+    if out.exists() and any(out.iterdir()):
         raise ExportOptionError(f"--output {out} exists and is not an empty folder")
     return out
 

@@ -44,6 +44,15 @@ def test_a_bad_option_is_one_line(
     assert err.count("\n") == 1 and why in err and "usage" not in err
 
 
+def test_an_output_that_is_a_file_is_named_as_one(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    (tmp_path / "afile").write_text("")
+    assert main(["export", str(tmp_path), "-f", "coco", "-o", str(tmp_path / "afile")]) == 2
+    said = f"--output {tmp_path / 'afile'} is a file; give a folder (new or empty)"
+    assert said in capsys.readouterr().err
+
+
 def test_a_bad_format_is_one_line_too(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
     with pytest.raises(SystemExit) as info:
         main(["export", str(tmp_path), "--format", "voc", "-o", str(tmp_path / "o")])
