@@ -20,8 +20,8 @@ from catabot.errors import CataBotError
 from catabot.run import compose, conduct, console, launcher, programs, secure, settings_cli
 from catabot.run.answer import OneLineParser, answered, output_file
 from catabot.run.companions import VIEW_MODES
+from catabot.run.generate import ONLY_GENERATE, generate
 from catabot.run.generate import add_arguments as add_generate_arguments
-from catabot.run.generate import generate
 from catabot.world.model_checks import displacement, model_notes
 
 
@@ -145,7 +145,7 @@ def _scenario(args: argparse.Namespace) -> int:
     if args.file is not None and _is_model(Path(args.file)):
         return answered("scenario validate", lambda: _valid_model(args.file))
     try:  # what `catabot run` checks before it starts anything, no less
-        world = launcher.prepare(launcher.RunOptions(scenario=args.file, sets=tuple(args.set)))
+        world = launcher.prepare(_validate_options(args))
     except CataBotError as exc:
         print(f"catabot scenario validate: {exc}", file=sys.stderr)
         return 2
@@ -168,6 +168,17 @@ def _is_model(path: Path) -> bool:
     except (OSError, ValueError, RecursionError):
         return False  # the scenario path says what is wrong with it
     return isinstance(data, dict) and "hulls" in data and "vessels" not in data
+
+
+def _validate_options(args: argparse.Namespace) -> launcher.RunOptions:
+    """`validate`'s flags as `catabot run` takes them (--seed and --set seed=... are refused
+    together by both); generate's own flags are refused, not ignored."""
+    wrong = [f"--{flag}" for flag in ONLY_GENERATE if getattr(args, flag) is not None]
+    if wrong:
+        raise launcher.LaunchError(f"{', '.join(wrong)}: only for `scenario generate`")
+    return launcher.RunOptions(
+        scenario=args.file, sets=tuple(args.set), seed=args.seed, duration_s=args.duration
+    )
 
 
 def _valid_model(file: str) -> str:

@@ -42,12 +42,13 @@ def parse_mix(text: str) -> dict[str, float]:
 
 
 def scenario_data(args: argparse.Namespace) -> dict[str, Any]:
+    mix = parse_mix(given(args, "mix"))
     data: dict[str, Any] = {
-        "name": args.name,
-        "seed": args.seed,
-        "duration_s": args.duration,
+        "name": given(args, "name"),
+        "seed": given(args, "seed"),
+        "duration_s": given(args, "duration"),
         "vessels": [{"id": "ego", "model": "catabot"}],
-        "traffic": {"count": args.boats, "behaviour_mix": parse_mix(args.mix)},
+        "traffic": {"count": given(args, "boats"), "behaviour_mix": mix},
     }
     if args.terrain:  # from the current directory, or a bundled one named bare
         data["terrain"] = {"elevation_image": args.terrain, **_bundled_scale(args.terrain)}
@@ -65,15 +66,26 @@ def _bundled_scale(image: str) -> dict[str, Any]:
     return scale
 
 
+DEFAULTS = {"boats": 10, "mix": "circle=1", "seed": 0, "duration": 60.0, "name": "traffic"}
+ONLY_GENERATE = ("boats", "mix", "terrain", "name")  # `validate` takes --seed and --duration
+
+
 def add_arguments(p: argparse.ArgumentParser) -> None:
-    p.add_argument("--boats", type=int, default=10, help="traffic boats (0-500)")
-    p.add_argument(
-        "--mix", default="circle=1", help="behaviour weights, e.g. circle=0.5,waypoints=0.5"
-    )
-    p.add_argument("--seed", type=int, default=0)
-    p.add_argument("--terrain", help="elevation image (PNG) for the terrain")
-    p.add_argument("--duration", type=float, default=60.0, help="simulated seconds")
-    p.add_argument("--name", default="traffic", help="world name")
+    """The flags default to None, so `scenario validate` can tell a flag it was given (and
+    refuse the ones that are generate's alone) from one it was not."""
+    p.add_argument("--boats", type=int, help="generate: traffic boats (0-500; default 10)")
+    p.add_argument("--mix", help="generate: behaviour weights (default circle=1), e.g. "
+                   "circle=0.5,waypoints=0.5")  # fmt: skip
+    p.add_argument("--seed", type=int, help="the seed (generate: default 0)")
+    p.add_argument("--terrain", help="generate: elevation image (PNG) for the terrain")
+    p.add_argument("--duration", type=float, help="simulated seconds (generate: default 60)")
+    p.add_argument("--name", help="generate: world name (default traffic)")
+
+
+def given(args: argparse.Namespace, flag: str) -> Any:
+    """A generate flag's value, or its default."""
+    value = getattr(args, flag)
+    return DEFAULTS[flag] if value is None else value
 
 
 def generate(args: argparse.Namespace) -> int:
@@ -90,4 +102,4 @@ def _write(args: argparse.Namespace) -> str | None:
         sys.stdout.write(text)
         return None
     output.write_text(text)
-    return f"{args.output}: {args.boats} boat(s), seed {args.seed}"
+    return f"{args.output}: {given(args, 'boats')} boat(s), seed {given(args, 'seed')}"

@@ -230,3 +230,17 @@ def test_a_service_without_a_run_dir_records_under_runs_not_where_it_was_started
     args = service_parser("recorder").parse_args(["--scenario", "harbour"])
     assert args.run_dir is None  # resolved against the scenario: runs/<its name>
     assert "runs/<the scenario's name>" in service_parser("recorder").format_help()
+
+
+def test_validate_takes_run_s_seed_and_duration_and_refuses_what_run_refuses(
+    capsys: pytest.CaptureFixture[str],
+) -> None:
+    """A sweep script validated `--seed 3 --set seed=4` (valid) and then ran it (refused):
+    validate had ignored --seed, a flag it shares with `scenario generate`."""
+    assert main(["scenario", "validate", "--seed", "3", "--set", "seed=4"]) == 2
+    assert "seed is given by --seed too" in capsys.readouterr().err
+    assert main(["scenario", "validate", "--duration", "5"]) == 0
+    assert "500 ticks" in capsys.readouterr().out
+    assert main(["scenario", "validate", "--boats", "5", "--name", "x"]) == 2
+    said = "catabot scenario validate: --boats, --name: only for `scenario generate`\n"
+    assert capsys.readouterr().err == said
