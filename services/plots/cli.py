@@ -1,5 +1,5 @@
 """`catabot plot RUN_FOLDER [-o OUT_DIR]`: PNG figures and `report.html` of a recorded run;
-`catabot plot RUN RUN ...`: their scenario vessels compared (compare.py).
+`catabot plot RUN RUN ...` or a folder of runs: their scenario vessels compared (compare.py).
 
 Trajectories over the terrain with the traffic and buoys, speed and heading, thrust and
 twist commands, IMU series, LiDAR returns and rain returns against the rain rate, and the
@@ -15,6 +15,7 @@ from pathlib import Path
 
 from catabot.errors import CataBotError
 from catabot.run.answer import OneLineParser, answered, output_folder
+from catabot.run.folders import is_run, run_folders
 from catabot.run.recorded import RecordedRun, RunFolderError
 from services.plots import compare, report, series
 from services.plots.figures import FIGURES
@@ -24,10 +25,11 @@ PNG = {"Software": None}  # no version string: the same run gives the same bytes
 
 def parser() -> argparse.ArgumentParser:
     p = OneLineParser(prog="catabot plot", description=__doc__.split("\n")[0])
-    p.add_argument("run", nargs="+", help="the run folder (runs/<world>-<time>); several: "
-                   "their scenario vessels compared on one set of axes")  # fmt: skip
+    p.add_argument("run", nargs="+", help="the run folder (runs/<world>-<time>); several, or "
+                   "a folder of runs: their vessels compared on one set of axes")  # fmt: skip
     p.add_argument("--output", "-o", help="folder for the PNGs and report.html (compared: "
-                   "compare.html; default RUN/plots, or the first RUN's compare/)")  # fmt: skip
+                   "compare.html; default RUN/plots, the first RUN's compare/, or the folder "
+                   "of runs' compare/)")  # fmt: skip
     return p
 
 
@@ -67,13 +69,26 @@ def plot_compared(folders: list[str], out: Path | None) -> str:
 def main(argv: list[str] | None = None) -> int:
     args = parser().parse_args(argv)
     try:
-        out = _out(args.output)
+        out, runs = _out(args.output), expanded(args.run)
     except CataBotError as exc:
         print(f"catabot plot: {exc}", file=sys.stderr)
         return 2
-    if len(args.run) > 1:
-        return answered("plot", lambda: plot_compared(args.run, out))
-    return answered("plot", lambda: f"plots and report.html in {plot(args.run[0], out)}")
+    if runs != args.run and len(args.run) == 1:  # a sweep's folder: compare/ beside its runs
+        out = out or Path(args.run[0]) / "compare"
+    if len(runs) > 1:
+        return answered("plot", lambda: plot_compared(runs, out))
+    return answered("plot", lambda: f"plots and report.html in {plot(runs[0], out)}")
+
+
+def expanded(paths: list[str]) -> list[str]:
+    """A folder of runs (a sweep's --out) as the runs in it, as `catabot results` takes it;
+    a run folder, or anything else (named by the reader if it is not a run), as given."""
+    out: list[str] = []
+    for path in paths:
+        folder = Path(path)
+        inner = folder.is_dir() and not is_run(folder)
+        out += [str(f) for f in run_folders([path])] if inner else [path]
+    return out
 
 
 def _out(output: str | None) -> Path | None:

@@ -16,14 +16,12 @@ import numpy as np
 from matplotlib import colormaps
 from matplotlib.figure import Figure
 
-from catabot.config.differences import differences
-from catabot.config.scenario import Scenario
-from services.plots.figures import draw_task, speed_heading_axes
+from catabot.config.differences import flat_fields, swept_fields
+from services.plots.figures import draw_task, speed_heading_axes, task_points
 from services.plots.report import table_row, vessel_cells
 from services.plots.series import RunSeries
 
 STYLES = ["-", "--", ":", "-."]
-MANY = 6  # a run differing from the first in more fields than this is named by its scenario
 COLORS = colormaps["tab20"]  # 20 runs apart by colour
 
 
@@ -34,17 +32,19 @@ def figures(runs: list[RunSeries]) -> dict[str, Figure]:
 
 
 def run_labels(runs: list[RunSeries]) -> list[str]:
-    """Each run's folder name, what in its scenario differs from the first's (another
-    scenario: its name), its setting changes, and how it ended unless it completed."""
-    first = runs[0].run.world.scenario
-    return [data.run.folder.name + _about(data, first) for data in runs]
+    """Each run's folder name, its value of every field the runs of the first run's scenario
+    differ in (the first run's too: a paper's legend names every case), its setting changes,
+    and how it ended unless it completed; a run of another scenario, that scenario's name."""
+    name = runs[0].run.world.scenario.name
+    swept = swept_fields([s for d in runs if (s := d.run.world.scenario).name == name])
+    return [data.run.folder.name + _about(data, swept, name) for data in runs]
 
 
-def _about(data: RunSeries, first: Scenario) -> str:
+def _about(data: RunSeries, swept: list[str], name: str) -> str:
     mine = data.run.world.scenario
-    parts = [f"{k}={json.dumps(v)}" for k, v in differences(first, mine).items()]
-    if len(parts) > MANY and mine.name != first.name:  # another scenario: its name says more
-        parts = [f"scenario {mine.name}"]
+    values = flat_fields(mine)
+    parts = ([f"{k}={json.dumps(values.get(k))}" for k in swept] if mine.name == name
+             else [f"scenario {mine.name}"])  # fmt: skip
     parts += [f"{c.key}={json.dumps(c.value)} at {c.t_s:g} s" for c in mine.settings]
     ended = (data.metrics or {}).get("end_reason", "completed")
     parts += [] if ended == "completed" else [f"ended: {ended}"[:40]]
@@ -74,12 +74,24 @@ def _tracks(runs: list[RunSeries], labels: list[str]) -> Figure:
             ax.plot(*xy[-1, row], "s", color=_style(k, j)["color"], ms=6, mec="black")
             seen.append(xy[:, row])
             draw_task(ax, data.run.world.scenario.vessels[row].task, _style(k, j)["color"], vid)
+        seen.append(task_points(data.run.world, data.own))
+    seen.append(_buoys(ax, runs))
     _square(ax, np.concatenate(seen))
     ax.set(xlabel="east x [m]", ylabel="north y [m]", aspect="equal",
            title="Trajectories of the scenario vessels (■ end; tasks dashed, dotted)")  # fmt: skip
     ax.grid(alpha=0.3)
     fig.legend(*_own_entries(ax), fontsize=7, loc="outside lower left")
     return fig
+
+
+def _buoys(ax: Any, runs: list[RunSeries]) -> np.ndarray:
+    """The scenarios' moored buoys, drawn once each: a run that stopped on one shows why."""
+    moored = sorted({(b.x_m, b.y_m) for d in runs for b in d.run.world.scenario.buoys})
+    xy = np.array(moored, dtype=np.float64).reshape(-1, 2)
+    if len(xy):
+        ax.scatter(xy[:, 0], xy[:, 1], s=30, c="#fac81e", edgecolors="black", lw=0.5,
+                   label=f"buoys ({len(xy)})", zorder=3)  # fmt: skip
+    return xy
 
 
 def _own_entries(ax: Any) -> tuple[list[Any], list[str]]:
@@ -98,8 +110,9 @@ def _square(ax: Any, xy: np.ndarray) -> None:
 
 
 def _style(run: int, vessel: int) -> dict[str, Any]:
-    """Run k's colour (20 apart, then the line style too), vessel j's line style."""
-    color = COLORS(run % 20)
+    """Run k's colour (the 10 dark ones of tab20 first, then the 10 light: its neighbours
+    are a dark and a light blue), then the line style too; vessel j's line style."""
+    color = COLORS((2 * run) % 20 + (run // 10) % 2)
     return {"color": color, "ls": STYLES[(vessel + run // 20) % len(STYLES)]}
 
 

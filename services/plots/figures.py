@@ -65,7 +65,7 @@ def _view(data: RunSeries, *, everyone: bool) -> tuple[np.ndarray, np.ndarray]:
     world, xy = data.run.world, data.states.position[:, :, :2]
     rows = len(world.vessels) if everyone else len(world.scenario.vessels)
     moored = [(b.x_m, b.y_m) for b in world.scenario.buoys] if everyone else []
-    seen = np.concatenate([xy[:, :rows].reshape(-1, 2), _task_points(world, data.own),
+    seen = np.concatenate([xy[:, :rows].reshape(-1, 2), task_points(world, data.own),
                            np.array(moored, dtype=np.float64).reshape(-1, 2)])  # fmt: skip
     margin = MARGIN_M if everyone else MARGIN_M / 4
     return np.nanmin(seen, axis=0) - margin, np.nanmax(seen, axis=0) + margin
@@ -112,13 +112,18 @@ def _boat_names(ax: Axes, world: World, xy: np.ndarray) -> None:
                     textcoords="offset points")  # fmt: skip
 
 
-def _task_points(world: World, own: Any) -> np.ndarray:
-    """The goals and route points of the vessels drawn, (K, 2): the view must hold them."""
+def task_points(world: World, own: Any) -> np.ndarray:
+    """The goals (their whole circles) and route points of the vessels drawn, (K, 2): the
+    view must hold them."""
     points: list[tuple[float, float]] = []
     for vid in own:
         task = world.scenario.vessels[world.body(vid).row].task
         if task is not None and task.goal is not None:
-            points.append((task.goal.x_m, task.goal.y_m))
+            g = task.goal
+            points += [
+                (g.x_m - g.radius_m, g.y_m - g.radius_m),
+                (g.x_m + g.radius_m, g.y_m + g.radius_m),
+            ]
         if task is not None and task.route is not None:
             points += [(float(x), float(y)) for x, y in task.route]
     return np.array(points, dtype=np.float64).reshape(-1, 2)

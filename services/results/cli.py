@@ -19,11 +19,13 @@ from typing import Any
 
 from catabot.config.base import ConfigError
 from catabot.run.answer import OneLineParser, answered, output_file
-from services.results import folders, rows
-from services.results.folders import ResultsError
+from catabot.run.folders import RunFoldersError, run_folders
+from services.results import rows
 
-SHOWN = ("seed", "reason", "goal_reached", "time_to_goal_s", "nearest_vessel_m", "collisions",
-         "groundings", "thrust_impulse_Ns")  # fmt: skip
+SHOWN = ("seed", "reason", "goal_reached", "time_to_goal_s", "nearest_vessel_m",
+         "nearest_buoy_m", "nearest_shore_m", "collisions", "groundings", "thrust_impulse_Ns",
+         "thrust_unknown_s")  # fmt: skip
+ALWAYS = {"run", "vessel", "seed", "reason"}  # the others shown where any row has a value
 
 
 def parser() -> argparse.ArgumentParser:
@@ -41,13 +43,28 @@ def main(argv: list[str] | None = None) -> int:
 
 def results(paths: list[str], csv_path: str | None) -> str:
     out = output_file(csv_path, flag="--csv") if csv_path else None  # before reading runs
-    records = _readable(folders.run_folders(paths))
+    records = _readable(run_folders(paths))
+    _mixed(records)
     header, table = rows.table(records)
     print(text_table(header, table))
     if out is not None:
         write_csv(out, header, table)
     written = f"; every column in {out}" if out else ""
-    return f"{len(records)} runs, {len(table)} rows{written}"
+    return f"{_count(len(records), 'run')}, {_count(len(table), 'row')}{written}"
+
+
+def _count(n: int, what: str) -> str:
+    return f"{n} {what}" + ("" if n == 1 else "s")
+
+
+def _mixed(records: list[rows.RunRecord]) -> None:
+    """Runs of different scenarios compare field by field, list items by position (a
+    sensor's noise against another's): said, since the table's columns are then not a sweep."""
+    names = sorted({r.scenario.name for r in records})
+    if len(names) > 1:
+        print(f"catabot results: runs of {len(names)} scenarios ({', '.join(names)}): their "
+              "differences are field by field; tabulate each scenario's runs apart for a "
+              "sweep's columns", file=sys.stderr)  # fmt: skip
 
 
 def _readable(found: list[Path]) -> list[rows.RunRecord]:
@@ -60,18 +77,25 @@ def _readable(found: list[Path]) -> list[rows.RunRecord]:
         except ConfigError as exc:
             print(f"catabot results: left out {folder}: {exc}".splitlines()[0], file=sys.stderr)
     if not records:
-        raise ResultsError("no run to tabulate: every folder found was left out (above)")
+        raise RunFoldersError("no run to tabulate: every folder found was left out (above)")
     return records
 
 
 def text_table(header: list[str], table: list[dict[str, Any]]) -> str:
     """The run, vessel, swept and main measured columns, aligned; blank where not measured."""
     swept = header[2 : header.index(rows.RUN_COLUMNS[0])]
-    columns = ["run", "vessel", *swept, *SHOWN]
+    shown = [c for c in SHOWN if c in ALWAYS or any(_measured(c, r.get(c)) for r in table)]
+    columns = ["run", "vessel", *swept, *shown]
     cells = [columns, *([_shown(r.get(c), set_as=c in swept) for c in columns] for r in table)]
     widths = [max(len(line[i]) for line in cells) for i in range(len(columns))]
     return "\n".join("  ".join(c.ljust(w) for c, w in zip(line, widths, strict=True)).rstrip()
                      for line in cells)  # fmt: skip
+
+
+def _measured(column: str, value: Any) -> bool:
+    """A value worth a console column: not blank, and for the time under velocity control
+    (a caveat to the thrust impulse), not zero."""
+    return value is not None and (column != "thrust_unknown_s" or bool(value))
 
 
 def _shown(value: Any, *, set_as: bool = False) -> str:

@@ -23,7 +23,7 @@ VESSEL_COLUMNS = (
     "goal_reached", "time_to_goal_s", "path_length_m", "final_distance_m",
     "max_cross_track_m", "rms_cross_track_m", "nearest_vessel_m", "nearest_vessel",
     "nearest_buoy_m", "nearest_shore_m", "collisions", "groundings", "capsizes",
-    "thrust_impulse_Ns", "distance_m", "max_speed_mps",
+    "thrust_impulse_Ns", "thrust_unknown_s", "distance_m", "max_speed_mps",
 )  # fmt: skip
 AFTER = ("closest_approach_m", "traffic_collisions")
 
@@ -118,5 +118,6 @@ def vessel_cells(m: dict[str, Any]) -> dict[str, Any]:
         "nearest_buoy_m": nearest["buoy"].get("distance_m"),
         "nearest_shore_m": nearest["shore"].get("distance_m"),
         **{k: m.get(k) for k in ("collisions", "groundings", "capsizes", "thrust_impulse_Ns")},
+        "thrust_unknown_s": m.get("thrust_unknown_s"),  # under velocity control: not in the impulse
         **{k: m.get(k) for k in ("distance_m", "max_speed_mps")},
     }

@@ -17,10 +17,10 @@ from services.plots.figures import (
     _boat_names,
     _changes,
     _in_force,
-    _task_points,
     _view,
     draw_task,
     rain_steps,
+    task_points,
 )
 from services.plots.series import _thruster_names, own_pairs
 
@@ -54,7 +54,12 @@ def test_trajectories_mark_the_task_and_number_the_boats() -> None:
             "goal": {"x_m": 60.0, "y_m": 20.0, "radius_m": 4.0}, "route": [[0, 0], [30, 5]]}}],
         "traffic": {"count": 12, "region": {"center_m": [0.0, 300.0], "size_m": [200.0, 200.0]}},
     }))  # fmt: skip
-    assert _task_points(world, ["ego"]).tolist() == [[60.0, 20.0], [0.0, 0.0], [30.0, 5.0]]
+    assert task_points(world, ["ego"]).tolist() == [
+        [56.0, 16.0],
+        [64.0, 24.0],
+        [0.0, 0.0],
+        [30.0, 5.0],
+    ]
     fig, ax = plt.subplots()
     draw_task(ax, world.scenario.vessels[0].task, "#ff8c00", "ego")
     xy = np.zeros((2, len(world.bodies), 2))
@@ -138,8 +143,9 @@ def test_compared_runs_are_named_by_what_differs_from_the_first() -> None:
                             metrics={"end_reason": e})
             for n, d, e in zip("abcd", (calm, drift, live, other), ends, strict=True)]  # fmt: skip
     assert run_labels(runs) == [  # type: ignore[arg-type]
-        "a", "b (water.current.velocity_mps=[0.0, 0.5])",
-        "c (current=[0.3, 0.0] at 1.26 s, ended: fault)", "d (scenario harbour)"]  # fmt: skip
+        "a (water.current.velocity_mps=[0.0, 0.0])", "b (water.current.velocity_mps=[0.0, 0.5])",
+        "c (water.current.velocity_mps=[0.0, 0.0], current=[0.3, 0.0] at 1.26 s, ended: fault)",
+        "d (scenario harbour)"]  # fmt: skip
 
 
 def test_each_pair_of_own_vessels_has_its_distance() -> None:

@@ -108,7 +108,10 @@ def test_runs_that_differ_in_nothing_have_no_swept_column(
     [
         (lambda p: p / "missing", "no such folder"),
         (lambda p: (p / "f.txt").write_text("x") and p / "f.txt", "a file; give a run folder"),
-        (lambda p: (p / "empty").mkdir() or p / "empty", "not a run folder (no scenario.json"),
+        (
+            lambda p: (p / "empty").mkdir() or p / "empty",
+            "not a run folder (it has no scenario.json), and no run folder",
+        ),
     ],
 )
 def test_what_is_not_a_run_is_named_in_one_line(
@@ -141,3 +144,29 @@ def test_an_unwritable_csv_is_refused_before_any_run_is_read(
     csv = sweep / "no" / "t.csv"
     said = f"catabot results: --csv {csv}: folder {csv.parent} does not exist\n"
     assert capsys.readouterr().err == said
+
+
+def test_one_run_reads_in_the_singular_and_its_unmeasured_thrust_is_a_column(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """A vessel under velocity control has no thrust impulse for that time: 0 alone read as
+    a real zero in pandas (metrics.json's thrust_unknown_s says how long)."""
+    run = make_run(tmp_path / "one")
+    record = json.loads((run / "metrics.json").read_text())
+    record["vessels"]["ego"] |= {"thrust_impulse_Ns": 0.0, "thrust_unknown_s": 19.99}
+    (run / "metrics.json").write_text(json.dumps(record))
+    assert cli.main([str(run), "--csv", str(tmp_path / "t.csv")]) == 0
+    lines = capsys.readouterr().out.splitlines()
+    assert lines[0].split()[-2:] == ["thrust_impulse_Ns", "thrust_unknown_s"]
+    assert lines[1].split()[-2:] == ["0.00", "19.99"] and lines[2].split()[-1] == "-"
+    assert lines[-1] == f"1 run, 2 rows; every column in {tmp_path / 't.csv'}"
+    assert pd.read_csv(tmp_path / "t.csv")["thrust_unknown_s"].tolist()[0] == 19.99
+
+
+def test_runs_of_different_scenarios_are_said_to_be(
+    sweep: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    data = json.loads((sweep / "sweep-2" / "scenario.json").read_text())
+    (sweep / "sweep-2" / "scenario.json").write_text(json.dumps(data | {"name": "other"}))
+    assert cli.main([str(sweep)]) == 0
+    assert "runs of 2 scenarios (other, sweep)" in capsys.readouterr().err

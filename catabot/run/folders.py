@@ -2,7 +2,8 @@
 
 A sweep writes its runs into one folder (`catabot run --out runs/sweep`, a run each in
 `runs/sweep/<name>-<time>`), so naming that folder names them all, in name order (the
-order they were started in, since the time is in the name).
+order they were started in, since the time is in the name). `catabot results` and `catabot
+plot` take folders alike.
 """
 
 from __future__ import annotations
@@ -12,15 +13,13 @@ from pathlib import Path
 from catabot.errors import CataBotError
 
 
-class ResultsError(CataBotError, ValueError):
+class RunFoldersError(CataBotError, ValueError):
     """A folder that is neither a run nor holds any."""
 
 
 def is_run(folder: Path) -> bool:
-    """A run folder: its scenario, and what `catabot run` wrote as it ended (log/run.json)
-    or the recorder (metrics.json)."""
-    has_end = (folder / "log" / "run.json").is_file() or (folder / "metrics.json").is_file()
-    return (folder / "scenario.json").is_file() and has_end
+    """A run folder: `catabot run` writes its scenario.json first."""
+    return (folder / "scenario.json").is_file()
 
 
 def run_folders(paths: list[str]) -> list[Path]:
@@ -33,15 +32,14 @@ def run_folders(paths: list[str]) -> list[Path]:
 
 def _runs_in(path: Path) -> list[Path]:
     if not path.exists():
-        raise ResultsError(f"{path}: no such folder")
+        raise RunFoldersError(f"{path}: no such folder")
     if not path.is_dir():
-        raise ResultsError(f"{path}: a file; give a run folder or a folder of runs")
+        raise RunFoldersError(f"{path}: a file; give a run folder or a folder of runs")
     if is_run(path):
         return [path]
     inside = sorted(f for f in path.iterdir() if f.is_dir() and is_run(f))
     if not inside:
-        raise ResultsError(
-            f"{path}: not a run folder (no scenario.json with log/run.json or metrics.json), "
-            "and no run folder in it"
+        raise RunFoldersError(
+            f"{path}: not a run folder (it has no scenario.json), and no run folder in it"
         )
     return inside
