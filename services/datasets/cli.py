@@ -1,4 +1,5 @@
-"""`catabot dataset export RUN_FOLDER --format yolo|coco|segmentation|kitti -o OUT_DIR`.
+"""`catabot dataset export RUN_FOLDER --format yolo|coco|segmentation|kitti -o OUT_DIR`;
+`catabot dataset preview RUN_FOLDER -o OUT_DIR`: the labels drawn on the frames (preview.py).
 
 Converts a recorded run after the fact: camera datasets from the run's `dataset/` (labelled
 frames), LiDAR scans from its `run.mcap`. `catabot run` calls the same program when the
@@ -17,7 +18,7 @@ from pathlib import Path
 from catabot.errors import CataBotError
 from catabot.run.answer import OneLineParser, answered
 from catabot.run.recorded import RecordedRun
-from services.datasets import coco, kitti, segmentation, yolo
+from services.datasets import coco, kitti, preview, segmentation, yolo
 from services.datasets.frames import ExportOptions
 
 FORMATS: dict[str, Callable[[RecordedRun, Path, ExportOptions], str]] = {
@@ -43,15 +44,31 @@ def parser() -> argparse.ArgumentParser:
         help="simulated seconds that go to train or val together (default: 10, or a tenth "
         "of the run if shorter)",
     )  # fmt: skip
-    exp.add_argument(
+    _box_options(exp)
+    look = sub.add_parser("preview", help="each labelled frame with its boxes and mask "
+                          "outlines drawn, as PNGs (the boxes the same options keep)")  # fmt: skip
+    look.add_argument("run", help="the run folder (runs/<world>-<time>)")
+    look.add_argument("--output", "-o", required=True, help="folder to write (new or empty)")
+    _box_options(look)
+    look.set_defaults(format="preview", val_fraction=0.2, split_block_s=None)  # no split
+    return p
+
+
+def _box_options(p: argparse.ArgumentParser) -> None:
+    """Which boxes are kept: the export's and the preview's alike, so a preview shows what
+    an export with the same options keeps."""
+    p.add_argument(
         "--min-box-px", type=int, default=0,
         help="leave out boxes narrower or lower than this many pixels (default 0: keep all)",
     )  # fmt: skip
-    exp.add_argument(
+    p.add_argument(
         "--keep-own", action="store_true",
         help="keep the boxes of each camera's own vessel (its bow in view; left out by default)",
     )  # fmt: skip
-    return p
+    p.add_argument(
+        "--min-visible", type=float, default=0.0,
+        help="leave out boxes of bodies less visible than this share, 0-1 (default 0: keep all)",
+    )  # fmt: skip
 
 
 class ExportOptionError(CataBotError, ValueError):
@@ -67,6 +84,8 @@ def _check(args: argparse.Namespace) -> Path:
         raise ExportOptionError(f"--split-block-s must be > 0 (got {args.split_block_s})")
     if args.min_box_px < 0:
         raise ExportOptionError(f"--min-box-px must be >= 0 (got {args.min_box_px})")
+    if not 0.0 <= args.min_visible <= 1.0:
+        raise ExportOptionError(f"--min-visible must be in [0, 1] (got {args.min_visible})")
     out = Path(args.output)
     if out.exists() and not out.is_dir():
         raise ExportOptionError(f"--output {out} is a file; give a folder (new or empty)")
@@ -83,17 +102,18 @@ def main(argv: list[str] | None = None) -> int:
         run = RecordedRun(args.run)
         made = not out.exists()
         out.mkdir(parents=True, exist_ok=True)
-        options = ExportOptions(
-            args.val_fraction, args.split_block_s, args.min_box_px, keep_own=args.keep_own
-        )
+        options = ExportOptions(args.val_fraction, args.split_block_s, args.min_box_px,
+                                keep_own=args.keep_own, min_visible=args.min_visible)  # fmt: skip
         try:
-            summary = FORMATS[args.format](run, out, options)
+            summary = {**FORMATS, "preview": preview.export}[args.format](run, out, options)
         except BaseException:
             _undo(out, made=made)
             raise
+        if args.action == "preview":
+            return f"preview in {out}: {summary}"
         return f"{args.format} dataset in {out}: {summary}{_one_set(args)}"
 
-    return answered("dataset export", export)
+    return answered(f"dataset {args.action}", export)
 
 
 def _one_set(args: argparse.Namespace) -> str:

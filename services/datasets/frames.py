@@ -37,6 +37,7 @@ class ExportOptions:
     block_s: float | None = None
     min_box_px: int = 0
     keep_own: bool = False
+    min_visible: float = 0.0  # the smallest visible share of a body kept as a box (0..1)
 
 
 @dataclass(frozen=True)
@@ -47,6 +48,7 @@ class Frame:
     subset: str  # "train" or "val"
     min_box_px: int = 0
     own: int = 0  # the instance id of the camera's own vessel (0: its boxes are kept)
+    min_visible: float = 0.0
 
     @property
     def color(self) -> Path:
@@ -67,9 +69,15 @@ class Frame:
         """The boxes of the camera's own vessel (none when `own` is 0)."""
         return np.asarray((self.labelled.boxes[:, 0] == self.own) & (self.own > 0))
 
+    @cached_property
+    def hidden(self) -> NDArray[np.bool_]:
+        """The boxes of bodies less visible than `min_visible` (a sliver past another boat:
+        its box says little of the boat)."""
+        return np.asarray(self.labelled.flags[:, 2] < round(100 * self.min_visible))
+
     @property
     def kept(self) -> NDArray[np.bool_]:
-        return ~self.small & ~self.mine
+        return ~self.small & ~self.mine & ~self.hidden
 
     @property
     def boxes(self) -> NDArray[np.float64]:
@@ -112,22 +120,26 @@ def camera_frames(
     subsets = split([f.stamp_ns for _, f, _ in pairs], seed=run.world.scenario.seed,
                     val_fraction=options.val_fraction, block_s=options.block_s)  # fmt: skip
     frames = [
-        Frame(f"{cam}_{f.tick:08d}", cam, f, subset, options.min_box_px, mine)
+        Frame(f"{cam}_{f.tick:08d}", cam, f, subset, options.min_box_px, mine, options.min_visible)
         for (cam, f, mine), subset in zip(pairs, subsets, strict=True)
     ]
-    return frames, _note(frames, without, what, options.min_box_px if boxes else None)
+    return frames, _note(frames, without, what, options if boxes else None)
 
 
-def _note(frames: list[Frame], without: list[str], what: str, min_box_px: int | None) -> str:
-    """What was left out: frames, and (`min_box_px` given: a format of boxes) boxes."""
+def _note(frames: list[Frame], without: list[str], what: str, options: ExportOptions | None) -> str:
+    """What was left out: frames, and (`options` given: a format of boxes) boxes."""
     note = ""
     if without:
         note += f"; left out {len(without)} frames without a {what} (first: {without[0]})"
-    if min_box_px is None:
+    if options is None:
         return note
     small = sum(int((f.small & ~f.mine).sum()) for f in frames)
     if small:
-        note += f"; left out {small} boxes under {min_box_px} px (--min-box-px)"
+        note += f"; left out {small} boxes under {options.min_box_px} px (--min-box-px)"
+    hidden = sum(int((f.hidden & ~f.small & ~f.mine).sum()) for f in frames)
+    if hidden:
+        note += (f"; left out {hidden} boxes of bodies under {options.min_visible:.0%} "
+                 "visible (--min-visible)")  # fmt: skip
     mine = sum(int(f.mine.sum()) for f in frames)
     if mine:
         note += f"; left out {mine} boxes of the cameras' own vessels (--keep-own keeps them)"

@@ -29,6 +29,7 @@ def test_a_run_without_a_camera_is_refused_and_leaves_no_folder(
     [
         (["--val-fraction", "1.5"], "--val-fraction must be in [0, 1] (got 1.5)"),
         (["--split-block-s", "0"], "--split-block-s must be > 0 (got 0.0)"),
+        (["--min-visible", "1.5"], "--min-visible must be in [0, 1] (got 1.5)"),
         ([], "exists and is not an empty folder"),
     ],
 )
