@@ -34,12 +34,16 @@ def _run(args: argparse.Namespace) -> int:
         except CataBotError as exc:
             print(f"catabot run: {exc}", file=sys.stderr)
             return 2
+    if args.out is not None and args.run_dir is not None:
+        print("catabot run: --out and --run-dir both name where the run goes: give one "
+              "(--run-dir is the run folder itself)", file=sys.stderr)  # fmt: skip
+        return 2
     opts = launcher.RunOptions(
         scenario=args.scenario,
         duration_s=args.duration,
         seed=args.seed,
         realtime=args.realtime,
-        out=Path(args.out),
+        out=Path(args.out or "runs"),
         connect=connect,
         listen=args.listen,
         quiet=args.quiet,
@@ -212,7 +216,7 @@ def parser() -> argparse.ArgumentParser:
         help="pace: 1.0 = wall clock; 0 = as fast as possible (the default, unless the "
         "scenario sets clock.realtime_factor)",
     )  # fmt: skip
-    run.add_argument("--out", default="runs", help="folder for run folders (default: runs)")
+    run.add_argument("--out", help="folder for run folders (default: runs)")
     run.add_argument("--run-dir", help="this run's folder itself, new or empty (instead of "
                      "--out's <name>-<time>): a script names its runs")  # fmt: skip
     run.add_argument(

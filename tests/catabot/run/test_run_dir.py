@@ -8,6 +8,7 @@ from pathlib import Path
 import pytest
 
 from catabot.config.load import parse_scenario
+from catabot.run.cli import main
 from catabot.run.launcher import LaunchError, RunOptions, make_run_dir, prepare
 
 
@@ -32,3 +33,13 @@ def test_a_run_dir_given_is_the_run_folder_itself_new_or_empty(tmp_path: Path) -
     with pytest.raises(LaunchError, match=r"--run-dir .*file: a file, not a folder"):
         prepare(RunOptions(run_dir=tmp_path / "file"))
     prepare(RunOptions(run_dir=tmp_path / "empty"))  # new: made when the run starts
+
+
+def test_out_and_run_dir_together_are_refused(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """--run-dir won and --out was dropped without a word."""
+    argv = ["run", "--out", str(tmp_path / "a"), "--run-dir", str(tmp_path / "b" / "x")]
+    assert main(argv) == 2
+    assert "--out and --run-dir both name where the run goes: give one" in capsys.readouterr().err
+    assert not (tmp_path / "a").exists() and not (tmp_path / "b").exists()
