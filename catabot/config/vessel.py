@@ -123,14 +123,25 @@ class Hull(Strict):
 
 
 class Damping(Strict):
-    """Fossen damping per DOF [X_u, Y_v, Z_w, K_p, M_q, N_r]: tau = -(linear + quadratic*|v|)*v.
+    """Fossen damping per DOF [X_u, Y_v, Z_w, K_p, M_q, N_r]: tau = -(linear + quadratic*|v|)*v,
+    and the hull's lift in a sideslip, `lift_uv` [Y_uv, N_uv]: Y += Y_uv |u| v, N += N_uv u v
+    (u, v surge and sway through the water).
 
-    Units: linear N·s/m (surge, sway, heave) and N·m·s/rad (roll, pitch, yaw);
-    quadratic N·s²/m² and N·m·s²/rad².
+    Why lift: added mass brings the ideal fluid's Munk moment -(A22 - A11) u v, which turns
+    a drifting hull broadside; a real hull's flow separates at its stern, and the lift there
+    cancels much of it. Without it a boat with added mass is straight-line unstable above
+    sqrt(Y_v N_r / ((m + A11) (A22 - A11))) (`scenario validate MODEL.json` says so).
+
+    Units: linear N·s/m (surge, sway, heave) and N·m·s/rad (roll, pitch, yaw); quadratic
+    N·s²/m² and N·m·s²/rad²; Y_uv N·s²/m² (< 0 resists the sideslip), N_uv kg (> 0 turns the
+    bow into the sideslip, against the Munk moment).
     """
 
     linear: Dof6
     quadratic: Dof6
+    lift_uv: tuple[float, float] = Field(
+        (0.0, 0.0), description="[Y_uv, N_uv]: Y += Y_uv |u| v (N s^2/m^2), N += N_uv u v (kg)"
+    )
 
 
 class Thruster(Strict):

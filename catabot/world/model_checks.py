@@ -13,6 +13,7 @@ from __future__ import annotations
 import numpy as np
 
 from catabot.config.vessel import VesselModel
+from catabot.world.course import top_speed_mps, unstable_above_mps
 from catabot.world.shapes import vessel_mesh
 
 SPREAD = 3.0  # a mesh this many times larger (or smaller) than the hulls is suspect
@@ -30,7 +31,18 @@ def displacement(model: VesselModel, density: float) -> str:
 
 
 def model_notes(model: VesselModel, *, source: str) -> list[str]:
-    return [*_mesh(model, source), *_thrusters(model), *_masses(model)]
+    return [*_mesh(model, source), *_thrusters(model), *_masses(model), *_course(model)]
+
+
+def _course(model: VesselModel) -> list[str]:
+    """A boat that cannot hold a straight course at speeds it reaches (course.py)."""
+    top, limit = top_speed_mps(model), unstable_above_mps(model)
+    if limit >= top:
+        return []
+    return [f"it cannot hold a straight course above {limit:.2f} m/s, below its top speed "
+            f"({top:.2f} m/s): the added mass's Munk moment (A22 - A11) u v outgrows the sway "
+            "and yaw damping Y_v N_r; give the hull's lift damping.lift_uv [Y_uv, N_uv] "
+            "(N_uv > 0 cancels the Munk moment) or more yaw damping"]  # fmt: skip
 
 
 def _mesh(model: VesselModel, source: str) -> list[str]:

@@ -37,6 +37,7 @@ class ForceTables:
     quadratic: Array
     loads: EnvironmentLoads
     weight_n: Array  # (N,) m g: the buoyancy that floats each body
+    lift: Array | None = None  # (N, 2) [Y_uv, N_uv]; None: no body has any
 
     def take(self, rows: Rows) -> ForceTables:
         """The tables of bodies `rows` (sorted), in that order."""
@@ -46,6 +47,7 @@ class ForceTables:
             self.quadratic[rows],
             self.loads.take(rows),
             self.weight_n[rows],
+            None if self.lift is None else self.lift[rows],
         )
 
 
@@ -117,7 +119,7 @@ def body_wrench(
         surface=water.surface,
     )
     wet = wetness(buoyancy, motion.rot, tables.weight_n)
-    damping = damping_wrench(nu, tables.linear, tables.quadratic, water_b)
+    damping = damping_wrench(nu, tables.linear, tables.quadratic, water_b, tables.lift)
     loads = {
         "buoyancy": buoyancy,
         "damping": damping if wet is None else damping * wet[:, None],

@@ -171,9 +171,15 @@ def _plain_rows(rows: NDArray[np.intp]) -> NDArray[np.intp]:
 
 
 def damping_wrench(
-    nu_body: Array, linear: Array, quadratic: Array, water_velocity_body: Array | None = None
+    nu_body: Array,
+    linear: Array,
+    quadratic: Array,
+    water_velocity_body: Array | None = None,
+    lift: Array | None = None,
 ) -> Array:
-    """Fossen damping (N, 6): -(linear + quadratic*|nu_r|)*nu_r, per DOF, body frame.
+    """Fossen damping (N, 6): -(linear + quadratic*|nu_r|)*nu_r, per DOF, body frame, and
+    the hulls' lift in a sideslip, `lift` (N, 2) [Y_uv, N_uv]: Y += Y_uv |u| v, N += N_uv u v
+    (catabot/config/vessel.py, Damping).
 
     nu_body is [u, v, w, p, q, r] (N, 6); water_velocity_body (N, 3) is the current seen in the
     body frame, so damping acts on the velocity relative to the water.
@@ -181,7 +187,12 @@ def damping_wrench(
     nu_r = nu_body.copy()
     if water_velocity_body is not None:
         nu_r[:, :3] -= water_velocity_body
-    return -(linear + quadratic * np.abs(nu_r)) * nu_r
+    wrench = -(linear + quadratic * np.abs(nu_r)) * nu_r
+    if lift is not None:
+        u, v = nu_r[:, 0], nu_r[:, 1]
+        wrench[:, 1] += lift[:, 0] * np.abs(u) * v
+        wrench[:, 5] += lift[:, 1] * u * v
+    return wrench
 
 
 # --- thrusters --------------------------------------------------------------------------

@@ -117,7 +117,10 @@ class PhysicsWorld:
         linear = np.array([m.damping.linear for m in models], dtype=np.float64)
         quadratic = np.array([m.damping.quadratic for m in models], dtype=np.float64)
         weight = np.array([m.mass_kg for m in models]) * self._g
-        self._tables = AwakeTables(ForceTables(columns, linear, quadratic, self._loads, weight))
+        lift = np.array([m.damping.lift_uv for m in models], dtype=np.float64).reshape(-1, 2)
+        tables = ForceTables(columns, linear, quadratic, self._loads, weight,
+                             lift if lift.any() else None)  # fmt: skip
+        self._tables = AwakeTables(tables)
         self._sea = SeaSampler(models, columns.bottom_m.transpose(0, 2, 1))
         self._sea.use(waves)  # eta at the columns, orbital velocity at the origins (sea.py)
         # Bottom contact with the terrain (grounding.py); buoyancy knows nothing about it.

@@ -43,6 +43,8 @@ def test_the_bundled_models_have_nothing_to_note() -> None:
         ({"added_mass": [0, 0, 0.079, 0, 0, 0]}, "is 0.00144 times its mass"),
         ({"thrusters": [{**CATAMARAN["thrusters"][0], "position_m": [3.0, 0.4, -0.1]}]},
          "thruster 0 at (3, 0.4) m is 2.05 m outside every hull"),
+        ({"damping": CATAMARAN["damping"] | {"lift_uv": [0.0, 0.0]}},
+         "cannot hold a straight course above 1.74 m/s, below its top speed (1.88 m/s)"),
     ],
 )  # fmt: skip
 def test_a_slip_is_noted(tmp_path: Path, changes: dict[str, Any], note: str) -> None:

@@ -1,0 +1,41 @@
+"""Whether a vessel model keeps a straight course: the linear sway-yaw stability criterion.
+
+Why here: a model file whose added mass brings a Munk moment larger than its damping can
+hold circles on equal thrust; the bundled catamaran did at full thrust. `scenario validate
+MODEL.json` says so, and the tests hold every bundled model to it, by this one rule.
+
+Straight at surge u > 0, the linearised sway and yaw (Fossen 2011, §7.1, no rudder) are
+    (m + A22) v' = -(Y_v - Y_uv u) v - (m + A11) u r
+    (I + A66) r' = -N_r r + (A11 - A22 + N_uv) u v
+(the Munk moment -(A22 - A11) u v and the hull's lift Y_uv |u| v, N_uv u v; the COG on the
+centreline at the origin), stable while (Y_v - Y_uv u) N_r > (m + A11) (A22 - A11 - N_uv) u^2.
+"""
+
+from __future__ import annotations
+
+import math
+
+from catabot.config.vessel import VesselModel
+
+
+def top_speed_mps(model: VesselModel) -> float:
+    """The steady surge speed at full forward thrust along the body x axis (0: none)."""
+    push = sum(t.max_forward_n * math.cos(t.yaw_rad) for t in model.thrusters)
+    linear, quadratic = model.damping.linear[0], model.damping.quadratic[0]
+    if push <= 0.0:
+        return 0.0
+    if quadratic <= 0.0:
+        return push / linear if linear > 0 else math.inf
+    return (-linear + math.sqrt(linear * linear + 4.0 * quadratic * push)) / (2.0 * quadratic)
+
+
+def unstable_above_mps(model: VesselModel) -> float:
+    """The surge speed above which a straight course is unstable (inf: at no speed): the
+    positive root of a u^2 + Y_uv N_r u - Y_v N_r = 0."""
+    lift_y, lift_n = model.damping.lift_uv
+    a = (model.mass_kg + model.added_mass[0]) * (model.added_mass[1] - model.added_mass[0] - lift_n)
+    if a <= 0.0:
+        return math.inf
+    n_r = model.damping.linear[5]
+    b, c = lift_y * n_r, max(model.damping.linear[1] * n_r, 0.0)
+    return (-b + math.sqrt(b * b + 4.0 * a * c)) / (2.0 * a)

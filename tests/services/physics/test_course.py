@@ -1,0 +1,61 @@
+"""A boat at full thrust keeps a straight course: the linear sway-yaw criterion
+(catabot/world/course.py) against the simulated boat, and every bundled model held to it.
+
+A naval architect found the bundled catamaran circling for good at full thrust after any
+sideways push (a steady -0.043 rad/s on a 44 m circle): its Munk moment outgrew its damping
+above 1.74 m/s, below its 1.88 m/s top speed. The hull's lift (damping.lift_uv) cancels most
+of it now."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from catabot.config.vessel import VesselModel, load_vessel_model
+from catabot.world.course import top_speed_mps, unstable_above_mps
+from services.physics.world import PhysicsWorld
+
+BUNDLED = ("catabot", "monohull", "wamv")
+
+
+@pytest.mark.parametrize("name", BUNDLED)
+def test_every_bundled_model_keeps_a_straight_course_at_any_speed_it_reaches(name: str) -> None:
+    model = load_vessel_model(name)
+    assert unstable_above_mps(model) > 1.2 * top_speed_mps(model)
+
+
+def test_the_criterion_is_the_munk_moment_against_the_damping() -> None:
+    """Without the lift the catamaran's limit is the naval architect's 1.74 m/s."""
+    model = load_vessel_model("catabot")
+    bare = model.model_copy(update={"damping": model.damping.model_copy(
+        update={"lift_uv": (0.0, 0.0)})})  # fmt: skip
+    assert unstable_above_mps(bare) == pytest.approx(np.sqrt(40 * 80 / (57.75 * 18.25)))
+    assert unstable_above_mps(bare) == pytest.approx(1.74, abs=0.005)
+    assert top_speed_mps(model) == pytest.approx(1.879, abs=0.001)  # 72 N = 12 u + 14 u^2
+
+
+def _pushed(model: VesselModel, seconds: float) -> np.ndarray:
+    """Yaw rate (rad/s) each step of a boat at full thrust, started at 1.5 m/s ahead and
+    0.5 m/s sideways (the naval architect's disturbance)."""
+    world = PhysicsWorld([("boat", model, (0.0, 0.0, 0.0, 0.0))], dt_s=0.01)
+    world.place(np.array([0]), np.zeros((1, 6)), np.array([[0.0, 0.0, 0.0, 1.5, 0.5, 0.0]]))
+    world.set_thrust("boat", np.ones(len(model.thrusters)))
+    rates = []
+    for _ in range(int(seconds / 0.01)):
+        world.step()
+        rates.append(world.surge_and_yaw_rate(np.array([0]))[0, 1])
+    return np.array(rates)
+
+
+def test_the_catamaran_pushed_sideways_at_full_thrust_goes_straight_again() -> None:
+    rate = _pushed(load_vessel_model("catabot"), 30.0)
+    assert np.abs(rate[-500:]).max() < 1e-3  # no steady turn (it held -0.043 rad/s)
+
+
+def test_without_the_lift_it_circles_as_the_criterion_says() -> None:
+    """The same push on the model without its lift: a steady turn, as found."""
+    model = load_vessel_model("catabot")
+    bare = model.model_copy(update={"damping": model.damping.model_copy(
+        update={"lift_uv": (0.0, 0.0)})})  # fmt: skip
+    rate = _pushed(bare, 30.0)
+    assert np.abs(rate[-500:]).min() > 0.02 and np.ptp(rate[-500:]) < 2e-3
