@@ -119,7 +119,7 @@ class Client:
 
     def join(
         self,
-        name: str,
+        name: str | None,
         *,
         vessel: str | None = None,
         sensors: Sequence[str] = (),
@@ -129,8 +129,10 @@ class Client:
         `controller.participant` or `clock.external_participants`). `vessel`: the one to
         observe and, if `name` is its controller, to command (default: the vessel `name`
         controls); `sensors`: that vessel's sensors to wait for. The control period is the
-        controller's rate, else `rate_hz` (default every tick)."""
+        controller's rate, else `rate_hz` (default every tick). `name` None: the controller
+        participant of `vessel` (`--participant` left out, as add_stack_args says)."""
         info = find_world(self.session, self.info.name, self.timeout_s, self._where)  # fresh
+        name = name if name is not None else _controller_of(info, vessel)
         self._expected(info, name)
         target = self._target(info, name, vessel)  # UnknownVessel
         _one_vessel(info, name, vessel)
@@ -186,8 +188,8 @@ class Client:
             raise ValueError(str(exc)) from None
 
     def run_lockstep(
-        self, name: str, step: Step, *, vessel: str | None = None, sensors: Sequence[str] = (),
-        rate_hz: float | None = None,
+        self, name: str | None, step: Step, *, vessel: str | None = None,
+        sensors: Sequence[str] = (), rate_hz: float | None = None,
     ) -> End:  # fmt: skip
         """Join as `name` and call `step(observation) -> command | None` every control
         period until the run ends; returns its End. A step that raises `EndRun(reason)`
@@ -280,6 +282,19 @@ def add_stack_args(parser: argparse.ArgumentParser) -> None:
     )
     parser.add_argument(
         "--timeout", type=float, default=30.0, help="seconds to wait for the run (default: 30)"
+    )
+
+
+def _controller_of(info: WorldInfo, vessel: str | None) -> str:
+    """The participant named by the vessel's `controller.participant`, the default of a
+    stack's `--participant`; NotAParticipant names what to give when there is none."""
+    own = info.vessels.get(vessel or "")
+    if own is not None and own.controller is not None and own.controller.participant:
+        return own.controller.participant
+    raise NotAParticipant(
+        f"no participant named and vessel {vessel!r} of world {info.name!r} has no controller "
+        f"participant: give one (--participant NAME; it expects "
+        f"{', '.join(info.external) or 'none'})"
     )
 
 

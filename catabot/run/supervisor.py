@@ -14,6 +14,7 @@ from __future__ import annotations
 
 import contextlib
 import json
+import re
 import signal
 import subprocess
 import threading
@@ -236,13 +237,31 @@ class Supervisor:
         return why
 
     def _waited(self, error: str) -> str:
-        """The conductor's fault, and whose data the participant it names waited for."""
+        """The conductor's fault, and whose data held the participant it names. When several
+        miss a deadline the conductor names one; a participant that waited for another's data
+        is not the late one, so the cause names that other first (a slow stack had the
+        recorder blamed), and a late one's own wait afterwards is left out (it had waited
+        for physics only after its long step)."""
         for name, child in self.services.items():
-            if f"participant {name!r}" in error:
-                waited = child.waited_line()
-                if waited:
-                    return f"{error}; {waited}"
+            if f"participant {name!r}" not in error:
+                continue
+            for other, line in self._waits():
+                if other != name and _producers(line) == [name]:
+                    return f"{error}; {line}"  # others waited for it: its own wait came after
+            waited = child.waited_line()
+            late = [p for p in _producers(waited) if p != name and p in self.services]
+            if late:
+                return f"participant {late[0]!r} held the run up: {waited} (the conductor: {error})"
+            return f"{error}; {waited}" if waited else error
         return error
+
+    def _waits(self) -> list[tuple[str, str]]:
+        return [(n, c.waited_line()) for n, c in self.services.items() if c.waited_line()]
+
+
+def _producers(waited: str) -> list[str]:
+    """The senders a waited line names (`... for KEY from 'stack', KEY from 'physics'`)."""
+    return re.findall(r" from '([^']+)'", waited)
 
 
 def ended(proc: subprocess.Popen[str], *, grace_s: float) -> None:

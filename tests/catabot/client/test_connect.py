@@ -173,6 +173,18 @@ def test_unknown_vessels_sensors_and_participants(served: Served) -> None:
             sim.vessel("ego").send(Thrust([0.5, 0.5]))
 
 
+def test_no_name_joins_as_the_vessels_controller_participant(served: Served) -> None:
+    """`--participant` left out is None, which add_stack_args says is the vessel's
+    controller.participant: join(None) had been refused as "a participant None"."""
+    with Client.connect([served.endpoint], timeout_s=10) as sim:
+        with pytest.raises(UnknownSensor, match="no sensor 'sonar'"):  # got past the name
+            sim.join(None, vessel="ego", sensors=["sonar"])
+        with pytest.raises(NotAParticipant, match="vessel 'other' of world 'info' has no "
+                           r"controller participant: give one \(--participant NAME; it "
+                           r"expects watcher, stack\)"):  # fmt: skip
+            sim.join(None, vessel="other")
+
+
 def test_a_free_command_waits_for_the_runs_first_tick(served: Served) -> None:
     """Sent while the services were still subscribing, a command reached some only (the
     recorder wrote a thrust that physics never applied): send waits for the vessel's first
