@@ -79,8 +79,12 @@ def _trajectories(data: RunSeries, lo: np.ndarray, hi: np.ndarray, title: str) -
     ax = _axes(fig)[0]
     _terrain(ax, data, lo, hi)
     own = {world.body(v).row for v in data.own}
-    for row in range(len(world.scenario.vessels), vessels):
+    first = len(world.scenario.vessels)
+    for row in range(first, vessels):
         ax.plot(xy[:, row, 0], xy[:, row, 1], color="white", lw=0.8, alpha=0.8)
+    if vessels > first:  # where each boat ended: one holding station has no track to see
+        ax.scatter(xy[-1, first:vessels, 0], xy[-1, first:vessels, 1], s=14, c="white",
+                   marker="s", edgecolors="black", lw=0.4, zorder=3)  # fmt: skip
     if vessels > len(own):
         ax.plot([], [], color="white", lw=0.8, label=f"traffic ({vessels - len(own)} boats)")
     _boat_names(ax, world, xy)
@@ -287,6 +291,9 @@ def lidar_rain(data: RunSeries) -> Figure | None:
               ylabel="rain returns [% of returns]", xlim=(-2, 52))  # fmt: skip
     share.set_ylim(0, max(1.0, share.get_ylim()[1] * 1.2))
     share.legend(fontsize=8, loc="upper left")
+    if not steps_rate.any():  # every scan sits at (0, 0) on the frame's edge: said
+        share.text(0.5, 0.5, "no rain in this run\n(every scan at 0 mm/h)", ha="center",
+                   va="center", transform=share.transAxes, color="0.4")  # fmt: skip
     for ax in (counts, share):
         ax.grid(alpha=0.3)
     return fig
