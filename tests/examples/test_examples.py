@@ -220,7 +220,7 @@ def test_navigate_reaches_its_goal_through_traffic_without_touching_a_boat(
     rain = np.loadtxt(folder / "sensor.ego.lidar.csv", delimiter=",", skiprows=1, usecols=3)
     assert rain.min() > 50  # every scan had raindrop returns for the grid to drop
     ego_metrics = json.loads((folder / "metrics.json").read_text())["vessels"]["ego"]
-    assert ego_metrics["goal"]["reached"] and ego_metrics["goal"]["time_to_goal_s"] < 72.0
+    assert ego_metrics["goal"]["reached"] and ego_metrics["goal"]["time_to_goal_s"] < 74.0
     assert ego_metrics["collisions"] == 0 and ego_metrics["groundings"] == 0, ego_metrics
     # contact needs the centres within 1.07 m (catamaran) + 2.49 m (monohull, bow)
     assert ego_metrics["nearest_vessel"]["distance_m"] > 3.6, ego_metrics["nearest_vessel"]
