@@ -237,26 +237,29 @@ class Supervisor:
         return why
 
     def _waited(self, error: str) -> str:
-        """The conductor's fault, and whose data held the participant it names. When several
-        miss a deadline the conductor names one; a participant that waited for another's data
-        is not the late one, so the cause names that other first (a slow stack had the
-        recorder blamed), and a late one's own wait afterwards is left out (it had waited
-        for physics only after its long step)."""
-        for name, child in self.services.items():
-            if f"participant {name!r}" not in error:
-                continue
-            for other, line in self._waits():
-                if other != name and _producers(line) == [name]:
-                    return f"{error}; {line}"  # others waited for it: its own wait came after
-            waited = child.waited_line()
-            late = [p for p in _producers(waited) if p != name and p in self.services]
-            if late:
-                return f"participant {late[0]!r} held the run up: {waited} (the conductor: {error})"
-            return f"{error}; {waited}" if waited else error
-        return error
+        """The conductor's fault, and whose data held the run. When several miss a deadline
+        the conductor names one; the wait at the earliest tick is the root (a stack that
+        skipped its command held physics at tick 101, then waited at 102 for physics), so
+        the cause leads with that wait's sender when another participant was the one named
+        (a stack asleep in its step had the recorder blamed)."""
+        named = [n for n in self.services if f"participant {n!r}" in error]
+        waits = sorted((_tick_of(line), n != named[0], n, line)
+                       for n, line in self._waits()) if named else []  # fmt: skip
+        if not waits:
+            return error
+        _, _, waiter, line = waits[0]
+        late = [p for p in _producers(line) if p != waiter and p in self.services]
+        if waiter == named[0] and late:
+            return f"participant {late[0]!r} held the run up: {line} (the conductor: {error})"
+        return f"{error}; {line}"
 
     def _waits(self) -> list[tuple[str, str]]:
         return [(n, c.waited_line()) for n, c in self.services.items() if c.waited_line()]
+
+
+def _tick_of(waited: str) -> int:
+    found = re.search(r" waited at tick (\d+) ", waited)
+    return int(found.group(1)) if found else 1 << 62
 
 
 def _producers(waited: str) -> list[str]:

@@ -41,3 +41,16 @@ def test_a_wait_for_no_other_participant_is_quoted_as_it_was() -> None:
     error = "participant 'physics' missed the 10 s deadline of tick 5"
     assert sup._waited(error) == f"{error}; physics waited at tick 5 for catabot/w/x from 'outside'"
     assert supervisor(physics="")._waited(error) == error
+
+
+def test_the_earliest_wait_is_the_root_of_a_wait_on_each_other() -> None:
+    """A stack that acked tick 101 without its command held physics there, then waited at 102
+    for physics' states: the stack held the run up, not physics."""
+    sup = supervisor(
+        physics=f"physics waited at tick 101 for {THRUST} from 'stack'",
+        stack="stack waited at tick 102 for catabot/w/world/states from 'physics'",
+    )
+    error = "participant 'physics' missed the 2 s deadline of tick 101"
+    assert sup._waited(error).startswith(
+        f"participant 'stack' held the run up: physics waited at tick 101 for {THRUST}"
+    )

@@ -220,16 +220,14 @@ def test_turn_on_the_spot_matches_yaw_damping_law(catabot: VesselModel) -> None:
 
 
 def test_turn_at_speed_matches_manoeuvring_steady_state(catabot: VesselModel) -> None:
-    """Surge, sway and yaw balance with the centripetal and Munk terms of M_RB + M_A, and the
-    hull's lift in the turn's sideslip (Y_uv |u| v, N_uv u v)."""
+    """Surge, sway, yaw balance: centripetal and Munk terms of M_RB + M_A, the hull's lift."""
     world = PhysicsWorld([("a", catabot, (0.0, 0.0, 0.0, 0.0))], dt_s=DT)
     world.set_thrust("a", [0.3, 1.0])
     run(world, 30.0)
     s = world.state_arrays()
     u, v, r = s.linear_velocity[0, 0], s.linear_velocity[0, 1], s.angular_velocity[0, 2]
-    m, a = catabot.mass_kg, catabot.added_mass
+    m, a, (lift_y, lift_n) = catabot.mass_kg, catabot.added_mass, catabot.damping.lift_uv
     lin, quad = catabot.damping.linear, catabot.damping.quadratic
-    lift_y, lift_n = catabot.damping.lift_uv
 
     def damping(i: int, x: float) -> float:
         return lin[i] * x + quad[i] * x * abs(x)
@@ -237,8 +235,7 @@ def test_turn_at_speed_matches_manoeuvring_steady_state(catabot: VesselModel) ->
     thrust, moment = 36.0 * 1.3, 0.40 * 36.0 * 0.7
     assert damping(0, u) - (m + a[1]) * v * r == pytest.approx(thrust, rel=0.02)
     sway = damping(1, v) - lift_y * abs(u) * v + (m + a[0]) * u * r
-    assert sway == pytest.approx(0.0, abs=0.02 * thrust)
-    assert lift_n != 0.0  # the catamaran has its lift: the yaw balance below includes it
+    assert sway == pytest.approx(0.0, abs=0.02 * thrust) and lift_n != 0.0  # it has a lift
     assert damping(5, r) + (a[1] - a[0] - lift_n) * u * v == pytest.approx(moment, rel=0.02)
 
 
