@@ -13,6 +13,7 @@ from typing import Any
 from catabot.config.scenario import Scenario
 
 NOT_SWEPT = {"name", "settings"}  # a run's own name; its timeline is told on its own
+FEW = 6  # fields: runs this close are one scenario's, whatever their names
 
 
 def flat_fields(scenario: Scenario) -> dict[str, Any]:
@@ -47,3 +48,9 @@ def swept_fields(scenarios: list[Scenario]) -> list[str]:
     for other in scenarios[1:]:
         keys |= differences(scenarios[0], other).keys() | differences(other, scenarios[0]).keys()
     return sorted(keys)
+
+
+def one_scenario(first: Scenario, other: Scenario) -> bool:
+    """Runs of one scenario: the same name, or few fields apart (a sweep that names each run
+    with `--set name=...`). Runs of others compare field by field, list items by position."""
+    return other.name == first.name or len(differences(first, other)) <= FEW

@@ -16,7 +16,7 @@ import numpy as np
 from matplotlib import colormaps
 from matplotlib.figure import Figure
 
-from catabot.config.differences import flat_fields, swept_fields
+from catabot.config.differences import flat_fields, one_scenario, swept_fields
 from services.plots.figures import draw_task, speed_heading_axes, task_points
 from services.plots.report import table_row, vessel_cells
 from services.plots.series import RunSeries
@@ -35,15 +35,16 @@ def run_labels(runs: list[RunSeries]) -> list[str]:
     """Each run's folder name, its value of every field the runs of the first run's scenario
     differ in (the first run's too: a paper's legend names every case), its setting changes,
     and how it ended unless it completed; a run of another scenario, that scenario's name."""
-    name = runs[0].run.world.scenario.name
-    swept = swept_fields([s for d in runs if (s := d.run.world.scenario).name == name])
-    return [data.run.folder.name + _about(data, swept, name) for data in runs]
+    first = runs[0].run.world.scenario
+    kin = [one_scenario(first, d.run.world.scenario) for d in runs]
+    swept = swept_fields([d.run.world.scenario for d, k in zip(runs, kin, strict=True) if k])
+    return [d.run.folder.name + _about(d, swept, kin=k) for d, k in zip(runs, kin, strict=True)]
 
 
-def _about(data: RunSeries, swept: list[str], name: str) -> str:
+def _about(data: RunSeries, swept: list[str], *, kin: bool) -> str:
     mine = data.run.world.scenario
     values = flat_fields(mine)
-    parts = ([f"{k}={json.dumps(values.get(k))}" for k in swept] if mine.name == name
+    parts = ([f"{k}={json.dumps(values.get(k))}" for k in swept] if kin
              else [f"scenario {mine.name}"])  # fmt: skip
     parts += [f"{c.key}={json.dumps(c.value)} at {c.t_s:g} s" for c in mine.settings]
     ended = (data.metrics or {}).get("end_reason", "completed")

@@ -18,6 +18,7 @@ from pathlib import Path
 from typing import Any
 
 from catabot.config.base import ConfigError
+from catabot.config.differences import one_scenario
 from catabot.run.answer import OneLineParser, answered, output_file
 from catabot.run.folders import RunFoldersError, run_folders
 from services.results import rows
@@ -60,8 +61,9 @@ def _count(n: int, what: str) -> str:
 def _mixed(records: list[rows.RunRecord]) -> None:
     """Runs of different scenarios compare field by field, list items by position (a
     sensor's noise against another's): said, since the table's columns are then not a sweep."""
-    names = sorted({r.scenario.name for r in records})
-    if len(names) > 1:
+    first = records[0].scenario
+    if not all(one_scenario(first, r.scenario) for r in records):
+        names = sorted({r.scenario.name for r in records})
         print(f"catabot results: runs of {len(names)} scenarios ({', '.join(names)}): their "
               "differences are field by field; tabulate each scenario's runs apart for a "
               "sweep's columns", file=sys.stderr)  # fmt: skip

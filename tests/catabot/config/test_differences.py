@@ -2,7 +2,13 @@
 
 from __future__ import annotations
 
-from catabot.config.differences import differences, flat_fields, flatten, swept_fields
+from catabot.config.differences import (
+    differences,
+    flat_fields,
+    flatten,
+    one_scenario,
+    swept_fields,
+)
 from catabot.config.load import parse_scenario
 from catabot.config.scenario import Scenario
 
@@ -35,3 +41,10 @@ def test_swept_fields_count_a_field_any_run_changes() -> None:
     assert swept_fields(runs[:1]) == []
     two = scenario(vessels=[{"id": "ego"}, {"id": "b", "pose": {"x_m": 9.0, "y_m": 0.0}}])
     assert "vessels.1.id" in swept_fields([two, scenario()])  # a field only the first has
+
+
+def test_runs_a_few_fields_apart_are_one_scenario_whatever_their_names() -> None:
+    """A sweep names each run (`--set name=gain2`): still one scenario's runs."""
+    assert one_scenario(scenario(), scenario(name="gain2", seed=5))
+    other = scenario(name="other", vessels=[{"id": f"v{k}"} for k in range(3)])
+    assert not one_scenario(scenario(), other) and one_scenario(scenario(), scenario(seed=9))

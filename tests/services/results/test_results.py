@@ -167,6 +167,12 @@ def test_runs_of_different_scenarios_are_said_to_be(
     sweep: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
     data = json.loads((sweep / "sweep-2" / "scenario.json").read_text())
-    (sweep / "sweep-2" / "scenario.json").write_text(json.dumps(data | {"name": "other"}))
+    (sweep / "sweep-2" / "scenario.json").write_text(json.dumps(data | {"name": "gain2"}))
+    assert cli.main([str(sweep)]) == 0  # a sweep that names its runs (--set name=gain2)
+    assert "scenarios" not in capsys.readouterr().err
+    sensors = [{"name": f"s{k}", "type": "imu", "rate_hz": 50.0} for k in range(4)]
+    other = {"name": "other", "duration_s": 9.0, "rain": {"rate_mm_h": 3.0},
+             "vessels": [{"id": "ego", "model": "wamv", "sensors": sensors}]}  # fmt: skip
+    (sweep / "sweep-2" / "scenario.json").write_text(json.dumps(other))
     assert cli.main([str(sweep)]) == 0
     assert "runs of 2 scenarios (other, sweep)" in capsys.readouterr().err
