@@ -57,13 +57,30 @@ def _json(path: Path) -> dict[str, Any] | None:
 def table(records: list[RunRecord]) -> tuple[list[str], list[dict[str, Any]]]:
     """The header (run, vessel, the swept fields, then the measured columns) and the rows."""
     swept = [k for k in swept_fields([r.scenario for r in records]) if k not in RUN_COLUMNS]
-    header = ["run", "vessel", *swept, *RUN_COLUMNS, *VESSEL_COLUMNS, *AFTER]
-    return header, [row for r in records for row in _rows(r, swept)]
+    values = [flat_fields(r.scenario) for r in records]
+    columns = [column for key in swept for column in _split(key, values)]
+    header = ["run", "vessel", *columns, *RUN_COLUMNS, *VESSEL_COLUMNS, *AFTER]
+    rows = zip(records, values, strict=True)
+    return header, [row for r, v in rows for row in _rows(r, v, columns)]
 
 
-def _rows(record: RunRecord, swept: list[str]) -> list[dict[str, Any]]:
-    fields = flat_fields(record.scenario)
-    common = {"run": record.folder.name, **{k: fields.get(k) for k in swept}}
+def _split(key: str, values: list[dict[str, Any]]) -> list[str]:
+    """A swept list of one length in every run (a current's [east, north], a program's
+    args) as a column per item that differs, `key.i` as `--set` names it: numbers pandas
+    reads as numbers (a plot against `water.current.velocity_mps.1`), not JSON text. The
+    columns the key became."""
+    found = [v.get(key) for v in values]
+    lists = [x for x in found if isinstance(x, list)]
+    if len(lists) != len(found) or len({len(x) for x in lists}) != 1:
+        return [key]
+    items = [i for i in range(len(lists[0])) if len({json.dumps(x[i]) for x in lists}) > 1]
+    for v, x in zip(values, lists, strict=True):
+        v |= {f"{key}.{i}": x[i] for i in items}
+    return [f"{key}.{i}" for i in items]
+
+
+def _rows(record: RunRecord, values: dict[str, Any], columns: list[str]) -> list[dict[str, Any]]:
+    common = {"run": record.folder.name, **{k: values.get(k) for k in columns}}
     common |= _run_cells(record) | _after(record.metrics)
     vessels = own_vessels(record.metrics)
     if not vessels:  # nothing measured: the run's row alone

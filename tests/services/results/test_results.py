@@ -176,3 +176,16 @@ def test_runs_of_different_scenarios_are_said_to_be(
     (sweep / "sweep-2" / "scenario.json").write_text(json.dumps(other))
     assert cli.main([str(sweep)]) == 0
     assert "runs of 2 scenarios (other, sweep)" in capsys.readouterr().err
+
+
+def test_a_swept_list_is_a_numeric_column_per_item_that_differs(tmp_path: Path) -> None:
+    """A sweep over the current's north component needed json.loads of "[0.0, 0.3]"."""
+    for k, north in enumerate((0.0, 0.3, 0.6)):
+        run = make_run(tmp_path / "sweep" / f"run-{k}")
+        data = json.loads((run / "scenario.json").read_text())
+        data["water"] = {"current": {"velocity_mps": [0.5, north]}}
+        (run / "scenario.json").write_text(json.dumps(data))
+    assert cli.main([str(tmp_path / "sweep"), "--csv", str(tmp_path / "t.csv")]) == 0
+    table = pd.read_csv(tmp_path / "t.csv")
+    assert "water.current.velocity_mps" not in table and "water.current.velocity_mps.0" not in table
+    assert table["water.current.velocity_mps.1"].tolist() == [0.0, 0.0, 0.3, 0.3, 0.6, 0.6]
