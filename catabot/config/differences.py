@@ -44,9 +44,9 @@ def differences(first: Scenario, other: Scenario) -> dict[str, Any]:
 def swept_fields(scenarios: list[Scenario]) -> list[str]:
     """The fields in which any of the scenarios differs from the first (either way: a field
     only the first has counts too), in name order."""
-    keys: set[str] = set()
-    for other in scenarios[1:]:
-        keys |= differences(scenarios[0], other).keys() | differences(other, scenarios[0]).keys()
+    base, keys = flat_fields(scenarios[0]), set()
+    for own in map(flat_fields, scenarios[1:]):
+        keys |= {k for k in own.keys() | base.keys() if own.get(k) != base.get(k)}
     return sorted(keys)
 
 

@@ -24,13 +24,22 @@ def metrics_lines(run_dir: Path) -> list[str]:
         return []
     lines = [
         f"  {vid}: " + "; ".join(filter(None, vessel_parts(m)))
-        for vid, m in record["vessels"].items()
-        if isinstance(m, dict) and "nearest_vessel" in m
+        for vid, m in own_vessels(record).items()
     ]
     if len(lines) > MAX_LINES:  # a fleet of scenario vessels: the file has them all
         more = len(lines) - MAX_LINES + 1
         lines[MAX_LINES - 1 :] = [f"  ... {more} more in {run_dir / 'metrics.json'}"]
     return lines + _traffic(record)
+
+
+def own_vessels(record: dict[str, Any] | None) -> dict[str, dict[str, Any]]:
+    """The scenario vessels' figures in a metrics.json record (those measured against
+    everything else: `nearest_vessel`), not the traffic boats'; the summary and `catabot
+    results` alike."""
+    vessels = (record or {}).get("vessels")
+    if not isinstance(vessels, dict):
+        return {}
+    return {v: m for v, m in vessels.items() if isinstance(m, dict) and "nearest_vessel" in m}
 
 
 def _traffic(record: dict[str, Any]) -> list[str]:

@@ -21,6 +21,7 @@ import threading
 import time
 from collections.abc import Callable, Iterator
 
+from catabot.bus.participant import WAITED
 from catabot.run.child import Child
 
 HANG_S = 3.0  # the conductor's heartbeat is every 0.5 s
@@ -254,11 +255,13 @@ class Supervisor:
         return f"{error}; {line}"
 
     def _waits(self) -> list[tuple[str, str]]:
-        return [(n, c.waited_line()) for n, c in self.services.items() if c.waited_line()]
+        lines = [(n, c.waited_line()) for n, c in self.services.items()]  # each read once
+        return [(n, line) for n, line in lines if line]
 
 
 def _tick_of(waited: str) -> int:
-    found = re.search(r" waited at tick (\d+) ", waited)
+    """The tick of a waited line as `Participant._waited` writes it."""
+    found = re.search(rf" {WAITED} (\d+) ", waited)
     return int(found.group(1)) if found else 1 << 62
 
 

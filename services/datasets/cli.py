@@ -105,7 +105,7 @@ def main(argv: list[str] | None = None) -> int:
         options = ExportOptions(args.val_fraction, args.split_block_s, args.min_box_px,
                                 keep_own=args.keep_own, min_visible=args.min_visible)  # fmt: skip
         try:
-            summary = {**FORMATS, "preview": preview.export}[args.format](run, out, options)
+            summary = _writer(args.format)(run, out, options)
         except BaseException:
             _undo(out, made=made)
             raise
@@ -114,6 +114,11 @@ def main(argv: list[str] | None = None) -> int:
         return f"{args.format} dataset in {out}: {summary}{_one_set(args)}"
 
     return answered(f"dataset {args.action}", export)
+
+
+def _writer(name: str) -> Callable[[RecordedRun, Path, ExportOptions], str]:
+    """A format's writer; `dataset preview` is the format "preview"."""
+    return preview.export if name == "preview" else FORMATS[name]
 
 
 def _one_set(args: argparse.Namespace) -> str:

@@ -46,9 +46,8 @@ class Frame:
     camera: str  # `<vessel>.<camera>`
     labelled: LabelledFrame
     subset: str  # "train" or "val"
-    min_box_px: int = 0
     own: int = 0  # the instance id of the camera's own vessel (0: its boxes are kept)
-    min_visible: float = 0.0
+    options: ExportOptions = ExportOptions()  # which boxes are kept (min_box_px, min_visible)
 
     @property
     def color(self) -> Path:
@@ -62,7 +61,7 @@ class Frame:
         """The boxes narrower or lower than `min_box_px`, in the camera's box order."""
         boxes = self.labelled.boxes
         size = np.minimum(boxes[:, 4] - boxes[:, 2], boxes[:, 5] - boxes[:, 3])
-        return np.asarray(size < self.min_box_px)
+        return np.asarray(size < self.options.min_box_px)
 
     @cached_property
     def mine(self) -> NDArray[np.bool_]:
@@ -73,7 +72,7 @@ class Frame:
     def hidden(self) -> NDArray[np.bool_]:
         """The boxes of bodies less visible than `min_visible` (a sliver past another boat:
         its box says little of the boat)."""
-        return np.asarray(self.labelled.flags[:, 2] < round(100 * self.min_visible))
+        return np.asarray(self.labelled.flags[:, 2] < round(100 * self.options.min_visible))
 
     @property
     def kept(self) -> NDArray[np.bool_]:
@@ -120,7 +119,7 @@ def camera_frames(
     subsets = split([f.stamp_ns for _, f, _ in pairs], seed=run.world.scenario.seed,
                     val_fraction=options.val_fraction, block_s=options.block_s)  # fmt: skip
     frames = [
-        Frame(f"{cam}_{f.tick:08d}", cam, f, subset, options.min_box_px, mine, options.min_visible)
+        Frame(f"{cam}_{f.tick:08d}", cam, f, subset, mine, options)
         for (cam, f, mine), subset in zip(pairs, subsets, strict=True)
     ]
     return frames, _note(frames, without, what, options if boxes else None)

@@ -25,7 +25,6 @@ LEFT_OUT = (150, 150, 150)
 
 def export(run: RecordedRun, out: Path, options: ExportOptions) -> str:
     frames, note = camera_frames(run, options)
-    out.mkdir(parents=True, exist_ok=True)
     for frame in frames:
         drawn(frame).save(out / f"{frame.name}.png")
     boxes = sum(len(f.boxes) for f in frames)

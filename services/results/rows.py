@@ -16,6 +16,7 @@ from typing import Any
 from catabot.config.differences import flat_fields, swept_fields
 from catabot.config.load import load_scenario
 from catabot.config.scenario import Scenario
+from catabot.run.metrics_summary import own_vessels
 
 # The measured columns: name -> (where in a vessel's metrics, or the run's), in table order.
 RUN_COLUMNS = ("seed", "reason", "error", "sim_s", "wall_s")
@@ -85,16 +86,7 @@ def _rows(record: RunRecord, values: dict[str, Any], columns: list[str]) -> list
     vessels = own_vessels(record.metrics)
     if not vessels:  # nothing measured: the run's row alone
         return [common | {"vessel": None}]
-    return [common | {"vessel": vid} | vessel_cells(m) for vid, m in vessels.items()]
-
-
-def own_vessels(metrics: dict[str, Any] | None) -> dict[str, dict[str, Any]]:
-    """The scenario vessels' metrics (measured against everything else: `nearest_vessel`),
-    not the traffic boats'."""
-    vessels = (metrics or {}).get("vessels")
-    if not isinstance(vessels, dict):
-        return {}
-    return {v: m for v, m in vessels.items() if isinstance(m, dict) and "nearest_vessel" in m}
+    return [common | {"vessel": vid} | vessel_columns(m) for vid, m in vessels.items()]
 
 
 def _run_cells(record: RunRecord) -> dict[str, Any]:
@@ -118,7 +110,7 @@ def _after(metrics: dict[str, Any] | None) -> dict[str, Any]:
     }
 
 
-def vessel_cells(m: dict[str, Any]) -> dict[str, Any]:
+def vessel_columns(m: dict[str, Any]) -> dict[str, Any]:
     """A scenario vessel's figures in metrics.json as flat cells (blank where it has none:
     no goal, no route, no buoy in the scenario)."""
     goal, route = m.get("goal") or {}, m.get("route") or {}

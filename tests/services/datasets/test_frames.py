@@ -23,8 +23,9 @@ def _frame(*, own: int, min_box_px: int = 0, min_visible: float = 0.0) -> Frame:
     for o, visible in zip(objects, (0.6, 0.25, 1.0), strict=True):
         o |= {"truncated": False, "occluded": visible < 1, "visible": visible}
     record = {"tick": 0, "stamp_ns": 0, "width": 640, "height": 480, "objects": objects}
+    options = ExportOptions(min_box_px=min_box_px, min_visible=min_visible)
     return Frame("ego.cam_00000000", "ego.cam", LabelledFrame(Path("."), record), "train",
-                 min_box_px, own, min_visible)  # fmt: skip
+                 own, options)  # fmt: skip
 
 
 def test_the_cameras_own_vessel_is_left_out_and_said() -> None:
@@ -62,7 +63,7 @@ def test_segmentation_ignores_the_cameras_own_vessel_unless_kept(tmp_path: Path)
     record = {"tick": 0, "stamp_ns": 0, "width": 3, "height": 2, "objects": [],
               "files": {"class": "c.png", "instance": "i.png"}}  # fmt: skip
     labelled = LabelledFrame(tmp_path, record)
-    own = annotation(Frame("ego.cam_00000000", "ego.cam", labelled, "train", 0, 1))
+    own = annotation(Frame("ego.cam_00000000", "ego.cam", labelled, "train", 1))
     assert own.tolist() == [[1, 1, 3], [IGNORE, IGNORE, 4]]
-    kept = annotation(Frame("ego.cam_00000000", "ego.cam", labelled, "train", 0, 0))
+    kept = annotation(Frame("ego.cam_00000000", "ego.cam", labelled, "train", 0))
     assert (kept == classes).all()

@@ -12,7 +12,7 @@ from PIL import Image
 from catabot.config.load import load_scenario
 from catabot.run.recorded_camera import LabelledFrame
 from services.datasets.cli import main
-from services.datasets.frames import Frame
+from services.datasets.frames import ExportOptions, Frame
 from services.datasets.preview import COLOURS, LEFT_OUT, drawn
 
 
@@ -32,7 +32,8 @@ def frame(tmp_path: Path, *, min_visible: float) -> Frame:
     record = {"tick": 0, "stamp_ns": 0, "width": 60, "height": 40, "objects": objects,
               "files": {"color": "c.png", "instance": "i.png"}}  # fmt: skip
     labelled = LabelledFrame(tmp_path, record)
-    return Frame("ego.cam_00000000", "ego.cam", labelled, "train", 0, 0, min_visible)
+    options = ExportOptions(min_visible=min_visible)
+    return Frame("ego.cam_00000000", "ego.cam", labelled, "train", 0, options)
 
 
 def test_kept_boxes_are_in_their_class_colour_and_left_out_ones_grey(tmp_path: Path) -> None:
