@@ -295,7 +295,7 @@ class PhysicsWorld:
         """Cache pose and world-frame velocity of all vessels from the generalized vectors."""
         q = self._fleet.positions()
         self._vel_w = self._fleet.velocities()
-        self._pos = q[:, 3:]
+        self._pos = np.ascontiguousarray(q[:, 3:])  # one layout for the compiled kernels
         self._quat, self._rot = kernels.poses(q)
 
     def _body_wrench(self) -> Array:
