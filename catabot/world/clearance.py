@@ -89,6 +89,18 @@ def off_rings(points: Array, r: float | Array, rings: Array) -> bool:
     return not bool((np.abs(d - rings[:, 2]) <= reach).any())
 
 
+def off_lanes(points: Array, r: float, lanes: Array) -> bool:
+    """Footprints of radius r at points (K, 2) clear of lanes (M, 5: segment ends x0, y0,
+    x1, y1, and the half-width the vessel using it needs)."""
+    a, b = lanes[:, 0:2], lanes[:, 2:4]
+    ab = b - a
+    rel = points[:, None, :] - a  # (K, M, 2)
+    length2 = np.maximum(np.einsum("mi,mi->m", ab, ab), 1e-12)
+    t = np.clip(np.einsum("kmi,mi->km", rel, ab) / length2, 0.0, 1.0)
+    gap = np.hypot(*(rel - t[:, :, None] * ab).transpose(2, 0, 1))
+    return not bool((gap <= r + lanes[:, 4] + CLEARANCE_M).any())
+
+
 def densify(track: Array, *, loop: bool, step_m: float = 5.0) -> tuple[Array, Array]:
     """Points every `step_m` along a polyline (closed back to its second point if looping),
     each segment a to b at a + t (b - a), t = k (1 / n) for k = 1..n and exactly 1 at its end

@@ -17,8 +17,9 @@ from catabot.config.base import ScenarioError
 from catabot.config.scenario import BuoyConfig, Pose, Scenario
 from catabot.config.terrain import TerrainError
 from catabot.config.traffic import BEHAVIOURS, BoatOverride, Point, Region, TrafficConfig, boat_id
+from catabot.config.vessel import VesselModel
 from catabot.world import seeding
-from catabot.world.clearance import Discs, Rows, clear, densify, off_rings
+from catabot.world.clearance import Discs, Rows, clear, densify, off_lanes, off_rings
 from catabot.world.placement import (
     BUOY_MODEL,
     CLEARANCE_M,
@@ -96,6 +97,7 @@ class Planner:
             self.placed.add(v.pose.x_m, v.pose.y_m, footprint_m(self._model(v.model)))
             self.hulls.append((v.id, v.pose, self._model(v.model)))
         self.buoy_r = footprint_m(self._model(BUOY_MODEL))
+        self.lanes = task_lanes(scenario, self._model)  # no drawn buoy on a vessel's way
         # Buoys are moored: a boat must not start on one, nor circle through one every lap.
         self.marks = Discs()  # buoys: x, y, footprint radius
         for b in scenario.buoys:
@@ -245,7 +247,8 @@ class Planner:
 
     def _buoys_clear(self, path: Sequence[Point], boat: Boat) -> bool:
         """Random waypoints (each to get a buoy) clear of every start, the boat's own
-        included, of every buoy and of every circling boat's track."""
+        included, of every buoy, of every circling boat's track and of every scenario
+        vessel's way to its task (a moored buoy on it would be an obstacle the task set)."""
         if not self.cfg.waypoints.buoys:
             return True
         points, r = np.array(path, dtype=np.float64).reshape(-1, 2), self.buoy_r
@@ -255,6 +258,7 @@ class Planner:
             and self.marks.clear_of(points, r)
             and clear(points, r, own)
             and off_rings(points, r, self.rings.array)
+            and off_lanes(points, r, self.lanes)
         )
 
     def _behave(
@@ -316,3 +320,21 @@ class Planner:
                     loop=w.mode == "loop", tolerance_m=w.tolerance_m,
                 )  # fmt: skip
         return None
+
+
+def task_lanes(scenario: Scenario, model: Callable[[str], VesselModel]) -> np.ndarray:
+    """(M, 5) segments x0, y0, x1, y1, half-width: each scenario vessel's way from its start
+    through its route to its goal, as wide as its footprint, and its goal disc (a segment of
+    no length, as wide as the goal or the footprint)."""
+    lanes = [np.zeros((0, 5))]
+    for v in scenario.vessels:
+        if v.task is None or v.pose is None:
+            continue
+        half = footprint_m(model(v.model))
+        goal = v.task.goal
+        to = [(goal.x_m, goal.y_m)] if goal else []
+        ends = np.array([(v.pose.x_m, v.pose.y_m), *(v.task.route or ()), *to], dtype=np.float64)
+        lanes.append(np.column_stack([ends[:-1], ends[1:], np.full(len(ends) - 1, half)]))
+        if goal is not None:
+            lanes.append(np.array([[*to[0], *to[0], max(half, goal.radius_m)]]))
+    return np.concatenate(lanes)

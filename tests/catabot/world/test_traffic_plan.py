@@ -109,3 +109,27 @@ def test_given_starts_may_lie_alongside_each_other_but_not_overlap() -> None:
     side[1] |= {"y_m": 2.5, "yaw_rad": 1.5708}  # turned across the first: stern into its side
     with pytest.raises(ScenarioError, match="its hull overlaps boat_000's"):
         _plan(2, boats=side)
+
+
+def test_drawn_buoys_keep_off_a_vessels_way_to_its_task() -> None:
+    """The student's river run: a traffic buoy drawn onto the ego's route took its goal."""
+    task = {
+        "route": [[0.0, 0.0], [120.0, 0.0], [120.0, 80.0]],
+        "goal": {"x_m": 0.0, "y_m": 80.0, "radius_m": 6.0},
+    }
+    data = {
+        "seed": 3,
+        "vessels": [{"id": "ego", "pose": {"x_m": -30.0, "y_m": 0.0}, "task": task}],
+        "traffic": {"count": 40, "behaviour_mix": {"waypoints": 1.0},
+                    "region": {"size_m": [400.0, 400.0]}, "waypoints": {"count": 5,
+                    "region": {"center_m": [60.0, 40.0], "size_m": [200.0, 140.0]}}},
+    }  # fmt: skip
+    buoys = np.array([(b.x_m, b.y_m) for b in World.resolve(parse_scenario(data)).traffic.buoys])
+    assert len(buoys) > 150  # the lane crosses the buoys' region: the rule has work to do
+    way = np.array([[-30.0, 0.0], [0.0, 0.0], [120.0, 0.0], [120.0, 80.0], [0.0, 80.0]])
+    a, b = way[:-1], way[1:]
+    t = np.clip(np.einsum("kmi,mi->km", buoys[:, None] - a, b - a) / ((b - a) ** 2).sum(1), 0, 1)
+    gap = np.hypot(*(buoys[:, None] - a - t[:, :, None] * (b - a)).transpose(2, 0, 1))
+    ego = footprint_m(load_vessel_model("catabot"))
+    assert gap.min() > ego + BUOY + CLEARANCE_M
+    assert np.hypot(*(buoys - (0.0, 80.0)).T).min() > 6.0 + BUOY + CLEARANCE_M
