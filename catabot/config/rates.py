@@ -52,7 +52,7 @@ def rate_in_ticks(rate_hz: float, dt_ns: int, *, where: str) -> int:
     try:  # first, so that e.g. 30 Hz at 10 ms names the allowed rates
         ticks = period_in_ticks(round(NS_PER_S / rate_hz), dt_ns, what=where)
     except ClockError as exc:
-        raise ScenarioError(str(exc)) from None
+        raise ScenarioError(f"{exc}; {nearest_rates(rate_hz, dt_ns)}") from None
     exact = NS_PER_S / rate_hz
     if not math.isclose(exact, round(exact), rel_tol=1e-12, abs_tol=1e-6):
         raise ScenarioError(f"{where}: {rate_hz} Hz is not a whole number of ns")
@@ -71,3 +71,14 @@ def traffic_record_period(scenario: Scenario) -> int:
         return 1
     where = "recording.traffic_rate_hz (null records every tick)"
     return rate_in_ticks(rate, scenario.dt_ns, where=where)
+
+
+def nearest_rates(rate_hz: float, dt_ns: int) -> str:
+    """The whole-tick rates either side of one that is not (a user asking 3 Hz at 100 Hz
+    ticks wants to hear 3.03 or 2.94 Hz, not to work it out)."""
+    tick_hz, every = NS_PER_S / dt_ns, NS_PER_S / dt_ns / rate_hz
+    if every < 1.0:
+        return f"the fastest is {tick_hz:g} Hz (every tick)"
+    low, high = math.floor(every), math.ceil(every)
+    slow, fast = tick_hz / high, tick_hz / low
+    return f"the nearest are {fast:.4g} Hz (every {low} ticks) and {slow:.4g} Hz (every {high})"

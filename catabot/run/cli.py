@@ -14,6 +14,7 @@ from pathlib import Path
 
 from catabot.bus.session import Connection, SessionError, add_connection_args, open_session
 from catabot.config.load import json_schema, model_schema
+from catabot.config.notes import angle_notes
 from catabot.config.scenario import WaterConfig
 from catabot.config.vessel import VesselModelError, load_vessel_model
 from catabot.errors import CataBotError
@@ -159,7 +160,7 @@ def _scenario(args: argparse.Namespace) -> int:
         f"{len(world.buoys)} buoy(s), {len(world.sensors)} sensor(s), {s.ticks} ticks"
     )
     print(f"{args.file or 'default'}: valid ({counts})")
-    for note in programs.shared_notes(s):
+    for note in [*programs.shared_notes(s), *angle_notes(s)]:
         print(note)
     return 0
 

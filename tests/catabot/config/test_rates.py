@@ -34,6 +34,7 @@ def test_sensor_rate_not_a_whole_number_of_ticks() -> None:
     assert "33333333" in msg
     assert "whole number of ticks" in msg
     assert "100 Hz divided by a whole number" in msg  # the allowed rates
+    assert "the nearest are 33.33 Hz (every 3 ticks) and 25 Hz (every 4)" in msg
 
 
 def test_sensor_rate_3_hz_refused() -> None:
@@ -116,3 +117,9 @@ def test_a_traffic_recording_rate_is_not_checked_without_traffic_or_buoys() -> N
     data = _base()
     data["recording"] = {"traffic_rate_hz": 30.0}  # no body it would apply to
     assert parse_scenario(data).recording.traffic_rate_hz == 30.0
+
+
+def test_a_rate_faster_than_the_clock_is_told_the_fastest() -> None:
+    data = _base()
+    data["vessels"][0]["sensors"][1]["rate_hz"] = 400.0
+    assert "the fastest is 100 Hz (every tick)" in _error(data)

@@ -173,6 +173,21 @@ def test_validate_notes_a_participant_given_two_vessels(
     assert "valid" in out and "note: participant 'pair' controls vessels a, b: a " in out
 
 
+def test_validate_notes_a_field_of_view_that_looks_like_radians(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """A trial user's `hfov_deg: 1.5708` (a 90-degree camera in radians) validated silently
+    as a 1.6-degree one; a 60-degree camera is not noted."""
+    cams = [{"name": n, "type": "camera", "rate_hz": 10.0, "params": {"hfov_deg": fov}}
+            for n, fov in (("tele", 1.5708), ("wide", 60.0))]  # fmt: skip
+    path = tmp_path / "cams.json"
+    path.write_text(json.dumps({"name": "cams", "vessels": [{"id": "ego", "sensors": cams}]}))
+    assert main(["scenario", "validate", str(path)]) == 0
+    notes = [line for line in capsys.readouterr().out.splitlines() if line.startswith("note")]
+    assert notes == ["note: vessels.0.sensors.0.params.hfov_deg (ego/tele) is 1.5708 degrees; "
+                     "if it is radians, that is 90 degrees: give that"]  # fmt: skip
+
+
 def test_the_vessel_model_schema_checks_every_bundled_model(tmp_path: Path) -> None:
     assert main(["scenario", "model-schema", "-o", str(tmp_path / "m.json")]) == 0
     schema = json.loads((tmp_path / "m.json").read_text())
