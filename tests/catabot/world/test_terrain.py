@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import re
 import time
 from pathlib import Path
 
@@ -227,3 +228,15 @@ def test_real_image_start_checks_and_mesh(river: Terrain) -> None:
     assert len(triangles) <= MAX_MESH_TRIANGLES and len(triangles) > 0.95 * MAX_MESH_TRIANGLES
     assert len(vertices) == (triangles.max() + 1)
     print(f"\nopen-water search {found_s:.3f} s, mesh {len(triangles)} triangles {mesh_s:.3f} s")
+
+
+def test_a_refused_start_names_the_nearest_start_that_is_not() -> None:
+    """A trial user read the image's pixels to find water; the refusal now says where."""
+    terrain = lake()
+    for x, y in [(5.0, 5.0), (60.0 + 29.5, 40.0)]:  # on land; in the shallow rim
+        with pytest.raises(TerrainError, match=r"nearest start deep enough is \(") as info:
+            terrain.check_start(x, y, draft_m=0.5, footprint_m=2.0)
+        fx, fy, away = map(float, re.findall(r"is \(([-\d.]+), ([-\d.]+)\), (\d+) m away",
+                                             str(info.value))[0])  # fmt: skip
+        terrain.check_start(fx, fy, draft_m=0.5, footprint_m=2.0)  # accepted as told
+        assert abs(np.hypot(fx - x, fy - y) - away) < 1.0
