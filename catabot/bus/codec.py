@@ -114,7 +114,7 @@ def decode(payload: bytes | bytearray | memoryview, expect: type[M]) -> M:
     if "v" not in body:
         raise CodecError(f'no "v": every payload carries the schema version, {SCHEMA_VERSION}')
     version = body.pop("v")
-    if version != SCHEMA_VERSION:
+    if type(version) is not int or version != SCHEMA_VERSION:  # not True: msgpack's true == 1
         raise CodecError(f"schema version {version!r} is not supported (this is {SCHEMA_VERSION})")
     wire = body.pop("type", None)
     if wire != expect.TYPE:

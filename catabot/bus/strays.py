@@ -20,6 +20,18 @@ def watch_strays(participant: Participant, pattern: str, why: Callable[[str], st
     def on_sample(sample: zenoh.Sample) -> None:
         key = str(sample.key_expr)
         if key not in known:  # the streams' own samples: a set lookup, nothing queued
-            events.put(("stray", key, why(key).encode(), sender_of(sample)))
+            reason = shape_problem(key, pattern) or why(key)
+            events.put(("stray", key, reason.encode(), sender_of(sample)))
 
     participant.keep(participant.session.declare_subscriber(pattern, on_sample))
+
+
+def shape_problem(key: str, pattern: str) -> str:
+    """Why `key` is no key of `pattern`'s form ("" if it is): a put on a wildcard expression
+    (`vessel/**`) reaches the subscriber as that expression, of any depth, and `why` reads
+    a key's segments (a hostile client's put made physics log a traceback per sample)."""
+    if "*" in key:
+        return f"a put on a key expression with wildcards; a command goes to one key ({pattern})"
+    if key.count("/") != pattern.count("/"):
+        return f"not a key of the form {pattern}"
+    return ""

@@ -58,11 +58,12 @@ def test_the_first_refusal_of_each_kind_reaches_the_console_once(tmp_path: Path)
 def test_a_command_to_no_vessel_or_of_no_kind_is_said_not_dropped_unheard(tmp_path: Path) -> None:
     """`vessel/ghost/cmd/thrust` and `vessel/ego/cmd/pose` reached no subscriber: a typo in
     an id was silent. Physics watches every command key and names what is wrong."""
-    proc, endpoint, _ = _listening_run(tmp_path, "stray", duration_s=4.0)
+    proc, endpoint, out = _listening_run(tmp_path, "stray", duration_s=4.0)
     keys = Keys("stray")
     ghost, pose = keys.cmd_thrust("ghost"), f"{keys.prefix}/vessel/ego/cmd/pose"
+    wild = f"{keys.prefix}/vessel/**"  # of any depth: physics logged a traceback per put
     with open_session(Connection(connect=(endpoint,))) as session:
-        for key in (ghost, pose):
+        for key in (ghost, pose, wild, f"{keys.prefix}/vessel/ego/cmd/thrust/**"):
             matched_publisher(session, key).put(b"anything")  # once physics' watch is there
             time.sleep(0.3)
     stdout, stderr = proc.communicate(timeout=60)
@@ -71,3 +72,7 @@ def test_a_command_to_no_vessel_or_of_no_kind_is_said_not_dropped_unheard(tmp_pa
     assert f"physics refused {ghost}: no such stream: no vessel 'ghost' in this world " in said
     assert "(its vessels: ego)" in said
     assert f"physics refused {pose}: no such stream: no command 'pose' (a vessel takes" in said
+    assert (
+        f"physics refused {wild}: no such stream: a put on a key expression with wildcards" in said
+    )
+    assert "Traceback" not in (only_run_dir(out) / "log" / "physics.log").read_text()

@@ -90,7 +90,7 @@ def test_not_a_map() -> None:
         codec.decode(msgpack.packb([1, 2]), Ack)
 
 
-@pytest.mark.parametrize("version", [0, 2, None, "1"])
+@pytest.mark.parametrize("version", [0, 2, None, "1", True, 1.0])  # True == 1 == 1.0
 def test_unknown_schema_version(version: object) -> None:
     body = _body(SAMPLES["ack"])
     if version is None:
