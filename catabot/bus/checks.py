@@ -35,6 +35,8 @@ MAX_SPEED_MPS = 50.0  # faster than any surface vessel CataBot models
 MAX_RATE_RADPS = 2 * math.pi  # a turn a second
 MAX_COORDINATE_M = 1e7  # a waypoint within 10 000 km of the world's origin
 MAX_TOLERANCE_M = 1e3
+MIN_TOLERANCE_M = 0.1  # 1e-300 was taken: a boat steering for a point that close circles it
+MIN_PATH_SPEED_MPS = 0.01  # slower, a path parks the boat (5e-324 m/s was taken)
 
 
 def body_states(ids: tuple[str, ...]) -> Check:
@@ -100,9 +102,10 @@ def waypoints(msg: WaypointsCmd) -> None:
         raise ValueError(f"{len(pts) // 2} waypoints: at most {MAX_WAYPOINTS} in one path")
     if max(abs(v) for v in pts) > MAX_COORDINATE_M:
         raise ValueError(f"points: each coordinate within ±{MAX_COORDINATE_M:g} m of the origin")
-    for name, value in (("speed", msg.speed), ("tolerance", msg.tolerance)):
-        if not (finite(value) and value > 0):  # the one that is wrong, named alone
-            raise ValueError(f"{name} {value} must be a finite number > 0")
+    for name, value, least in (("speed", msg.speed, MIN_PATH_SPEED_MPS),
+                               ("tolerance", msg.tolerance, MIN_TOLERANCE_M)):  # fmt: skip
+        if not (finite(value) and value >= least):  # the one that is wrong, named alone
+            raise ValueError(f"{name} {value} must be a finite number >= {least:g}")
     if msg.speed > MAX_SPEED_MPS or msg.tolerance > MAX_TOLERANCE_M:
         raise ValueError(
             f"speed {msg.speed} m/s and tolerance {msg.tolerance} m: at most "

@@ -27,10 +27,12 @@ from catabot.config.rates import guidance_period_ticks
 from catabot.config.traffic import AvoidParams
 from catabot.run.service import Built, ServiceContext, run_service
 from catabot.world import rotations
+from catabot.world.course import top_speed_mps
 from catabot.world.placement import footprint_m
 from catabot.world.world import World
 from services.traffic.avoid import KeepClear, Obstacles
 from services.traffic.behaviours import Behaviours
+from services.traffic.outside import OutsidePaths
 
 
 class TrafficService:
@@ -51,6 +53,8 @@ class TrafficService:
         states = world.streams.guidance_states  # only the batches guidance reads
         self.states_key = states.key
         self.boat_rows = np.array([world.body(vid).row for vid in self.ids], dtype=np.intp)
+        top = [top_speed_mps(world.body(vid).model) for vid in self.ids]
+        self.outside = OutsidePaths(self.ids, top)  # said on the console
         waypoints = [s for s in world.streams.waypoints if ctx.keys.vessel_of(s.key) in self.row]
         (self.twists_key,) = [s.key for s in world.streams.twists if s.producer == ctx.name]
         self.period = guidance_period_ticks(ctx.scenario)
@@ -66,7 +70,7 @@ class TrafficService:
             i = self.row[self.keys.vessel_of(key)]
             for msg in msgs:
                 if isinstance(msg, WaypointsCmd):
-                    self._take_waypoints(i, msg)
+                    self._take_waypoints(i, msg, tick.stamp_ns)
         for change in changes_of(tick.settings):
             self._take_setting(change.key, change.decoded)
         if guide:
@@ -101,14 +105,16 @@ class TrafficService:
                 i, str(value), self.pos[i], float(self.yaw[i]), self.traffic
             )
 
-    def _take_waypoints(self, i: int, msg: WaypointsCmd) -> None:
+    def _take_waypoints(self, i: int, msg: WaypointsCmd, stamp_ns: int) -> None:
         """Adopt a path from outside, or release the boat (paths are checked on arrival:
-        catabot/bus/checks.py)."""
+        catabot/bus/checks.py), said on the console (outside.py)."""
         if msg.mode == "release":
             self.behaviours.release(i)
+            self.outside.released(i, stamp_ns)
             return
         points = np.array(msg.points, dtype=np.float64).reshape(-1, 2)
         self.behaviours.set_path(i, points, msg.speed, loop=msg.mode == "loop", tol=msg.tolerance)
+        self.outside.taken(i, msg, stamp_ns)
 
 
 def keep_clear(

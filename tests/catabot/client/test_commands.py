@@ -44,8 +44,10 @@ def test_good_commands_become_their_messages() -> None:
         (Waypoints([(1, 2)], tolerance=5e3), "at most 50 m/s and 1000 m"),
         (Waypoints([(1e300, 2)]), "each coordinate within ±1e[+]07 m of the origin"),
         (Waypoints([(1, 2, 3)]), r"a waypoint is \(x, y\) in m"),
-        (Waypoints([(1, 2)], speed=0), "speed 0.0 must be a finite number > 0"),
-        (Waypoints([(1, 2)], tolerance=-1), "tolerance -1.0 must be a finite number > 0"),
+        (Waypoints([(1, 2)], speed=0), "speed 0.0 must be a finite number >= 0.01"),
+        (Waypoints([(1, 2)], tolerance=-1), "tolerance -1.0 must be a finite number >= 0.1"),
+        (Waypoints([(1, 2)], tolerance=1e-300), "tolerance 1e-300 must be"),  # circles for ever
+        (Waypoints([(1, 2)], speed=5e-324), "speed 5e-324 must be"),  # parks the boat
         (Waypoints([(1, NAN)]), "an even number of finite values"),
         (Waypoints([(1, 2)], mode="zigzag"), "mode 'zigzag' is not one of"),
         (Waypoints([(k, 0) for k in range(1001)]), "1001 waypoints: at most 1000 in one path"),
