@@ -133,10 +133,27 @@ class Inbox:
                 f"tick {tick} (period {stream.period}, last {self.latest[stream.key]}, "
                 f"granted below {horizon})",
             )
+        skipped = self._skipped(stream, tick)
+        if skipped >= 0:  # a producer sends every due tag in order: a forger's future tags
+            raise Rejected(  # were taken, and the producer's own refused as late (lost rows)
+                "tag skips ahead", f"tick {tick} before tick {skipped} (period {stream.period})"
+            )
         stamp = getattr(msg, "stamp_ns", None)
         expected = (tick + stream.stamp_ticks) * self.dt_ns
         if self.dt_ns and stamp != expected:
             raise Rejected("stamp of another tick", f"stamp {stamp} ns, tick {tick} has {expected}")
+
+    def _skipped(self, s: Stream, tick: int) -> int:
+        """The first tag due after the last one heard and before `tick` that its producer
+        was not switched off at (-1: none; a tag of an off span is never sent)."""
+        due = _next_tag(s, self.latest[s.key])
+        for start, end in self._off.get(s.key, ()):
+            if due >= end:
+                continue
+            if due < start:
+                break
+            due = _next_tag(s, end - 1)  # the first due tag at or after the span's end
+        return due if due < tick else -1
 
     def drop_producers(self, names: Iterable[str]) -> None:
         """Stop waiting for streams of participants the conductor dropped."""

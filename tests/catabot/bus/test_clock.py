@@ -148,10 +148,10 @@ def test_jacobi_release() -> None:
 
 def test_release_holds_samples_of_the_current_and_later_ticks() -> None:
     inbox = _inbox()
-    for k in (1, 2, 3, 4):
+    for k in (0, 1, 2, 3):
         _add(inbox, STATE, _state(k))
-    assert [m.tick for m in inbox.release(3)[STATE]] == [1, 2]  # oldest first
-    assert [m.tick for m in inbox.release(5)[STATE]] == [3, 4]
+    assert [m.tick for m in inbox.release(2)[STATE]] == [0, 1]  # oldest first
+    assert [m.tick for m in inbox.release(4)[STATE]] == [2, 3]
 
 
 def test_free_samples_are_released_at_the_next_step() -> None:
@@ -228,13 +228,30 @@ def test_a_late_or_repeated_sample_is_refused_and_keeps_the_mark() -> None:
     """One producer publishes a key in tick order: an older or repeated tag is a forgery or
     a replay, never data."""
     inbox = _inbox()
-    _add(inbox, STATE, _state(5))
+    for k in range(6):
+        _add(inbox, STATE, _state(k))
     with pytest.raises(Rejected, match="tag out of the window"):
         _add(inbox, STATE, _state(2))
     with pytest.raises(Rejected, match="second sample for one tick: tick 5: one a tick at most"):
         _add(inbox, STATE, _state(5))
     assert inbox.latest[STATE] == 5
     assert STATE not in inbox.missing(6)
+
+
+def test_a_sample_that_skips_a_due_tag_is_refused() -> None:
+    """A hostile trial put states for ticks ahead, with physics' copied source info: taken,
+    they made physics' own samples for the ticks between late, and their rows were lost.
+    A producer sends every due tag in order, so a tag past the next due one is refused."""
+    inbox = _inbox()
+    _add(inbox, STATE, _state(0))
+    with pytest.raises(Rejected, match=r"tag skips ahead: tick 5 before tick 1 \(period 1\)"):
+        _add(inbox, STATE, _state(5))
+    _add(inbox, STATE, _state(1))  # the producer's own, still taken
+    inbox.switch(STATE, 2, on=False)  # switched off from tag 2 to tag 7
+    inbox.switch(STATE, 7, on=True)
+    _add(inbox, STATE, _state(7))  # the tags it was off at are not skipped
+    with pytest.raises(Rejected, match="tag skips ahead: tick 9 before tick 8"):
+        _add(inbox, STATE, _state(9))
 
 
 def test_dropped_producers_are_not_waited_for() -> None:
@@ -319,17 +336,17 @@ def test_a_lockstep_order_refused_for_its_content_still_answers_its_tick() -> No
     twist_key = KEYS.cmd_twist("ego")
     stream = Stream(twist_key, TwistCmd, "p", 10, check=checks.twist)
     inbox = Inbox([stream], roster=Roster(ZIDS))
-    bad = codec.encode(TwistCmd(float("nan"), 0.0, 10, 100))
-    with pytest.raises(Rejected, match=r"invalid content: surge nan .*tick 10 goes on without it"):
+    bad = codec.encode(TwistCmd(float("nan"), 0.0, 0, 0))
+    with pytest.raises(Rejected, match=r"invalid content: surge nan .*tick 0 goes on without it"):
         inbox.add(twist_key, bad, sender=ZIDS["p"])
-    assert inbox.missing(11) == [] and inbox.release(11) == {}
-    inbox.add(twist_key, codec.encode(TwistCmd(1.0, 0.0, 20, 200)), sender=ZIDS["p"])
-    assert inbox.release(21) == {twist_key: [TwistCmd(1.0, 0.0, 20, 200)]}
+    assert inbox.missing(1) == [] and inbox.release(1) == {}
+    inbox.add(twist_key, codec.encode(TwistCmd(1.0, 0.0, 10, 100)), sender=ZIDS["p"])
+    assert inbox.release(11) == {twist_key: [TwistCmd(1.0, 0.0, 10, 100)]}
     fixes = Stream("f", GpsFix, "p", 10, check=_refuse)
     inbox = Inbox([fixes], roster=Roster(ZIDS))
     with pytest.raises(Rejected, match="invalid content: no"):
-        inbox.add("f", codec.encode(GpsFix(10, 100, 0.0, 0.0, 0.0, 0.0, 0.0)), sender=ZIDS["p"])
-    assert inbox.missing(11) == ["f"]
+        inbox.add("f", codec.encode(GpsFix(0, 0, 0.0, 0.0, 0.0, 0.0, 0.0)), sender=ZIDS["p"])
+    assert inbox.missing(1) == ["f"]
 
 
 def _refuse(_msg: object) -> None:
