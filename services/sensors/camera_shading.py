@@ -7,7 +7,7 @@ per VGA frame because every step is a vectorised NumPy expression over the hit p
 - water: a dark blue-green body plus the sky reflected in the wave normal, weighted by
   Schlick's Fresnel term (glancing rays mirror the sky, steep ones see into the water);
 - terrain: sand, grass, rock by height, Lambert-shaded from a fixed sun;
-- vessels and buoys: one palette colour per instance, Lambert-shaded.
+- vessels and buoys: one palette colour per instance (buoys: a mark's), Lambert-shaded.
 Rain (mm/h) attenuates contrast toward a grey veil with distance, t = exp(-k R^a d)
 (extinction grows sub-linearly with rain rate, as in visibility-vs-rain fits), and draws
 seeded bright streaks whose count grows with the rate.
@@ -40,6 +40,10 @@ PALETTE = np.array(
         [255, 110, 0],
     ],
     dtype=np.float32,
+)  # fmt: skip
+BUOY_PALETTE = np.array(  # IALA marks: lateral red and green, special yellow, and orange;
+    [[200, 30, 30], [30, 150, 60], [250, 200, 30], [255, 120, 0]],  # the vessels' palette
+    dtype=np.float32,  # drew some buoys teal or grey, lost against the water (a trial user)
 )  # fmt: skip
 RAIN_K_PER_M = 2.0e-4  # extinction at 1 mm/h (1/m): ~0.2 /km, visibility ~20 km
 RAIN_EXPONENT = 0.7  # extinction ~ R^0.7: 50 mm/h gives ~3 /km, visibility ~1.3 km
@@ -74,7 +78,7 @@ def shade(
     The sky is one pass over every pixel with no gather; water, terrain and bodies are
     gathered (np.take), shaded and put back over it."""
     out = _sky_and_water(cls, normal, dirs)
-    for c, fn in ((CLASS_TERRAIN, _terrain), (CLASS_VESSEL, _body), (CLASS_BUOY, _body)):
+    for c, fn in ((CLASS_TERRAIN, _terrain), (CLASS_VESSEL, _body), (CLASS_BUOY, _buoy)):
         idx = np.flatnonzero(cls == c)
         if idx.size:
             out[:, idx] = fn(idx, instance, rng, normal, dirs, origin_z)
@@ -108,7 +112,16 @@ def _terrain(
 
 
 def _body(idx: NDArray[np.intp], inst: NDArray[np.int32], r: F32, n: F32, d: F32, z: float) -> F32:
-    colour: F32 = PALETTE.T[:, np.take(inst, idx) % len(PALETTE)]
+    return _painted(PALETTE, idx, inst, n)
+
+
+def _buoy(idx: NDArray[np.intp], inst: NDArray[np.int32], r: F32, n: F32, d: F32, z: float) -> F32:
+    return _painted(BUOY_PALETTE, idx, inst, n)
+
+
+def _painted(palette: F32, idx: NDArray[np.intp], inst: NDArray[np.int32], n: F32) -> F32:
+    """A palette colour per instance, Lambert-shaded."""
+    colour: F32 = palette.T[:, np.take(inst, idx) % len(palette)]
     return colour * lambert(np.take(n, idx, axis=0))
 
 
