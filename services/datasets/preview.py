@@ -38,20 +38,34 @@ def drawn(frame: Frame) -> Image.Image:
     if instance is not None:
         image = _outlined(image, instance, frame)
     pen = ImageDraw.Draw(image)
-    for row, kept, flags in zip(frame.labelled.boxes, frame.kept, frame.labelled.flags,
-                                strict=True):  # fmt: skip
-        _box(pen, row, flags, kept=bool(kept))
+    boxes, kept, flags = frame.labelled.boxes, frame.kept, frame.labelled.flags
+    for row, keep in zip(boxes, kept, strict=True):
+        _box(pen, row, kept=bool(keep))
+    taken: list[tuple[float, float, float, float]] = []
+    area = [(r[4] - r[2]) * (r[5] - r[3]) for r in boxes]
+    for k in sorted(np.flatnonzero(kept).tolist(), key=lambda k: -area[k]):
+        _label(pen, boxes[k], flags[k], taken)
     return image
 
 
-def _box(pen: ImageDraw.ImageDraw, row: NDArray[np.float64], flags: NDArray[np.uint8],
-         *, kept: bool) -> None:  # fmt: skip
-    name = _class_name(int(row[1]))
+def _box(pen: ImageDraw.ImageDraw, row: NDArray[np.float64], *, kept: bool) -> None:
+    colour = COLOURS.get(_class_name(int(row[1])), (255, 255, 255)) if kept else LEFT_OUT
     x0, y0, x1, y1 = (float(v) for v in row[2:6])
-    colour = COLOURS.get(name, (255, 255, 255)) if kept else LEFT_OUT
     pen.rectangle((x0, y0, x1 - 1, y1 - 1), outline=colour, width=2 if kept else 1)
-    if kept:
-        pen.text((x0, max(y0 - 11, 0)), f"{name} {int(row[0])} {int(flags[2])}%", fill=colour)
+
+
+def _label(pen: ImageDraw.ImageDraw, row: NDArray[np.float64], flags: NDArray[np.uint8],
+           taken: list[tuple[float, float, float, float]]) -> None:  # fmt: skip
+    """A kept box's name above it, unless it would cover a larger box's name (distant boats'
+    names ran together into one unreadable strip, a trial user found)."""
+    name = _class_name(int(row[1]))
+    text = f"{name} {int(row[0])} {int(flags[2])}%"
+    at = (float(row[2]), max(float(row[3]) - 11, 0.0))
+    x0, y0, x1, y1 = pen.textbbox(at, text)
+    if any(x0 < b[2] and b[0] < x1 and y0 < b[3] and b[1] < y1 for b in taken):
+        return
+    taken.append((x0, y0, x1, y1))
+    pen.text(at, text, fill=COLOURS.get(name, (255, 255, 255)))
 
 
 def _outlined(image: Image.Image, instance: NDArray[np.generic], frame: Frame) -> Image.Image:

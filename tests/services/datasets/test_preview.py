@@ -52,6 +52,26 @@ def test_each_mask_edge_is_traced_inside_the_body(tmp_path: Path) -> None:
     assert tuple(pixels[17, 15]) == (0, 0, 0)  # inside the mask: the image's own
 
 
+def test_a_label_that_would_cover_a_larger_boxs_is_left_out(tmp_path: Path) -> None:
+    """Distant boats' names ran together into one unreadable strip (a trial user)."""
+    Image.fromarray(np.zeros((40, 120, 3), np.uint8)).save(tmp_path / "c.png")
+    objects = [
+        {"instance": 5, "class": "vessel", "box": [10, 20, 40, 30], "visible": 1.0},
+        {"instance": 7, "class": "buoy", "box": [44, 24, 48, 28], "visible": 1.0},
+    ]
+    record = {"tick": 0, "stamp_ns": 0, "width": 120, "height": 40,
+              "objects": [o | {"truncated": False, "occluded": False} for o in objects],
+              "files": {"color": "c.png"}}  # fmt: skip
+    labelled = LabelledFrame(tmp_path, record)
+    options = ExportOptions(min_visible=0.0)
+    pixels = np.asarray(drawn(Frame("c_0", "c", labelled, "train", 0, options)))
+    red, green = (pixels[:19, :, c].astype(float) for c in (0, 1))  # above the boxes: names
+    inked = red > 60  # text is smoothed: its colour by hue, red (vessel) or yellow (buoy)
+    assert (inked & (green < 0.4 * red)).any()  # the larger box's name
+    assert not (inked & (green > 0.6 * red)).any()  # not the buoy's, over it
+    assert (pixels[24:28, 44] == COLOURS["buoy"]).all()  # its box is drawn all the same
+
+
 def test_a_run_without_a_camera_is_refused_in_one_line(
     tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
