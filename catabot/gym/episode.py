@@ -71,6 +71,7 @@ class Draw:
         models = scenario_models(base)
         self.base = resolve_poses(base, self.terrain, models=models)
         self.index = ids.index(self.vessel)
+        _no_one_waited_for(base, self.vessel)
         ego = self.base.vessels[self.index]
         self.model = models[ego.model]
         self.radius = footprint_m(self.model)
@@ -177,6 +178,20 @@ def _base(scenario: str | dict[str, Any]) -> Scenario:
     if isinstance(scenario, dict):
         return parse_scenario(scenario, source="the env's scenario")
     return load_scenario(Path(scenario) if scenario.endswith(".json") else scenario)
+
+
+def _no_one_waited_for(scenario: Scenario, vessel: str) -> None:
+    """Another vessel whose controller no program starts would hold every episode's run
+    until its start timeout (a swarm researcher's reset waited 20 s, then failed): said
+    before any run, with what to do."""
+    for i, v in enumerate(scenario.vessels):
+        c = v.controller
+        if v.id != vessel and c is not None and c.program is None:
+            raise EnvOptionsError(
+                f"vessels.{i} ({v.id}) is driven by participant {c.participant!r}, which no "
+                f"program starts: an env drives one vessel ({vessel}); give {v.id} a script "
+                "or its controller a `program`, or leave it out"
+            )
 
 
 def _others(scenario: Scenario, ego: int, models: Models) -> np.ndarray:

@@ -75,3 +75,18 @@ def test_bad_options_name_the_field() -> None:
     crowded = {"vessels": [{"id": "ego"}], "buoys": [{"id": "b", "x_m": 0.0, "y_m": 0.0}]}
     with pytest.raises(EnvOptionsError, match="no start in open water"):
         Draw(env_options(scenario=crowded, start_radius_m=0.0)).episode(0, "w")
+
+
+def test_another_vessel_with_a_controller_no_program_starts_is_refused_before_any_run() -> None:
+    """A swarm researcher's reset waited out the start timeout for its followers' stacks."""
+    follower = {"id": "f1", "pose": {"x_m": 20.0, "y_m": 0.0},
+                "controller": {"participant": "ctl_f1", "rate_hz": 10.0}}  # fmt: skip
+    swarm = {"vessels": [{"id": "leader"}, follower]}
+    with pytest.raises(
+        EnvOptionsError,
+        match=r"vessels.1 \(f1\) is driven by participant "
+        r"'ctl_f1', which no program starts: an env drives one vessel \(leader\)",
+    ):
+        Draw(env_options(scenario=swarm))  # fmt: skip
+    scripted = {"vessels": [{"id": "leader"}, {"id": "f1", "pose": {"x_m": 20.0, "y_m": 0.0}}]}
+    assert Draw(env_options(scenario=scripted)).vessel == "leader"  # scripted: as they are
