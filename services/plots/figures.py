@@ -300,12 +300,13 @@ def lidar_rain(data: RunSeries) -> Figure | None:
 
 
 def metrics(data: RunSeries) -> Figure | None:
-    """Closest approach between any two vessels over time; distance and top speed by vessel."""
+    """Closest approach of a scenario vessel to any other over time (metrics.json's); distance
+    and top speed by vessel."""
     fig = _figure(1, 2, size=(11, 4))
     gap, bars = _axes(fig)
     finite = np.isfinite(data.closest)
     if finite.any():
-        gap.plot(data.t, data.closest, color="#1f77b4", label="any two vessels")
+        gap.plot(data.t, data.closest, color="#1f77b4", label="own vessel to any other")
         k = int(np.nanargmin(np.where(finite, data.closest, np.nan)))
         gap.plot(data.t[k], data.closest[k], "v", color="red",
                  label=f"minimum {data.closest[k]:.2f} m at {data.t[k]:.1f} s")  # fmt: skip
@@ -315,7 +316,7 @@ def metrics(data: RunSeries) -> Figure | None:
     else:  # one vessel alone: an empty 0..1 panel read as a plot gone wrong
         gap.text(0.5, 0.5, "one vessel: no pair to measure", ha="center", va="center",
                  transform=gap.transAxes, color="gray")  # fmt: skip
-    gap.set(title="Closest approach between two vessels (dashed: own pairs)",
+    gap.set(title="Closest approach to another vessel (dashed: own pairs)",
             xlabel="simulated time [s]", ylabel="distance [m]")  # fmt: skip
     gap.grid(alpha=0.3)
     vessels = (data.metrics or {}).get("vessels", {})

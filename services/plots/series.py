@@ -59,7 +59,7 @@ def read(run: RecordedRun, *, full: bool = True) -> RunSeries:
     for k, (vid, row) in enumerate(zip(own, rows, strict=True)):
         out.speed[vid] = np.hypot(states.twist[:, row, 0], states.twist[:, row, 1])
         out.heading[vid] = (90.0 - np.degrees(yaw[:, k])) % 360.0
-    out.closest = closest_approach(states.position[:, : len(run.world.vessels), :2])
+    out.closest = closest_approach(states.position[:, : len(run.world.vessels), :2], rows)
     out.pairs = own_pairs(states.position[:, rows, :2], own)
     if full:
         _commands(run, out)
@@ -77,16 +77,17 @@ def own_pairs(xy: F64, own: list[str], most: int = 6) -> dict[str, F64]:
     return {f"{own[a]}-{own[b]}": gaps[:, k] for k, (a, b) in enumerate(zip(i, j, strict=True))}
 
 
-def closest_approach(xy: F64) -> F64:
-    """(T,) smallest distance between two vessels at each tick (inf with fewer than two)."""
-    if xy.shape[1] < 2:
+def closest_approach(xy: F64, own: list[int]) -> F64:
+    """(T,) smallest distance from one of the `own` rows (the scenario's vessels) to any
+    other vessel at each tick (inf without a pair): as metrics.json's closest approach,
+    which leaves out traffic boat against traffic boat (the plot's curve had them)."""
+    if xy.shape[1] < 2 or not own:
         return np.full(len(xy), np.inf)
     out = np.empty(len(xy))
-    for start in range(0, len(xy), 256):  # bounded memory: (256, N, N) distances at a time
+    for start in range(0, len(xy), 256):  # bounded memory: (256, S, N) distances at a time
         block = xy[start : start + 256]
-        gap = np.linalg.norm(block[:, :, None] - block[:, None], axis=-1)
-        idx = np.arange(xy.shape[1])
-        gap[:, idx, idx] = np.inf
+        gap = np.linalg.norm(block[:, own, None] - block[:, None], axis=-1)
+        gap[:, np.arange(len(own)), own] = np.inf
         out[start : start + 256] = gap.min(axis=(1, 2))
     return out
 
