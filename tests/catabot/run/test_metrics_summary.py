@@ -52,6 +52,15 @@ def test_a_fleet_is_cut_short(tmp_path: Path) -> None:
     assert lines[7] == f"  ... 13 more in {tmp_path / 'metrics.json'}"
 
 
+def test_vessels_come_in_the_scenarios_order_not_the_files(tmp_path: Path) -> None:
+    """metrics.json sorts its keys (for identical bytes): a swarm's leader came last."""
+    record = {"vessels": {v: EGO for v in ("f1", "f2", "leader")}}
+    (tmp_path / "metrics.json").write_text(json.dumps(record))
+    scenario = {"vessels": [{"id": v} for v in ("leader", "f2", "f1")]}
+    (tmp_path / "scenario.json").write_text(json.dumps(scenario))
+    assert [line.split(":")[0] for line in metrics_lines(tmp_path)] == ["  leader", "  f2", "  f1"]
+
+
 def test_the_traffic_collisions_have_a_line_where_there_is_traffic(tmp_path: Path) -> None:
     boat = {"distance_m": 3.0, "max_speed_mps": 1.0, "final_position_m": [0, 0, 0]}
     hit = {"bodies": ["boat_0", "boat_1"], "start_s": 1.0, "end_s": 2.0}
