@@ -18,7 +18,8 @@ $(STAMP): pyproject.toml scripts/system-deps.sh
 	@# numba's cache of the compiled kernels, three processes side by side (20 s → 10 s)
 	$(PY) -c "from services.sensors.wave_pass import warm_up; warm_up()" & a=$$!; \
 	$(PY) -c "from services.physics.kernels import warm_up; warm_up()" & b=$$!; \
-	$(PY) -c "from services.physics.wet import warm_up; warm_up()" && wait $$a && wait $$b
+	$(PY) -c "from services.physics import wave_pull, wet; wet.warm_up(); wave_pull.warm_up()" \
+		&& wait $$a && wait $$b
 	touch $(STAMP)
 
 setup: $(STAMP)

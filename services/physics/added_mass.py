@@ -9,9 +9,9 @@ the orbital velocity: the Munk terms then see the flow past the hull, and a body
 the orbit with the water feels none. With the current alone, a buoy in the medium swell
 felt a roll moment -A22 v w from its own orbit and tilted up to 0.46 rad from the surface
 normal in a sea no steeper than 0.11 rad (0.07 rad now). The water's acceleration (its
-Froude-Krylov force and the added mass's share of it) is not modelled. M_A = diag(A11 ..
-A66) acts as inertia in all six DOF. DART integrates only M_RB and its own rigid-body
-Coriolis and centripetal terms C_RB(nu) nu (about the COG) and gravity; C_A is ours.
+Froude-Krylov force and the added mass's share of it) is wave_pull.py's, an applied load.
+M_A = diag(A11 .. A66) acts as inertia in all six DOF. DART integrates only M_RB and its own
+rigid-body Coriolis and centripetal terms C_RB(nu) nu (about the COG) and gravity; C_A is ours.
 
 C_A: Fossen's eq. 6.43 for a diagonal M_A (Kirchhoff form, momenta pa1 = A_lin * v_r,
 pa2 = A_ang * w, C_A nu_r = [w x pa1, v_r x pa1 + w x pa2]) built from the MANOEUVRING added

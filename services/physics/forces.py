@@ -18,14 +18,16 @@ import numpy as np
 from numpy.typing import NDArray
 
 from services.physics import kernels
-from services.physics.hydro import Array, Columns, buoyancy_wrench, damping_wrench
+from services.physics.hydro import Array, Columns, buoyancy_wrench, column_heights, damping_wrench
 from services.physics.loads import EnvironmentLoads
 from services.physics.sea import SeaSampler
 from services.physics.sleep import Sleep
+from services.physics.wave_pull import wave_pull
 from services.physics.wet import ThrustLoad, wetness
 
 Rows = NDArray[np.intp]
 OTHER = "wind, moorings and added mass"
+PULL = "waves' pull"
 
 
 @dataclass(frozen=True)
@@ -38,6 +40,8 @@ class ForceTables:
     loads: EnvironmentLoads
     weight_n: Array  # (N,) m g: the buoyancy that floats each body
     lift: Array | None = None  # (N, 2) [Y_uv, N_uv]; None: no body has any
+    fluid_mass: Array | None = None  # (N, 3) m + A11, A22, A33: what the waves pull (wave_pull)
+    pull_at: Array | None = None  # (N, 3) body frame: where (the centre of buoyancy at rest)
 
     def take(self, rows: Rows) -> ForceTables:
         """The tables of bodies `rows` (sorted), in that order."""
@@ -48,6 +52,8 @@ class ForceTables:
             self.loads.take(rows),
             self.weight_n[rows],
             None if self.lift is None else self.lift[rows],
+            None if self.fluid_mass is None else self.fluid_mass[rows],
+            None if self.pull_at is None else self.pull_at[rows],
         )
 
 
@@ -109,15 +115,10 @@ def body_wrench(
     if water.velocity_w is not None:  # and added mass act on motion relative to the water
         water_w = water_w + water.velocity_w
     water_b = kernels.to_body(motion.rot, np.ascontiguousarray(water_w))
-    buoyancy = buoyancy_wrench(
-        tables.columns,
-        motion.rot,
-        motion.pos,
-        density=fluid.density,
-        gravity=fluid.gravity,
-        time_s=time_s,
-        surface=water.surface,
-    )
+    cols, rot = tables.columns, motion.rot
+    eta = column_heights(cols, rot, motion.pos, time_s=time_s, surface=water.surface)
+    buoyancy = buoyancy_wrench(cols, rot, motion.pos, density=fluid.density,
+                               gravity=fluid.gravity, eta=eta)  # fmt: skip
     wet = wetness(buoyancy, motion.rot, tables.weight_n)
     damping = damping_wrench(nu, tables.linear, tables.quadratic, water_b, tables.lift)
     loads = {
@@ -126,6 +127,12 @@ def body_wrench(
         "thrust": thrust.wrench(motion.rot, motion.pos, water.at_points, time_s),
     }
     base = loads["buoyancy"] + loads["damping"] + loads["thrust"]
+    if water.velocity_w is not None and tables.fluid_mass is not None:  # waves
+        assert tables.pull_at is not None, "ForceTables: fluid_mass without pull_at"
+        pull = wave_pull((tables.fluid_mass, tables.pull_at), cols, rot, eta,
+                         gravity=fluid.gravity, wet=wet)  # fmt: skip
+        loads[PULL] = pull
+        base = base + pull
     total = tables.loads.total(motion.rot, motion.pos, nu, water_b, base, wet=wet)
     loads[OTHER] = total - base
     loads["total"] = total

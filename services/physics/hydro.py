@@ -136,26 +136,36 @@ def buoyancy_wrench(
     gravity: float,
     time_s: float = 0.0,
     surface: WaterHeight = water_height,
+    eta: Array | None = None,
 ) -> Array:
     """Body-frame buoyancy wrench (N, 6) of all vessels given rotations (N,3,3), positions (N,3).
+    `eta`: the water's height at the columns when the caller has it (`column_heights`).
 
     Each column's submerged fraction f is measured along its own axis (body z) from whichever
     end is lower, so a tilted or capsized hull is handled. Its force rho*g*A*h*f points up
     (world +z) and acts at the centroid of the submerged part: the total is rho*g times the
     submerged volume (Archimedes, exact for boxes) and tilt gives a restoring moment.
     """
-    columns = column_surface(surface)
-    if surface is water_height:  # calm water: nothing to sample
-        eta = cols.calm
-    elif columns is not None:  # a surface that evaluates columns itself
-        eta = columns.at_columns(_plain(rot), cols.bottom_m)
-    else:
-        bottom_w = np.matmul(rot, cols.bottom_m, out=cols._world)  # (N, 3, C), world frame
-        bottom_w += pos[:, :, None]
-        eta = np.empty_like(cols.height_m)
-        eta[...] = surface(bottom_w[:, 0], bottom_w[:, 1], time_s)
+    if eta is None:
+        eta = column_heights(cols, rot, pos, time_s=time_s, surface=surface)
     tables = (cols.bottom_m, cols.height_m, cols.volume_m3)
     return kernels.buoyancy(_plain(rot), _plain(pos), tables, eta, density * gravity)
+
+
+def column_heights(
+    cols: Columns, rot: Array, pos: Array, *, time_s: float, surface: WaterHeight
+) -> Array:
+    """The water's height (N, C) above each column's bottom point (calm: zeros)."""
+    columns = column_surface(surface)
+    if surface is water_height:  # calm water: nothing to sample
+        return cols.calm
+    if columns is not None:  # a surface that evaluates columns itself
+        return columns.at_columns(_plain(rot), cols.bottom_m)
+    bottom_w = np.matmul(rot, cols.bottom_m, out=cols._world)  # (N, 3, C), world frame
+    bottom_w += pos[:, :, None]
+    eta = np.empty_like(cols.height_m)
+    eta[...] = surface(bottom_w[:, 0], bottom_w[:, 1], time_s)
+    return eta
 
 
 def _plain(a: Array) -> Array:

@@ -27,7 +27,7 @@ from catabot.config.vessel import VesselModel
 from catabot.world.environment import CurrentField, WindField
 from catabot.world.terrain import Terrain
 from catabot.world.waves import WaveField
-from services.physics import kernels, wet
+from services.physics import kernels, wave_pull, wet
 from services.physics.diverged import check_finite, check_state
 from services.physics.fleet import Fleet, buoy_bodies
 from services.physics.forces import AwakeTables, BodyMotion, Fluid, ForceTables, body_wrench, spread
@@ -118,8 +118,10 @@ class PhysicsWorld:
         quadratic = np.array([m.damping.quadratic for m in models], dtype=np.float64)
         weight = np.array([m.mass_kg for m in models]) * self._g
         lift = np.array([m.damping.lift_uv for m in models], dtype=np.float64).reshape(-1, 2)
+        fluid = np.array([[m.mass_kg + a for a in m.added_mass[:3]] for m in models])
         tables = ForceTables(columns, linear, quadratic, self._loads, weight,
-                             lift if lift.any() else None)  # fmt: skip
+                             lift if lift.any() else None, fluid.reshape(-1, 3),
+                             wave_pull.centres_of_buoyancy(columns))  # fmt: skip
         self._tables = AwakeTables(tables)
         self._sea = SeaSampler(models, columns.bottom_m.transpose(0, 2, 1))
         self._sea.use(waves)  # eta at the columns, orbital velocity at the origins (sea.py)
@@ -134,6 +136,7 @@ class PhysicsWorld:
         self._wet: Array | None = None  # each hull's wetness this step (wet.py)
         kernels.warm_up()  # the compiled force laws load now, not inside the first step
         wet.warm_up()
+        wave_pull.warm_up()
 
     # --- public API -----------------------------------------------------------------
 

@@ -15,7 +15,7 @@ from catabot.config.vessel import load_vessel_model
 from catabot.config.waves import WaveConfig
 from catabot.world import rotations
 from catabot.world.waves import WaveField
-from services.physics import kernels, wet
+from services.physics import kernels, wave_pull, wet
 from services.physics.control import TwistControllerBank
 from services.physics.hydro import Columns, build_columns, buoyancy_wrench
 from services.physics.world import PhysicsWorld
@@ -77,6 +77,7 @@ def test_a_stepping_world_reaches_each_kernel_as_the_one_type_warm_up_compiled(
 ) -> None:
     kernels.warm_up()
     wet.warm_up()
+    wave_pull.warm_up()
     starts = [(f"v{i}", m, (12.0 * i, 0.0, 0.0, 0.3 * i)) for i, m in enumerate(MODELS[:3])]
     world = PhysicsWorld(
         starts, dt_s=0.01, waves=WaveField(waves, 2) if waves else None, buoys=[("b", (0, 30))]
@@ -95,9 +96,10 @@ def test_a_stepping_world_reaches_each_kernel_as_the_one_type_warm_up_compiled(
 
 
 def compiled_kernels() -> list[Any]:
-    """Every compiled kernel of the physics step (kernels.py and wet.py), found, not listed,
+    """Every compiled kernel of the physics step (kernels.py, wet.py, wave_pull.py), found,
+    not listed,
     so a new one is checked too."""
-    found = (getattr(module, name) for module in (kernels, wet) for name in dir(module))
+    found = (getattr(module, name) for module in (kernels, wet, wave_pull) for name in dir(module))
     return [f for f in found if isinstance(f, numba.core.registry.CPUDispatcher)]
 
 

@@ -1,0 +1,54 @@
+"""The waves' horizontal pull (services/physics/wave_pull.py): the fitted surface slope, and a
+hull at rest in a long regular wave swinging as far as the water it floats in."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from catabot.config.vessel import load_vessel_model
+from catabot.config.waves import WaveConfig
+from catabot.world import rotations
+from catabot.world.waves import WaveField
+from services.physics.hydro import build_columns
+from services.physics.wave_pull import surface_slopes
+from services.physics.world import PhysicsWorld
+
+
+def test_the_slope_of_a_plane_is_found_whatever_the_heading() -> None:
+    cols = build_columns([load_vessel_model("wamv")])
+    rot = rotations.matrices(np.array([rotations.from_yaw(0.7)]))
+    world = np.matmul(rot, cols.bottom_m)  # (1, 3, C)
+    eta = 0.1 + 0.02 * world[:, 0] - 0.03 * world[:, 1]
+    assert surface_slopes(rot, cols.bottom_m, cols.area_m2, eta)[0] == pytest.approx(
+        [0.02, -0.03, 0.0], abs=1e-12
+    )
+
+
+def test_a_hull_on_its_side_has_no_slope() -> None:
+    """Seen from above its columns lie on a line: no plane to fit, so no pull (not a NaN)."""
+    cols = build_columns([load_vessel_model("catabot")])
+    rot = rotations.matrices(np.array([rotations.from_rpy(np.pi / 2, 0.0, 0.0)]))
+    eta = np.random.default_rng(1).normal(size=cols.area_m2.shape)
+    assert (surface_slopes(rot, cols.bottom_m, cols.area_m2, eta) == 0.0).all()
+
+
+@pytest.mark.parametrize("name", ["catabot", "wamv"])
+def test_a_hull_at_rest_swings_with_the_water_of_a_long_wave(name: str) -> None:
+    """A naval architect's check: a hull short against the wave moves with the water's
+    particles, horizontally as vertically; with buoyancy pushing straight up, the damping
+    alone dragged it a third of the way (0.18-0.5 of the particles' swing)."""
+    cfg = WaveConfig(significant_height_m=0.5, peak_period_s=6.0, gamma=10, spreading=None,
+                     frequency_components=1, direction_components=1, direction_rad=0.0)  # fmt: skip
+    waves = WaveField(cfg, 1)
+    world = PhysicsWorld([("v", load_vessel_model(name), (0.0, 0.0, 0.0, 0.0))], dt_s=0.01,
+                         waves=waves)  # fmt: skip
+    x = np.empty(4000)
+    for k in range(6000):
+        world.step()
+        if k >= 2000:
+            x[k - 2000] = world.state_arrays().position[0, 0]
+    t = np.arange(4000) * 0.01
+    swing = x - np.polyval(np.polyfit(t, x, 1), t)  # less the slow drift
+    particle = waves.amplitudes_m[0] / np.sqrt(2.0)  # a surface particle's circle, std
+    assert swing.std() / particle == pytest.approx(1.0, abs=0.1)
