@@ -19,6 +19,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from catabot.world import rotations
 from services.physics import kernels
 from services.physics.hydro import Array, Columns
 from services.physics.kernels import jit
@@ -69,7 +70,7 @@ def wave_pull(
     slopes = surface_slopes(rot, cols.bottom_m, cols.area_m2, np.ascontiguousarray(eta))
     out = np.zeros((len(rot), 6))
     out[:, :3] = mass * kernels.to_body(rot, -gravity * slopes)
-    out[:, 3:] = np.cross(at, out[:, :3])
+    out[:, 3:] = rotations.cross(at, out[:, :3])
     if wet is not None:
         out *= wet[:, None]
     return out
