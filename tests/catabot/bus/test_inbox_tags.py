@@ -1,0 +1,24 @@
+"""A clocked stream's tags in order: a sample past the next due tag is refused."""
+
+from __future__ import annotations
+
+import pytest
+
+from catabot.bus.rejections import Rejected
+from tests.catabot.bus.inbox_samples import STATE, _add, _inbox, _state
+
+
+def test_a_sample_that_skips_a_due_tag_is_refused() -> None:
+    """A hostile trial put states for ticks ahead, with physics' copied source info: taken,
+    they made physics' own samples for the ticks between late, and their rows were lost.
+    A producer sends every due tag in order, so a tag past the next due one is refused."""
+    inbox = _inbox()
+    _add(inbox, STATE, _state(0))
+    with pytest.raises(Rejected, match=r"tag skips ahead: tick 5 before tick 1 \(period 1\)"):
+        _add(inbox, STATE, _state(5))
+    _add(inbox, STATE, _state(1))  # the producer's own, still taken
+    inbox.switch(STATE, 2, on=False)  # switched off from tag 2 to tag 7
+    inbox.switch(STATE, 7, on=True)
+    _add(inbox, STATE, _state(7))  # the tags it was off at are not skipped
+    with pytest.raises(Rejected, match="tag skips ahead: tick 9 before tick 8"):
+        _add(inbox, STATE, _state(9))
