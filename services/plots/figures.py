@@ -100,7 +100,7 @@ def _trajectories(data: RunSeries, lo: np.ndarray, hi: np.ndarray, title: str) -
                    label=f"buoys ({len(b)})", zorder=3)  # fmt: skip
     ax.set(xlim=(lo[0], hi[0]), ylim=(lo[1], hi[1]), xlabel="east x [m]", ylabel="north y [m]",
            title=f"{title}, {data.t[-1]:.1f} s (o start, ■ end)", aspect="equal")  # fmt: skip
-    ax.legend(loc="upper right", fontsize=8, framealpha=0.9, facecolor="#9fb0c0")  # white shows
+    ax.legend(loc="best", fontsize=8, framealpha=0.9, facecolor="#9fb0c0")  # white shows
     return fig
 
 
