@@ -1,8 +1,9 @@
 """Notes on a valid scenario that is likely not what its author meant, said before the run.
 
-Why: `hfov_deg: 1.5708` is a legal 1.6° camera, but it is far more often a 90° one written
-in radians (a trial user's scenario); refusing it would refuse the rare telephoto lens, and
-saying nothing leaves a dataset of sky to be found afterwards.
+Two kinds: a participant given several vessels (a catabot.client stack drives one), and a
+field of view that looks like radians: `hfov_deg: 1.5708` is a legal 1.6° camera, but far
+more often a 90° one written in radians (a trial user's scenario); refusing it would refuse
+the rare telephoto lens, and saying nothing leaves a dataset of sky to be found afterwards.
 """
 
 from __future__ import annotations
@@ -12,6 +13,29 @@ import math
 from catabot.config.scenario import Scenario
 
 FIELDS_OF_VIEW = ("hfov_deg", "vertical_fov_deg")
+
+
+def scenario_notes(scenario: Scenario) -> list[str]:
+    """Every note, said by `scenario validate` and before a run alike."""
+    return [*shared_notes(scenario), *angle_notes(scenario)]
+
+
+def shared_notes(scenario: Scenario) -> list[str]:
+    """A participant given several vessels is allowed (a stack on the bus itself publishes
+    each one's commands), but `catabot.client`'s join() commands one vessel and refuses it:
+    said before the run, not after a start timeout."""
+    driven: dict[str, list[str]] = {}
+    for vessel in scenario.vessels:
+        if vessel.controller is not None:
+            driven.setdefault(vessel.controller.participant, []).append(vessel.id)
+    return [_shared_note(name, ids) for name, ids in driven.items() if len(ids) > 1]
+
+
+def _shared_note(name: str, ids: list[str]) -> str:
+    return (f"note: participant {name!r} controls vessels {', '.join(ids)}: a catabot.client "
+            "stack commands one vessel per participant (give each its own "
+            "controller.participant; one process may join several), only a stack on the bus "
+            "itself can drive them together")  # fmt: skip
 
 
 def angle_notes(scenario: Scenario) -> list[str]:

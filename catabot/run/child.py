@@ -15,7 +15,6 @@ import time
 from pathlib import Path
 from typing import IO
 
-from catabot.bus.clock import CONDUCTOR
 from catabot.bus.participant import WAITED
 from catabot.bus.rejections import report_of
 from catabot.run.advice import advice_of
@@ -90,9 +89,7 @@ class Child:
             return
         hint = " (messages: docs/MESSAGES.md)" if reason in HINTED else ""
         said = f"{reason}: {detail}" if detail else reason
-        counts = str(self.log_path.with_name(f"{self.name}.rejected.json"))
-        if self.name == CONDUCTOR:  # its counts come in its result line, into run.json
-            counts = f'{self.log_path.with_name("run.json")} ("rejected")'
+        counts = self.log_path.with_name(f"{self.name}.rejected.json")
         self.notes.append(f"{self.name} refused {key}: {said}{hint}; first of its kind, all "
                             f"counted in {counts}")  # fmt: skip
 

@@ -14,11 +14,11 @@ from pathlib import Path
 
 from catabot.bus.session import Connection, SessionError, add_connection_args, open_session
 from catabot.config.load import json_schema, model_schema
-from catabot.config.notes import angle_notes
+from catabot.config.notes import scenario_notes
 from catabot.config.scenario import WaterConfig
 from catabot.config.vessel import VesselModelError, load_vessel_model
 from catabot.errors import CataBotError
-from catabot.run import compose, conduct, console, launcher, programs, secure, settings_cli
+from catabot.run import compose, conduct, console, launcher, secure, settings_cli
 from catabot.run.answer import OneLineParser, answered, output_file
 from catabot.run.companions import VIEW_MODES
 from catabot.run.generate import ONLY_GENERATE, generate
@@ -160,7 +160,7 @@ def _scenario(args: argparse.Namespace) -> int:
         f"{len(world.buoys)} buoy(s), {len(world.sensors)} sensor(s), {s.ticks} ticks"
     )
     print(f"{args.file or 'default'}: valid ({counts})")
-    for note in [*programs.shared_notes(s), *angle_notes(s)]:
+    for note in scenario_notes(s):
         print(note)
     return 0
 

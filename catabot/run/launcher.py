@@ -20,7 +20,7 @@ from catabot.bus.session import check_listen, check_router, free_port
 from catabot.config import overrides
 from catabot.config.base import ScenarioError
 from catabot.config.load import load_scenario, parse_scenario, scenario_data, scenario_json
-from catabot.config.notes import angle_notes
+from catabot.config.notes import scenario_notes
 from catabot.config.scenario import Scenario
 from catabot.config.sensors import service_of
 from catabot.errors import CataBotError
@@ -225,7 +225,7 @@ def run(opts: RunOptions) -> int:
 def _tell_external(world: World, opts: RunOptions, endpoint: str) -> None:
     """The clock starts only once the participants started outside the run have joined:
     say so, or the console shows a progress bar standing at zero until the start timeout."""
-    for note in [*programs.shared_notes(world.scenario), *angle_notes(world.scenario)]:
+    for note in scenario_notes(world.scenario):
         print(note, flush=True)
     launched = {p.participant for p in programs.programs(world.scenario, opts.scenario)}
     outside = [p for p in world.participants if p not in {*world.services, *launched}]

@@ -8,13 +8,14 @@ from __future__ import annotations
 
 import contextlib
 import json
+from collections.abc import Sequence
 from pathlib import Path
 from typing import Any
 
 MAX_LINES = 8
 
 
-def metrics_lines(run_dir: Path) -> list[str]:
+def metrics_lines(run_dir: Path, order: Sequence[str] = ()) -> list[str]:
     """`  <vessel>: goal ..., nearest ..., collisions ..., thrust impulse ...` per scenario
     vessel (the vessels measured against everything else: they have `nearest_vessel`)."""
     record: Any = None
@@ -23,23 +24,13 @@ def metrics_lines(run_dir: Path) -> list[str]:
     if not isinstance(record, dict) or not isinstance(record.get("vessels"), dict):
         return []
     own = own_vessels(record)
-    order = {vid: k for k, vid in enumerate(_scenario_order(run_dir))}  # metrics.json sorts
-    ids = sorted(own, key=lambda vid: (order.get(vid, len(order)), vid))
+    rank = {vid: k for k, vid in enumerate(order)}  # the scenario's: metrics.json sorts its keys
+    ids = sorted(own, key=lambda vid: (rank.get(vid, len(rank)), vid))
     lines = [f"  {vid}: " + "; ".join(filter(None, vessel_parts(own[vid]))) for vid in ids]
     if len(lines) > MAX_LINES:  # a fleet of scenario vessels: the file has them all
         more = len(lines) - MAX_LINES + 1
         lines[MAX_LINES - 1 :] = [f"  ... {more} more in {run_dir / 'metrics.json'}"]
     return lines + _traffic(record)
-
-
-def _scenario_order(run_dir: Path) -> list[str]:
-    """The vessels' ids in the scenario's order (a leader, then f1..f3, not f1..f3 then the
-    leader): the run folder's scenario.json, or none."""
-    data: Any = None
-    with contextlib.suppress(OSError, ValueError):
-        data = json.loads((run_dir / "scenario.json").read_text())
-    vessels = data.get("vessels") if isinstance(data, dict) else None
-    return [v["id"] for v in vessels or [] if isinstance(v, dict) and isinstance(v.get("id"), str)]
 
 
 def own_vessels(record: dict[str, Any] | None) -> dict[str, dict[str, Any]]:

@@ -78,21 +78,3 @@ def environment(run_dir: Path) -> dict[str, str]:
         "CATABOT_SCENARIO": str(run_dir / "scenario.json"),
         "CATABOT_RUN_DIR": str(run_dir),
     }
-
-
-def shared_notes(scenario: Scenario) -> list[str]:
-    """A participant given several vessels is allowed (a stack on the bus itself publishes
-    each one's commands), but `catabot.client`'s join() commands one vessel and refuses it:
-    said before the run, not after a start timeout."""
-    driven: dict[str, list[str]] = {}
-    for vessel in scenario.vessels:
-        if vessel.controller is not None:
-            driven.setdefault(vessel.controller.participant, []).append(vessel.id)
-    return [_shared_note(name, ids) for name, ids in driven.items() if len(ids) > 1]
-
-
-def _shared_note(name: str, ids: list[str]) -> str:
-    return (f"note: participant {name!r} controls vessels {', '.join(ids)}: a catabot.client "
-            "stack commands one vessel per participant (give each its own "
-            "controller.participant; one process may join several), only a stack on the bus "
-            "itself can drive them together")  # fmt: skip

@@ -14,7 +14,7 @@ import sys
 from collections.abc import Mapping
 from pathlib import Path
 
-from catabot.bus.clock import ender_of
+from catabot.bus.clock import CONDUCTOR, ender_of
 from catabot.config.scenario import Scenario
 from catabot.run.metrics_summary import metrics_lines
 from catabot.run.provenance import provenance
@@ -58,13 +58,18 @@ def _processes(
 def _rejected(
     run_dir: Path, services: Mapping[str, object], result: Mapping[str, object]
 ) -> dict[str, dict[str, int]]:
-    """Inputs each process refused, by reason (log/<service>.rejected.json, the conductor's
-    in its result line)."""
+    """Inputs each process refused, by reason (log/<process>.rejected.json). The conductor's
+    come in its result line; they are written to its file here, so every process has one
+    where its console line says (it named a file that was never written)."""
     out: dict[str, dict[str, int]] = {}
     conductor = result.get("rejected")
     if isinstance(conductor, dict) and conductor:
-        out["conductor"] = {str(k): int(v) for k, v in conductor.items()}
-    for name in services:
+        totals = {str(k): int(v) for k, v in sorted(conductor.items())}
+        with contextlib.suppress(OSError):
+            (run_dir / "log" / f"{CONDUCTOR}.rejected.json").write_text(
+                json.dumps(totals, indent=2) + "\n"
+            )
+    for name in [CONDUCTOR, *services]:
         path = run_dir / "log" / f"{name}.rejected.json"
         with contextlib.suppress(OSError, ValueError):
             out[name] = {str(k): int(v) for k, v in json.loads(path.read_text()).items()}
@@ -133,7 +138,8 @@ def summarise(
         f"{ticks} ticks, {sim_s:.2f} s simulated in {wall:.2f} s "
         f"({ticks / max(wall, 1e-9):.0f} ticks/s, real-time factor {rtf:.1f})"
     )
-    for line in metrics_lines(run_dir) if ticks else []:  # no tick stepped: nothing measured
+    order = [v.id for v in scenario.vessels]
+    for line in metrics_lines(run_dir, order) if ticks else []:  # no tick stepped: nothing measured
         print(line)
     for name in (n for n, c in service_codes.items() if c == 0 and n.startswith("export-")):
         print(f"  {name}: {_last_line(run_dir, name)}")  # what it wrote, as the CLI says it

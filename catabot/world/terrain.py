@@ -17,7 +17,6 @@ the map meets the same shore or sea it left.
 from __future__ import annotations
 
 import math
-from collections.abc import Callable
 from pathlib import Path
 from typing import TYPE_CHECKING
 
@@ -224,11 +223,11 @@ class Terrain:
         started inside it was fired out at 117 m/s)."""
         _non_negative(draft_m=draft_m, clearance_m=clearance_m)
         _non_negative(footprint_m=footprint_m)
-        hint = self._hint(x, y, draft_m, clearance_m, footprint_m)
+        hull = (draft_m, clearance_m, footprint_m)
         try:
             self.check_water(x, y, what=what)
         except TerrainError as exc:
-            raise TerrainError(f"{exc}{hint()}") from None
+            raise TerrainError(f"{exc}{self._nearest_start(x, y, *hull)}") from None
         where = f"{what} ({x:.1f}, {y:.1f})"
         px, py = disk_samples(x, y, footprint_m, 0.5 * self._mpp)
         depth = float(self.depth(px, py).min())
@@ -242,26 +241,23 @@ class Terrain:
             )
         raise TerrainError(
             f"{where}: water depth {depth:.2f} m (shallowest within {footprint_m:g} m) is too "
-            f"shallow for draft {draft_m:g} m + clearance {clearance_m:g} m{hint()}"
+            f"shallow for draft {draft_m:g} m + clearance {clearance_m:g} m"
+            f"{self._nearest_start(x, y, *hull)}"
         )
 
-    def _hint(
+    def _nearest_start(
         self, x: float, y: float, draft_m: float, clearance_m: float, footprint_m: float
-    ) -> Callable[[], str]:
-        """Where a refused start could go instead (a trial user read the image's pixels to
-        find water): the nearest that check_start accepts, worked out only when needed."""
-
-        def hint() -> str:
-            try:
-                fx, fy = self.find_open_water(
-                    draft_m, near=(x, y), clearance_m=clearance_m, footprint_m=footprint_m
-                )
-            except TerrainError:
-                return ""
-            away = math.hypot(fx - x, fy - y)
-            return f"; the nearest start deep enough is ({fx:.1f}, {fy:.1f}), {away:.0f} m away"
-
-        return hint
+    ) -> str:
+        """Where a refused start could go instead, the nearest that check_start accepts ("":
+        none): a trial user read the image's pixels to find water."""
+        try:
+            fx, fy = self.find_open_water(
+                draft_m, near=(x, y), clearance_m=clearance_m, footprint_m=footprint_m
+            )
+        except TerrainError:
+            return ""
+        away = math.hypot(fx - x, fy - y)
+        return f"; the nearest start deep enough is ({fx:.1f}, {fy:.1f}), {away:.0f} m away"
 
 
 def _non_negative(**values: float) -> float:

@@ -42,8 +42,9 @@ def drawn(frame: Frame) -> Image.Image:
     for row, keep in zip(boxes, kept, strict=True):
         _box(pen, row, kept=bool(keep))
     taken: list[tuple[float, float, float, float]] = []
-    area = [(r[4] - r[2]) * (r[5] - r[3]) for r in boxes]
-    for k in sorted(np.flatnonzero(kept).tolist(), key=lambda k: -area[k]):
+    rows = np.flatnonzero(kept)
+    area = (boxes[rows, 4] - boxes[rows, 2]) * (boxes[rows, 5] - boxes[rows, 3])
+    for k in rows[np.argsort(-area, kind="stable")]:  # the largest box names itself first
         _label(pen, boxes[k], flags[k], taken)
     return image
 

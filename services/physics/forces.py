@@ -22,7 +22,7 @@ from services.physics.hydro import Array, Columns, buoyancy_wrench, column_heigh
 from services.physics.loads import EnvironmentLoads
 from services.physics.sea import SeaSampler
 from services.physics.sleep import Sleep
-from services.physics.wave_pull import wave_pull
+from services.physics.wave_pull import PullTable, wave_pull
 from services.physics.wet import ThrustLoad, wetness
 
 Rows = NDArray[np.intp]
@@ -40,8 +40,7 @@ class ForceTables:
     loads: EnvironmentLoads
     weight_n: Array  # (N,) m g: the buoyancy that floats each body
     lift: Array | None = None  # (N, 2) [Y_uv, N_uv]; None: no body has any
-    fluid_mass: Array | None = None  # (N, 3) m + A11, A22, A33: what the waves pull (wave_pull)
-    pull_at: Array | None = None  # (N, 3) body frame: where (the centre of buoyancy at rest)
+    pull: PullTable | None = None  # what the waves pull on each hull, and where (wave_pull)
 
     def take(self, rows: Rows) -> ForceTables:
         """The tables of bodies `rows` (sorted), in that order."""
@@ -52,8 +51,7 @@ class ForceTables:
             self.loads.take(rows),
             self.weight_n[rows],
             None if self.lift is None else self.lift[rows],
-            None if self.fluid_mass is None else self.fluid_mass[rows],
-            None if self.pull_at is None else self.pull_at[rows],
+            None if self.pull is None else self.pull.take(rows),
         )
 
 
@@ -127,10 +125,8 @@ def body_wrench(
         "thrust": thrust.wrench(motion.rot, motion.pos, water.at_points, time_s),
     }
     base = loads["buoyancy"] + loads["damping"] + loads["thrust"]
-    if water.velocity_w is not None and tables.fluid_mass is not None:  # waves
-        assert tables.pull_at is not None, "ForceTables: fluid_mass without pull_at"
-        pull = wave_pull((tables.fluid_mass, tables.pull_at), cols, rot, eta,
-                         gravity=fluid.gravity, wet=wet)  # fmt: skip
+    if water.velocity_w is not None and tables.pull is not None:  # waves
+        pull = wave_pull(tables.pull, cols, rot, eta, gravity=fluid.gravity, wet=wet)
         loads[PULL] = pull
         base = base + pull
     total = tables.loads.total(motion.rot, motion.pos, nu, water_b, base, wet=wet)

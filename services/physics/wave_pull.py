@@ -17,8 +17,13 @@ drafts are small against the waves that move them).
 
 from __future__ import annotations
 
-import numpy as np
+from collections.abc import Sequence
+from dataclasses import dataclass
 
+import numpy as np
+from numpy.typing import NDArray
+
+from catabot.config.vessel import VesselModel
 from catabot.world import rotations
 from services.physics import kernels
 from services.physics.hydro import Array, Columns
@@ -57,20 +62,35 @@ def surface_slopes(rot: Array, bottom: Array, area: Array, eta: Array) -> Array:
     return out
 
 
+@dataclass(frozen=True)
+class PullTable:
+    """Per hull: what the waves pull, (m + A11, A22, A33) along the body axes (N, 3), and
+    where, its centre of buoyancy at rest (N, 3, body frame)."""
+
+    mass: Array
+    at: Array
+
+    @classmethod
+    def of(cls, models: Sequence[VesselModel], cols: Columns) -> PullTable:
+        mass = np.array([[m.mass_kg + a for a in m.added_mass[:3]] for m in models])
+        return cls(mass.reshape(-1, 3), centres_of_buoyancy(cols))
+
+    def take(self, rows: NDArray[np.intp]) -> PullTable:
+        return PullTable(self.mass[rows], self.at[rows])
+
+
 def wave_pull(
-    fluid: tuple[Array, Array], cols: Columns, rot: Array, eta: Array, *, gravity: float,
+    table: PullTable, cols: Columns, rot: Array, eta: Array, *, gravity: float,
     wet: Array | None,
 ) -> Array:  # fmt: skip
-    """Body-frame wrench (N, 6) about the origin: (m + A11, A22, A33 along the body axes)
-    times the water's acceleration -g <grad(eta)>, acting at each hull's centre of buoyancy
-    (`fluid`: those masses and that point, `centres_of_buoyancy`), scaled by its wetness
-    (None: all wet). At the origin (the waterline) it heeled a buoyed mark off the surface
-    normal, its ballast below."""
-    mass, at = fluid
+    """Body-frame wrench (N, 6) about the origin: the table's masses times the water's
+    acceleration -g <grad(eta)>, acting at each hull's centre of buoyancy, scaled by its
+    wetness (None: all wet). At the origin (the waterline) it heeled a buoyed mark off the
+    surface normal, its ballast below."""
     slopes = surface_slopes(rot, cols.bottom_m, cols.area_m2, np.ascontiguousarray(eta))
     out = np.zeros((len(rot), 6))
-    out[:, :3] = mass * kernels.to_body(rot, -gravity * slopes)
-    out[:, 3:] = rotations.cross(at, out[:, :3])
+    out[:, :3] = table.mass * kernels.to_body(rot, -gravity * slopes)
+    out[:, 3:] = rotations.cross(table.at, out[:, :3])
     if wet is not None:
         out *= wet[:, None]
     return out

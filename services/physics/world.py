@@ -118,10 +118,9 @@ class PhysicsWorld:
         quadratic = np.array([m.damping.quadratic for m in models], dtype=np.float64)
         weight = np.array([m.mass_kg for m in models]) * self._g
         lift = np.array([m.damping.lift_uv for m in models], dtype=np.float64).reshape(-1, 2)
-        fluid = np.array([[m.mass_kg + a for a in m.added_mass[:3]] for m in models])
         tables = ForceTables(columns, linear, quadratic, self._loads, weight,
-                             lift if lift.any() else None, fluid.reshape(-1, 3),
-                             wave_pull.centres_of_buoyancy(columns))  # fmt: skip
+                             lift if lift.any() else None,
+                             wave_pull.PullTable.of(models, columns))  # fmt: skip
         self._tables = AwakeTables(tables)
         self._sea = SeaSampler(models, columns.bottom_m.transpose(0, 2, 1))
         self._sea.use(waves)  # eta at the columns, orbital velocity at the origins (sea.py)

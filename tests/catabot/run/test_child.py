@@ -15,7 +15,7 @@ LINE = "2026 x WARNING {who}: refused a sample on catabot/w/config/set: malforme
 
 @pytest.mark.parametrize(("name", "counts"), [
     ("physics", "physics.rejected.json"),
-    (CONDUCTOR, 'run.json ("rejected")'),  # it writes no file: a hostile trial looked for it
+    (CONDUCTOR, "conductor.rejected.json"),  # written from its result line (test_summary)
 ])  # fmt: skip
 def test_the_first_refusal_names_the_file_that_counts_them(
     tmp_path: Path, name: str, counts: str

@@ -65,3 +65,17 @@ def test_run_json_says_what_produced_the_run(tmp_path: Path) -> None:
     digest = "2e4f7bf0a6ac1f19b2ba0a2dbfcaec4b7c6d3fe2f8a1b2a04b0bf3bb16b0c5b0"
     assert record["programs"]["stack"]["path"] == str(program)
     assert len(record["programs"]["stack"]["sha256"]) == len(digest)
+
+
+def test_the_conductors_refusals_are_counted_in_the_file_its_console_line_names(
+    tmp_path: Path,
+) -> None:
+    """A hostile trial looked for log/conductor.rejected.json, which the console named and
+    nobody wrote: its counts came only in the result line."""
+    counts = {"setting refused": 24, "malformed": 2}
+    _end(tmp_path, {"physics": 0}, ticks_done=40, reason="completed", rejected=counts)
+    written = json.loads((tmp_path / "log" / "conductor.rejected.json").read_text())
+    assert written == {"malformed": 2, "setting refused": 24}
+    assert json.loads((tmp_path / "log" / "run.json").read_text())["rejected"] == {
+        "conductor": written
+    }
