@@ -174,7 +174,9 @@ def test_follow_waypoints_free_running_beside_a_run(run: type[Run], tmp_path: Pa
     rows = twists.read_text().splitlines()
     assert rows[0].startswith("stamp_ns,tick,surge")
     surges = [float(r.split(",")[2]) for r in rows[1:]]
-    assert len(surges) > 50 and max(surges) == pytest.approx(1.0, abs=1e-3) and surges[-1] == 0.0
+    # its full 1.0 m/s, times cos(heading error) as it samples the wall clock: within 1e-3
+    # needed 1.8 degrees of error at some sample, and a loaded rehearsal's best was 2.8
+    assert len(surges) > 50 and max(surges) == pytest.approx(1.0, abs=1e-2) and surges[-1] == 0.0
 
 
 GOAL = (90.0, 0.0)  # examples/navigate.json's task.goal
