@@ -18,7 +18,7 @@ from services.recorder.mcap_read import read_mcap_messages
 
 
 def _scenario(tmp: Path) -> Path:
-    data = basic_scenario("settings", duration_s=6.0, clock={"realtime_factor": 0.3})
+    data = basic_scenario("settings", duration_s=6.0, clock={"realtime_factor": 0.5})
     data["vessels"][0]["sensors"] = [
         {"name": "lidar", "type": "lidar", "rate_hz": 10.0},
         {"name": "cam", "type": "camera", "rate_hz": 5.0, "params": {"width": 64, "height": 48}},
