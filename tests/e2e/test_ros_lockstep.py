@@ -96,11 +96,12 @@ def _run(tmp: Path, tag: str, *, rmw: bool) -> Path:
 
 
 def test_the_same_commands_give_byte_identical_runs(tmp_path: Path) -> None:
-    runs = [_run(tmp_path, "a", rmw=False), _run(tmp_path, "b", rmw=False)]
-    runs.append(_run(tmp_path, "c", rmw=True))
+    """Two runs, the stack on the bridge's keys and on rmw_zenoh's: the same bytes, so the
+    same commands give the same run whichever way they come."""
+    runs = [_run(tmp_path, "a", rmw=False), _run(tmp_path, "b", rmw=True)]
     files = [files_of(run) for run in runs]
     assert {"run.mcap", "vessel.ego.state.csv", "vessel.ego.cmd.twist.csv"} <= set(files[0])
-    assert files[0] == files[1] == files[2]
+    assert files[0] == files[1]
     commands = [m for m in read_mcap_messages(runs[0] / "run.mcap") if m.topic == "/ego/cmd_vel"]
     assert [m.log_time for m in commands] == [k * PERIOD_NS for k in range(30)]
     for m in commands:  # each tick's command is the answer to that tick's /clock, 0's too

@@ -31,7 +31,7 @@ def fleet(shards: int, guides: int = 1) -> dict[str, Any]:
 
 def test_any_number_of_sensor_and_traffic_shards_records_the_same_bytes(tmp_path: Path) -> None:
     recorded = {}
-    for shards, guides in ((1, 1), (2, 2), (4, 3)):
+    for shards, guides in ((1, 1), (3, 2)):  # uneven splits of 10 sensors and 5 boats
         out = tmp_path / f"out{shards}"
         scenario = scenario_file(tmp_path, fleet(shards, guides), name=f"s{shards}.json")
         done = catabot("run", str(scenario), "--out", str(out), "--quiet")
@@ -42,8 +42,7 @@ def test_any_number_of_sensor_and_traffic_shards_records_the_same_bytes(tmp_path
         assert logs >= ({"sensors"} if shards == 1 else {f"sensors.{i}" for i in range(shards)})
         assert logs >= ({"traffic"} if guides == 1 else {f"traffic.{i}" for i in range(guides)})
     assert len(recorded[1]) > 10
-    assert recorded[2] == recorded[1]
-    assert recorded[4] == recorded[1]
+    assert recorded[3] == recorded[1]
 
 
 def test_a_shard_started_without_its_place_is_refused(tmp_path: Path) -> None:
