@@ -12,6 +12,7 @@ from typing import Any
 
 import pytest
 
+from catabot.run.cli import main
 from tests.paths import REPO
 
 pytestmark = pytest.mark.timeout(120)
@@ -106,3 +107,48 @@ def matched_publisher(session: Any, key: str, *, timeout: float = 60.0) -> Any:
     finally:
         sub.undeclare()
     return pub
+
+
+VIZ_SECONDS = 2.0
+
+
+def _viz_scenario() -> dict[str, Any]:
+    """Every sensor, traffic, a buoy and rain, recorded with run.rrd and every export."""
+    data = basic_scenario("viz", duration_s=VIZ_SECONDS)
+    data["vessels"][0]["pose"] = {"x_m": 0.0, "y_m": 0.0}
+    data["vessels"][0]["sensors"] = [
+        {"name": "cam", "type": "camera", "rate_hz": 5.0, "params": {"width": 160, "height": 120}},
+        {"name": "lidar", "type": "lidar", "rate_hz": 10.0,
+         "params": {"channels": 16, "columns": 256}},
+        {"name": "radar", "type": "radar", "rate_hz": 20.0, "params": {"rotation_period_s": 0.5}},
+        {"name": "imu", "type": "imu", "rate_hz": 50.0},
+    ]  # fmt: skip
+    data["vessels"].append({"id": "other", "pose": {"x_m": 30.0, "y_m": 1.0}})
+    data["buoys"] = [{"id": "b1", "x_m": 25.0, "y_m": -6.0}]
+    data["traffic"] = {"count": 2, "behaviour_mix": {"circle": 1.0}}
+    data["rain"] = {"rate_mm_h": 20.0}
+    data["recording"] = {"rerun": True, "export": ["yolo", "coco", "kitti", "segmentation"]}
+    return data
+
+
+@pytest.fixture(scope="session")
+def viz_run(tmp_path_factory: pytest.TempPathFactory) -> Path:
+    """One recorded run that the viewer, plot and dataset tests all read (once a worker)."""
+    tmp = tmp_path_factory.mktemp("viz")
+    out = tmp / "runs"
+    out.mkdir()
+    result = catabot("run", str(scenario_file(tmp, _viz_scenario())), "--out", str(out), "--quiet")
+    assert result.returncode == 0, result.stdout + result.stderr
+    (tmp / "console.txt").write_text(result.stdout)
+    return only_run_dir(out)
+
+
+def in_process(args: list[str], capsys: pytest.CaptureFixture[str]) -> tuple[int, str, str]:
+    """`catabot ARGS` run by main in this process (a tool's refusal needs no start-up of
+    its own): its exit code, argparse's own exits too, and what it printed."""
+    try:
+        code = main(args)
+    except SystemExit as exit_:
+        code = exit_.code if isinstance(exit_.code, int) else 1
+    said = capsys.readouterr()
+    return code, said.out, said.err

@@ -8,7 +8,7 @@ from pathlib import Path
 from typing import Any
 
 import pytest
-from conftest import catabot
+from conftest import catabot, in_process
 
 from catabot.run.cli import main
 from tests.paths import BAY
@@ -121,8 +121,7 @@ def test_run_and_validate_refuse_it_with_exit_2_and_no_traceback(
         run = catabot("run", str(path), "--out", str(out))
         code, said_out, said_err = run.returncode, run.stdout, run.stderr
     else:
-        code = main(["run", str(path), "--out", str(out)])
-        said_out, said_err = capsys.readouterr()
+        code, said_out, said_err = in_process(["run", str(path), "--out", str(out)], capsys)
     assert code == 2, (what, said_out, said_err)
     assert message in said_err, (what, said_err)
     assert "Traceback" not in said_err + said_out, what

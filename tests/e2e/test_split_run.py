@@ -22,6 +22,7 @@ import pytest
 from conftest import scenario_file, start
 
 from catabot.bus.session import free_port
+from catabot.run.probe import on_bus, port_open
 
 pytestmark = pytest.mark.timeout(180)
 SCENARIO: dict[str, Any] = {
@@ -69,6 +70,15 @@ def test_a_process_given_another_scenario_stops_and_says_why(tmp_path: Path) -> 
             proc.communicate()
 
 
+def _until_joined(endpoint: str, name: str) -> None:
+    """Its liveliness token is there (a fixed 2 s sleep lost the race on a loaded machine:
+    the second physics joined first and the first one was the one refused)."""
+    limit = time.monotonic() + 60
+    while port_open(endpoint) or on_bus(endpoint, name, None, timeout_s=1.0):
+        assert time.monotonic() < limit, f"{name} never joined"
+        time.sleep(0.2)
+
+
 def test_a_second_physics_or_conductor_stops_and_the_run_goes_on(tmp_path: Path) -> None:
     scenario = scenario_file(tmp_path, SCENARIO)
     endpoint, run = f"tcp/127.0.0.1:{free_port()}", tmp_path / "run"
@@ -76,7 +86,7 @@ def test_a_second_physics_or_conductor_stops_and_the_run_goes_on(tmp_path: Path)
     physics = _service("physics", scenario, endpoint, "--run-dir", str(run))
     procs = [conductor, physics]
     try:
-        time.sleep(2.0)  # both joined: the world has its conductor and its physics
+        _until_joined(endpoint, "physics")  # the world has its conductor and its physics
         again = _service("physics", scenario, endpoint, "--run-dir", str(tmp_path / "again"))
         rival = start("service", "conductor", "--scenario", str(scenario), "--connect", endpoint)
         procs += [again, rival]
