@@ -16,19 +16,8 @@ from collections.abc import Callable
 
 import zenoh
 
-from catabot.bus import codec
-from catabot.bus.clock import (
-    CONDUCTOR,
-    FAULT_STOP,
-    ClockError,
-    ClockSpec,
-    Policy,
-    Progress,
-    RunResult,
-    end_reason_problem,
-    ended_by,
-    never_joined,
-)
+from catabot.bus import clock, codec
+from catabot.bus.clock import CONDUCTOR, ClockError, ClockSpec, Policy, Progress, RunResult
 from catabot.bus.identity import Roster, sender_of
 from catabot.bus.keys import Keys
 from catabot.bus.members import Members, claim
@@ -40,6 +29,7 @@ from catabot.bus.settings import Schedule
 log = logging.getLogger("catabot.bus.conductor")
 WAITING_NOTE_S = 5.0  # how often the log names who has not joined yet
 GONE_GRACE_S = 0.2  # after a participant's token goes, for others gone with it
+LEFT = "left the run"  # a participant's token went without its words
 
 
 class Conductor:
@@ -117,7 +107,7 @@ class Conductor:
             error = ""
         except ClockError as exc:
             error = str(exc)
-        error = self._told or error or (FAULT_STOP if self._stop_reason == "fault" else "")
+        error = self._told or error or (clock.FAULT_STOP if self._stop_reason == "fault" else "")
         done = self._done  # complete ticks, also when a fault or a stop cut the run short
         reason = "fault" if error else (self._stop_reason or "completed")
         self._out.publish(self.keys.end(), End(self.run_id, done - 1, reason, error))
@@ -134,7 +124,7 @@ class Conductor:
                 return
             if self._next_event(min(limit, note))[0] == "late":
                 if time.monotonic() >= limit:
-                    raise ClockError(never_joined(sorted(expected - self.members), limit_s))
+                    raise ClockError(clock.never_joined(sorted(expected - self.members), limit_s))
                 note = time.monotonic() + WAITING_NOTE_S
                 self._waiting_note(expected, limit)
 
@@ -230,9 +220,8 @@ class Conductor:
             return
         self._acked[name] = max(self._acked[name], min(ack.tick, self._granted))
         told = f"stopped at tick {ack.tick + 1}: {ack.fault}" if ack.fault else ""
-        if told and self.spec.policy is not Policy.ABORT:  # its words, before it leaves
-            if name not in self.dropped:
-                self._fault(name, told)
+        if told and self.spec.policy is not Policy.ABORT:  # its words, also once it left
+            self._told_drop(name, told)
         elif told or ack.end:
             self._end_request(name, ack, fault=f"participant {name!r} {told}" if told else "")
         self._advance()
@@ -243,7 +232,7 @@ class Conductor:
         if self._stop_reason:
             return
         self._end_at = max(min(ack.tick, self._granted), self._done - 1)
-        self._stop_reason = "fault" if fault else ended_by(name, self._end_at, ack.end)
+        self._stop_reason = "fault" if fault else clock.ended_by(name, self._end_at, ack.end)
         self._told = fault
         log.info("run %s", fault or self._stop_reason)
         self._grant(self._granted, again=True)
@@ -262,8 +251,8 @@ class Conductor:
         if ack.run != self.run_id or ack.tick < -1:
             raise Rejected("ack of another run or tick", f"run {ack.run}, tick {ack.tick}")
         for text, what in ((ack.end, "end request"), (ack.fault, "fault")):
-            if text and end_reason_problem(text):
-                raise Rejected(f"{what} with a bad reason", end_reason_problem(text))
+            if text and clock.end_reason_problem(text):
+                raise Rejected(f"{what} with a bad reason", clock.end_reason_problem(text))
         return name, ack
 
     def _advance(self) -> None:
@@ -303,7 +292,7 @@ class Conductor:
             )
         for name in gone:
             first = " before it stepped one (its own log says why)" if self._acked[name] < 0 else ""
-            self._fault(name, f"left the run at tick {self._acked[name] + 1}{first}")
+            self._fault(name, f"{LEFT} at tick {self._acked[name] + 1}{first}")
         k = self._done
         if self._deadline is not None and time.monotonic() > self._deadline:
             for name in [n for n in active if self._acked[n] < k <= self._granted]:
@@ -315,6 +304,14 @@ class Conductor:
     def _through(self, name: str) -> bool:
         """`name` has stepped the run's last tick (ended by a participant): it may leave."""
         return self._end_at is not None and self._acked[name] >= self._end_at
+
+    def _told_drop(self, name: str, told: str) -> None:
+        """Dropped for its own words; they replace "left the run" when they came after its
+        token went (a loaded machine delivered them later than GONE_GRACE_S)."""
+        if name not in self.dropped:
+            self._fault(name, told)
+        elif LEFT in self.dropped[name]:
+            self.dropped[name] = f"participant {name!r} {told}"
 
     def _fault(self, name: str, what: str) -> None:
         message = f"participant {name!r} {what}"

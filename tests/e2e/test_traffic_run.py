@@ -57,7 +57,7 @@ def _window(rate: np.ndarray, start: int, ok: np.ndarray, length: int) -> int:
 
 def _until(boat: Vessel, t_s: float) -> None:
     """Simulated time, not the wall clock's: a loaded machine runs slower than its pace."""
-    while boat.state().stamp_ns < t_s * 1e9:
+    while boat.state(timeout_s=60).stamp_ns < t_s * 1e9:  # the first, once the run starts
         time.sleep(0.05)
 
 

@@ -3,9 +3,12 @@ the run's error quotes it on every host; a bad or forged fault text changes noth
 
 from __future__ import annotations
 
+import time
+
 import pytest
 
 from catabot.bus.clock import Policy
+from catabot.bus.conductor import GONE_GRACE_S
 from catabot.bus.inbox import Inputs
 from catabot.bus.messages import Ack, Tick
 from tests.catabot.bus.lockstep_world import Step, World
@@ -55,6 +58,27 @@ def test_policy_drop_goes_on_without_the_participant_that_failed(world: World) -
     a = world.members["a"]
     a.join()
     assert a.ticks == list(range(30))
+
+
+def test_words_that_come_after_the_token_went_still_name_the_drop(world: World) -> None:
+    """A loaded machine delivered a crashed stack's fault after its token had gone: the
+    drop said "left the run at tick 120", not the stack's ZeroDivisionError."""
+    names = ["a", "teller"]
+
+    def step(t: Tick, _inputs: Inputs) -> None:
+        if t.tick == 10:
+            teller = world.members["teller"]
+            teller.participant._token.undeclare()  # the token first, as if its words came late
+            time.sleep(4 * GONE_GRACE_S)
+            teller.participant.report_fault(WHY)
+            teller.session.close()
+
+    world.member("a", peers=names)
+    world.member("teller", step, peers=names)
+    paced = {"realtime_factor": 1.0}  # 1.5 s: its words come 0.8 s after tick 10
+    result = world.run(names, 150, deadline_s=5.0, start_timeout_s=5.0, policy=Policy.DROP, **paced)
+    assert (result.dropped, result.ticks_done) == (["teller"], 150)
+    assert result.why_dropped == {"teller": f"participant 'teller' stopped at tick 10: {WHY}"}
 
 
 @pytest.mark.parametrize("fault", ["\x00" * 10, "y" * 201], ids=["unprintable", "too-long"])
