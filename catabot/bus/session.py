@@ -52,6 +52,7 @@ class Connection:
     zid: str | None = None  # this session's id (catabot run picks one per process); None: random
     file: str | None = None
     timestamping: bool = False  # Zenoh's advanced publishers (a cache for late joiners) need it
+    open_timeout_ms: int | None = None  # a handshake's limit (Zenoh's 10 s: a silent listener)
 
     def config(self) -> zenoh.Config:
         if self.mode is not None and self.mode not in MODES:
@@ -71,6 +72,8 @@ class Connection:
             cfg.insert_json5("id", json.dumps(check_zid(self.zid)))
         if self.timestamping:
             cfg.insert_json5("timestamping/enabled", "true")
+        if self.open_timeout_ms is not None:
+            cfg.insert_json5("transport/unicast/open_timeout", str(self.open_timeout_ms))
         return cfg
 
 
@@ -184,12 +187,31 @@ def open_session(conn: Connection) -> zenoh.Session:
     except Exception as exc:
         said = re.sub(r"\s+at \S+\.rs:\d+\.?$", "", str(exc).strip())  # Zenoh's source line
         if "Unable to connect" in said:
-            said += " (nothing answers there: start a router first, catabot router --listen ...)"
+            said += _why_unreachable(conn.connect)
         raise SessionError(
             f"cannot open zenoh (mode {conn.mode or 'peer'}, connect {list(conn.connect)}, "
             f"listen {list(conn.listen)}, config {conn.file or os.environ.get('ZENOH_CONFIG')}): "
             f"{said}"
         ) from None
+
+
+def _why_unreachable(endpoints: tuple[str, ...]) -> str:
+    """A port that takes a TCP connection but no Zenoh handshake is another program's (an
+    HTTP server, a TLS endpoint given as tcp/): "start a router" sent people the wrong way."""
+    taken = [e for e in endpoints if _tcp(e)[0] is not None and _takes_tcp(e)]
+    if taken:
+        return (f" ({', '.join(taken)} takes connections but does not answer as Zenoh: "
+                "another program listens there, or it wants tls/)")  # fmt: skip
+    return " (nothing answers there: start a router first, catabot router --listen ...)"
+
+
+def _takes_tcp(endpoint: str) -> bool:
+    host, port = _tcp(endpoint)
+    try:
+        with socket.create_connection((host or "", port), timeout=1.0):
+            return True
+    except OSError:
+        return False
 
 
 def alone(session: zenoh.Session) -> str:

@@ -38,7 +38,9 @@ Command = Thrust | Twist
 ASK_S = 0.5  # how long one look for the run's world/info waits before the run is checked
 END_WAIT_S = 5.0  # an ended run's End comes in milliseconds; past this, the run is stopped
 RETRY = {"period_init_ms": 20, "period_max_ms": 100, "period_increase_factor": 1.5}
-OPEN_TIMEOUT_MS = 3000  # a handshake on loopback takes milliseconds, on a loaded machine too
+# a port clash met a listener that never answers the handshake: closing the session waited
+# out Zenoh's 10 s open timeout before reset could try a fresh port (loopback takes ms)
+OPEN_TIMEOUT_MS = 3000
 _zenoh = {"opened": False, "forked": False}  # this process opened a session; then forked
 
 
@@ -146,12 +148,9 @@ def _session(endpoint: str) -> zenoh.Session:
             "vector_kwargs={'context': 'spawn'})"
         )
     _zenoh["opened"] = True
-    config = Connection(connect=(endpoint,)).config()
+    config = Connection(connect=(endpoint,), open_timeout_ms=OPEN_TIMEOUT_MS).config()
     config.insert_json5("connect/retry", json.dumps(RETRY))
     config.insert_json5("scouting/delay", "0")
-    # a port clash met a listener that never answers the handshake: closing the session
-    # waited out Zenoh's 10 s open timeout before reset could try a fresh port
-    config.insert_json5("transport/unicast/open_timeout", str(OPEN_TIMEOUT_MS))
     # every episode's run offered its shared-memory segments, which this process mapped and
     # kept: ≈1.3 files and 2-10 MB a reset, never released; loopback TCP is enough here
     config.insert_json5("transport/shared_memory/enabled", "false")

@@ -21,7 +21,7 @@ left (named in the conductor's log), a missed deadline; 2 a bad scenario. Profil
 (the rerun web viewer), ros2dds (zenoh-bridge-ros2dds, with a ROS scenario).
 Environment (default): CATABOT_IMAGE (catabot:latest); CATABOT_SCENARIO_DIR (the scenario's
 folder, mounted read-only as /scenario); CATABOT_RUNS (./runs, the run folders) and
-CATABOT_RUN (the scenario's name: this run's folder in it); CATABOT_PORT (the router's
+CATABOT_RUN (the scenario's name: this run's folder in it, one a run); CATABOT_PORT (the router's
 published port); CATABOT_LISTEN and CATABOT_ROUTER (where the router listens, where the
 processes reach it); CATABOT_START_TIMEOUT (the scenario's clock.start_timeout_s);
 CATABOT_SECURE (the secure profile's folder); CATABOT_WEB_PORT (9090).

@@ -2,8 +2,8 @@
 
 Cheap and real, so an engine can run it every few seconds beside a busy simulation:
 
-- `probe ENDPOINT`: the router is up when its port takes a TCP connection (nothing is
-  sent; a TLS endpoint is probed the same way).
+- `probe ENDPOINT`: the router is up when its port takes a TCP connection and a Zenoh
+  client session opens there (an open port alone was any program's: an HTTP server passed).
 - `probe ENDPOINT --name physics`: a CataBot process is healthy once it is on the bus,
   i.e. its liveliness token `catabot/<world>/live/physics/<zid>` is there (declared when it
   joined: catabot/bus/participant.py; gone when it ends or crashes). One short Zenoh client
@@ -48,10 +48,22 @@ def port_open(endpoint: str, timeout_s: float = TIMEOUT_S) -> str:
         return f"{endpoint}: {exc.strerror or exc}"
 
 
+def _client(endpoint: str, config: str | None) -> Connection:
+    limit = round(TIMEOUT_S * 1000)  # a silent listener held the handshake 10 s
+    return Connection(connect=(endpoint,), mode="client", file=config, open_timeout_ms=limit)
+
+
+def speaks_zenoh(endpoint: str, config: str | None) -> str:
+    """'' when a Zenoh session opens there: an open port alone was any program's (an HTTP
+    server passed for a healthy router)."""
+    open_session(_client(endpoint, config)).close()
+    return ""
+
+
 def on_bus(endpoint: str, name: str, config: str | None, timeout_s: float = TIMEOUT_S) -> str:
     """'' when a liveliness token of `name` (in any world on this router) answers."""
     key = lives_of(name)
-    session = open_session(Connection(connect=(endpoint,), mode="client", file=config))
+    session = open_session(_client(endpoint, config))
     try:
         replies = session.liveliness().get(key, timeout=timeout_s)
         if any(reply.ok is not None for reply in replies):
@@ -65,8 +77,12 @@ def main(argv: list[str] | None = None) -> int:
     args = parser().parse_args(argv)
     try:
         why = port_open(args.endpoint)
-        if not why and args.name:
-            why = on_bus(args.endpoint, args.name, args.zenoh_config)
+        if not why:
+            why = (
+                on_bus(args.endpoint, args.name, args.zenoh_config)
+                if args.name
+                else (speaks_zenoh(args.endpoint, args.zenoh_config))
+            )
     except CataBotError as exc:  # a bad endpoint, name or login file
         why = str(exc)
     if why:

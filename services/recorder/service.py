@@ -33,7 +33,6 @@ from catabot.bus.taken import taken
 from catabot.config.load import scenario_json
 from catabot.config.scenario import Scenario
 from catabot.ros2.convert import Converter
-from catabot.run.advice import advise
 from catabot.run.service import Built, ServiceContext, run_service
 from catabot.world.orders import Orders, command_timeouts
 from services.recorder.batches import BatchFormatter, Block, without
@@ -47,29 +46,35 @@ log = logging.getLogger("recorder")
 FLUSH_EVERY_S = 0.1
 
 
-def _own_scenario(run_dir: Path, scenario: Scenario) -> None:
-    """The run folder's scenario.json is this run's: `catabot run` wrote it; a split run has
-    none, or the last run's in a folder used again (a compose file's fixed one). That one
-    was kept, so `catabot plot` drew this run's states against another's scenario, or
-    refused it; now it is replaced and the console told of the files left beside it."""
+RECORDED = (".csv", ".mcap", ".rrd")  # and the folders and files below, a run's recording
+RECORDED_NAMES = ("metrics.json", "dataset", "export")
+
+
+def _fresh_folder(run_dir: Path, scenario: Scenario) -> None:
+    """The run folder holds this run alone. Used again (a compose file's fixed folder, one
+    --run-dir given twice) it kept the last run's files beside this run's, those of the same
+    name replaced: one folder, two runs, nothing said when their scenarios were the same.
+    Refused, as rosbag2 refuses an output folder that exists; a scenario.json and log/ alone
+    (written by `catabot run` for this run, or left by a run that never recorded) are not a
+    recording."""
+    found = run_dir.iterdir()
+    earlier = sorted(p.name for p in found if p.suffix in RECORDED or p.name in RECORDED_NAMES)
+    if earlier:
+        shown = ", ".join(earlier[:4]) + (f" and {len(earlier) - 4} more" if earlier[4:] else "")
+        raise RecorderError(
+            f"run folder {run_dir} already holds a recording ({shown}): give this run a "
+            "folder of its own (--run-dir; compose: CATABOT_RUN=<name>) or move those away"
+        )
     own, text = run_dir / "scenario.json", scenario_json(scenario)
-    before = own.read_text() if own.is_file() else None
-    if before == text:
-        return
-    if before is not None:
-        left = len([p for p in run_dir.iterdir() if p.suffix in (".csv", ".mcap")])
-        advise(log, f"{run_dir} held another run's scenario.json: replaced with this run's; "
-                    f"the {left} CSV and MCAP files there are replaced as this run writes its "
-                    "own, and any of streams it does not have stay: give each run its own "
-                    "--run-dir")  # fmt: skip
-    own.write_text(text)
+    if not own.is_file() or own.read_text() != text:
+        own.write_text(text)
 
 
 class Recorder:
     def __init__(self, ctx: ServiceContext) -> None:
         rec = ctx.scenario.recording
         ctx.run_dir.mkdir(parents=True, exist_ok=True)
-        _own_scenario(ctx.run_dir, ctx.scenario)
+        _fresh_folder(ctx.run_dir, ctx.scenario)
         self.keys = ctx.keys
         world = ctx.world
         convert = Converter(world, ctx.scenario.ros)  # the gateway's topics and frames

@@ -19,7 +19,7 @@ from pathlib import Path
 from typing import Any
 
 import pytest
-from conftest import scenario_file, start
+from conftest import catabot, scenario_file, start
 
 from catabot.bus.session import free_port
 from catabot.run.probe import on_bus, port_open
@@ -104,6 +104,13 @@ def test_a_second_physics_or_conductor_stops_and_the_run_goes_on(tmp_path: Path)
         recorder.communicate(timeout=60)
         assert json.loads((run / "scenario.json").read_text())["name"] == "split"
         assert (run / "vessel.ego.state.csv").is_file()
+        kept = (run / "run.mcap").read_bytes()
+        twice = catabot("service", "recorder", "--scenario", str(scenario), "--listen",
+                        f"tcp/127.0.0.1:{free_port()}", "--run-dir", str(run))  # fmt: skip
+        assert twice.returncode == 2 and f"run folder {run} already holds a recording (" in (
+            twice.stderr
+        )  # it overwrote run.mcap and metrics.json, beside the first run's CSVs
+        assert (run / "run.mcap").read_bytes() == kept
     finally:
         for proc in procs:
             proc.kill()

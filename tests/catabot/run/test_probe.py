@@ -104,3 +104,23 @@ def test_the_router_ends_at_once_on_sigterm() -> None:
     finally:
         proc.kill()
         proc.wait()
+
+
+def test_a_router_probe_needs_zenoh_not_an_open_port(capsys: pytest.CaptureFixture[str]) -> None:
+    """Any program on the router's port passed (an operator's HTTP server): the probe now
+    opens a Zenoh session there, within its 3 s, even against a listener that never answers."""
+    with socket.create_server(("127.0.0.1", 0)) as server:
+        endpoint = f"tcp/127.0.0.1:{server.getsockname()[1]}"
+        start = time.monotonic()
+        assert probe.main([endpoint]) == 1
+        assert time.monotonic() - start < probe.TIMEOUT_S + 2.0
+    said = capsys.readouterr().err
+    assert f"{endpoint} takes connections but does not answer as Zenoh" in said, said
+
+
+def test_a_router_probe_passes_on_a_zenoh_node(
+    bus: tuple[str, zenoh.Session], capsys: pytest.CaptureFixture[str]
+) -> None:
+    endpoint, _ = bus
+    assert probe.main([endpoint]) == 0
+    assert f"healthy: {endpoint}" in capsys.readouterr().out
