@@ -36,6 +36,7 @@ log = logging.getLogger("catabot.bus.participant")
 WAITED = "waited at tick"  # the fault line `_waited` logs, which the launcher quotes
 ORPHAN_GRACE_S = 0.5
 NOTE_EVERY_S = 10.0  # before tick 0, how often a participant says it still waits
+NO_CLOCK = "; is its conductor on this router (--connect), or has its run ended?"
 LOST = "conductor lost"  # the reason of the End a participant makes when the clock vanished
 MAX_HELD_CLOCK = 64  # clock messages held while the conductor's session is not known yet
 StepFn = Callable[[Tick, Inputs], None]
@@ -77,11 +78,10 @@ class Participant(Outputs):
         self._grant: Tick | None = None
         self._settings: dict[int, list[str]] = {}  # changes granted, by the tick they apply
         self._held_clock: list[Event] = []  # until the conductor's session is known
-        self._waiting_since = time.monotonic()  # for the warning about a long wait
         self.events: queue.SimpleQueue[Event] = queue.SimpleQueue()
         self.run_id, self._orphaned_at = "", 0.0
         self._warned_tick, self._met = -1, False  # _met: every peer seen present once
-        self._notes = 0  # "no tick yet" lines logged
+        self._waiting_since, self._notes = time.monotonic(), 0  # "no tick yet" lines logged
         self._subs = [
             session.declare_subscriber(keys.tick(), self._push("tick")),
             session.declare_subscriber(keys.end(), self._push("end")),
@@ -192,7 +192,7 @@ class Participant(Outputs):
             self._notes += 1
             log.warning("%s: no tick from the conductor of world %r after %.0f s (present: %s)%s",
                         self.name, self.keys.world, waited, sorted(self.present),
-                        alone(self.session))  # fmt: skip
+                        alone(self.session) or NO_CLOCK)  # fmt: skip
 
     def _tick_of(self, grant: Tick, k: int) -> Tick:
         stamp = grant.stamp_ns - (grant.tick - k) * grant.dt_ns

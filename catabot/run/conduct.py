@@ -96,7 +96,7 @@ def heartbeat(stop: threading.Event) -> None:
 
 
 def main(argv: list[str] | None = None) -> int:
-    parser = OneLineParser(prog="catabot conductor")
+    parser = OneLineParser(prog="catabot service conductor")
     parser.add_argument("--scenario", help="scenario file (default: the bundled default)")
     add_connection_args(parser)
     add_roster_args(parser)

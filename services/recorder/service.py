@@ -249,7 +249,8 @@ class Recorder:
             self.mcap.close()
         self.metrics.write(self.run_dir / "metrics.json", end_reason=end.reason)
         more = f" ({past} ticks stepped past the end left out)" if past else ""
-        log.info("recorder closed its files after tick %d%s", end.tick, more)
+        when = f"after tick {end.tick}" if end.tick >= 0 else "before the first tick"
+        log.info("recorder closed its files %s%s", when, more)
 
 
 def _stamped(msg: Message, tick: Tick) -> Message:

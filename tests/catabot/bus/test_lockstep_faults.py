@@ -272,6 +272,7 @@ def test_a_participant_without_a_conductor_says_what_it_waits_for(
         r.getMessage() for r in caplog.records if "no tick from the conductor" in r.getMessage()
     ]
     assert notes and f"of world {world.keys.world!r} after " in notes[0], notes
+    assert notes[0].endswith("is its conductor on this router (--connect), or has its run ended?")
 
 
 def test_participants_gone_at_once_are_named_together_as_a_lost_link(world: World) -> None:
