@@ -77,6 +77,7 @@ class CataBotEnv(gym.Env[Obs, np.ndarray]):
                 f"reset options: this env takes none (got {sorted(options)}); its episodes "
                 "are set by gymnasium.make's keywords (catabot.gym.options.EnvOptions)"
             )
+        self._open()
         super().reset(seed=seed)
         if seed is not None or self._upcoming is None:
             episode_seed = int(self.np_random.integers(0, SEED_HIGH))
@@ -103,6 +104,7 @@ class CataBotEnv(gym.Env[Obs, np.ndarray]):
         return self._observer(frame), self._info(frame) | self._judge.flags(frame.bodies) | where
 
     def step(self, action: Any) -> tuple[Obs, float, bool, bool, dict[str, Any]]:
+        self._open()
         if self._over or self._judge is None or self._observer is None:
             raise ResetNeeded(
                 "Cannot call env.step() before calling env.reset() or after the episode "
@@ -135,6 +137,14 @@ class CataBotEnv(gym.Env[Obs, np.ndarray]):
         super().close()
 
     # -- helpers ----------------------------------------------------------------------
+
+    def _open(self) -> None:
+        """A reset after close() started a run that nothing would end: its processes and
+        Zenoh's threads held the interpreter's exit for ever."""
+        if not self._closer.alive:
+            raise gym.error.ClosedEnvironmentError(
+                "this env is closed (its runs ended): make a new one with gymnasium.make"
+            )
 
     def _checked(self, action: Any) -> np.ndarray:
         space = self.action_space

@@ -17,7 +17,7 @@ import psutil
 import pytest
 
 import catabot.gym  # noqa: F401 - registers the envs
-from catabot.gym import process
+from catabot.gym import ActionError, process
 
 pytestmark = pytest.mark.timeout(180)
 
@@ -122,3 +122,26 @@ def test_a_port_taken_before_the_run_binds_it_is_tried_again(
             env.close()
     assert next(ports, None) is None  # the taken one was tried first
     assert len(folders) == 2 and not [f for f in folders if f.exists()]
+
+
+def test_a_refused_first_reset_and_step_leave_the_env_usable_until_it_is_closed() -> None:
+    """Gymnasium's passive checker (on by default) broke the env for good after a first
+    reset that raised: every later step raised "cannot unpack non-iterable NoneType". And a
+    reset after close() started a run that nothing ended: the program never exited."""
+    env = gym.make("CataBot/Navigate-v0", max_steps=5)
+    try:
+        with pytest.raises(gym.error.Error, match="reset options"):
+            env.reset(options={"goal": 1})
+        env.reset(seed=1)
+        with pytest.raises(ActionError, match="not finite"):
+            env.step(np.array([np.nan, 0.0]))
+        obs, *_ = env.step(np.zeros(2, np.float32))
+        assert env.observation_space.contains(obs)
+    finally:
+        env.close()
+    before = set(psutil.Process().children(recursive=True))
+    with pytest.raises(gym.error.ClosedEnvironmentError, match="make a new one"):
+        env.reset(seed=1)
+    with pytest.raises(gym.error.ClosedEnvironmentError):
+        env.step(np.zeros(2, np.float32))
+    assert set(psutil.Process().children(recursive=True)) <= before  # no run started
