@@ -135,11 +135,9 @@ class ClientLink:
         self._client.close()
 
 
-def _session(endpoint: str) -> zenoh.Session:
-    """A peer connecting to the run's conductor, which may not listen yet: Zenoh retries
-    every 20 ms (its default waits 1 s, then 2 s, ...: a reset took a whole retry longer),
-    and opens at once (a peer's default is to scout for 0.5 s first; the env knows its one
-    endpoint and waits for the run's tokens anyway)."""
+def not_forked() -> None:
+    """LinkError in a child forked after this process opened Zenoh: asked before a run is
+    started for it (a forked vector env's worker left a run's folder and "still running")."""
     if _zenoh["forked"]:
         raise LinkError(
             "this process was forked from one that had opened Zenoh sessions, and Zenoh does "
@@ -147,6 +145,14 @@ def _session(endpoint: str) -> zenoh.Session:
             "AsyncVectorEnv(..., context='spawn') or gymnasium.make_vec(..., "
             "vector_kwargs={'context': 'spawn'})"
         )
+
+
+def _session(endpoint: str) -> zenoh.Session:
+    """A peer connecting to the run's conductor, which may not listen yet: Zenoh retries
+    every 20 ms (its default waits 1 s, then 2 s, ...: a reset took a whole retry longer),
+    and opens at once (a peer's default is to scout for 0.5 s first; the env knows its one
+    endpoint and waits for the run's tokens anyway)."""
+    not_forked()
     _zenoh["opened"] = True
     config = Connection(connect=(endpoint,), open_timeout_ms=OPEN_TIMEOUT_MS).config()
     config.insert_json5("connect/retry", json.dumps(RETRY))

@@ -15,7 +15,7 @@ import time
 from dataclasses import dataclass
 
 from catabot.gym.episode import Draw, Episode
-from catabot.gym.link import ClientLink, Command, Frame, LinkError, LinkTimeout
+from catabot.gym.link import ClientLink, Command, Frame, LinkError, LinkTimeout, not_forked
 from catabot.gym.options import EnvOptions
 from catabot.gym.process import RunError, SimProcess
 from catabot.world.world import World
@@ -44,6 +44,7 @@ class Runner:
     def start(self, seed: int, upcoming: int | None) -> Live:
         """The episode of `seed` joined at tick 0 (its frame taken: act next); with
         `upcoming`, that episode's run starts now in the background."""
+        not_forked()
         self.end("reset before the episode ended")
         early, self.next = self.next, None
         if early is not None and early.episode.seed == seed and early.run.alive:

@@ -17,7 +17,7 @@ import psutil
 import pytest
 
 import catabot.gym  # noqa: F401 - registers the envs
-from catabot.gym import ActionError, process
+from catabot.gym import ActionError, link, process
 
 pytestmark = pytest.mark.timeout(180)
 
@@ -145,3 +145,18 @@ def test_a_refused_first_reset_and_step_leave_the_env_usable_until_it_is_closed(
     with pytest.raises(gym.error.ClosedEnvironmentError):
         env.step(np.zeros(2, np.float32))
     assert set(psutil.Process().children(recursive=True)) <= before  # no run started
+
+
+def test_a_forked_env_is_refused_before_any_run_starts(monkeypatch: pytest.MonkeyPatch) -> None:
+    """A vector env's worker forked after Zenoh opened: refused only once its run had
+    started, which left that run's folder behind and said "catabot run (still running...)"."""
+    monkeypatch.setitem(link._zenoh, "forked", True)  # as os.register_at_fork sets it
+    env = gym.make("CataBot/Navigate-v0", max_steps=5)
+    before = set(psutil.Process().children(recursive=True))
+    try:
+        with pytest.raises(link.LinkError, match="context='spawn'") as refused:
+            env.reset(seed=1)
+        assert "catabot run" not in str(refused.value)
+        assert set(psutil.Process().children(recursive=True)) <= before
+    finally:
+        env.close()
