@@ -16,6 +16,7 @@ from __future__ import annotations
 
 import argparse
 import logging
+import os
 import signal
 import sys
 import time
@@ -80,8 +81,25 @@ def recording(world: World, args: argparse.Namespace, *, live: bool) -> rr.Recor
     elif args.web:
         print(f"rerun web viewer: {_serve_web(rec, layout, args)}", flush=True)
     else:
-        rec.spawn(default_blueprint=layout)
+        _spawn(rec, layout)
     return rec
+
+
+def _spawn(rec: rr.RecordingStream, layout: Any) -> None:
+    """The desktop viewer, from this Python's own environment: a venv not activated has its
+    `rerun` off PATH (rerun's traceback said "pip install rerun-sdk"), and with no display
+    the viewer died and this process hung past SIGTERM."""
+    if sys.platform.startswith("linux") and not (
+        os.environ.get("DISPLAY") or os.environ.get("WAYLAND_DISPLAY")
+    ):
+        raise ViewerError("no display here (DISPLAY and WAYLAND_DISPLAY are unset): use --web "
+                          "for a browser, or --save FILE.rrd to open elsewhere")  # fmt: skip
+    beside = Path(sys.executable).with_name("rerun")
+    path = str(beside) if beside.is_file() else None
+    try:
+        rr.spawn(recording=rec, default_blueprint=layout, executable_path=path)
+    except RuntimeError as exc:
+        raise ViewerError(f"cannot start the rerun viewer ({exc}): use --web or --save") from None
 
 
 def _serve_web(rec: rr.RecordingStream, layout: Any, args: argparse.Namespace) -> str:
@@ -97,7 +115,11 @@ def _serve_web(rec: rr.RecordingStream, layout: Any, args: argparse.Namespace) -
     return f"http://127.0.0.1:{web}/?url={quote(grpc, safe=':/')}"
 
 
-class ViewerPortError(CataBotError, OSError):
+class ViewerError(CataBotError, OSError):
+    """The viewer could not be shown: no display, no viewer program."""
+
+
+class ViewerPortError(ViewerError):
     """The web viewer could not serve on its ports."""
 
 
