@@ -51,6 +51,13 @@ class Viewer:
         self.ready_file.unlink(missing_ok=True)
         return self.proc.poll() is None
 
+    def why(self) -> str:
+        """Its log's last line (`catabot view`'s one-line refusal: no display, a port), else
+        where its log is: the launcher said only "see log/viewer.log"."""
+        log = self.ready_file.with_name("viewer.log")
+        lines = log.read_text(errors="replace").strip().splitlines() if log.is_file() else []
+        return lines[-1].removeprefix("catabot view: ") if lines else f"see {log}"
+
     def stop(self, *, wait_s: float) -> None:
         """Let it finish (it ends after the run's End), then stop it."""
         try:

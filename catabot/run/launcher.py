@@ -290,7 +290,7 @@ def _viewer(opts: RunOptions, run_dir: Path, svc_flags: list[str]) -> Viewer | N
         return None
     viewer = start_viewer(opts.view, run_dir, svc_flags, hold=sys.stdin.isatty())
     if not viewer.wait_ready():
-        print(f"catabot run: the viewer did not start (see {run_dir}/log/viewer.log)",
+        print(f"catabot run: the viewer did not start: {viewer.why()} (--view web here)",
               file=sys.stderr)  # fmt: skip
     elif viewer.url:
         print(f"rerun web viewer: {viewer.url}", flush=True)

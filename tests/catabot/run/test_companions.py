@@ -26,3 +26,14 @@ def test_a_signal_ends_the_hold_and_stops_the_viewer(tmp_path: Path, sig: signal
     viewer.hold()
     assert serving.poll() is not None  # stopped, not left serving
     assert signal.getsignal(sig) == before  # the launcher's own handling is back
+
+
+def test_a_viewer_that_did_not_start_is_told_in_its_own_words(tmp_path: Path) -> None:
+    """`catabot run --view native` with no display said only "see log/viewer.log"."""
+    proc = subprocess.Popen([sys.executable, "-c", "pass"], text=True)
+    proc.wait()
+    viewer = Viewer(proc, None, tmp_path / "log" / "viewer.ready")
+    assert viewer.why() == f"see {tmp_path / 'log' / 'viewer.log'}"  # no log yet
+    (tmp_path / "log").mkdir()
+    (tmp_path / "log" / "viewer.log").write_text("INFO x\ncatabot view: no display here\n")
+    assert viewer.why() == "no display here"
