@@ -198,20 +198,25 @@ def open_session(conn: Connection) -> zenoh.Session:
 def _why_unreachable(endpoints: tuple[str, ...]) -> str:
     """A port that takes a TCP connection but no Zenoh handshake is another program's (an
     HTTP server, a TLS endpoint given as tcp/): "start a router" sent people the wrong way."""
-    taken = [e for e in endpoints if _tcp(e)[0] is not None and _takes_tcp(e)]
+    taken = [e for e in endpoints if _tcp(e)[0] is not None and not port_open(e, 1.0)]
     if taken:
         return (f" ({', '.join(taken)} takes connections but does not answer as Zenoh: "
                 "another program listens there, or it wants tls/)")  # fmt: skip
     return " (nothing answers there: start a router first, catabot router --listen ...)"
 
 
-def _takes_tcp(endpoint: str) -> bool:
-    host, port = _tcp(endpoint)
+def port_open(endpoint: str, timeout_s: float = 3.0) -> str:
+    """'' when the endpoint's TCP port takes a connection, else why not (any protocol: a
+    TLS port is probed the same way). A listening address (0.0.0.0, [::]) is probed on this
+    host's loopback."""
+    host, _, port = check_endpoint(endpoint).partition("/")[2].rpartition(":")
+    host = host.strip("[]")
+    host = {"0.0.0.0": "127.0.0.1", "::": "::1"}.get(host, host)
     try:
-        with socket.create_connection((host or "", port), timeout=1.0):
-            return True
-    except OSError:
-        return False
+        with socket.create_connection((host, int(port)), timeout=timeout_s):
+            return ""
+    except OSError as exc:
+        return f"{endpoint}: {exc.strerror or exc}"
 
 
 def alone(session: zenoh.Session) -> str:

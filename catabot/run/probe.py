@@ -16,11 +16,10 @@ code: a probe costs a Python start-up and one session, not the simulation's impo
 from __future__ import annotations
 
 import argparse
-import socket
 import sys
 
 from catabot.bus.keys import lives_of
-from catabot.bus.session import Connection, check_endpoint, open_session
+from catabot.bus.session import Connection, open_session, port_open
 from catabot.errors import CataBotError
 from catabot.run.answer import OneLineParser
 
@@ -35,29 +34,15 @@ def parser() -> argparse.ArgumentParser:
     return p
 
 
-def port_open(endpoint: str, timeout_s: float = TIMEOUT_S) -> str:
-    """'' when the endpoint's TCP port takes a connection, else why not. A listening
-    address (0.0.0.0, [::]) is probed on this host's loopback."""
-    host, _, port = check_endpoint(endpoint).partition("/")[2].rpartition(":")
-    host = host.strip("[]")
-    host = {"0.0.0.0": "127.0.0.1", "::": "::1"}.get(host, host)
-    try:
-        with socket.create_connection((host, int(port)), timeout=timeout_s):
-            return ""
-    except OSError as exc:
-        return f"{endpoint}: {exc.strerror or exc}"
-
-
 def _client(endpoint: str, config: str | None) -> Connection:
     limit = round(TIMEOUT_S * 1000)  # a silent listener held the handshake 10 s
     return Connection(connect=(endpoint,), mode="client", file=config, open_timeout_ms=limit)
 
 
-def speaks_zenoh(endpoint: str, config: str | None) -> str:
-    """'' when a Zenoh session opens there: an open port alone was any program's (an HTTP
-    server passed for a healthy router)."""
+def speaks_zenoh(endpoint: str, config: str | None) -> None:
+    """SessionError unless a Zenoh session opens there: an open port alone was any
+    program's (an HTTP server passed for a healthy router)."""
     open_session(_client(endpoint, config)).close()
-    return ""
 
 
 def on_bus(endpoint: str, name: str, config: str | None, timeout_s: float = TIMEOUT_S) -> str:
@@ -76,13 +61,11 @@ def on_bus(endpoint: str, name: str, config: str | None, timeout_s: float = TIME
 def main(argv: list[str] | None = None) -> int:
     args = parser().parse_args(argv)
     try:
-        why = port_open(args.endpoint)
-        if not why:
-            why = (
-                on_bus(args.endpoint, args.name, args.zenoh_config)
-                if args.name
-                else (speaks_zenoh(args.endpoint, args.zenoh_config))
-            )
+        why = port_open(args.endpoint, TIMEOUT_S)
+        if not why and args.name:
+            why = on_bus(args.endpoint, args.name, args.zenoh_config)
+        elif not why:
+            speaks_zenoh(args.endpoint, args.zenoh_config)
     except CataBotError as exc:  # a bad endpoint, name or login file
         why = str(exc)
     if why:

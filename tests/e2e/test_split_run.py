@@ -74,7 +74,7 @@ def _until_joined(endpoint: str, name: str) -> None:
     """Its liveliness token is there (a fixed 2 s sleep lost the race on a loaded machine:
     the second physics joined first and the first one was the one refused)."""
     limit = time.monotonic() + 60
-    while port_open(endpoint) or on_bus(endpoint, name, None, timeout_s=1.0):
+    while port_open(endpoint, 1.0) or on_bus(endpoint, name, None, timeout_s=1.0):
         assert time.monotonic() < limit, f"{name} never joined"
         time.sleep(0.2)
 
