@@ -1,9 +1,7 @@
 """The conductor: owns the clock, publishes ticks, collects acks, ends the run.
 
-Zenoh callbacks only put events on a queue (they must never block); the conductor's
-own thread takes them off with a timeout, which is how the per-tick deadline and
-liveliness faults are noticed without polling.
-"""
+Zenoh callbacks only put events on a queue (they must never block); the conductor's own thread
+takes them off with a timeout: how the deadline and liveliness faults are noticed unpolled."""
 
 from __future__ import annotations
 
@@ -29,6 +27,7 @@ from catabot.bus.settings import Schedule
 log = logging.getLogger("catabot.bus.conductor")
 WAITING_NOTE_S = 5.0  # how often the log names who has not joined yet
 GONE_GRACE_S = 0.2  # after a participant's token goes, for others gone with it
+WORDS_S = 0.6  # under abort, how long (from its token going) its fault may still come
 LEFT = "left the run"  # a participant's token went without its words
 
 
@@ -115,23 +114,17 @@ class Conductor:
         return RunResult(done, wall, error, [*dropped], reason, joined - self._created, dropped)
 
     def _await_members(self) -> None:
-        expected = set(self.spec.participants)
-        limit_s = self.spec.start_timeout_s
-        limit = time.monotonic() + limit_s
-        note = time.monotonic() + WAITING_NOTE_S
-        while not expected <= self.members:
-            if self._stop_reason:
-                return
+        """Every participant's token; a note naming who is missing every WAITING_NOTE_S (a
+        conductor started by hand said nothing until it gave up)."""
+        expected, limit_s = set(self.spec.participants), self.spec.start_timeout_s
+        limit, note = time.monotonic() + limit_s, time.monotonic() + WAITING_NOTE_S
+        while not expected <= self.members and not self._stop_reason:
             if self._next_event(min(limit, note))[0] == "late":
-                if time.monotonic() >= limit:
-                    raise ClockError(clock.never_joined(sorted(expected - self.members), limit_s))
-                note = time.monotonic() + WAITING_NOTE_S
-                self._waiting_note(expected, limit)
-
-    def _waiting_note(self, expected: set[str], limit: float) -> None:
-        """Who the run still waits for (a conductor started by hand said nothing until then)."""
-        missing = ", ".join(sorted(expected - self.members))
-        log.info("waiting for %s to join (%.0f s left)", missing, limit - time.monotonic())
+                now, missing = time.monotonic(), sorted(expected - self.members)
+                if now >= limit:
+                    raise ClockError(clock.never_joined(missing, limit_s))
+                note = now + WAITING_NOTE_S
+                log.info("waiting for %s to join (%.0f s left)", ", ".join(missing), limit - now)
 
     def _tick_loop(self, on_progress: Callable[[Progress], None] | None, start: float) -> None:
         """Grant ticks while the window and the pace allow, take acks, report progress.
@@ -275,15 +268,10 @@ class Conductor:
         """Apply pending membership events (a stop is noted in `_stop_reason`) and the deadline."""
         while not self.events.empty():
             self._next_event(0.0)
-        active = self._active()
-        gone = self._gone(active)
+        gone = self._gone(self._active())
         if gone:  # a lost link takes every token behind it: name them together
-            time.sleep(GONE_GRACE_S)
-            self._take_queued()  # a fault told before leaving names the cause (raises)
-            while not self.events.empty():
-                self._next_event(0.0)
-            active = self._active()  # less any dropped for a fault it told (policy drop)
-            gone = self._gone(active)
+            gone = self._settled_gone()
+        active = self._active()  # less any dropped for a fault it told (policy drop)
         if len(gone) > 1 and self.spec.policy is Policy.ABORT:  # one link: every token at once
             raise ClockError(
                 f"participants {', '.join(map(repr, gone))} left the run at once at tick "
@@ -297,6 +285,21 @@ class Conductor:
         if self._deadline is not None and time.monotonic() > self._deadline:
             for name in [n for n in active if self._acked[n] < k <= self._granted]:
                 self._fault(name, f"missed the {self.spec.deadline_s:g} s deadline of tick {k}")
+
+    def _settled_gone(self) -> list[str]:
+        """Who is gone once their words had time to come: a fault told before leaving names
+        the cause and may land after the token went (a loaded machine). Under abort the run
+        ends here anyway, so it waits longer for them (WORDS_S) than a drop does."""
+        limit = time.monotonic() + (WORDS_S if self.spec.policy is Policy.ABORT else 0.0)
+        time.sleep(GONE_GRACE_S)
+        while True:
+            self._take_queued()
+            while not self.events.empty():
+                self._next_event(0.0)
+            gone = self._gone(self._active())
+            if not gone or self._told or time.monotonic() >= limit:
+                return gone
+            time.sleep(GONE_GRACE_S / 4)
 
     def _gone(self, active: list[str]) -> list[str]:
         return [n for n in active if n not in self.members and not self._through(n)]

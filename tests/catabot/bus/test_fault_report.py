@@ -8,7 +8,7 @@ import time
 import pytest
 
 from catabot.bus.clock import Policy
-from catabot.bus.conductor import GONE_GRACE_S
+from catabot.bus.conductor import GONE_GRACE_S, WORDS_S
 from catabot.bus.inbox import Inputs
 from catabot.bus.messages import Ack, Tick
 from tests.catabot.bus.lockstep_world import Step, World
@@ -60,25 +60,44 @@ def test_policy_drop_goes_on_without_the_participant_that_failed(world: World) -
     assert a.ticks == list(range(30))
 
 
-def test_words_that_come_after_the_token_went_still_name_the_drop(world: World) -> None:
-    """A loaded machine delivered a crashed stack's fault after its token had gone: the
-    drop said "left the run at tick 120", not the stack's ZeroDivisionError."""
+def _late_words(world: World, *, after_s: float) -> list[str]:
+    """A teller whose token goes at tick 10 and whose fault comes `after_s` later."""
     names = ["a", "teller"]
 
     def step(t: Tick, _inputs: Inputs) -> None:
         if t.tick == 10:
             teller = world.members["teller"]
             teller.participant._token.undeclare()  # the token first, as if its words came late
-            time.sleep(4 * GONE_GRACE_S)
+            time.sleep(after_s)
             teller.participant.report_fault(WHY)
             teller.session.close()
 
     world.member("a", peers=names)
     world.member("teller", step, peers=names)
+    return names
+
+
+def test_words_that_come_after_the_token_went_still_name_the_drop(world: World) -> None:
+    """A loaded machine delivered a crashed stack's fault after its token had gone: the
+    drop said "left the run at tick 120", not the stack's ZeroDivisionError."""
+    names = _late_words(world, after_s=4 * GONE_GRACE_S)
     paced = {"realtime_factor": 1.0}  # 1.5 s: its words come 0.8 s after tick 10
     result = world.run(names, 150, deadline_s=5.0, start_timeout_s=5.0, policy=Policy.DROP, **paced)
     assert (result.dropped, result.ticks_done) == (["teller"], 150)
     assert result.why_dropped == {"teller": f"participant 'teller' stopped at tick 10: {WHY}"}
+
+
+@pytest.mark.parametrize("after_s", [2 * GONE_GRACE_S, 2 * WORDS_S], ids=["late", "never"])
+def test_under_abort_late_words_name_the_fault_and_none_say_it_left(
+    world: World, after_s: float
+) -> None:
+    """Under abort the run ends when the token goes, so it waits WORDS_S for the fault:
+    "left the run at tick 10" alone had hidden a crash whose words came 0.4 s late."""
+    names = _late_words(world, after_s=after_s)
+    result = world.run(names, 150, deadline_s=5.0, start_timeout_s=5.0)
+    told = f"participant 'teller' stopped at tick 10: {WHY}"
+    left = "participant 'teller' left the run at tick 10"
+    assert result.error == (told if after_s < WORDS_S else left), result.error
 
 
 @pytest.mark.parametrize("fault", ["\x00" * 10, "y" * 201], ids=["unprintable", "too-long"])
