@@ -204,6 +204,14 @@ class Inbox:
             if s.producer not in self.dropped and self.latest[s.key] < self._due(s, tick)
         ]
 
+    def unarrived(self, tick: int) -> str:
+        """The samples due before `tick` that never came, by stream and producer, with the
+        last tag each did send: what a recording ends without, in one line."""
+        return "; ".join(
+            f"{key} from {self.streams[key].producer!r} after its tick {self.latest[key]}"
+            for key in self.missing(tick)
+        )
+
     def release(self, tick: int) -> dict[str, list[Message]]:
         """Hand over every held sample produced before `tick`, oldest tick first."""
         out: dict[str, list[Message]] = {}

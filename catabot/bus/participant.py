@@ -325,8 +325,8 @@ class Participant(Outputs):
                 break
             if event[0] == "data":
                 self._take_data(event[1], event[2], event[3])
-        if missing := self.inbox.missing(end.tick + 1):
-            log.warning("%s: run ended without samples from %s", self.name, missing)
+        if missing := self.inbox.unarrived(end.tick + 1):  # in flight when a link went
+            log.warning("%s: the run ended at tick %d without %s", self.name, end.tick, missing)
         if on_end is not None:
             on_end(end, self.inbox.release(end.tick + 1))
         return end

@@ -5,7 +5,7 @@ from __future__ import annotations
 import pytest
 
 from catabot.bus.rejections import Rejected
-from tests.catabot.bus.inbox_samples import STATE, _add, _inbox, _state
+from tests.catabot.bus.inbox_samples import GPS, STATE, _add, _gps, _inbox, _state
 
 
 def test_a_sample_that_skips_a_due_tag_is_refused() -> None:
@@ -22,3 +22,16 @@ def test_a_sample_that_skips_a_due_tag_is_refused() -> None:
     _add(inbox, STATE, _state(7))  # the tags it was off at are not skipped
     with pytest.raises(Rejected, match="tag skips ahead: tick 9 before tick 8"):
         _add(inbox, STATE, _state(9))
+
+
+def test_what_a_run_ended_without_names_each_stream_and_its_last_tag() -> None:
+    """After a lost link the recorder said "run ended without samples from [imu]", which
+    read as no IMU at all: it was the last tick's, in flight when the link went."""
+    inbox = _inbox()
+    for tick in range(4):
+        _add(inbox, STATE, _state(tick))
+    _add(inbox, GPS, _gps(0))
+    assert inbox.unarrived(4) == ""
+    assert inbox.unarrived(6) == f"{STATE} from 'physics' after its tick 3"
+    both = f"{STATE} from 'physics' after its tick 3; {GPS} from 'sensors' after its tick 0"
+    assert inbox.unarrived(12) == both
