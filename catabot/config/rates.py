@@ -34,9 +34,7 @@ def check_rates(scenario: Scenario) -> None:
     ):
         traffic_record_period(scenario)
     if scenario.recording.dataset_rate_hz is not None:
-        rate_in_ticks(
-            scenario.recording.dataset_rate_hz, scenario.dt_ns, where="recording.dataset_rate_hz"
-        )
+        dataset_period(scenario)
     try:
         scenario.ticks  # noqa: B018 - validates duration against dt
     except ClockError as exc:
@@ -82,3 +80,24 @@ def nearest_rates(rate_hz: float, dt_ns: int) -> str:
     low, high = math.floor(every), math.ceil(every)
     slow, fast = tick_hz / high, tick_hz / low
     return f"the nearest are {fast:.4g} Hz (every {low} ticks) and {slow:.4g} Hz (every {high})"
+
+
+def dataset_period(scenario: Scenario) -> int:
+    """Ticks between two saved camera frames (`recording.dataset_rate_hz`): a whole number
+    of every camera's periods, so the frames kept are evenly spaced. A 4 Hz dataset of a 5 Hz
+    camera had kept frames 0.4 and 0.2 s apart in turn, and 10 Hz had kept 5 Hz, unsaid."""
+    rate, where = scenario.recording.dataset_rate_hz, "recording.dataset_rate_hz"
+    assert rate is not None
+    every = rate_in_ticks(rate, scenario.dt_ns, where=where)
+    cameras = [(f"{v.id}/{s.name}", s.rate_hz) for v in scenario.vessels for s in v.sensors
+               if s.type == "camera"]  # fmt: skip
+    periods = {name: rate_in_ticks(hz, scenario.dt_ns, where=name) for name, hz in cameras}
+    unfit = [name for name, p in periods.items() if every % p]
+    if unfit and scenario.recording.dataset:
+        whole = math.lcm(*periods.values())
+        fits = ", ".join(f"{NS_PER_S / scenario.dt_ns / (whole * n):.4g}" for n in range(1, 5))
+        hz = " or ".join(f"{name}'s {dict(cameras)[name]:g} Hz" for name in unfit)
+        raise ScenarioError(f"{where}: {rate:g} Hz is not {hz} divided by a whole number: the "
+                            f"dataset keeps whole camera frames, evenly spaced; rates that fit: "
+                            f"{fits} Hz, ...")  # fmt: skip
+    return every

@@ -185,7 +185,10 @@ class RecordingConfig(Strict):
     )
     dataset: StrictBool = Field(True, description="camera frames as PNGs + labels in dataset/")
     dataset_rate_hz: float | None = Field(
-        None, gt=0, description="camera frames saved to dataset/ per second; null: every frame"
+        None,
+        gt=0,
+        description="camera frames saved to dataset/ per second, each camera's rate divided by a "
+        "whole number; null: every frame",
     )
     ppi: StrictBool = Field(True, description="the radar's PPI (the paper's minimap) in dataset/")
     rerun: StrictBool = Field(False, description="run.rrd for the rerun viewer, from run.mcap")

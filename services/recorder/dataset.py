@@ -8,7 +8,7 @@ Layout (one folder per sensor, `<vessel>.<sensor>`):
   `LABEL_CLASSES`: 0 none, 1 water, 2 terrain, 3 vessel, 4 buoy) and `<tick>_instance.png`
   (16-bit, a body's row + 1), for the outputs that are on, plus one `labels.jsonl` line per
   frame with its boxes, each naming its body;
-  every frame, or with `recording.dataset_rate_hz` the first frame of each of its periods;
+  every frame, or with `recording.dataset_rate_hz` one in every n (config/rates.py);
 - radars: `ppi_<tick>.png`, the north-up PPI (services/recorder/ppi.py) once per antenna turn;
 - with cameras or PPIs, `calibration.json`: every sensor's mount and each camera's K
   (calibration.py): a radar-only run's mounts were in `/tf_static` alone.
@@ -26,6 +26,7 @@ import numpy as np
 from PIL import Image
 
 from catabot.bus.messages import LABEL_CLASSES, CameraFrame, Message, RadarSweep
+from catabot.config.rates import dataset_period
 from catabot.config.sensors import RadarParams
 from catabot.world.world import World
 from services.recorder.calibration import write_calibration
@@ -91,8 +92,7 @@ class Dataset:
         self.bodies = instances(world)
         recording = world.scenario.recording
         self.cameras = recording.dataset
-        rate = recording.dataset_rate_hz
-        self.every = 1 if rate is None else max(1, round(1e9 / rate / world.scenario.dt_ns))
+        self.every = 1 if recording.dataset_rate_hz is None else dataset_period(world.scenario)
         self.camera_period = {  # ticks between two frames of each camera stream
             world.keys.relative(s.key): s.period for s in world.sensors if s.config.type == "camera"
         }

@@ -59,6 +59,19 @@ def test_everything_asked_for_with_its_sources() -> None:
         ),
         ({"dataset_rate_hz": 3.0}, [CAMERA], "recording.dataset_rate_hz: period 333333333 ns"),
         ({"dataset_rate_hz": 0}, [CAMERA], "recording.dataset_rate_hz: must be > 0"),
+        (  # kept 0.4 and 0.2 s apart in turn: a camera at 5 Hz, a dataset at 4
+            {"dataset_rate_hz": 4.0},
+            [{**CAMERA, "rate_hz": 5.0}],
+            "recording.dataset_rate_hz: 4 Hz is not ego/cam's 5 Hz divided by a whole number: "
+            "the dataset keeps whole camera frames, evenly spaced; rates that fit: 5, 2.5, "
+            "1.667, 1.25 Hz, ...",
+        ),
+        (  # kept 5 Hz, unsaid
+            {"dataset_rate_hz": 10.0},
+            [{**CAMERA, "rate_hz": 5.0}, {**CAMERA, "name": "c2", "rate_hz": 2.0}],
+            "10 Hz is not ego/cam's 5 Hz or ego/c2's 2 Hz divided by a whole number: "
+            "the dataset keeps whole camera frames, evenly spaced; rates that fit: 1, 0.5,",
+        ),
         ({"rerun": "yes"}, [], "recording.rerun: must be true or false"),
     ],
 )

@@ -45,9 +45,9 @@ def test_every_frame_without_a_rate(tmp_path: Path) -> None:
     assert [r["tick"] for r in _record(tmp_path, None)] == list(range(0, 110, 10))
 
 
-def test_the_first_frame_of_each_dataset_period(tmp_path: Path) -> None:
-    # 4 Hz: periods start at ticks 0, 25, 50, 75, 100; the camera's frames are 10 ticks apart.
-    assert [r["tick"] for r in _record(tmp_path, 4.0)] == [0, 30, 50, 80, 100]
+def test_one_frame_in_every_n(tmp_path: Path) -> None:
+    # 2.5 Hz: one of every 4 of the camera's frames, which are 10 ticks apart.
+    assert [r["tick"] for r in _record(tmp_path, 2.5)] == [0, 40, 80]
 
 
 def test_depth_as_exact_float32_beside_the_png(tmp_path: Path) -> None:
