@@ -23,6 +23,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from catabot.config.load import TERRAINS
 from catabot.config.terrain import TerrainConfig, TerrainError
 from catabot.world.elevation import ElevationImageError, read_elevation_band
 from catabot.world.terrain_grid import (
@@ -46,7 +47,7 @@ def load_terrain(config: TerrainConfig, *, base_dir: str | Path | None = None) -
     if not path.is_absolute() and base_dir is not None:
         path = Path(base_dir) / path
     if not path.is_file():
-        raise TerrainError(f"terrain.elevation_image: file not found: {path}")
+        raise TerrainError(f"terrain.elevation_image: file not found: {path}{_where_looked()}")
     try:
         band, full_scale = read_elevation_band(path)
     except ElevationImageError as exc:
@@ -61,6 +62,14 @@ def load_terrain(config: TerrainConfig, *, base_dir: str | Path | None = None) -
         resolution_m=config.resolution_m,
         name=str(path),
     )
+
+
+def _where_looked() -> str:
+    """Where a name is looked for: a bare name that is not beside the scenario may be a
+    bundled image (config/load.py)."""
+    names = ", ".join(sorted(p.name for p in TERRAINS.glob("*.png")))
+    return (f" (a relative path is taken from the scenario file's folder; a bare name not "
+            f"there from the bundled images: {names})")  # fmt: skip
 
 
 class Terrain:
