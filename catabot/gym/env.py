@@ -99,7 +99,7 @@ class CataBotEnv(gym.Env[Obs, np.ndarray]):
         frame = self._runner.observe()
         self._judge.start(self._episode.goal, frame.bodies)
         self._steps, self._over = 0, False
-        run_dir = live.run.run_dir() if self.options.runs_dir is not None else None
+        run_dir = str(live.run.run_dir()) if self.options.runs_dir is not None else None
         where = {"run_dir": run_dir, "endpoint": live.run.endpoint}  # `catabot view --connect`
         return self._observer(frame), self._info(frame) | self._judge.flags(frame.bodies) | where
 

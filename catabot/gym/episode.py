@@ -83,7 +83,7 @@ class Draw:
     def episode(self, seed: int, world: str) -> Episode:
         start = self._start(seed)
         goal = self._goal(seed, start)
-        return Episode(seed, self._scenario(seed, world, start), start, goal)
+        return Episode(seed, self._scenario(seed, world, start, goal), start, goal)
 
     def _start(self, seed: int) -> Pose:
         rng = seeding.rng(seed, "gym/start")
@@ -135,7 +135,7 @@ class Draw:
         gap = np.hypot(self.others[:, 0] - x, self.others[:, 1] - y) - self.others[:, 2]
         return bool(gap.min() > clear_m)
 
-    def _scenario(self, seed: int, world: str, start: Pose) -> Scenario:
+    def _scenario(self, seed: int, world: str, start: Pose, goal: Goal) -> Scenario:
         o = self.options
         data: dict[str, Any] = self.base.model_dump(mode="json")
         period_s = 1.0 / o.control_hz
@@ -157,6 +157,8 @@ class Draw:
                            "command": o.action},
             "sensors": self.sensors(ego["sensors"]),
         }  # fmt: skip
+        if o.task == "navigate":  # in the run folder's scenario.json; metrics.json times it
+            ego["task"] = {"goal": {"x_m": goal.x_m, "y_m": goal.y_m, "radius_m": o.goal_radius_m}}
         where = o.scenario if isinstance(o.scenario, str) else "the env's scenario"
         return parse_scenario(data, source=f"episode {seed} of {where}")
 

@@ -75,8 +75,12 @@ def _episode(runs: Path, steps: int) -> Path:
             assert not terminated
     finally:
         env.close()
-    assert info["run_dir"] is not None
-    return Path(info["run_dir"])
+    assert isinstance(info["run_dir"], str)  # JSON as it is (a Path was not)
+    run_dir = Path(info["run_dir"])
+    ego = json.loads((run_dir / "scenario.json").read_text())["vessels"][0]
+    goal = ego["task"]["goal"]  # the episode's goal is in its run folder
+    assert (ego["id"], (goal["x_m"], goal["y_m"]), goal["radius_m"]) == ("ego", info["goal"], 3.0)
+    return run_dir
 
 
 def test_an_episode_ends_its_run_at_the_terminal_step_with_the_same_bytes(tmp_path: Path) -> None:
