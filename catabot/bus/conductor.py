@@ -22,6 +22,7 @@ from catabot.bus.members import Members, claim
 from catabot.bus.messages import Ack, End, Tick
 from catabot.bus.outputs import Outputs
 from catabot.bus.rejections import Rejected, Rejections
+from catabot.bus.session import LEASE_MS
 from catabot.bus.settings import Schedule
 
 log = logging.getLogger("catabot.bus.conductor")
@@ -29,6 +30,9 @@ WAITING_NOTE_S = 5.0  # how often the log names who has not joined yet
 GONE_GRACE_S = 0.2  # after a participant's token goes, for others gone with it
 WORDS_S = 0.6  # under abort, how long (from its token going) its fault may still come
 LEFT = "left the run"  # a participant's token went without its words
+BEFORE = " before it stepped one (its own log says why)"
+SILENT = f" without a word: its process ended, or stopped answering for {LEASE_MS / 1000:g} s \
+(killed, frozen, or its link lost)"
 
 
 class Conductor:
@@ -114,8 +118,7 @@ class Conductor:
         return RunResult(done, wall, error, [*dropped], reason, joined - self._created, dropped)
 
     def _await_members(self) -> None:
-        """Every participant's token; a note naming who is missing every WAITING_NOTE_S (a
-        conductor started by hand said nothing until it gave up)."""
+        """Every token; who is missing every WAITING_NOTE_S (by hand, it said nothing)."""
         expected, limit_s = set(self.spec.participants), self.spec.start_timeout_s
         limit, note = time.monotonic() + limit_s, time.monotonic() + WAITING_NOTE_S
         while not expected <= self.members and not self._stop_reason:
@@ -256,8 +259,7 @@ class Conductor:
             self._restart_deadline()
 
     def _restart_deadline(self) -> None:
-        """`deadline_s` (and a slow setting change's grace) from now while a granted tick
-        is outstanding; none otherwise."""
+        """`deadline_s` (+ a slow setting's grace) from now while a granted tick is out."""
         wait = self.spec.deadline_s + self.settings.grace(self._done, self._granted)
         self._deadline = time.monotonic() + wait if self._done <= self._granted else None
 
@@ -279,17 +281,16 @@ class Conductor:
                 "between them, gone?)"
             )
         for name in gone:
-            first = " before it stepped one (its own log says why)" if self._acked[name] < 0 else ""
-            self._fault(name, f"{LEFT} at tick {self._acked[name] + 1}{first}")
+            why = BEFORE if self._acked[name] < 0 else SILENT
+            self._fault(name, f"{LEFT} at tick {self._acked[name] + 1}{why}")
         k = self._done
         if self._deadline is not None and time.monotonic() > self._deadline:
             for name in [n for n in active if self._acked[n] < k <= self._granted]:
                 self._fault(name, f"missed the {self.spec.deadline_s:g} s deadline of tick {k}")
 
     def _settled_gone(self) -> list[str]:
-        """Who is gone once their words had time to come: a fault told before leaving names
-        the cause and may land after the token went (a loaded machine). Under abort the run
-        ends here anyway, so it waits longer for them (WORDS_S) than a drop does."""
+        """Who is gone once their words had time to come (a fault told before leaving may land
+        after the token went); under abort the run ends here anyway: it waits WORDS_S."""
         limit = time.monotonic() + (WORDS_S if self.spec.policy is Policy.ABORT else 0.0)
         time.sleep(GONE_GRACE_S)
         while True:
@@ -309,8 +310,7 @@ class Conductor:
         return self._end_at is not None and self._acked[name] >= self._end_at
 
     def _told_drop(self, name: str, told: str) -> None:
-        """Dropped for its own words; they replace "left the run" when they came after its
-        token went (a loaded machine delivered them later than GONE_GRACE_S)."""
+        """Dropped for its words; they replace "left the run" that came first (a loaded VM)."""
         if name not in self.dropped:
             self._fault(name, told)
         elif LEFT in self.dropped[name]:

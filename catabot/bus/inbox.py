@@ -102,8 +102,8 @@ class Inbox:
             self._pending_bytes += len(payload)
             return False
         if sender != producer:
-            kind = key.rsplit("/", 1)[-1]
-            driven = (f" (the vessel's {kind} is driven in lockstep by it: a free command "
+            kind, whose = key.rsplit("/", 1)[-1], "vessel's" if "/vessel/" in key else "fleet's"
+            driven = (f" (the {whose} {kind} is driven in lockstep by it: a free command "
                       "would change the run)") if "/cmd/" in key else ""  # fmt: skip
             why = f"sender {sender or '?'} is not {stream.producer}{driven}"
             raise Rejected("not from its producer", why)

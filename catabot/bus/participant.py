@@ -1,15 +1,13 @@
 """A stepping participant: joins the lockstep, waits for due inputs, steps, acks.
 
-Services write only a `step(tick, inputs)` function; this class owns the protocol of
-DESIGN.md §4: membership by a liveliness token, stepping every tick the conductor has
-granted as soon as its inputs are complete (so a fast participant runs ahead of a slow
-one, within the window), Jacobi input release (a sample tagged k is handed over at tick
-k+1, never earlier), acks every few ticks, a clean end (`clock/end`), its own faults told.
-
-Nothing from the bus is believed blindly (identity.py, inbox.py): clock messages only from
-the conductor's session and only if its clock could send them (`ClockLimits`), samples only
-from their producer's; refusals are counted and logged without flooding (rejections.py).
-"""
+Services write only a `step(tick, inputs)` function; this class owns the protocol of DESIGN.md
+§4: membership by a liveliness token, stepping every tick the conductor has granted as soon as
+its inputs are complete (a fast participant runs ahead of a slow one, within the window),
+Jacobi input release (a sample tagged k is handed over at tick k+1, never earlier), acks every
+few ticks, a clean end (`clock/end`), its own faults told. Nothing from the bus is believed
+blindly (identity.py, inbox.py): clock messages only from the conductor's session and only if
+its clock could send them (`ClockLimits`), samples only from their producer's; refusals are
+counted and logged without flooding (rejections.py)."""
 
 from __future__ import annotations
 
@@ -38,6 +36,8 @@ ORPHAN_GRACE_S = 0.5
 NOTE_EVERY_S = 10.0  # before tick 0, how often a participant says it still waits
 NO_CLOCK = "; is its conductor on this router (--connect), or has its run ended?"
 LOST = "conductor lost"  # the reason of the End a participant makes when the clock vanished
+VANISHED = "the conductor vanished without an End reaching it: the conductor stopped, or \
+this process lost its link or was frozen (the conductor's own error says which)"
 MAX_HELD_CLOCK = 64  # clock messages held while the conductor's session is not known yet
 StepFn = Callable[[Tick, Inputs], None]
 EndFn = Callable[[End, Inputs], None]
@@ -71,8 +71,7 @@ class Participant(Outputs):
         self.rejections = Rejections(log, name)
         self.peers, self.drain_s = set(peers) - {name}, drain_s
         self._everyone = self.peers | {name}  # the peers a tick may name as dropped
-        self.next_tick = 0
-        self._acked = -1  # the last tick acked
+        self.next_tick, self._acked = 0, -1  # the next tick to step, the last acked
         self._ended = False  # asked the conductor to end the run: no more steps
         self._asked = False  # a repeated grant: ack progress as it comes from then on
         self._grant: Tick | None = None
@@ -120,7 +119,7 @@ class Participant(Outputs):
         """Step every granted tick until the run ends; its End (`LOST`: the conductor vanished)."""
         while True:
             if self._orphaned_at and time.monotonic() - self._orphaned_at > ORPHAN_GRACE_S:
-                why = f"{self.name}: the conductor disappeared without ending the run"
+                why = f"{self.name}: {VANISHED}"
                 return self._finish(End(self.run_id, self.next_tick - 1, LOST, why), on_end)
             event = self._next()
             if event[0] == "stop":
@@ -315,7 +314,8 @@ class Participant(Outputs):
 
     def _finish(self, end: End, on_end: EndFn | None) -> End:
         """Collect samples due up to the last complete tick, bounded in time."""
-        if end.error:
+        own = f"participant {self.name!r} " in end.error  # its own lateness held the others
+        if end.error and not own:
             self._waited(self.next_tick)
         limit = time.monotonic() + (self.drain_s if not end.error else 1.0)
         while self.inbox.missing(end.tick + 1) and time.monotonic() < limit:
@@ -325,7 +325,7 @@ class Participant(Outputs):
                 break
             if event[0] == "data":
                 self._take_data(event[1], event[2], event[3])
-        if missing := self.inbox.unarrived(end.tick + 1):  # in flight when a link went
+        if not own and (missing := self.inbox.unarrived(end.tick + 1)):  # a link went
             log.warning("%s: the run ended at tick %d without %s", self.name, end.tick, missing)
         if on_end is not None:
             on_end(end, self.inbox.release(end.tick + 1))

@@ -162,18 +162,20 @@ class Client:
         return driven[0] if driven else None
 
     def _not_taken(self, info: WorldInfo, name: str) -> None:
-        """TooLate once the clock has started (the run went on without `name`) or while
-        another session holds the name."""
+        """TooLate while another session holds the name (first: a second copy of a stack
+        was told it came too late), or once the clock has started (the run went on without
+        `name`)."""
+        holder = self.watch.members.present.get(name)
+        if holder is not None:
+            raise TooLate(f"participant {name!r} of world {info.name!r} is already joined by "
+                          f"another session ({holder}): a second copy of the stack? stop it, "
+                          "or join another run")  # fmt: skip
         if info.granted >= 0:
             raise TooLate(
                 f"the run of world {info.name!r} has started (tick {info.granted} granted): "
                 f"participant {name!r} joined too late, or left it; start the stack before "
                 "the run's clock.start_timeout_s runs out"
             )
-        holder = self.watch.members.present.get(name)
-        if holder is not None:
-            raise TooLate(f"participant {name!r} of world {info.name!r} is already joined "
-                          f"(session {holder})")  # fmt: skip
 
     def _period(self, info: WorldInfo, name: str, target: VesselInfo | None,
                 rate_hz: float | None) -> int:  # fmt: skip

@@ -32,7 +32,7 @@ from catabot.bus.identity import Roster, sender_of
 from catabot.bus.inbox import checked
 from catabot.bus.keys import Keys
 from catabot.bus.messages import BodyStates, CameraFrame, End, LidarScan, Message, Tick
-from catabot.bus.participant import EndFn, StepFn
+from catabot.bus.participant import VANISHED, EndFn, StepFn
 from catabot.bus.rejections import Rejected, Rejections
 
 log = logging.getLogger("ros.observer")
@@ -138,7 +138,7 @@ class Observer:
                 self._end = None
         gone = self._conductor_gone_at
         if gone and time.monotonic() - gone > ORPHAN_GRACE_S:
-            raise ClockError("ros: the conductor disappeared without ending the run")
+            raise ClockError(f"ros: {VANISHED}")
         return None
 
     def _drain(self) -> dict[str, list[Message]]:

@@ -143,7 +143,7 @@ def test_a_conductor_that_dies_while_a_stack_waits_is_run_ended(tmp_path: Path) 
                 stack.act(Thrust([0.2, 0.2]))
             os.kill(service_pid(run.proc.pid, "catabot.run.conduct"), signal.SIGKILL)
             started = time.monotonic()
-            with pytest.raises(RunEnded, match="conductor disappeared without ending the run"):
+            with pytest.raises(RunEnded, match="the conductor vanished without an End reaching it"):
                 while True:
                     stack.observe()  # act(None) implied: keep the last command
             assert time.monotonic() - started < 15

@@ -15,6 +15,8 @@ import pytest
 from conftest import REPO, basic_scenario, catabot, files_of, only_run_dir, scenario_file
 from mcap.reader import make_reader
 
+from catabot.bus.participant import VANISHED
+
 DETECT_S = 2.0  # the link lease (1.5 s) and the token's way to the conductor
 SLACK_S = 1.0  # a loaded CI machine
 
@@ -112,7 +114,7 @@ def test_a_recorder_cut_off_from_the_clock_still_closes_its_files(tmp_path: Path
         assert make_reader(f).get_summary() is not None  # the footer and summary written
     assert (run / "metrics.json").is_file()
     log = next(run.glob("**/recorder.log")).read_text()
-    assert "the conductor disappeared without ending the run (its files end at tick" in log
+    assert f"{VANISHED} (its files end at tick" in log
 
 
 def test_a_fault_on_no_service_of_the_scenario_is_refused_leaving_no_folder(

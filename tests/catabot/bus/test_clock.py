@@ -9,7 +9,7 @@ from catabot.bus import inbox as inbox_module
 from catabot.bus.clock import ClockError, Policy, Stream, period_in_ticks, ticks_for
 from catabot.bus.identity import Roster
 from catabot.bus.inbox import Inbox
-from catabot.bus.messages import GpsFix, ImuSample, ThrustCmd, TwistCmd, VesselState
+from catabot.bus.messages import GpsFix, ImuSample, ThrustCmd, TwistBatch, TwistCmd, VesselState
 from catabot.bus.rejections import Rejected
 from tests.catabot.bus.inbox_samples import (
     CMD,
@@ -320,3 +320,7 @@ def test_a_free_command_to_a_vessel_driven_in_lockstep_is_refused_saying_so() ->
     )
     with pytest.raises(Rejected, match=r"^not from its producer: sender x is not physics$"):
         _inbox().add(STATE, _state(0), sender="x")  # not a command: no such words
+    batch = KEYS.world_twists()  # the traffic's set-points: no one vessel's
+    inbox = Inbox([Stream(batch, TwistBatch, "p", 10)], roster=Roster(ZIDS))
+    with pytest.raises(Rejected, match=r"is not p \(the fleet's twist is driven in"):
+        inbox.add(batch, b"", sender="")

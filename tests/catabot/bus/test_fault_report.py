@@ -8,7 +8,7 @@ import time
 import pytest
 
 from catabot.bus.clock import Policy
-from catabot.bus.conductor import GONE_GRACE_S, WORDS_S
+from catabot.bus.conductor import GONE_GRACE_S, SILENT, WORDS_S
 from catabot.bus.inbox import Inputs
 from catabot.bus.messages import Ack, Tick
 from tests.catabot.bus.lockstep_world import Step, World
@@ -96,7 +96,7 @@ def test_under_abort_late_words_name_the_fault_and_none_say_it_left(
     names = _late_words(world, after_s=after_s)
     result = world.run(names, 150, deadline_s=5.0, start_timeout_s=5.0)
     told = f"participant 'teller' stopped at tick 10: {WHY}"
-    left = "participant 'teller' left the run at tick 10"
+    left = f"participant 'teller' left the run at tick 10{SILENT}"
     assert result.error == (told if after_s < WORDS_S else left), result.error
 
 

@@ -11,6 +11,7 @@ import pytest
 from catabot.bus import codec, conductor
 from catabot.bus import participant as participant_module
 from catabot.bus.clock import Policy, Stream
+from catabot.bus.conductor import SILENT
 from catabot.bus.inbox import Inputs
 from catabot.bus.messages import Tick, VesselState
 from catabot.bus.participant import Participant, Stopped
@@ -75,6 +76,40 @@ def test_a_participant_waiting_for_a_late_ones_data_is_not_named(world: World) -
     finally:
         release.set()
     assert result.error == "participant 'slow' missed the 2.5 s deadline of tick 12"
+
+
+def test_the_late_one_does_not_blame_whom_it_waited_for(
+    world: World, caplog: pytest.LogCaptureFixture
+) -> None:
+    """A stack past its deadline logged "stack waited at tick 14 for world/states from
+    'physics'" as the run ended: physics had waited for it, not the other way round."""
+    release = threading.Event()
+    names, holder = ["cons", "slow"], {}
+    out = {name: world.keys.vessel_state(name) for name in names}
+
+    def stepper(name: str, hang_at: int | None) -> Step:
+        def step(tick: Tick, _inputs: Inputs) -> None:
+            if tick.tick == hang_at:
+                release.wait(3.0)
+            holder[name].publish(out[name], _state(tick.tick))
+
+        return step
+
+    for name, other, hang_at in (("cons", "slow", None), ("slow", "cons", 13)):
+        stream = Stream(out[other], VesselState, other, 1)
+        member = world.member(name, stepper(name, hang_at), inputs=[stream], peers=names)
+        holder[name] = member.participant
+    try:
+        with caplog.at_level("WARNING", logger="catabot.bus.participant"):
+            result = world.run(names, 100, deadline_s=1.0, start_timeout_s=5.0, window_ticks=8)
+            world.members["slow"].join()
+            world.members["cons"].join()
+    finally:
+        release.set()
+    assert result.error == "participant 'slow' missed the 1 s deadline of tick 12"
+    said = [r.getMessage() for r in caplog.records]
+    assert [m for m in said if m.startswith("slow ")] == [], said
+    assert [m for m in said if m.startswith("cons waited at tick 14")], said  # the one held
 
 
 # -- (d) policy drop ----------------------------------------------------------------------
@@ -168,7 +203,11 @@ def test_a_participant_that_crashes_is_named_within_a_second(world: World) -> No
     names, crashed_at = _with_a_crash_at_tick_10(world)
     result = world.run(names, 50, deadline_s=5.0, start_timeout_s=5.0)
     assert crashed_at, "the crash never happened"
-    assert result.error == "participant 'crash' left the run at tick 10"
+    assert result.error == f"participant 'crash' left the run at tick 10{SILENT}"
+    assert SILENT == (
+        " without a word: its process ended, or stopped answering for 1.5 s (killed, frozen, "
+        "or its link lost)"
+    )  # a stack frozen 2 s (SIGSTOP) read as gone for good
     assert world.result_at - crashed_at[0] < 1.0
     assert result.ticks_done == 10
     for name in ("a", "b"):

@@ -12,6 +12,7 @@ from typing import Any
 import pytest
 import zenoh
 
+from catabot.bus.keys import Keys
 from catabot.bus.session import Connection, free_port, open_session
 from catabot.bus.settings import Schedule
 from catabot.client import (
@@ -203,6 +204,24 @@ def test_a_run_that_has_started_is_too_late_to_join(served: Served) -> None:
     late = r"has started \(tick 3 granted\): participant 'stack'"
     with Client.connect([served.endpoint], timeout_s=10) as sim, pytest.raises(TooLate, match=late):
         sim.join("stack")
+
+
+def test_a_name_held_by_another_session_is_said_so_also_once_the_run_started(
+    served: Served,
+) -> None:
+    """A second copy of a stack, started while the first stepped, was told it came too late
+    and to start before the timeout: the name was the cause."""
+    served.schedule.grant(3)
+    first = served.session.zid()
+    token = served.session.liveliness().declare_token(Keys("info").live("stack", str(first)))
+    try:
+        held = rf"'stack' of world 'info' is already joined by another session \({first}\)"
+        with Client.connect([served.endpoint], timeout_s=10) as sim:
+            time.sleep(0.5)  # the token arrives
+            with pytest.raises(TooLate, match=held + ": a second copy of the stack"):
+                sim.join("stack")
+    finally:
+        token.undeclare()
 
 
 def test_a_second_different_answer_for_the_world_is_refused(served: Served) -> None:
