@@ -22,6 +22,7 @@ from catabot.config.rates import rate_in_ticks
 from catabot.config.scenario import Pose, Scenario
 from catabot.config.terrain import TerrainError
 from catabot.gym.options import EnvOptions, EnvOptionsError
+from catabot.gym.paths import path_points
 from catabot.world import seeding
 from catabot.world.placement import (
     BUOY_MODEL,
@@ -78,7 +79,7 @@ class Draw:
         self.keel = keel_depth_m(self.model)
         assert ego.pose is not None, "resolve_poses placed every vessel"
         self.home = ego.pose
-        self.others = _others(self.base, self.index, models)
+        self.others = _others(self.base, self.index, models, seconds=run_seconds(options))
 
     def episode(self, seed: int, world: str) -> Episode:
         start = self._start(seed)
@@ -138,8 +139,7 @@ class Draw:
     def _scenario(self, seed: int, world: str, start: Pose, goal: Goal) -> Scenario:
         o = self.options
         data: dict[str, Any] = self.base.model_dump(mode="json")
-        period_s = 1.0 / o.control_hz
-        data |= {"name": world, "seed": seed, "duration_s": (o.max_steps + 3) * period_s}
+        data |= {"name": world, "seed": seed, "duration_s": run_seconds(o)}
         data["clock"] |= {
             "deadline_s": 86400.0,  # the env holds the clock while the agent learns
             "start_timeout_s": o.start_timeout_s,
@@ -196,12 +196,20 @@ def _no_one_waited_for(scenario: Scenario, vessel: str) -> None:
             )
 
 
-def _others(scenario: Scenario, ego: int, models: Models) -> np.ndarray:
-    """(x, y, footprint radius) of every other scenario vessel and buoy at its start."""
+def run_seconds(options: EnvOptions) -> float:
+    """An episode's run: its steps and three control periods more (the env ends it)."""
+    return (options.max_steps + 3) / options.control_hz
+
+
+def _others(scenario: Scenario, ego: int, models: Models, *, seconds: float) -> np.ndarray:
+    """(x, y, footprint radius) of every buoy, and of every other scenario vessel at each
+    point of its path over an episode of `seconds` (paths.py: with a margin)."""
     rows = []
     for i, v in enumerate(scenario.vessels):
-        if i != ego and v.pose is not None:
-            rows.append((v.pose.x_m, v.pose.y_m, footprint_m(models[v.model])))
+        if i != ego:
+            path = path_points(v, scenario, seconds=seconds)
+            path[:, 2] += footprint_m(models[v.model])
+            rows += path.tolist()
     buoy = models[BUOY_MODEL]
     rows += [(b.x_m, b.y_m, footprint_m(buoy)) for b in scenario.buoys]
     return np.array(rows, dtype=np.float64).reshape(-1, 3)

@@ -5,10 +5,13 @@ from __future__ import annotations
 import json
 from pathlib import Path
 
+import numpy as np
 import pytest
 from conftest import basic_scenario, catabot, csv_rows, only_run_dir, scenario_file
 
+from catabot.config.load import load_scenario
 from catabot.config.terrain import TerrainConfig
+from catabot.gym.paths import PATH_MARGIN_M, path_points
 from catabot.world.terrain import load_terrain
 from tests.paths import BAY, SHARED_DATA
 
@@ -41,12 +44,18 @@ def test_pose_in_too_shallow_water_is_refused(tmp_path: Path, out: Path) -> None
 
 
 def test_bundled_harbour_scenario_runs(out: Path) -> None:
-    result = catabot("run", "harbour", "--duration", "3", "--out", str(out), "--quiet")
+    """Also: its WAM-V follows the path the gym envs keep their starts clear of (arcs of its
+    twist script, carried by the current: catabot/gym/paths.py) within PATH_MARGIN_M."""
+    result = catabot("run", "harbour", "--duration", "60.3", "--out", str(out), "--quiet")
     assert result.returncode == 0, result.stderr
     run = only_run_dir(out)
     poses = [v["pose"] for v in json.loads((run / "scenario.json").read_text())["vessels"]]
     assert all(p is not None for p in poses), "missing poses are resolved into the run folder"
-    assert (run / "vessel.wamv.state.csv").is_file()
+    world = load_scenario(run / "scenario.json")
+    path = path_points(world.vessels[1], world, seconds=60.3)[:, :2]
+    track = np.loadtxt(run / "vessel.wamv.state.csv", delimiter=",", skiprows=1, usecols=(2, 3))
+    off = np.hypot(track[:, None, 0] - path[None, :, 0], track[:, None, 1] - path[None, :, 1])
+    assert len(track) == 6031 and off.min(axis=1).max() < PATH_MARGIN_M  # measured 1.45 m
 
 
 @pytest.mark.skipif(not RIVER.is_file(), reason="needs ../shared/data/elevation")
