@@ -209,11 +209,15 @@ class WaveField:
                 out[s:e] = self.orbital(cos, np.sin(block, out=block), z_flat[s:e])
         return out.reshape((*shape, 3))
 
-    def orbital(self, cos: NDArray[np.float32], sin: NDArray[np.float32], z: Array) -> Array:
+    def orbital(
+        self, cos: NDArray[np.float32], sin: NDArray[np.float32], z: Array, *,
+        eta: Array | None = None,
+    ) -> Array:  # fmt: skip
         """`velocity` at points whose phases' cosines and sines are given, (P, M) float32
-        each (overwritten): for a caller that has them already (physics' sea sampler)."""
-        eta = (cos @ self._height_w)[:, 0]
-        depth = np.minimum(z - eta, 0.0).astype(np.float32)
+        each (overwritten): for a caller that has them already (physics' sea sampler, which
+        gives them averaged over each hull with the surface height `eta` at its origin)."""
+        height = (cos @ self._height_w)[:, 0] if eta is None else eta
+        depth = np.minimum(z - height, 0.0).astype(np.float32)
         decay = np.exp(depth[:, None] * self._k32)
         cos *= decay
         sin *= decay

@@ -108,7 +108,7 @@ def body_wrench(
     under water."""
     nu = kernels.body_twist(motion.rot, motion.vel_w)
     current_w = tables.loads.current_world(motion.pos)
-    water = sea.sample(motion.pos, time_s)
+    water = sea.sample(motion.pos, time_s, motion.rot)
     water_w = current_w  # plus the waves' orbital velocity at each body origin: damping
     if water.velocity_w is not None:  # and added mass act on motion relative to the water
         water_w = water_w + water.velocity_w

@@ -17,6 +17,7 @@ from numpy.typing import NDArray
 from catabot.config.vessel import VesselModel
 from catabot.world.waves import WaveField
 from services.physics import kernels
+from services.physics.hull_average import HullAverage
 from services.physics.hydro import Array, WaterHeight, water_height
 from services.physics.surface import (
     F32,
@@ -42,11 +43,12 @@ class SeaSample:
 class SeaSampler:
     """Per world: the column layout's radii; per sea (`use`): the method; per step: `sample`."""
 
-    def __init__(self, models: Sequence[VesselModel], bottom_m: Array) -> None:
+    def __init__(self, models: Sequence[VesselModel], bottom_m: Array, area_m2: Array) -> None:
         """`bottom_m`: (N, C, 3) body-frame column bottoms as `hydro.build_columns` lays
-        them out (padding columns sit at the body origin)."""
+        them out (padding columns sit at the body origin), `area_m2` (N, C) their areas."""
         self._radius_m = float(np.linalg.norm(bottom_m, axis=2).max(initial=0.0))
         self._patches = PatchLayout(models, bottom_m)
+        self._hulls = HullAverage(bottom_m, area_m2)
         self._waves: WaveField | None = None
         self._order: int | None = None
 
@@ -55,6 +57,7 @@ class SeaSampler:
         self._waves = None if waves is None or waves.is_calm else waves
         if self._waves is None:
             return
+        self._hulls.use(self._waves)
         self._order = choose_order(self._waves, self._radius_m)
         if self._order is not None:
             self._row, weights = expansion(self._waves, self._order)
@@ -76,24 +79,25 @@ class SeaSampler:
             return f"vessel expansions, order {self._order}"
         return "exact sum" if self._surface == self._waves.height else "hull patches"
 
-    def sample(self, pos: Array, time_s: float) -> SeaSample:
-        """The water of this step for bodies at `pos` (N, 3, map)."""
+    def sample(self, pos: Array, time_s: float, rot: Array) -> SeaSample:
+        """The water of this step for bodies at `pos` (N, 3, map) turned by `rot` (N, 3, 3):
+        the orbital velocity averaged over each hull's waterplane (hull_average.py)."""
         waves = self._waves
         if waves is None:
             return SeaSample(None, water_height)
-        if self._order is None:
-            velocity = waves.velocity(pos[:, 0], pos[:, 1], pos[:, 2], time_s)
-            return SeaSample(velocity, self._surface, waves.height)
         phase = waves.phases(pos[:, 0], pos[:, 1], time_s)
         m = phase.shape[1]
         trig = np.empty((len(phase), 2 * m), np.float32)  # [cos | sin]: one matmul below
         cos, sin = np.cos(phase, out=trig[:, :m]), np.sin(phase, out=trig[:, m:])
-        grid = trig @ self._to_grid  # before `orbital` scales cos and sin
-        velocity = waves.orbital(cos, sin, pos[:, 2])
-        order = self._order
-        grid = grid.reshape(len(phase), order + 1, order + 1)
-        surface = _Expansions(grid, self._row, self._pq, pos)
-        return SeaSample(velocity, surface, surface)  # thrusters: within the columns' radius
+        eta = cos @ waves.amplitudes_m.astype(np.float32)  # at each origin: the stretching
+        if self._order is not None:
+            grid = (trig @ self._to_grid).reshape(len(phase), self._order + 1, self._order + 1)
+            surface: WaterHeight = _Expansions(grid, self._row, self._pq, pos)
+        else:
+            surface = self._surface
+        velocity = waves.orbital(*self._hulls.average(cos, sin, rot), pos[:, 2], eta=eta)
+        at_points = waves.height if self._order is None else surface  # thrusters: within
+        return SeaSample(velocity, surface, at_points)  # the columns' radius
 
 
 class _Expansions:

@@ -122,7 +122,7 @@ class PhysicsWorld:
                              lift if lift.any() else None,
                              wave_pull.PullTable.of(models, columns))  # fmt: skip
         self._tables = AwakeTables(tables)
-        self._sea = SeaSampler(models, columns.bottom_m.transpose(0, 2, 1))
+        self._sea = SeaSampler(models, columns.bottom_m.transpose(0, 2, 1), columns.area_m2)
         self._sea.use(waves)  # eta at the columns, orbital velocity at the origins (sea.py)
         # Bottom contact with the terrain (grounding.py); buoyancy knows nothing about it.
         self._ground = (

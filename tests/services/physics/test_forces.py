@@ -54,7 +54,7 @@ def motion_of(n: int) -> BodyMotion:
 
 def test_the_awake_rows_get_the_same_wrench_bit_for_bit(models: list[VesselModel]) -> None:
     tables, motion = tables_of(models), motion_of(len(models))
-    sea = SeaSampler(models, tables.columns.bottom_m.transpose(0, 2, 1))
+    sea = SeaSampler(models, tables.columns.bottom_m.transpose(0, 2, 1), tables.columns.area_m2)
     bank = ThrusterBank([m.thrusters for m in models], 0.01)
     bank.force_n[...] = np.random.default_rng(3).normal(0.0, 50.0, bank.force_n.shape)
     thrust = ThrustLoad(bank.force_n, bank.unit_wrench, bank.position_m)
