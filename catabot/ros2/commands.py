@@ -29,6 +29,7 @@ MAX_WAYPOINTS = 1000
 MAX_SURGE_MPS = 50.0  # plausible set-points: a command beyond them is a wrong payload, not
 MAX_YAW_RATE_RADPS = 2 * math.pi  # an order (the controller clamps what thrust can do)
 MAX_COORDINATE_M = 1e7
+STAMPED = "geometry_msgs/msg/TwistStamped"  # refused on cmd_vel, by name
 
 
 class CommandError(CataBotError, ValueError):
@@ -57,7 +58,10 @@ def decode(payload: bytes, typename: str) -> Any:
 
 
 def twist(payload: bytes) -> TwistCmd:
-    msg = decode(payload, types.TWIST)
+    try:
+        msg = decode(payload, types.TWIST)
+    except Malformed as exc:
+        raise Malformed(f"{exc}{_stamped_hint(payload)}") from None
     surge, yaw_rate = float(msg.linear.x), float(msg.angular.z)
     if not (abs(surge) <= MAX_SURGE_MPS and abs(yaw_rate) <= MAX_YAW_RATE_RADPS):
         raise CommandError(
@@ -65,6 +69,16 @@ def twist(payload: bytes) -> TwistCmd:
             f"{yaw_rate} (|z| <= {MAX_YAW_RATE_RADPS:.4f} rad/s)"
         )
     return TwistCmd(surge=surge, yaw_rate=yaw_rate)
+
+
+def _stamped_hint(payload: bytes) -> str:
+    """Newer Nav2 may publish TwistStamped on cmd_vel: said so, not only "size mismatch"."""
+    try:
+        decode(payload, STAMPED)
+    except Malformed:
+        return ""
+    return (f"; it is a {STAMPED}: cmd_vel takes {types.TWIST} (Nav2: "
+            "enable_stamped_cmd_vel: false)")  # fmt: skip
 
 
 def thrust(payload: bytes, thrusters: int) -> ThrustCmd:

@@ -12,6 +12,7 @@ second per topic and kind, counted (log/ros.rejected.json, the run's summary) an
 
 from __future__ import annotations
 
+import logging
 import queue
 from collections.abc import Callable
 from dataclasses import dataclass
@@ -24,9 +25,11 @@ from catabot.bus.rejections import Rejected, Rejections
 from catabot.config.ros import RosConfig
 from catabot.ros2.commands import CommandError, Malformed, command
 from catabot.ros2.names import COMMANDS, Names
-from catabot.ros2.wire import DATA, Convention
+from catabot.ros2.wire import DATA, Convention, parse_attachment
 from catabot.world.world import Body
 from services.ros.wire import Wire
+
+log = logging.getLogger("ros.inbound")
 
 UNKNOWN = "ROS command on an unknown topic"  # the reasons refusals are counted by
 MALFORMED = "malformed ROS command"
@@ -48,6 +51,7 @@ class _Route:
     name: str
     topic: str
     thrusters: int
+    rmw: bool  # an rmw_zenoh key: its publishers attach (sequence, stamp, gid)
 
 
 class Inbound:
@@ -62,14 +66,17 @@ class Inbound:
         rejections: Rejections,
     ) -> None:
         self.ros, self.rejections = ros, rejections
-        self._samples: queue.SimpleQueue[tuple[str, bytes]] = queue.SimpleQueue()
+        self._samples: queue.SimpleQueue[tuple[str, bytes, bytes | None]] = queue.SimpleQueue()
+        self._told_attachment: set[str] = set()  # topics warned of a missing attachment
         self._on_sample = on_sample
         self._routes: dict[str, _Route] = {}
         for vessel in vessels:
             for name, (topic, typename) in names.command_topics(vessel.id).items():
                 for convention in wire.conventions:
                     key = wire.key(convention, topic, typename)
-                    self._routes[key] = _Route(vessel.id, name, topic, len(vessel.model.thrusters))
+                    rmw = convention is Convention.RMW
+                    self._routes[key] = _Route(vessel.id, name, topic, len(vessel.model.thrusters),
+                                               rmw)  # fmt: skip
                     wire.announce(convention, "MS", topic, typename, DATA)
         self._subscribers = [
             wire.session.declare_subscriber(_wildcard(wire, convention, name, typename), self._push)
@@ -81,7 +88,8 @@ class Inbound:
         key = str(sample.key_expr)
         if key.startswith(ROOT + "/"):  # `**/thrust` matches CataBot's own command keys too
             return
-        self._samples.put((key, sample.payload.to_bytes()))
+        attached = None if sample.attachment is None else sample.attachment.to_bytes()
+        self._samples.put((key, sample.payload.to_bytes(), attached))
         self._on_sample()
 
     def take(self) -> list[Command]:
@@ -89,24 +97,26 @@ class Inbound:
         out: list[Command] = []
         while True:
             try:
-                key, payload = self._samples.get_nowait()
+                key, payload, attached = self._samples.get_nowait()
             except queue.Empty:
                 return out
-            out += self._checked(key, payload)
+            out += self._checked(key, payload, attached)
 
     def wait(self, timeout_s: float) -> list[Command]:
         """The next sample's command (blocking up to `timeout_s`), then all that queued."""
         try:
-            key, payload = self._samples.get(timeout=max(timeout_s, 0.0))
+            key, payload, attached = self._samples.get(timeout=max(timeout_s, 0.0))
         except queue.Empty:
             return []
-        return [*self._checked(key, payload), *self.take()]
+        return [*self._checked(key, payload, attached), *self.take()]
 
-    def _checked(self, key: str, payload: bytes) -> list[Command]:
+    def _checked(self, key: str, payload: bytes, attached: bytes | None) -> list[Command]:
         route = self._routes.get(key)
         if route is None:
             self.rejections.add(key, Rejected(UNKNOWN, "no vessel of this world has it"))
             return []
+        if route.rmw:
+            self._check_attachment(route.topic, attached)
         try:
             msg = command(
                 route.name, payload, thrusters=route.thrusters, defaults=self.ros.waypoints
@@ -115,6 +125,19 @@ class Inbound:
             self.refuse(route.topic, exc)
             return []
         return [Command(route.vessel, route.name, msg)]
+
+    def _check_attachment(self, topic: str, attached: bytes | None) -> None:
+        """Taken all the same, but said once a topic: real rmw_zenoh subscribers drop a sample
+        without its 33-byte attachment, so a publisher made by hand that works here would
+        fail against ROS 2 nodes."""
+        try:
+            parse_attachment(attached or b"")
+        except ValueError as exc:
+            if topic not in self._told_attachment:
+                self._told_attachment.add(topic)
+                log.warning("%s: taken, but %s: real rmw_zenoh subscribers drop such a sample "
+                            "(attach int64 sequence, int64 ns, 0x10 and a 16-byte gid)", topic,
+                            "no attachment" if attached is None else exc)  # fmt: skip
 
     def refuse(self, topic: str, exc: ValueError) -> None:
         """Counted and logged at most once a second per topic and kind (malformed or not)."""

@@ -80,6 +80,21 @@ def test_bad_twists_are_refused_with_the_reason(payload: bytes, reason: str) -> 
         commands.twist(payload)
 
 
+def test_a_twist_stamped_on_cmd_vel_is_refused_by_name() -> None:
+    """Newer Nav2 publishes TwistStamped on cmd_vel: the refusal said only "CDR message
+    size mismatch for 'geometry_msgs/msg/Twist'"."""
+    header = T["std_msgs/msg/Header"](
+        stamp=T["builtin_interfaces/msg/Time"](sec=3, nanosec=0), frame_id="base_link"
+    )
+    v3 = T["geometry_msgs/msg/Vector3"]
+    twist = T["geometry_msgs/msg/Twist"](linear=v3(x=1.0, y=0.0, z=0.0), angular=v3(x=0, y=0, z=0))
+    msg = T["geometry_msgs/msg/TwistStamped"](header=header, twist=twist)
+    payload = bytes(ROSBAGS.serialize_cdr(msg, "geometry_msgs/msg/TwistStamped"))
+    said = r"; it is a geometry_msgs/msg/TwistStamped: cmd_vel takes geometry_msgs/msg/Twist \("
+    with pytest.raises(commands.Malformed, match=r"^not a geometry_msgs/msg/Twist.*" + said):
+        commands.twist(payload)
+
+
 def test_thrust_needs_one_value_per_thruster_in_range() -> None:
     assert commands.thrust(_thrust([0.5, -1.0]), 2) == ThrustCmd(thrust=(0.5, -1.0))
     with pytest.raises(commands.CommandError, match="3 thrust values for 2 thrusters"):

@@ -20,6 +20,8 @@ from catabot.bus.messages import Message, ThrustCmd, Tick, TwistCmd
 from catabot.bus.rejections import Rejections
 from catabot.bus.session import Connection, free_port, open_session
 from catabot.config.load import parse_scenario
+from catabot.ros2.types import TWIST
+from catabot.ros2.wire import Convention, attachment
 from catabot.world.world import World
 from services.ros.gateway import Gateway
 from services.ros.inbound import MALFORMED, REFUSED
@@ -100,6 +102,38 @@ def test_free_commands_go_to_the_bus_and_bad_ones_are_refused(
             time.sleep(0.3)
             gateway.commands()
         assert not caplog.records  # not a ROS topic: nothing said, nothing queued
+    finally:
+        bus.undeclare()
+        gateway.close()
+
+
+def test_an_rmw_command_without_its_attachment_is_taken_and_said_once(
+    sessions: Any, caplog: pytest.LogCaptureFixture
+) -> None:
+    """A hand-made rmw_zenoh publisher with no attachment worked here and would fail against
+    real ROS 2 nodes (their subscribers drop such samples): taken, and said once a topic."""
+    ours, ros = sessions
+    world = World.resolve(parse_scenario(scenario(mode="rmw_zenoh")))
+    got: list[Message] = []
+    bus = ros.declare_subscriber(
+        world.keys.cmd_twist("ego"),
+        lambda s: got.append(codec.decode(s.payload.to_bytes(), TwistCmd)),
+    )
+    gateway = Gateway(world, world.scenario.ros, ours, rejections=_refused())  # type: ignore[arg-type]
+    key = gateway.wire.key(Convention.RMW, "/ego/cmd_vel", TWIST)
+    try:
+        time.sleep(0.3)  # the wildcard subscribers reach the other session
+        with caplog.at_level(logging.WARNING, logger="ros.inbound"):
+            ros.put(key, _twist(1.0))
+            ros.put(key, _twist(2.0), attachment=b"xyz")
+            ros.put(key, _twist(3.0), attachment=attachment(1, 5, bytes(16)))
+            assert _until(lambda: (gateway.commands(), len(got) == 3)[1])
+        assert [g.surge for g in got] == [1.0, 2.0, 3.0]  # type: ignore[attr-defined]
+        said = [r.getMessage() for r in caplog.records]
+        assert said == [
+            "/ego/cmd_vel: taken, but no attachment: real rmw_zenoh subscribers drop such a "
+            "sample (attach int64 sequence, int64 ns, 0x10 and a 16-byte gid)"
+        ]
     finally:
         bus.undeclare()
         gateway.close()
