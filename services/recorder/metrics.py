@@ -42,6 +42,7 @@ EPISODE_GAP_S = 1.0  # a contact that stops for less than this is the same conta
 class Metrics:
     def __init__(self, world: World, orders: Orders) -> None:
         self.ids = [v.id for v in world.vessels]  # the first rows of every batch
+        self.scenario, self.seed = world.scenario.name, world.scenario.seed  # metrics.json's
         self.body_ids = list(world.body_ids)
         subjects = world.bodies[: len(world.scenario.vessels)]
         self.subjects = len(subjects)

@@ -24,7 +24,8 @@ def write_metrics(m: Metrics, path: Path, *, end_reason: str = "") -> None:
     """`end_reason`: how the run ended (`completed`, `interrupted`, a fault, `ended by ...`),
     so the file alone says whether its figures cover the whole run; `dropped`, only when a
     participant was (clock.policy drop): from when the run went on without it."""
-    data = record(m) | {"end_reason": end_reason} | ({"dropped": m.dropped} if m.dropped else {})
+    data = record(m) | {"end_reason": end_reason, "scenario": m.scenario, "seed": m.seed}
+    data |= {"dropped": m.dropped} if m.dropped else {}
     text = json.dumps(_finite(data), indent=2, sort_keys=True, allow_nan=False)
     path.write_text(text + "\n")
 

@@ -25,7 +25,7 @@ import rerun as rr
 import zenoh
 
 from catabot.bus import codec
-from catabot.bus.messages import BodyStates, End, Message, ThrustCmd
+from catabot.bus.messages import BodyStates, End, Message, ThrustCmd, TwistCmd
 from catabot.config.sensors import SENSOR_TYPES
 from catabot.world.world import MountedSensor, World
 from services.viewer.logger import RunLogger
@@ -91,9 +91,11 @@ class LiveView:
             self._real_time_factor(logger, batch.stamp_ns)
         for sensor, sub in self.sensors:
             self._sensor(logger, sensor, sub)
-        for cmd in _all(self.cmds, _thrust_only):
-            vessel, thrust = cmd
-            logger.thrust(vessel, self._stamp_ns, thrust)
+        for vessel, cmd in _all(self.cmds, _command):
+            if isinstance(cmd, ThrustCmd):
+                logger.thrust(vessel, self._stamp_ns, cmd.thrust)
+            else:
+                logger.setpoints(vessel, [self._stamp_ns], [(cmd.surge, cmd.yaw_rate)])
 
     def _sensor(self, logger: RunLogger, sensor: MountedSensor, sub: Any) -> None:
         cls = SENSOR_TYPES[sensor.config.type].message
@@ -126,12 +128,14 @@ class LiveView:
                 self._rate.popleft()
 
 
-def _thrust_only(payload: bytes, key: str) -> tuple[str, tuple[float, ...]] | None:
-    if not key.endswith("/cmd/thrust"):
+def _command(payload: bytes, key: str) -> tuple[str, ThrustCmd | TwistCmd] | None:
+    """A vessel's thrust or twist command (its path is drawn from the states)."""
+    kind = {"thrust": ThrustCmd, "twist": TwistCmd}.get(key.rsplit("/", 1)[-1])
+    if kind is None:
         return None
-    msg = codec.decode(payload, ThrustCmd)
-    assert isinstance(msg, ThrustCmd)
-    return key.split("/")[-3], msg.thrust
+    msg: Message = codec.decode(payload, kind)
+    assert isinstance(msg, ThrustCmd | TwistCmd)
+    return key.split("/")[-3], msg
 
 
 def _drain(sub: Any) -> list[zenoh.Sample]:

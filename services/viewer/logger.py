@@ -26,7 +26,7 @@ from catabot.world import rotations
 from catabot.world.terrain_grid import grid_triangles
 from catabot.world.world import MountedSensor, World
 from services.viewer import palette, paths
-from services.viewer.static import body_groups, log_static
+from services.viewer.static import body_groups, log_static, setpoint_lines
 
 TRAIL_S = 0.2
 WATER_S = 0.25
@@ -42,6 +42,7 @@ class RunLogger:
         self.waves = world.waves
         self._last = {"trail": -math.inf, "water": -math.inf}
         self._closest = math.inf
+        self._named: set[str] = set()  # vessels whose set-point lines are named
         log_static(rec, world)
         self._series_names()
         if self.waves.is_calm:
@@ -195,6 +196,21 @@ class RunLogger:
             values = np.array([getattr(s, field) for s in samples], dtype=np.float64)
             columns = rr.Scalars.columns(scalars=values)
             self.rec.send_columns(paths.series(kind, owner), when, columns)
+
+    def setpoints(
+        self, vessel: str, stamps_ns: Sequence[int], twists: Sequence[tuple[float, float]]
+    ) -> None:
+        """Twist set-points (surge, yaw rate) a vessel was given by a stack, an outside client
+        or the traffic: run.rrd had only a script's, so a navigator's panel stayed empty."""
+        if not len(stamps_ns):
+            return
+        path = paths.series("setpoint", vessel)
+        if vessel not in self._named:
+            self._named.add(vessel)
+            self.rec.log(path, setpoint_lines(vessel), static=True)
+        when = [rr.TimeColumn("sim_time", duration=np.array(stamps_ns, dtype="timedelta64[ns]"))]
+        values = np.array(twists, dtype=np.float64).reshape(-1, 2)
+        self.rec.send_columns(path, when, rr.Scalars.columns(scalars=values))
 
     def thrust(self, vessel: str, stamp_ns: int, thrust: tuple[float, ...]) -> None:
         """A thrust command from the bus (a controller or an outside client)."""

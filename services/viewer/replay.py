@@ -26,6 +26,10 @@ def replay(run: RecordedRun, rec: rr.RecordingStream) -> RunLogger:
     for body in run.world.vessels:
         for stamp_ns, cmd in run.thrust(body.id):
             logger.thrust(body.id, stamp_ns, cmd.thrust)
+        twists = list(run.twist(body.id))
+        logger.setpoints(
+            body.id, [t for t, _ in twists], [(c.surge, c.yaw_rate) for _, c in twists]
+        )
     metrics = run.metrics()
     if metrics is not None and len(states):
         logger.metrics(int(states.stamp_ns[-1]), metrics)

@@ -152,11 +152,16 @@ def _script(rec: rr.RecordingStream, body: Body) -> None:
         values = np.array([[*t, *[np.nan] * (n - len(t))] for _, t in thrust])
         _columns(rec, paths.series("thrust", body.id), [t for t, _ in thrust], values)
     if twist:
-        names = [f"{body.id} surge [m/s]", f"{body.id} yaw rate [rad/s]"]
-        rec.log(paths.series("setpoint", body.id), rr.SeriesLines(names=names,
-                interpolation_mode=step), static=True)  # fmt: skip
+        rec.log(paths.series("setpoint", body.id), setpoint_lines(body.id), static=True)
         values = np.array([[t.surge_mps, t.yaw_rate_radps] for _, t in twist])
         _columns(rec, paths.series("setpoint", body.id), [t for t, _ in twist], values)
+
+
+def setpoint_lines(vessel: str) -> rr.SeriesLines:
+    """A vessel's twist set-points, as steps: a script's here, every other's (a stack's, the
+    traffic's) in logger.py."""
+    names = [f"{vessel} surge [m/s]", f"{vessel} yaw rate [rad/s]"]
+    return rr.SeriesLines(names=names, interpolation_mode=rr.components.InterpolationMode.StepAfter)
 
 
 def _columns(rec: rr.RecordingStream, path: str, t_s: list[float], values: np.ndarray) -> None:

@@ -86,6 +86,7 @@ def test_head_on_collision_at_the_contact_tick(run: tuple[Path, Any]) -> None:
     a, b = _states(run_dir, "a"), _states(run_dir, "b")
     (hit,) = _metrics(run_dir)["collisions"]
     assert _metrics(run_dir)["end_reason"] == "completed"  # the figures cover the whole run
+    assert (_metrics(run_dir)["scenario"], _metrics(run_dir)["seed"]) == ("metrics", 5)
     assert hit["bodies"] == ["a", "b"]
     overlap = _first(b["x"] - a["x"] <= 2 * HALF_LENGTH, a["t"])  # the boxes, along x
     pushed = _first(a["ax"] < -10.0, a["t"])  # thrust gives < 1 m/s^2

@@ -139,3 +139,17 @@ def test_a_model_without_a_shape_is_drawn_as_its_hull_box(tmp_path: Path) -> Non
     assert len(box.mesh.triangles) == 12 and len(np.unique(box.mesh.vertices, axis=0)) == 8
     assert np.allclose(box.mesh.lo, lo) and np.allclose(box.mesh.hi, hi)
     assert len(shape.mesh.triangles) > 12
+
+
+def test_twist_set_points_are_step_lines_with_their_values(tmp_path: Path) -> None:
+    """A navigator's set-points (and the traffic's) were missing from run.rrd: only a
+    script's were drawn."""
+
+    def log(logger: RunLogger, _world: World) -> None:
+        logger.setpoints("ego", [0, 100_000_000], [(1.0, 0.1), (1.5, -0.2)])
+        logger.setpoints("ego", [], [])  # a vessel never commanded: nothing
+
+    got = _record(tmp_path / "t.rrd", log)
+    assert _column(got["/series/setpoint/ego"], ":scalars") == [[1.0, 0.1], [1.5, -0.2]]
+    names = _column(got["/series/setpoint/ego"], ":names")
+    assert names == [["ego surge [m/s]", "ego yaw rate [rad/s]"]]
