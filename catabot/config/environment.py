@@ -108,11 +108,11 @@ def _check_polygon(vertices: list[Vec2] | None) -> None:
     if vertices is None or len(vertices) < 3:
         got = 0 if vertices is None else len(vertices)
         raise ValueError(f"a polygon zone needs vertices_m with at least 3 points (got {got})")
-    if abs(polygon_area(vertices)) < 1e-9:
-        raise ValueError("polygon vertices_m enclose no area (all points on a line?)")
-    crossing = polygon_self_intersects(vertices)
+    crossing = polygon_self_intersects(vertices)  # first: a bow tie's halves cancel in area
     if crossing is not None:
         raise ValueError(f"polygon vertices_m: edges {crossing[0]} and {crossing[1]} cross")
+    if abs(polygon_area(vertices)) < 1e-9:
+        raise ValueError("polygon vertices_m enclose no area (all points on a line?)")
 
 
 class WindConfig(Strict):

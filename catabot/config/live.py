@@ -277,6 +277,7 @@ def check_timeline(scenario: Scenario) -> None:
     """Refuse a timeline entry with an unknown key, a bad value or a time that is no time.
     One past the run's end is taken and never applies (the conductor tells it): a sweep's
     `--duration` shorter than the timeline is no mistake in the file, as for scripts."""
+    seen: dict[tuple[int, str], int] = {}  # (tick, key): the entry that sets it there
     for i, s in enumerate(scenario.settings):
         if not math.isfinite(s.t_s):
             raise FieldProblem(f"settings.{i}.t_s", f"must be a finite time (got {s.t_s})")
@@ -284,6 +285,12 @@ def check_timeline(scenario: Scenario) -> None:
             check(scenario, s.key, s.value)
         except SettingError as exc:
             raise FieldProblem(f"settings.{i}", str(exc)) from None
+        at = (tick_at(s.t_s, scenario.dt_ns), s.key)
+        if at in seen:  # the file's order decided it, unsaid (script steps are refused so)
+            raise FieldProblem(f"settings.{i}", f"{s.key!r} at {s.t_s:g} s: settings."
+                               f"{seen[at]} sets it at the same tick; which should win? give "
+                               "one")  # fmt: skip
+        seen[at] = i
 
 
 def _short(value: Any) -> str:

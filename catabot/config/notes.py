@@ -1,15 +1,18 @@
 """Notes on a valid scenario that is likely not what its author meant, said before the run.
 
-Two kinds: a participant given several vessels (a catabot.client stack drives one), and a
-field of view that looks like radians: `hfov_deg: 1.5708` is a legal 1.6° camera, but far
-more often a 90° one written in radians (a trial user's scenario); refusing it would refuse
-the rare telephoto lens, and saying nothing leaves a dataset of sky to be found afterwards.
+A participant given several vessels (a catabot.client stack drives one), and a field of
+view that looks like radians: `hfov_deg: 1.5708` is a legal 1.6° camera, but far more often a
+90° one written in radians (a trial user's scenario); refusing it would refuse the rare
+telephoto lens, and saying nothing leaves a dataset of sky to be found afterwards. And entries
+of the timeline and of scripts after the run's end (late_settings, late_steps): taken, since a
+sweep's `--duration` may cut a file short on purpose, but said.
 """
 
 from __future__ import annotations
 
 import math
 
+from catabot.config import live
 from catabot.config.scenario import Scenario
 
 FIELDS_OF_VIEW = ("hfov_deg", "vertical_fov_deg")
@@ -53,3 +56,22 @@ def angle_notes(scenario: Scenario) -> list[str]:
                         f"{math.degrees(value):.4g} degrees: give that"
                     )
     return notes
+
+
+def late_settings(scenario: Scenario) -> list[str]:
+    """Timeline entries after the run's last tick (a `--duration` shorter than the file's):
+    taken, never applied. Said by `scenario validate` and by the conductor at a run."""
+    last = live.last_tick_s(scenario)
+    return [f"settings.{i} ({s.key} at {s.t_s:g} s) comes after the run's last tick "
+            f"({last:g} s), so it never applies"
+            for i, s in enumerate(scenario.settings)
+            if live.after_end(scenario, s.t_s)]  # fmt: skip
+
+
+def late_steps(scenario: Scenario) -> list[str]:
+    """Script steps after the run's last tick: said by `scenario validate` and physics."""
+    last = live.last_tick_s(scenario)
+    return [f"{v.id}: its script step at {step.t_s:g} s comes after the run's last tick "
+            f"({last:g} s), so it is never applied"
+            for v in scenario.vessels for step in v.script
+            if live.after_end(scenario, step.t_s)]  # fmt: skip

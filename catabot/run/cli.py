@@ -14,7 +14,7 @@ from pathlib import Path
 
 from catabot.bus.session import Connection, SessionError, add_connection_args, open_session
 from catabot.config.load import json_schema, model_schema
-from catabot.config.notes import scenario_notes
+from catabot.config.notes import late_settings, late_steps, scenario_notes
 from catabot.config.scenario import WaterConfig
 from catabot.config.vessel import VesselModelError, load_vessel_model
 from catabot.errors import CataBotError
@@ -162,6 +162,8 @@ def _scenario(args: argparse.Namespace) -> int:
     print(f"{args.file or 'default'}: valid ({counts})")
     for note in scenario_notes(s):
         print(note)
+    for text in [*late_settings(s), *late_steps(s)]:  # at a run: the conductor's, physics'
+        print(f"note: {text}")
     return 0
 
 

@@ -34,6 +34,7 @@ from catabot.bus.session import (
 from catabot.bus.settings import Schedule
 from catabot.config import live
 from catabot.config.load import digest, load_scenario
+from catabot.config.notes import late_settings
 from catabot.config.scenario import Scenario, participants
 from catabot.errors import CataBotError
 from catabot.run.advice import advise
@@ -68,11 +69,8 @@ HEARTBEAT_S = 0.5
 
 def _tell_late_settings(scenario: Scenario) -> None:
     """Advice on timeline entries after the run's last tick (taken, never applied)."""
-    last = live.last_tick_s(scenario)
-    for i, s in enumerate(scenario.settings):
-        if live.after_end(scenario, s.t_s):
-            advise(log, f"settings.{i} ({s.key} at {s.t_s:g} s) comes after the run's last "
-                        f"tick ({last:g} s), so it never applies")  # fmt: skip
+    for text in late_settings(scenario):
+        advise(log, text)
 
 
 def emit(kind: str, **fields: object) -> bool:

@@ -21,8 +21,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from catabot.bus.messages import Message, ThrustCmd, TwistBatch, TwistCmd, WaypointsCmd
-from catabot.config import live
-from catabot.config.scenario import Scenario, ScriptStep
+from catabot.config.scenario import ScriptStep
 from catabot.run.advice import advise, tell
 from catabot.world.orders import Orders, command_timeouts, script_step
 from catabot.world.world import Body
@@ -140,16 +139,6 @@ class CommandBook:
             if isinstance(msg, TwistCmd) and msg.tick >= 0:
                 self.set_point[self.row[vessel]] = (msg.surge, msg.yaw_rate)
                 self.has_set_point[self.row[vessel]] = True
-
-
-def never_applied(vessels: Sequence[Body], scenario: Scenario) -> list[str]:
-    """Advice on script steps after the run's last tick (a `--duration` shorter than the
-    script, say): they are taken, and never applied."""
-    last = live.last_tick_s(scenario)
-    return [f"{v.id}: its script step at {step.t_s:g} s comes after the run's last tick "
-            f"({last:g} s), so it is never applied"
-            for v in vessels for step in v.script
-            if live.after_end(scenario, step.t_s)]  # fmt: skip
 
 
 def _place(

@@ -18,11 +18,12 @@ from catabot.bus.settings import changes_of
 from catabot.bus.strays import watch_strays
 from catabot.bus.taken import entry
 from catabot.config import live
+from catabot.config.notes import late_steps
 from catabot.run.advice import advise
 from catabot.run.service import Built, ServiceContext, run_service
 from catabot.world.sea_change import SeaChange
 from services.physics import settings
-from services.physics.commands import CommandBook, never_applied, some
+from services.physics.commands import CommandBook, some
 from services.physics.control import TwistControllerBank
 from services.physics.reach import Reach
 from services.physics.setup import build_world
@@ -50,7 +51,7 @@ class PhysicsService:
         self.book = CommandBook(world.vessels)
         self.driven_by = world.driven_by  # clock.policy drop: the vessels a participant drove
         self.reach = Reach(world.vessels, self.controllers.single)  # says a twist is too much
-        for text in never_applied(world.vessels, world.scenario):
+        for text in late_steps(world.scenario):
             advise(log, text)
         streams = world.streams
         self.streams = [*streams.commands, *streams.controls, *streams.waypoints]

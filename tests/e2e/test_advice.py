@@ -21,8 +21,11 @@ def test_a_scripted_twist_beyond_reach_is_told_on_the_console(tmp_path: Path) ->
          "sensors": [{"name": "low", "type": "lidar", "rate_hz": 10.0, "params": {
              "channels": 8, "columns": 64, "mount_xyz": [0.0, 0.0, 0.2]}}]},
     ]}  # fmt: skip
-    out = tmp_path / "runs"
-    result = catabot("run", str(scenario_file(tmp_path, data)), "--out", str(out), "--quiet")
+    out, file = tmp_path / "runs", str(scenario_file(tmp_path, data))
+    checked = catabot("scenario", "validate", file).stdout  # said before any run, too
+    assert "note: settings.0 (rain at 2 s) comes after the run's last tick (0.49 s)" in checked
+    assert "note: slow: its script step at 2 s comes after the run's last tick" in checked
+    result = catabot("run", file, "--out", str(out), "--quiet")
     assert result.returncode == 0, result.stderr
     told = [line for line in result.stderr.splitlines() if "beyond its thrusters" in line]
     assert len(told) == 1, result.stderr  # the console notes, as refusals

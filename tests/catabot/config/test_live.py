@@ -119,6 +119,12 @@ def test_the_timeline_is_checked_like_the_rest_of_the_scenario() -> None:
         )
     with pytest.raises(ScenarioError, match=r"settings\.0: rain: 99 is not allowed"):
         _scenario(settings=[{"t_s": 1, "key": "rain", "value": 99}])
+    twice = [{"t_s": 3, "key": "current", "value": [0.5, 0]},
+             {"t_s": 2.995, "key": "current", "value": [-0.5, 0]}]  # fmt: skip
+    with pytest.raises(ScenarioError, match=r"settings\.1: 'current' at 2.995 s: settings\.0 "
+                       r"sets it at the same tick; which should win\? give one"):  # fmt: skip
+        _scenario(settings=twice)  # the last one won, unsaid
+    _scenario(settings=[twice[0], {"t_s": 3, "key": "rain", "value": 5}])  # another key: fine
     late = _scenario(settings=[{"t_s": 5, "key": "rain", "value": 1}])  # past the end: taken
     assert Schedule(live.timeline(late), ticks=late.ticks).in_force() == []  # never applied
 

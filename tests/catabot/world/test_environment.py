@@ -41,6 +41,14 @@ def circle(**kw: Any) -> WindZone:
             {"shape": "polygon", "speed_mps": 1, "vertices_m": [(0, 0), (3, 3), (3, 0), (0, 2)]},
             "edges 0 and 2 cross",
         ),
+        (  # a bow tie: its halves' areas cancel, and it said "enclose no area"
+            {
+                "shape": "polygon",
+                "speed_mps": 1,
+                "vertices_m": [(20, 20), (80, 80), (80, 20), (20, 80)],
+            },
+            "edges 0 and 2 cross",
+        ),
         (
             {"shape": "polygon", "speed_mps": 1, "vertices_m": L_SHAPE, "radius_m": 1},
             "only for shape 'circle'",
