@@ -18,6 +18,7 @@ from catabot.world.shapes import vessel_mesh
 
 SPREAD = 3.0  # a mesh this many times larger (or smaller) than the hulls is suspect
 THRUSTER_ROOM_M = 0.5  # a thruster this far outside every hull's box is suspect
+TINY_GYRATION = 0.02  # of the length: the bundled models' smallest is 0.10
 
 
 def displacement(model: VesselModel, density: float) -> str:
@@ -31,7 +32,22 @@ def displacement(model: VesselModel, density: float) -> str:
 
 
 def model_notes(model: VesselModel, *, source: str) -> list[str]:
-    return [*_mesh(model, source), *_thrusters(model), *_masses(model), *_course(model)]
+    return [*_mesh(model, source), *_thrusters(model), *_masses(model), *_course(model),
+            *_balance(model)]  # fmt: skip
+
+
+def _balance(model: VesselModel) -> list[str]:
+    """Where it floats: a centre of gravity beyond the hulls (a trial's model, 5 m forward on
+    a 4.4 m boat, capsized in 2 s), hulls above the waterline z = 0 of the body frame."""
+    lo, hi = model.hull_box()
+    (x, y, _), notes = model.cog_m, []
+    if not (lo[0] <= x <= hi[0] and lo[1] <= y <= hi[1]):
+        notes.append(f"its centre of gravity ({x:g}, {y:g}) m lies outside every hull in plan "
+                     "view: it floats heeled or trimmed over, or capsizes")  # fmt: skip
+    if lo[2] > 0.0:
+        notes.append(f"its hulls' bottom is {lo[2]:g} m above z = 0, the waterline at "
+                     "rest (body frame): it sinks to float, thrusters and mounts too")  # fmt: skip
+    return notes
 
 
 def _course(model: VesselModel) -> list[str]:
@@ -94,4 +110,8 @@ def _masses(model: VesselModel) -> list[str]:
             notes.append(f"its radius of gyration about {axis} is {radius:.3g} m, more than "
                          f"its length ({size:.3g} m): mass in tonnes, or inertia in another "
                          "unit?")  # fmt: skip
+        elif radius < TINY_GYRATION * size:
+            notes.append(f"its radius of gyration about {axis} is {radius:.3g} m, under "
+                         f"{TINY_GYRATION:g} of its length ({size:.3g} m): inertia in another "
+                         "unit (kg m^2)?")  # fmt: skip
     return notes

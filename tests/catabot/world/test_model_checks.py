@@ -45,6 +45,13 @@ def test_the_bundled_models_have_nothing_to_note() -> None:
          "thruster 0 at (3, 0.4) m is 2.05 m outside every hull"),
         ({"damping": CATAMARAN["damping"] | {"lift_uv": [0.0, 0.0]}},
          "cannot hold a straight course above 1.74 m/s, below its top speed (1.88 m/s)"),
+        ({"cog_m": [5.0, 0.0, 0.19]},  # a trial's model: capsized in 2 s, validate said valid
+         "its centre of gravity (5, 0) m lies outside every hull in plan view"),
+        ({"hulls": [h | {"center_m": [h["center_m"][0], h["center_m"][1], 2.0]}
+                    for h in CATAMARAN["hulls"]]},
+         "its hulls' bottom is 1.85 m above z = 0, the waterline at rest (body frame)"),
+        ({"inertia_kgm2": [v / 1000 for v in CATAMARAN["inertia_kgm2"]]},
+         "radius of gyration about x is 0.0114 m, under 0.02 of its length"),
     ],
 )  # fmt: skip
 def test_a_slip_is_noted(tmp_path: Path, changes: dict[str, Any], note: str) -> None:
