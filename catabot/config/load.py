@@ -89,7 +89,9 @@ def absolute_paths(data: Any, base: Path) -> Any:
     if not isinstance(data, dict):
         return data
     data = json.loads(json.dumps(data))
-    _absolute(_node(data, "terrain"), "elevation_image", base, bundled=TERRAINS)
+    terrain = _node(data, "terrain")
+    _absolute(terrain, "elevation_image", base, bundled=TERRAINS)
+    _bundled_scale(terrain)
     _absolute(_node(data, "water", "current", "map"), "path", base)
     vessels = data.get("vessels")
     for vessel in vessels if isinstance(vessels, list) else []:
@@ -119,6 +121,18 @@ def _absolute(node: dict[str, Any], key: str, base: Path, *, bundled: Path | Non
     if bundled is not None and named and not path.exists() and (bundled / node[key]).is_file():
         path = bundled / node[key]
     node[key] = str(path)
+
+
+def _bundled_scale(terrain: dict[str, Any]) -> None:
+    """A bundled image's own heights and scale where the scenario gives none (`bay.json`
+    beside `bay.png`, the harbour's): a PNG carries none, and the defaults (5 m a pixel, -35
+    to 60 m) made `"bay.png"` alone a bay 2.5 times the harbour's."""
+    image = terrain.get("elevation_image")
+    if not isinstance(image, str) or Path(image).resolve().parent != TERRAINS.resolve():
+        return
+    sidecar = Path(image).with_suffix(".json")
+    for key, value in (json.loads(sidecar.read_text()) if sidecar.is_file() else {}).items():
+        terrain.setdefault(key, value)
 
 
 def _program(controller: dict[str, Any], base: Path) -> None:

@@ -12,7 +12,7 @@ import sys
 from pathlib import Path
 from typing import Any
 
-from catabot.config.load import TERRAINS, absolute_paths, parse_scenario
+from catabot.config.load import absolute_paths, parse_scenario
 from catabot.config.traffic import BEHAVIOURS
 from catabot.errors import CataBotError
 from catabot.run.answer import answered, output_file
@@ -51,19 +51,8 @@ def scenario_data(args: argparse.Namespace) -> dict[str, Any]:
         "traffic": {"count": given(args, "boats"), "behaviour_mix": mix},
     }
     if args.terrain:  # from the current directory, or a bundled one named bare
-        data["terrain"] = {"elevation_image": args.terrain, **_bundled_scale(args.terrain)}
+        data["terrain"] = {"elevation_image": args.terrain}  # a bundled one: its own scale
     return absolute_paths(data, Path.cwd())
-
-
-def _bundled_scale(image: str) -> dict[str, Any]:
-    """A bundled image's own heights and scale (`bay.json` beside `bay.png`, as the harbour
-    scenario gives them): a PNG carries none, and the defaults (5 m a pixel, -35 to 60 m)
-    made a bay 2.5 times the harbour's, not the harbour's bay."""
-    sidecar = (TERRAINS / image).with_suffix(".json")
-    if "/" in image or Path(image).is_file() or not sidecar.is_file():
-        return {}
-    scale: dict[str, Any] = json.loads(sidecar.read_text())
-    return scale
 
 
 DEFAULTS = {"boats": 10, "mix": "circle=1", "seed": 0, "duration": 60.0, "name": "traffic"}

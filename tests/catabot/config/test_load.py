@@ -33,6 +33,18 @@ def test_a_copied_bundled_scenario_still_finds_its_terrain(tmp_path: Path) -> No
     assert load_scenario(copy).terrain.elevation_image == str(TERRAINS / "bay.png")  # type: ignore[union-attr]
 
 
+@pytest.mark.parametrize("image", ["bay.png", str(TERRAINS / "bay.png")])
+def test_the_bundled_image_brings_its_own_heights_and_scale(tmp_path: Path, image: str) -> None:
+    """`"bay.png"` alone made a 1500 m bay (the defaults: 5 m a pixel, -35 to 60 m), while
+    `scenario generate --terrain bay.png` made the harbour's 600 m one (bay.json)."""
+    path = tmp_path / "s.json"
+    terrain = {"elevation_image": image, "metres_per_pixel": 3.0}  # what it gives stays
+    path.write_text(json.dumps({"name": "s", "terrain": terrain, "vessels": [{"id": "ego"}]}))
+    got = load_scenario(path).terrain
+    assert got is not None
+    assert (got.min_elevation_m, got.max_elevation_m, got.metres_per_pixel) == (-15.0, 25.0, 3.0)
+
+
 def test_an_image_beside_the_scenario_comes_before_the_bundled_one(tmp_path: Path) -> None:
     shutil.copy(BAY, tmp_path / "bay.png")
     path = tmp_path / "s.json"
