@@ -190,17 +190,23 @@ class Planner:
 
     def _points(self, region: Region, count: int) -> list[Point]:
         """`count` points drawn as `_point` draws them one by one (x then y, in order)."""
-        cx, cy = self._centre(region)
-        w, h = region.size_m
-        xy = self.rng.uniform((-w / 2, -h / 2), (w / 2, h / 2), size=(count, 2))
-        return [(float(cx + x), float(cy + y)) for x, y in xy.tolist()]
+        lo, hi = self._bounds(region)
+        return [(float(x), float(y)) for x, y in self.rng.uniform(lo, hi, (count, 2)).tolist()]
 
     def _point(self, region: Region) -> Point:
-        cx, cy = self._centre(region)
-        w, h = region.size_m
-        return float(cx + self.rng.uniform(-w / 2, w / 2)), float(
-            cy + self.rng.uniform(-h / 2, h / 2)
-        )
+        (x0, y0), (x1, y1) = self._bounds(region)
+        return float(self.rng.uniform(x0, x1)), float(self.rng.uniform(y0, y1))
+
+    def _bounds(self, region: Region) -> tuple[Point, Point]:
+        """The region's corners, cut to the terrain's (beyond its edge there is no water: a
+        default 1000 m region over the bundled 600 m bay drew two points in five off it)."""
+        (cx, cy), (w, h) = self._centre(region), region.size_m
+        lo, hi = (cx - w / 2, cy - h / 2), (cx + w / 2, cy + h / 2)
+        if self.terrain is None:
+            return lo, hi
+        (tw, th) = self.terrain.size_m
+        cut = (max(lo[0], 0.0), max(lo[1], 0.0)), (min(hi[0], tw), min(hi[1], th))
+        return cut if cut[0][0] < cut[1][0] and cut[0][1] < cut[1][1] else (lo, hi)
 
     def _centre(self, region: Region) -> Point:
         if region.center_m is not None:

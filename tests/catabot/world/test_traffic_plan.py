@@ -12,6 +12,7 @@ from catabot.config.vessel import load_vessel_model
 from catabot.world.placement import CLEARANCE_M, footprint_m
 from catabot.world.traffic_plan import START_ROOM_M, TrafficPlan
 from catabot.world.world import World
+from tests.paths import BAY
 
 HULL = footprint_m(load_vessel_model("monohull"))
 BUOY = footprint_m(load_vessel_model("buoy"))
@@ -133,3 +134,17 @@ def test_drawn_buoys_keep_off_a_vessels_way_to_its_task() -> None:
     ego = footprint_m(load_vessel_model("catabot"))
     assert gap.min() > ego + BUOY + CLEARANCE_M
     assert np.hypot(*(buoys - (0.0, 80.0)).T).min() > 6.0 + BUOY + CLEARANCE_M
+
+
+def test_waypoints_of_the_default_region_are_drawn_on_the_terrain() -> None:
+    """The default 1000 m region over the bundled 600 m bay drew two points in five off it,
+    so 50 boats on waypoints found no paths ("no path of 5 waypoints ... in 5000 draws")."""
+    world = World.resolve(parse_scenario({
+        "seed": 3, "terrain": {"elevation_image": str(BAY), "min_elevation_m": -15.0,
+                               "max_elevation_m": 25.0, "metres_per_pixel": 2.0},
+        "vessels": [{"id": "ego"}],
+        "traffic": {"count": 50, "behaviour_mix": {"waypoints": 1.0}},
+    }))  # fmt: skip
+    assert world.terrain is not None and world.terrain.size_m == (600.0, 600.0)
+    points = np.array([p for boat in world.traffic.boats for p in boat.path])
+    assert len(points) == 250 and (points >= 0).all() and (points <= 600).all()
