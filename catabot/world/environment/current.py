@@ -107,7 +107,15 @@ class CurrentField:
 
 
 def load_current_map(config: CurrentMapConfig, *, base_dir: Path | None = None) -> Array:
-    """Read a current map file into a (rows, cols, 2) float64 grid, row 0 at the south edge."""
+    """Read a current map file into a (rows, cols, 2) float64 grid, row 0 at the south edge;
+    a refusal names the field, as the rest of a scenario's do."""
+    try:
+        return _load_map(config, base_dir)
+    except CurrentMapError as exc:
+        raise CurrentMapError(f"water.current.map: {exc}") from None
+
+
+def _load_map(config: CurrentMapConfig, base_dir: Path | None) -> Array:
     path = Path(config.path)
     if not path.is_absolute() and base_dir is not None:
         path = Path(base_dir) / path

@@ -229,5 +229,5 @@ def test_bad_current_map_is_refused(
 def test_grey_image_is_refused(tmp_path: Path) -> None:
     Image.fromarray(np.zeros((2, 2), dtype=np.uint8), "L").save(tmp_path / "g.png")
     config = CurrentMapConfig(path=str(tmp_path / "g.png"), spacing_m=1.0, scale_mps=1.0)
-    with pytest.raises(CurrentMapError, match="image mode 'L'"):
-        CurrentField.from_config(CurrentConfig(map=config))
+    with pytest.raises(CurrentMapError, match=r"^water\.current\.map: current map .* mode 'L'"):
+        CurrentField.from_config(CurrentConfig(map=config))  # named as the field, as others
