@@ -105,7 +105,7 @@ def test_tiff_float_metres_and_integer_scaling(tmp_path: Path) -> None:
 
 
 def test_precise_errors(tmp_path: Path) -> None:
-    where = r"\(a relative path is taken from the scenario file's folder; .* images: bay.png\)$"
+    where = r"\(a relative path is taken from the scenario file's folder, .* images: bay.png\)$"
     with pytest.raises(TerrainError, match=r"elevation_image: file not found: .*nope.png " + where):
         load_terrain(config(tmp_path / "nope.png"))
     (tmp_path / "junk.png").write_bytes(b"definitely not an image")
