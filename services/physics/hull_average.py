@@ -49,9 +49,19 @@ class HullAverage:
         self._weights = weights  # (L, C)
         self._re: F32 | None = None
         self._im: F32 | None = None
+        self._tables: dict[bytes, tuple[F32, F32]] = {}  # the last three seas' (use)
 
     def use(self, waves: WaveField) -> None:
-        """The factors of a sea's components (at the start and at a change of the waves)."""
+        """The factors of a sea's components (at the start and at a change of the waves).
+        They depend on the components' wave vectors alone, not their amplitudes, so the 40
+        stages of a change of sea (sea_change.py: the same components, rescaled) share one
+        table: built at every stage, 0.1 s each, a paced run fell behind for 10 s."""
+        key = waves.wavenumbers_radpm.tobytes() + waves.directions_rad.tobytes()
+        if key not in self._tables:
+            self._tables = {**dict(list(self._tables.items())[-2:]), key: self._build(waves)}
+        self._re, self._im = self._tables[key]
+
+    def _build(self, waves: WaveField) -> tuple[F32, F32]:
         heading = np.arange(BINS) * (2.0 * math.pi / BINS)
         turned = waves.directions_rad[None, :] - heading[:, None]  # (B, M)
         k = waves.wavenumbers_radpm[None, :]
@@ -60,7 +70,7 @@ class HullAverage:
         for layout, (plan, w) in enumerate(zip(self._plan, self._weights, strict=True)):
             real = w > 0  # padding columns weigh nothing
             factor[layout] = _factor(plan[real], w[real], kx, ky)
-        self._re, self._im = factor.real.astype(np.float32), factor.imag.astype(np.float32)
+        return factor.real.astype(np.float32), factor.imag.astype(np.float32)
 
     def average(self, cos: F32, sin: F32, rot: Array) -> tuple[F32, F32]:
         """The waterplane averages of cos and sin of each body's phases (N, M), given the

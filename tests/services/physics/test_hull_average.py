@@ -42,3 +42,21 @@ def test_a_hull_short_against_the_waves_sees_its_origins_velocity() -> None:
     hulls.use(WaveField(WaveConfig(preset="heavy"), 3))
     assert hulls._re is not None and hulls._im is not None
     assert np.abs(hulls._re - 1.0).max() < 0.01 and np.abs(hulls._im).max() < 0.01
+
+
+def test_the_stages_of_a_change_of_sea_share_one_table() -> None:
+    """A change of sea rescales the same components 40 times in 10 s (sea_change.py): built
+    at every stage, the table cost 0.1 s each and a paced run fell behind."""
+    cols = build_columns([load_vessel_model("wamv")])
+    hulls = HullAverage(cols.bottom_m.transpose(0, 2, 1), cols.area_m2)
+    medium, heavy = (
+        WaveField(WaveConfig(preset="medium"), 1),
+        WaveField(WaveConfig(preset="heavy"), 1),
+    )
+    hulls.use(WaveField.blend(medium, heavy, 0.025))
+    first = hulls._re
+    hulls.use(WaveField.blend(medium, heavy, 0.5))
+    assert hulls._re is first  # the same components, only rescaled: the same table
+    hulls.use(heavy)
+    assert hulls._re is not first and hulls._re is not None
+    assert hulls._re.shape == (1, 512, heavy.amplitudes_m.size)
