@@ -71,8 +71,9 @@ def main(argv: list[str] | None = None) -> None:
     print()
     print("| what | env steps/s | control periods/s of the bare run | target |")
     print("|---|---:|---:|---|")
+    share = open_one.rate / open_bare
     print(f"| 1 world, state only, open water | **{open_one.rate:.0f}** | {open_bare:.0f} | "
-          f">= {TARGET:.0f}: {met} |")  # fmt: skip
+          f">= {TARGET:.0f}: {met} ({share:.2f} of the bare run) |")  # fmt: skip
     print(f"| 1 world, state only, the bay | {one.rate:.0f} | {bare:.0f} | |")
     print(f"| 1 world, state + LiDAR 16 x 64 | {lidar.rate:.0f} | | |")
     print(f"| 4 worlds, AsyncVectorEnv, state only | {asyn:.0f} (4 x {asyn / 4:.0f}) | | |")
