@@ -290,8 +290,8 @@ def _viewer(opts: RunOptions, run_dir: Path, svc_flags: list[str]) -> Viewer | N
         return None
     viewer = start_viewer(opts.view, run_dir, svc_flags, hold=sys.stdin.isatty())
     if not viewer.wait_ready():
-        print(f"catabot run: the viewer did not start: {viewer.why()} (--view web here)",
-              file=sys.stderr)  # fmt: skip
+        print(f"catabot run: the viewer did not start: {viewer.why()} (for a run: --view "
+              "web, or --set recording.rerun=true for run.rrd)", file=sys.stderr)  # fmt: skip
     elif viewer.url:
         print(f"rerun web viewer: {viewer.url}", flush=True)
     return viewer
