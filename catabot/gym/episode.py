@@ -17,7 +17,7 @@ from typing import Any
 import numpy as np
 
 from catabot.config.base import ScenarioError
-from catabot.config.load import load_scenario, parse_scenario
+from catabot.config.load import absolute_paths, load_scenario, parse_scenario
 from catabot.config.rates import rate_in_ticks
 from catabot.config.scenario import Pose, Scenario
 from catabot.config.terrain import TerrainError
@@ -177,8 +177,10 @@ class Draw:
 
 
 def _base(scenario: str | dict[str, Any]) -> Scenario:
+    """A dict's file paths are taken from the current folder, as `--set`'s are, and a bare
+    bundled image name (`bay.png`) names the bundled one, as in a file."""
     if isinstance(scenario, dict):
-        return parse_scenario(scenario, source="the env's scenario")
+        return parse_scenario(absolute_paths(scenario, Path.cwd()), source="the env's scenario")
     return load_scenario(Path(scenario) if scenario.endswith(".json") else scenario)
 
 

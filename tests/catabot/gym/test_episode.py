@@ -90,3 +90,10 @@ def test_another_vessel_with_a_controller_no_program_starts_is_refused_before_an
         Draw(env_options(scenario=swarm))  # fmt: skip
     scripted = {"vessels": [{"id": "leader"}, {"id": "f1", "pose": {"x_m": 20.0, "y_m": 0.0}}]}
     assert Draw(env_options(scenario=scripted)).vessel == "leader"  # scripted: as they are
+
+
+def test_a_dict_scenario_may_name_the_bundled_bay_bare() -> None:
+    """A file could say `"bay.png"`; a dict given to the env got "file not found"."""
+    data = {"terrain": {"elevation_image": "bay.png"}, "vessels": [{"id": "ego"}]}
+    draw = Draw(env_options(scenario=data))
+    assert draw.terrain is not None and draw.terrain.size_m == (600.0, 600.0)  # bay.json's
