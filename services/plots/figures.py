@@ -214,8 +214,8 @@ def thrust(data: RunSeries) -> Figure | None:
             if series is None:
                 continue
             t, held = _in_force(series.t, series.values, other.t if other else None, end)
-            for c, name in enumerate(series.names):
-                ax.step(t, held[:, c], style, where="post", label=name)
+            for c, name in enumerate(series.names):  # thinner each: equal ones both show
+                ax.step(t, held[:, c], style, where="post", label=name, lw=max(2.8 - c, 1.0))
         ax.set(title=f"{vid}: commands (solid: thrust, -1..1; dashed: twist set-points)",
                xlabel="simulated time [s]", xlim=(0, end))  # fmt: skip
         ax.grid(alpha=0.3)
