@@ -62,11 +62,11 @@ def _label(pen: ImageDraw.ImageDraw, row: NDArray[np.float64], flags: NDArray[np
     name = _class_name(int(row[1]))
     text = f"{name} {int(row[0])} {int(flags[2])}%"
     at = (float(row[2]), max(float(row[3]) - 11, 0.0))
-    x0, y0, x1, y1 = pen.textbbox(at, text)
+    x0, y0, x1, y1 = pen.textbbox(at, text, stroke_width=1)
     if any(x0 < b[2] and b[0] < x1 and y0 < b[3] and b[1] < y1 for b in taken):
         return
-    taken.append((x0, y0, x1, y1))
-    pen.text(at, text, fill=COLOURS.get(name, (255, 255, 255)))
+    taken.append((x0, y0, x1, y1))  # outlined in black: a buoy's yellow on a pale sky
+    pen.text(at, text, fill=COLOURS.get(name, (255, 255, 255)), stroke_width=1, stroke_fill=0)
 
 
 def _outlined(image: Image.Image, instance: NDArray[np.generic], frame: Frame) -> Image.Image:
