@@ -11,6 +11,7 @@ from __future__ import annotations
 import argparse
 import json
 import os
+import random
 import re
 import socket
 import time
@@ -26,6 +27,7 @@ from catabot.errors import CataBotError
 
 MODES = ("peer", "client", "router")
 LEASE_MS = 1500
+FIRST_PORT = 20000  # free_port draws from here to the ephemeral range: above the well-known
 LOOPBACK = "tcp/127.0.0.1:0"
 RETRY = "{period_init_ms: 250, period_max_ms: 1000, period_increase_factor: 2}"  # connect
 ASK_AGAIN_S = 0.2  # between two queries nobody answered (until_answered)
@@ -229,10 +231,30 @@ def alone(session: zenoh.Session) -> str:
 
 
 def free_port() -> int:
-    """A TCP port that is free on loopback now (the embedded conductor listens on it)."""
+    """A TCP port that is free on loopback now (the embedded conductor listens on it), below
+    the kernel's ephemeral range: a port from bind(0) lies in that range, where any outgoing
+    connection may take it before the listener binds it (a CI run's test lost a run to
+    "Address already in use" so). Drawn at random, each tried; bind(0) if none is free."""
+    low = _ephemeral_low()
+    for port in random.Random().sample(range(FIRST_PORT, low), k=min(64, low - FIRST_PORT)):
+        with socket.socket(socket.AF_INET, socket.SOCK_STREAM) as s:
+            try:
+                s.bind(("127.0.0.1", port))
+            except OSError:
+                continue
+            return port
     with socket.socket(socket.AF_INET, socket.SOCK_STREAM) as s:
         s.bind(("127.0.0.1", 0))
         return int(s.getsockname()[1])
+
+
+def _ephemeral_low() -> int:
+    """The lowest port the kernel gives outgoing connections (Linux; 32768 elsewhere)."""
+    try:
+        low = int(Path("/proc/sys/net/ipv4/ip_local_port_range").read_text().split()[0])
+    except (OSError, ValueError, IndexError):
+        return 32768
+    return max(low, FIRST_PORT + 1)
 
 
 def add_connection_args(parser: argparse.ArgumentParser) -> None:

@@ -8,6 +8,7 @@ import time
 
 import pytest
 
+from catabot.bus import session
 from catabot.bus.session import (
     Connection,
     SessionError,
@@ -70,3 +71,13 @@ def test_a_session_that_reaches_nobody_is_told_so_and_one_that_does_is_not() -> 
             other.close()
     finally:
         lonely.close()
+
+
+def test_a_free_port_lies_below_the_kernels_ephemeral_range() -> None:
+    """bind(0)'s ports are the ones outgoing connections take: one did, between a test's
+    pick and its run's bind ("Address already in use")."""
+    low = session._ephemeral_low()
+    ports = {session.free_port() for _ in range(20)}
+    assert all(session.FIRST_PORT <= p < low for p in ports), ports
+    with socket.socket(socket.AF_INET, socket.SOCK_STREAM) as s:
+        s.bind(("127.0.0.1", ports.pop()))  # free indeed
