@@ -61,6 +61,17 @@ def ender_of(reason: str) -> str | None:
     return rest.split("'", 2)[1] if found and not head and rest.startswith("'") else None
 
 
+def blame(name: str, what: str) -> str:
+    """A run's error that names the participant at fault (`blames` reads it back)."""
+    return f"participant {name!r} {what}"
+
+
+def blames(error: str, name: str) -> bool:
+    """Whether a run's error names `name` as the participant at fault (a launcher's cause
+    may quote it inside its own words)."""
+    return f"participant {name!r} " in error
+
+
 def never_joined(missing: list[str], timeout_s: float) -> str:
     """The conductor's fault when participants never came (`who_never_joined` reads it)."""
     return f"participant(s) {NEVER_JOINED} {timeout_s:g} s: {', '.join(missing)}"

@@ -47,14 +47,14 @@ class Conductor:
     ) -> None:
         self.session, self.keys, self.spec = session, keys, spec
         self.settings = settings if settings is not None else Schedule(ticks=spec.ticks)
-        self.run_id = uuid.uuid4().hex[:12]
-        self._created = time.monotonic()
+        self.run_id, self._created = uuid.uuid4().hex[:12], time.monotonic()
         self.events: queue.SimpleQueue[tuple[str, str, bytes]] = queue.SimpleQueue()
         roster = roster if roster is not None else Roster()
         claim(session, keys, CONDUCTOR, roster)  # NameTaken: a second conductor stops
         self._members = Members(keys, roster)
         self.rejections = Rejections(log, CONDUCTOR)
         self.dropped: dict[str, str] = {}  # name: why (policy drop)
+        self._left: set[str] = set()  # dropped for a token gone without words
         self._stop_reason = ""
         self._end_at: int | None = None  # the last tick, when a participant ended the run
         self._told = ""  # the fault a participant told (Ack.fault): the run's error
@@ -219,7 +219,7 @@ class Conductor:
         if told and self.spec.policy is not Policy.ABORT:  # its words, also once it left
             self._told_drop(name, told)
         elif told or ack.end:
-            self._end_request(name, ack, fault=f"participant {name!r} {told}" if told else "")
+            self._end_request(name, ack, fault=clock.blame(name, told) if told else "")
         self._advance()
 
     def _end_request(self, name: str, ack: Ack, *, fault: str = "") -> None:
@@ -268,9 +268,7 @@ class Conductor:
 
     def _check_events(self) -> None:
         """Apply pending membership events (a stop is noted in `_stop_reason`) and the deadline."""
-        while not self.events.empty():
-            self._next_event(0.0)
-        gone = self._gone(self._active())
+        gone = self._now_gone()
         if gone:  # a lost link takes every token behind it: name them together
             gone = self._settled_gone()
         active = self._active()  # less any dropped for a fault it told (policy drop)
@@ -282,6 +280,7 @@ class Conductor:
             )
         for name in gone:
             why = BEFORE if self._acked[name] < 0 else SILENT
+            self._left.add(name)  # until words of its own come (_told_drop)
             self._fault(name, f"{LEFT} at tick {self._acked[name] + 1}{why}")
         k = self._done
         if self._deadline is not None and time.monotonic() > self._deadline:
@@ -295,15 +294,16 @@ class Conductor:
         time.sleep(GONE_GRACE_S)
         while True:
             self._take_queued()
-            while not self.events.empty():
-                self._next_event(0.0)
-            gone = self._gone(self._active())
+            gone = self._now_gone()
             if not gone or self._told or time.monotonic() >= limit:
                 return gone
             time.sleep(GONE_GRACE_S / 4)
 
-    def _gone(self, active: list[str]) -> list[str]:
-        return [n for n in active if n not in self.members and not self._through(n)]
+    def _now_gone(self) -> list[str]:
+        """Events applied: the active ones whose token went (unless through the run's end)."""
+        while not self.events.empty():
+            self._next_event(0.0)
+        return [n for n in self._active() if n not in self.members and not self._through(n)]
 
     def _through(self, name: str) -> bool:
         """`name` has stepped the run's last tick (ended by a participant): it may leave."""
@@ -313,11 +313,12 @@ class Conductor:
         """Dropped for its words; they replace "left the run" that came first (a loaded VM)."""
         if name not in self.dropped:
             self._fault(name, told)
-        elif LEFT in self.dropped[name]:
-            self.dropped[name] = f"participant {name!r} {told}"
+        elif name in self._left:
+            self._left.discard(name)
+            self.dropped[name] = clock.blame(name, told)
 
     def _fault(self, name: str, what: str) -> None:
-        message = f"participant {name!r} {what}"
+        message = clock.blame(name, what)
         if self.spec.policy is Policy.ABORT:
             raise ClockError(message)
         log.error("%s; dropping it and going on (policy drop)", message)
@@ -332,8 +333,7 @@ class Conductor:
         except queue.Empty:
             return ("late", "", b"")
         kind, key, _ = event
-        joined = kind == "join"
-        if kind in ("join", "leave") and self._members.token(key, alive=joined) is None:
+        if kind in ("join", "leave") and self._members.token(key, alive=kind == "join") is None:
             self.rejections.add(key, Rejected("token contradicts the roster", key))
         return event
 

@@ -19,7 +19,7 @@ from collections.abc import Callable, Sequence
 import zenoh
 
 from catabot.bus import codec
-from catabot.bus.clock import CONDUCTOR, ClockError, ClockLimits, EndRun, Stream, end_reason
+from catabot.bus.clock import CONDUCTOR, ClockError, ClockLimits, EndRun, Stream, blames, end_reason
 from catabot.bus.identity import Roster, sender_of
 from catabot.bus.inbox import Inbox, Inputs
 from catabot.bus.keys import Keys
@@ -314,7 +314,7 @@ class Participant(Outputs):
 
     def _finish(self, end: End, on_end: EndFn | None) -> End:
         """Collect samples due up to the last complete tick, bounded in time."""
-        own = f"participant {self.name!r} " in end.error  # its own lateness held the others
+        own = blames(end.error, self.name)  # its own lateness held the others
         if end.error and not own:
             self._waited(self.next_tick)
         limit = time.monotonic() + (self.drain_s if not end.error else 1.0)

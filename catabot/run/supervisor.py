@@ -21,6 +21,7 @@ import threading
 import time
 from collections.abc import Callable, Iterator
 
+from catabot.bus import clock
 from catabot.bus.participant import WAITED
 from catabot.run.child import Child
 
@@ -176,7 +177,7 @@ class Supervisor:
         ended with an error: its own crash is the cause, not merely its leaving."""
         error = str(self.result.get("error", ""))
         for name, child in self.services.items():
-            left = child.program and f"participant {name!r}" in error
+            left = child.program and clock.blames(error, name)
             if left and _exits(child.proc, within_s=1.0):
                 child.crashed()
 
@@ -186,7 +187,7 @@ class Supervisor:
         whose data it waited for is not hung but starved: the cause is that data's sender."""
         error = str(self.result.get("error", ""))
         for name, child in self.services.items():
-            if f"participant {name!r}" in error and not _exits(child.proc, within_s=1.0):
+            if clock.blames(error, name) and not _exits(child.proc, within_s=1.0):
                 state = {"T": "stopped by a signal", "t": "stopped by a debugger"}.get(
                     child.state(), "alive but not stepping"
                 )
@@ -243,7 +244,7 @@ class Supervisor:
         skipped its command held physics at tick 101, then waited at 102 for physics), so
         the cause leads with that wait's sender when another participant was the one named
         (a stack asleep in its step had the recorder blamed)."""
-        named = [n for n in self.services if f"participant {n!r}" in error]
+        named = [n for n in self.services if clock.blames(error, n)]
         waits = sorted((_tick_of(line), n != named[0], n, line)
                        for n, line in self._waits()) if named else []  # fmt: skip
         if not waits:

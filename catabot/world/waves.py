@@ -211,12 +211,12 @@ class WaveField:
 
     def orbital(
         self, cos: NDArray[np.float32], sin: NDArray[np.float32], z: Array, *,
-        eta: Array | None = None,
+        eta: NDArray[np.float32] | None = None,
     ) -> Array:  # fmt: skip
         """`velocity` at points whose phases' cosines and sines are given, (P, M) float32
         each (overwritten): for a caller that has them already (physics' sea sampler, which
         gives them averaged over each hull with the surface height `eta` at its origin)."""
-        height = (cos @ self._height_w)[:, 0] if eta is None else eta
+        height = self.height_of(cos) if eta is None else eta
         depth = np.minimum(z - height, 0.0).astype(np.float32)
         decay = np.exp(depth[:, None] * self._k32)
         cos *= decay
@@ -225,6 +225,11 @@ class WaveField:
         out[:, :2] = cos @ self._orbital_w[:, :2]
         out[:, 2] = sin @ self._orbital_w[:, 2]
         return out
+
+    def height_of(self, cos: NDArray[np.float32]) -> NDArray[np.float32]:
+        """The surface height at points whose phases' cosines are given (P, M): `height`
+        for a caller that has them (`orbital`; physics' sea sampler)."""
+        return (cos @ self._height_w)[:, 0]
 
     def phases(self, x: ArrayLike, y: ArrayLike, t: ArrayLike = 0.0) -> NDArray[np.float32]:
         """Every component's phase k . (x, y) - omega t + phi at each point, (P, M) float32

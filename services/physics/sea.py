@@ -89,7 +89,7 @@ class SeaSampler:
         m = phase.shape[1]
         trig = np.empty((len(phase), 2 * m), np.float32)  # [cos | sin]: one matmul below
         cos, sin = np.cos(phase, out=trig[:, :m]), np.sin(phase, out=trig[:, m:])
-        eta = cos @ waves.amplitudes_m.astype(np.float32)  # at each origin: the stretching
+        eta = waves.height_of(cos)  # at each origin, for the stretching: before the average
         if self._order is not None:
             grid = (trig @ self._to_grid).reshape(len(phase), self._order + 1, self._order + 1)
             surface: WaterHeight = _Expansions(grid, self._row, self._pq, pos)
