@@ -34,7 +34,7 @@ WATER_HALF_M, WATER_CELLS = 80.0, 48
 
 
 class RunLogger:
-    def __init__(self, rec: rr.RecordingStream, world: World) -> None:
+    def __init__(self, rec: rr.RecordingStream, world: World, *, scripts: bool = True) -> None:
         self.rec, self.world = rec, world
         self.groups = body_groups(world)
         self.vessels = len(world.vessels)
@@ -43,7 +43,7 @@ class RunLogger:
         self._last = {"trail": -math.inf, "water": -math.inf}
         self._closest = math.inf
         self._named: set[str] = set()  # vessels whose set-point lines are named
-        log_static(rec, world)
+        log_static(rec, world, scripts=scripts)
         self._series_names()
         if self.waves.is_calm:
             self._calm_water()

@@ -17,7 +17,7 @@ from services.viewer.logger import RunLogger
 
 
 def replay(run: RecordedRun, rec: rr.RecordingStream) -> RunLogger:
-    logger = RunLogger(rec, run.world)
+    logger = RunLogger(rec, run.world, scripts=False)  # run.mcap holds the scripted ones
     states = run.states()
     for i in range(len(states)):
         logger.states(states.batch(i, run.dt_ns))

@@ -33,7 +33,10 @@ OPTICAL_TO_BODY = np.array([[0.0, 0.0, 1.0], [-1.0, 0.0, 0.0], [0.0, -1.0, 0.0]]
 """ROS optical frame (z forward, x right, y down) into the camera's FLU frame (DESIGN.md §8)."""
 
 
-def log_static(rec: rr.RecordingStream, world: World) -> None:
+def log_static(rec: rr.RecordingStream, world: World, *, scripts: bool) -> None:
+    """`scripts`: draw the scenario's scripted commands. The live view needs them (physics
+    follows a script without a word on the bus); a replay does not, since run.mcap holds
+    them as the commands they are, and drawing both doubled every scripted point."""
     rec.log(paths.WORLD, rr.ViewCoordinates.RIGHT_HAND_Z_UP, static=True)
     rec.log(paths.WORLD, rr.AnnotationContext(palette.class_table()), static=True)
     rec.log("minimap", rr.AnnotationContext(palette.class_table()), static=True)
@@ -41,7 +44,7 @@ def log_static(rec: rr.RecordingStream, world: World) -> None:
     _bodies(rec, world)
     for sensor in world.sensors:
         _mount(rec, sensor)
-    for body in world.vessels[: len(world.scenario.vessels)]:
+    for body in world.vessels[: len(world.scenario.vessels)] if scripts else []:
         _script(rec, body)
 
 

@@ -69,6 +69,7 @@ def test_run_rrd_holds_every_stream_on_sim_time(run: Path) -> None:
     assert rows["/series/imu_accel/ego.imu"] == topics["/ego/imu/imu"] == 100
     for boat in ("boat_000", "boat_001"):  # the traffic's set-points (only a script's before)
         assert rows[f"/series/setpoint/{boat}"] == topics[f"/{boat}/cmd_vel"] > 0
+    assert rows["/series/thrust/ego"] == topics["/ego/thrust"] == 1  # the script's, not twice
     assert (
         rows["/world/trails"] == round(VIZ_SECONDS / 0.2) + 1 and rows["/metrics"] == 1
     )  # from t = 0
