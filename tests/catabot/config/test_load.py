@@ -13,6 +13,7 @@ import pytest
 
 from catabot.config.base import ScenarioError
 from catabot.config.load import BUNDLED, TERRAINS, json_schema, load_scenario, parse_scenario
+from catabot.config.notes import scenario_notes
 from tests.paths import BAY
 
 
@@ -90,13 +91,16 @@ def test_a_sensors_unknown_parameter_lists_that_types_parameters(tmp_path: Path)
     assert "(allowed: gyro_sigma, accel_sigma" in message and "rate_hz" not in message
 
 
-def test_json_schema_is_valid_and_accepts_the_bundled_default() -> None:
+def test_json_schema_is_valid_and_accepts_every_bundled_scenario() -> None:
     schema = json_schema()
     validator_cls = jsonschema.validators.validator_for(schema)
     validator_cls.check_schema(schema)
     assert validator_cls is jsonschema.Draft202012Validator
-    default = json.loads((BUNDLED / "default.json").read_text())
-    validator_cls(schema).validate(default)
+    bundled = sorted(BUNDLED.glob("*.json"))
+    assert {p.stem for p in bundled} >= {"default", "harbour", "navigate", "perception"}
+    for path in bundled:
+        validator_cls(schema).validate(json.loads(path.read_text()))
+        assert scenario_notes(load_scenario(path.stem)) == [], path.name  # nothing to warn of
     validator_cls(schema).validate(_base())
     assert schema["title"] == "CataBot scenario"
     assert "vessels" in schema["required"]
