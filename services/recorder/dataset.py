@@ -10,8 +10,9 @@ Layout (one folder per sensor, `<vessel>.<sensor>`):
   frame with its boxes, each naming its body;
   every frame, or with `recording.dataset_rate_hz` one in every n (config/rates.py);
 - radars: `ppi_<tick>.png`, the north-up PPI (services/recorder/ppi.py) once per antenna turn;
-- with cameras or PPIs, `calibration.json`: every sensor's mount and each camera's K
-  (calibration.py): a radar-only run's mounts were in `/tf_static` alone.
+- with `recording.dataset` and a camera or a LiDAR, or with PPIs, `calibration.json`: every
+  sensor's mount and each camera's K (calibration.py): a radar-only run's mounts were in
+  `/tf_static` alone, and a LiDAR-only run (the KITTI export's scans) had none.
 PNGs are written with fixed settings and no time chunk, so the same run gives the same bytes.
 `catabot.run.recorded_camera` reads this layout back (dataset export, replay).
 """
@@ -102,7 +103,8 @@ class Dataset:
             if s.config.type == "radar" and recording.ppi
         }
         self._ppi: dict[str, Ppi] = {}
-        if (self.cameras and self.camera_period) or self.radar:  # dataset/ has sensor data
+        imaging = any(s.config.type in ("camera", "lidar") for s in world.sensors)
+        if (self.cameras and imaging) or self.radar:  # frames, scans to export, or PPIs
             write_calibration(root, world)
 
     def folder(self, stream: str) -> Path:

@@ -80,3 +80,21 @@ def test_a_radar_only_dataset_says_where_its_radar_sits(tmp_path: Path) -> None:
     Dataset(tmp_path, world)
     sensors = json.loads((tmp_path / "calibration.json").read_text())["sensors"]
     assert list(sensors) == ["ego.radar"] and "body_from_sensor" in sensors["ego.radar"]
+
+
+def test_a_lidar_only_dataset_says_where_its_lidar_sits(tmp_path: Path) -> None:
+    """`recording.dataset` with a LiDAR alone wrote no dataset/ at all: a KITTI user had no
+    calibration.json to place the scans on the vessel."""
+    lidar = {"name": "lidar", "type": "lidar", "rate_hz": 10.0}
+    data = {"vessels": [{"id": "ego", "sensors": [lidar]}], "recording": {"dataset": True}}
+    Dataset(tmp_path, World.resolve(parse_scenario(data)))
+    sensors = json.loads((tmp_path / "calibration.json").read_text())["sensors"]
+    assert list(sensors) == ["ego.lidar"] and "body_from_sensor" in sensors["ego.lidar"]
+    off = {**data, "recording": {"dataset": False}}
+    Dataset(tmp_path / "off", World.resolve(parse_scenario(off)))
+    imu = {"name": "imu", "type": "imu", "rate_hz": 10.0}  # no dataset of an IMU alone
+    Dataset(
+        tmp_path / "imu",
+        World.resolve(parse_scenario({"vessels": [{"id": "a", "sensors": [imu]}]})),
+    )
+    assert not (tmp_path / "off").exists() and not (tmp_path / "imu").exists()
