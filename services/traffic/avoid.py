@@ -11,16 +11,18 @@ scenario's vessels only with `traffic.avoid.vessels`), each a footprint circle:
 - Rounding: a waypoint with a buoy on it (a mark) is aimed at `pass_m` to the right of the
   line of sight, so the boat leaves the mark to port about that far off; it counts as
   reached within the tolerance plus `pass_m` of the mark.
-- Corridor: a buoy ahead of a boat on the arc it is turning on, within lookahead_s at its
-  speed and closer to that track than both footprints plus the clearance, turns it at its
-  full rate away from the side the buoy bears on now: to starboard unless it lies well to
-  starboard (a third of the corridor). The nearest one decides; first, anything closer than
-  that anywhere but astern (a boat turning at low speed, two boats alongside), buoy or
-  boat, which it simply turns away from, backing off while it lies under the bow. The
-  boat's own law resumes when the corridor is clear. The marks on a boat's own path are
-  left to the first rule. Boats under way ahead are not corridor obstacles: reacting to
-  where another boat is now, both boats of a pair turned, each to the side the other bore
-  on, and still met; colregs.py gives such meetings to one of the two.
+- Corridor: a buoy on the arc a boat's own law turns it on, within lookahead_s at its
+  speed and closer to that arc than both footprints plus the clearance, makes it take the
+  clear arc nearest its law's among nine turns from full starboard to full port (to
+  starboard on a tie; clear by half as much again, for the boat's lag in turning); with
+  none clear, the one that passes its obstacles widest, at half speed. First,
+  anything closer than the corridor's half-width anywhere but astern (a boat turning at
+  low speed, two boats alongside), buoy or boat, which it simply turns away from, backing
+  off while it lies under the bow. The boat's own law resumes when its arc is clear. The
+  marks on a boat's own path are left to the first rule. Boats under way ahead are not
+  corridor obstacles: reacting to where another boat is now, both boats of a pair turned,
+  each to the side the other bore on, and still met; colregs.py gives such meetings to one
+  of the two.
 """
 
 from __future__ import annotations
@@ -34,6 +36,8 @@ Array = NDArray[np.float64]
 Rows = NDArray[np.intp]
 MARK_M = 0.5  # a waypoint this close to a buoy's anchor is that buoy's mark
 PAIRS = 250_000  # boats x obstacles compared at once (bounds the temporaries)
+TURNS = np.linspace(-1.0, 1.0, 9)  # the turns a blocked boat may take, parts of its full rate
+MARGIN = 1.5  # a turn taken instead keeps this much wider clear than the law's arc missed by
 
 
 @dataclass(frozen=True)
@@ -81,28 +85,88 @@ def mark_aim(pos: Array, mark: Array, pass_m: Array) -> Array:
 
 
 def corridor_turn(
-    pos: Array, chi: Array, curvature: Array, reach: Array, width: Array, obstacles: Obstacles,
-    marks: Array,
-) -> tuple[Array, NDArray[np.bool_]]:  # fmt: skip
-    """Per boat: -1 turn to starboard, +1 to port, 0 its corridor is clear; and whether it
-    must back off, an obstacle being under its bow. The corridor follows the arc the boat is
-    turning on (curvature (N,), 1/m, left positive), `reach` (N,) metres along it, `width`
-    (N,) its footprint plus the clearance either side; marks (N, K, 2): the marks on a
-    boat's own path (nan: none), which it rounds instead."""
-    out, stop = np.zeros(len(pos)), np.zeros(len(pos), dtype=bool)
-    step = max(1, PAIRS // max(len(obstacles.xy), 1))
+    pos: Array, chi: Array, turn: Array, full_bend: Array, reach: Array, width: Array,
+    obstacles: Obstacles, marks: Array,
+) -> tuple[Array, NDArray[np.bool_], NDArray[np.bool_]]:  # fmt: skip
+    """Per boat: the turn that keeps its corridor clear, a part of its full rate (+ to port),
+    nan where its own law's turn (`turn`, the same units) already does; whether it must
+    back off, an obstacle being under its bow; and whether it must slow, no turn being
+    clear. `full_bend` (N,): the curvature of a full turn at its speed (1/m); `reach` (N,)
+    metres along each arc; `width` (N,) its footprint plus the clearance either side;
+    marks (N, K, 2): the marks on a boat's own path (nan: none), which it rounds instead."""
+    out, stop = np.full(len(pos), np.nan), np.zeros(len(pos), dtype=bool)
+    slow = np.zeros(len(pos), dtype=bool)
+    step = max(1, PAIRS // max(len(obstacles.xy) * len(TURNS), 1))
     for s in range(0, len(pos), step):
         rows = np.arange(s, min(s + step, len(pos)))
         boat, obs = near_pairs(pos, reach + width + obstacles.radius.max(), obstacles, rows)
         boat, obs = _others(boat, obs, (pos, width), obstacles, marks)
-        threat = _threats(boat, obs, (pos, chi, curvature, reach, width), obstacles)
-        boat, along, left, wide, bow = threat
-        order = np.lexsort((along, boat))  # each boat's nearest threat first
+        ahead, left, wide = _seen(boat, obs, pos, chi, width, obstacles)
+        near = _close(out, stop, boat, (ahead, left, wide), width)
+        far = ~near[boat] & ~obstacles.under_way[obs]  # boats meeting boats: colregs.py
+        arcs = np.append(TURNS, 0.0)[None, :] * full_bend[boat[far], None]
+        arcs[:, -1] = turn[boat[far]] * full_bend[boat[far]]  # the last: the law's own arc
+        lie = (ahead[far], left[far], wide[far])
+        _clear_arc(out, slow, boat[far], lie, arcs, (reach, turn))
+    return out, stop, slow
+
+
+def _seen(
+    boat: Rows, obs: Rows, pos: Array, chi: Array, width: Array, obstacles: Obstacles
+) -> tuple[Array, Array, Array]:
+    """Each pair's obstacle in the boat's frame (ahead, to the left) and the corridor's
+    half-width there (both footprints plus the clearance)."""
+    rel = obstacles.xy[obs] - pos[boat]
+    cos, sin = np.cos(chi[boat]), np.sin(chi[boat])
+    ahead, left = rel[:, 0] * cos + rel[:, 1] * sin, rel[:, 1] * cos - rel[:, 0] * sin
+    return ahead, left, width[boat] + obstacles.radius[obs]
+
+
+def _close(
+    out: Array, stop: NDArray[np.bool_], boat: Rows, lie: tuple[Array, Array, Array],
+    width: Array,
+) -> NDArray[np.bool_]:  # fmt: skip
+    """Anything closer than the corridor's half-width anywhere but astern (a boat turning
+    at low speed, two boats alongside), buoy or boat: the nearest decides, a full turn
+    away from the side it lies on, backing off while it is under the bow. Which boats."""
+    ahead, left, wide = lie
+    gap = np.hypot(ahead, left)
+    close = np.flatnonzero((ahead > -width[boat]) & (gap < wide))
+    near = np.zeros(len(out), dtype=bool)
+    if close.size:
+        order = close[np.lexsort((gap[close], boat[close]))]
         first = order[np.unique(boat[order], return_index=True)[1]]
-        bias = np.where(along[first] > 0.0, wide[first] / 3.0, 0.0)  # far: starboard first
-        out[boat[first]] = np.where(left[first] < -bias, 1.0, -1.0)  # the side it bears now
-        stop[boat[first]] = bow[first]
-    return out, stop
+        out[boat[first]] = np.where(left[first] < 0.0, 1.0, -1.0)
+        stop[boat[first]] = (ahead[first] > 0.0) & (np.abs(left[first]) < width[boat[first]] / 2)
+        near[boat[first]] = True
+    return near
+
+
+def _clear_arc(
+    out: Array, slow: NDArray[np.bool_], boat: Rows, lie: tuple[Array, Array, Array],
+    arcs: Array, laws: tuple[Array, Array],
+) -> None:  # fmt: skip
+    """Boats whose own arc meets an obstacle within reach take the clear turn nearest their
+    law's, to starboard on a tie (COLREGs rule 14); with none clear, the one that passes its
+    obstacles widest, at half speed (rule 8(e): more time to act).
+    Why not a full turn away, as before: a boat turning for its waypoint met a buoy on that
+    arc, turned away, found its arc clear, turned back, and so on at every guidance tick:
+    the yaw rate flipped between its limits and the boat never got there."""
+    if boat.size == 0:
+        return
+    (ahead, left, wide), (reach, turn) = lie, laws
+    along, off = _on_arc(ahead[:, None], left[:, None], arcs)
+    ahead_of_it = (along > 0.0) & (along < (reach[boat] + wide)[:, None])
+    rows, at = np.unique(boat, return_inverse=True)
+    room = np.full((len(rows), arcs.shape[1]), np.inf)  # each arc's least |off| / corridor
+    np.minimum.at(room, at, np.where(ahead_of_it, np.abs(off) / wide[:, None], np.inf))
+    stuck, starboard = room[:, -1] < 1.0, 1e-6 * (TURNS > 0.0)
+    cost = np.abs(TURNS[None, :] - turn[rows, None]) + starboard
+    pick = np.argmin(np.where(room[:, :-1] < MARGIN, np.inf, cost), axis=1)
+    walled = stuck & (room[np.arange(len(rows)), pick] < MARGIN)
+    pick = np.where(walled, np.argmax(room[:, :-1] - starboard, axis=1), pick)
+    out[rows[stuck]] = TURNS[pick[stuck]]
+    slow[rows[walled]] = True
 
 
 def _others(
@@ -118,27 +182,6 @@ def _others(
     gap = obstacles.xy[obs][:, None, :] - marks[boat]  # (pairs, K, 2); nan: no mark
     mark = np.any(gap[..., 0] ** 2 + gap[..., 1] ** 2 < MARK_M**2, axis=1)
     return boat[~mark], obs[~mark]
-
-
-def _threats(
-    boat: Rows, obs: Rows, boats: tuple[Array, ...], obstacles: Obstacles
-) -> tuple[Rows, Array, Array, Array, NDArray[np.bool_]]:
-    """The pairs where the obstacle is in the boat's corridor or close (distance 0 along
-    it), with where it lies ahead and to the left, the corridor's half-width and whether
-    it is under the bow."""
-    pos, chi, curvature, reach, width = boats
-    rel = obstacles.xy[obs] - pos[boat]
-    cos, sin = np.cos(chi[boat]), np.sin(chi[boat])
-    ahead, left = rel[:, 0] * cos + rel[:, 1] * sin, rel[:, 1] * cos - rel[:, 0] * sin
-    along, off = _on_arc(ahead, left, curvature[boat])
-    wide = width[boat] + obstacles.radius[obs]
-    hit = (along > 0.0) & (along < reach[boat] + wide) & (np.abs(off) < wide)
-    hit &= ~obstacles.under_way[obs]  # boats meeting boats: colregs.py
-    close = (ahead > -width[boat]) & (np.hypot(ahead, left) < wide)  # alongside too
-    bow = close & (ahead > 0.0) & (np.abs(left) < width[boat] / 2.0)
-    hit |= close
-    along = np.where(close, 0.0, along)
-    return boat[hit], along[hit], left[hit], wide[hit], bow[hit]
 
 
 def near_pairs(pos: Array, far: Array, obstacles: Obstacles, rows: Rows) -> tuple[Rows, Rows]:

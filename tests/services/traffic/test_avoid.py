@@ -15,52 +15,68 @@ from catabot.world.placement import footprint_m
 from catabot.world.traffic_plan import Boat
 from services.physics.control import TwistControllerBank
 from services.physics.world import PhysicsWorld
-from services.traffic.avoid import KeepClear, Obstacles, _on_arc, corridor_turn, mark_aim, marks_on
+from services.traffic.avoid import (
+    MARGIN,
+    KeepClear,
+    Obstacles,
+    _on_arc,
+    corridor_turn,
+    mark_aim,
+    marks_on,
+)
 from services.traffic.behaviours import Behaviours
 
 NO_MARKS = np.full((1, 1, 2), np.nan)
 
 
-def turn_for(xy: tuple[float, float], *, own: int = -1, marks: np.ndarray = NO_MARKS) -> tuple:
-    """One boat at the origin heading +x at 5 m/s (40 m ahead, 5 m wide), one obstacle."""
+def turn_for(
+    xy: tuple[float, float], *, own: int = -1, marks: np.ndarray = NO_MARKS, law: float = 0.0
+) -> tuple[float, bool, bool]:
+    """One boat at the origin heading +x at 5 m/s (its law's turn `law`, 40 m ahead, 5 m
+    wide, a full turn 0.35 rad/s), one obstacle: its turn, whether it backs off, slows."""
     obstacles = Obstacles.fixed(np.array([xy], dtype=float), np.array([0.3]), np.array([own]))
     zero, one = np.zeros(1), np.ones(1)
-    turn, stop = corridor_turn(zeros2(), zero, zero, 40.0 * one, 5.0 * one, obstacles, marks)
-    return float(turn[0]), bool(stop[0])
+    arcs = (law * one, 0.07 * one, 40.0 * one, 5.0 * one)
+    turn, stop, slow = corridor_turn(zeros2(), zero, *arcs, obstacles, marks)
+    return float(turn[0]), bool(stop[0]), bool(slow[0])
 
 
 def zeros2() -> np.ndarray:
     return np.zeros((1, 2))
 
 
-def test_an_obstacle_dead_ahead_turns_the_boat_to_starboard() -> None:
-    assert turn_for((20.0, 0.5)) == (-1.0, False)  # COLREGs: to starboard first
-    assert turn_for((20.0, -0.5)) == (-1.0, False)
-    assert turn_for((20.0, -4.0)) == (1.0, False)  # well to starboard: round it to port
+def test_an_obstacle_dead_ahead_takes_the_clear_turn_nearest_the_law_to_starboard() -> None:
+    assert turn_for((20.0, 0.0)) == (-0.75, False, False)  # a tie: COLREGs, to starboard
+    assert turn_for((20.0, 0.5)) == (-0.75, False, False)
+    assert turn_for((20.0, -4.0)) == (0.5, False, False)  # well to starboard: round it to port
+    _, off = _on_arc(np.array([20.0]), np.array([-4.0]), np.array([0.5 * 0.07]))
+    assert abs(off[0]) >= MARGIN * 5.3  # the turn taken clears it by the margin
+
+
+def test_a_boat_walled_in_slows_on_the_turn_that_passes_widest() -> None:
+    assert turn_for((10.0, 1.75), law=0.5) == (-1.0, False, True)  # every arc meets it
 
 
 def test_what_is_behind_beside_beyond_reach_or_its_own_is_no_threat() -> None:
-    assert turn_for((-20.0, 0.0)) == (0.0, False)  # astern
-    assert turn_for((20.0, 8.0)) == (0.0, False)  # clear of the corridor
-    assert turn_for((60.0, 0.0)) == (0.0, False)  # beyond reach
-    assert turn_for((20.0, 0.0), own=0) == (0.0, False)  # itself
-    assert turn_for((20.0, 0.0), marks=np.array([[[20.2, 0.1]]])) == (0.0, False)  # its mark
+    clear = (np.nan, False, False)
+    for xy in ((-20.0, 0.0), (20.0, 8.0), (60.0, 0.0)):  # astern, clear, beyond reach
+        assert np.isnan(turn_for(xy)[0]) and turn_for(xy)[1:] == clear[1:]
+    assert np.isnan(turn_for((20.0, 0.0), own=0)[0])  # itself
+    assert np.isnan(turn_for((20.0, 0.0), marks=np.array([[[20.2, 0.1]]]))[0])  # its mark
 
 
 def test_one_alongside_or_under_the_bow_is_met_at_once() -> None:
-    assert turn_for((0.5, 3.0)) == (-1.0, False)  # close on the port beam: away to starboard
-    assert turn_for((0.5, -3.0)) == (1.0, False)
-    assert turn_for((2.0, 0.3)) == (-1.0, True)  # under the bow: back off while turning
+    assert turn_for((0.5, 3.0)) == (-1.0, False, False)  # close on the port beam: away
+    assert turn_for((0.5, -3.0)) == (1.0, False, False)
+    assert turn_for((2.0, 0.3)) == (-1.0, True, False)  # under the bow: back off while turning
 
 
-def test_the_corridor_follows_the_arc_the_boat_turns_on() -> None:
+def test_the_corridor_follows_the_arc_the_law_turns_on() -> None:
     along, off = _on_arc(np.array([10.0]), np.array([10.0]), np.array([0.1]))
     np.testing.assert_allclose([along[0], off[0]], [5.0 * np.pi, 0.0], atol=1e-9)  # on it
-    obstacles = Obstacles.fixed(np.array([[10.0, 10.0]]), np.array([0.3]), np.array([-1]))
-    zero, one = np.zeros(1), np.ones(1)
-    bent = corridor_turn(zeros2(), zero, 0.1 * one, 40.0 * one, 5.0 * one, obstacles, NO_MARKS)
-    straight = corridor_turn(zeros2(), zero, zero, 40.0 * one, 5.0 * one, obstacles, NO_MARKS)
-    assert bent[0][0] != 0.0 and straight[0][0] == 0.0  # met on the arc, not on the line
+    law = 0.1 / 0.07  # the law's arc through (10, 10), a full turn's curvature 0.07
+    assert not np.isnan(turn_for((10.0, 10.0), law=law)[0])  # met on the arc
+    assert np.isnan(turn_for((10.0, 10.0))[0])  # not on the line
 
 
 def test_marks_are_aimed_at_to_their_right() -> None:
@@ -84,14 +100,16 @@ BUOYS = [("m0", PATH[0]), ("m1", PATH[1]), ("stranger", (60.0, 0.4))]
 
 
 def _voyage(
-    *, avoid: bool, seconds: float = 70.0, path: list[Point] = PATH, buoys: Buoys = BUOYS
-) -> tuple[float, np.ndarray, int]:
+    *, avoid: bool, seconds: float = 70.0, path: list[Point] = PATH, buoys: Buoys = BUOYS,
+    yaw: float = 0.0,
+) -> tuple[float, np.ndarray, int]:  # fmt: skip
     """A monohull from the origin along `path` past moored buoys; returns its least gap to
     any buoy (hull footprint to buoy footprint), how far the buoys moved, and the
     waypoints it reached."""
-    boat = Boat("b", "monohull", Pose(x_m=0.0, y_m=0.0), "waypoints", 5.0, path=tuple(path))
+    pose = Pose(x_m=0.0, y_m=0.0, yaw_rad=yaw)
+    boat = Boat("b", "monohull", pose, "waypoints", 5.0, path=tuple(path))
     model, buoy = load_vessel_model("monohull"), load_vessel_model("buoy")
-    world = PhysicsWorld([("b", model, (0.0, 0.0, 0.0, 0.0))], dt_s=DT, buoys=buoys)
+    world = PhysicsWorld([("b", model, (0.0, 0.0, 0.0, yaw))], dt_s=DT, buoys=buoys)
     own_r, buoy_r = footprint_m(model), footprint_m(buoy)
     anchors = np.array([xy for _, xy in buoys])
     pass_m = np.array([own_r + buoy_r + 2.0 if avoid else 0.0])
@@ -135,3 +153,13 @@ def test_a_boat_keeps_clear_of_its_own_later_marks() -> None:
     gap, moved, _ = _voyage(avoid=True, seconds=12.0, path=path,
                             buoys=[(f"m{i}", xy) for i, xy in enumerate(path)])  # fmt: skip
     assert gap > 0.0 and moved.max() < 1e-3
+
+
+def test_a_boat_turning_for_its_waypoint_past_buoys_gets_there() -> None:
+    """A trial's boat, heading away from its waypoint with two other boats' buoys beside
+    its turn: the full turn away from a buoy on its arc, then back to its law, flipped its
+    yaw rate between the limits at every guidance tick, and in 30 s it made 3.6 m."""
+    buoys = [("x0", (12.6, 18.2)), ("x1", (22.7, 6.9))]
+    gap, moved, reached = _voyage(avoid=True, seconds=35.0, path=[(60.0, 0.0), (60.0, -60.0)],
+                                  buoys=buoys, yaw=2.8)  # fmt: skip
+    assert reached >= 1 and gap > 0.0 and moved.max() < 1e-3
