@@ -184,12 +184,13 @@ def until_answered(ask: Callable[[float], A], timeout_s: float) -> A:
 
 
 def open_session(conn: Connection) -> zenoh.Session:
+    config = conn.config()
     try:
-        return zenoh.open(conn.config())
+        return zenoh.open(config)
     except Exception as exc:
         said = re.sub(r"\s+at \S+\.rs:\d+\.?$", "", str(exc).strip())  # Zenoh's source line
-        if "Unable to connect" in said:
-            said += _why_unreachable(conn.connect)
+        if "Unable to connect" in said:  # the endpoints a config file names too
+            said += _why_unreachable(tuple(json.loads(config.get_json("connect/endpoints"))))
         raise SessionError(
             f"cannot open zenoh (mode {conn.mode or 'peer'}, connect {list(conn.connect)}, "
             f"listen {list(conn.listen)}, config {conn.file or os.environ.get('ZENOH_CONFIG')}): "
@@ -204,6 +205,12 @@ def _why_unreachable(endpoints: tuple[str, ...]) -> str:
     if taken:
         return (f" ({', '.join(taken)} takes connections but does not answer as Zenoh: "
                 "another program listens there, or it wants tls/)")  # fmt: skip
+    tls = [e for e in endpoints if e.startswith("tls/") and not port_open(e, 1.0)]
+    if tls:  # a secure router is there: its certificate or the login was refused
+        return (f" ({', '.join(tls)} takes connections, but the TLS handshake or the login "
+                "failed: the router's certificate must name the host you connect to, an "
+                "address included (catabot secure init --host), and the login must be one "
+                "of its profile's)")  # fmt: skip
     return " (nothing answers there: start a router first, catabot router --listen ...)"
 
 

@@ -144,15 +144,22 @@ def _router(p: Plan) -> Service:
         "command": ["router", "--listen", p.listen, *config],
         "ports": [f"${{CATABOT_PORT:-{p.port}}}:{p.port}"],
         "restart": "no",
-        "healthcheck": _health([p.listen], 30),
+        "healthcheck": _health(_router_probe(p), 30),
     }
     return svc | (p.secure.router_mounts() if p.secure else {})
+
+
+def _router_probe(p: Plan) -> list[str]:
+    """Plain: a Zenoh session at its listening port. Secure: a login at the name in its
+    certificate, as the observer 'viewer' (a check of 0.0.0.0 without the CA's certificate
+    and a login never passed, and every other container waited on it)."""
+    return [p.router, *p.login("viewer")] if p.secure else [p.listen]
 
 
 def _viewer(p: Plan) -> Service:
     web, grpc = VIEWER_PORTS
     command = ["view", p.source, "--web", "--web-port", str(web), "--grpc-port", str(grpc)]
-    svc = _process(p, "viewer", command, [f"tcp/127.0.0.1:{web}"], runs=False)
+    svc = _process(p, "viewer", command, [f"tcp/127.0.0.1:{web}", "--http"], runs=False)
     svc["ports"] = [f"${{CATABOT_WEB_PORT:-{web}}}:{web}", f"{grpc}:{grpc}"]
     return {"profiles": ["viewer"], **svc}
 

@@ -56,10 +56,13 @@ class Profile:
                 "volumes": [f"{ca}:{ca}:ro"]}  # fmt: skip
 
     def router_mounts(self) -> dict[str, Any]:
-        pem = f"{self.var}/router.pem"
+        """Its config, users and key; and, for its health check, the observer 'viewer''s
+        login and the CA's certificate (compose.py `_router_probe`)."""
+        pem, ca = f"{self.var}/router.pem", f"{self.var}/ca.pem"
         secrets = [{"source": s, "target": f"{self.var}/{f}"} for s, f in ROUTER_SECRETS.items()]
+        secrets.append({"source": "viewer-login", "target": self.login("viewer")})
         networks = {} if self.host == "router" else {"default": {"aliases": [self.host]}}
-        return {"secrets": secrets, "volumes": [f"{pem}:{pem}:ro"],
+        return {"secrets": secrets, "volumes": [f"{pem}:{pem}:ro", f"{ca}:{ca}:ro"],
                 **({"networks": networks} if networks else {})}  # fmt: skip
 
     def secrets(self, names: list[str]) -> dict[str, Any]:

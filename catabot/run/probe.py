@@ -4,6 +4,8 @@ Cheap and real, so an engine can run it every few seconds beside a busy simulati
 
 - `probe ENDPOINT`: the router is up when its port takes a TCP connection and a Zenoh
   client session opens there (an open port alone was any program's: an HTTP server passed).
+- `probe ENDPOINT --http`: a web server (the viewer's) is up when it answers an HTTP request
+  there (a Zenoh handshake never passed it).
 - `probe ENDPOINT --name physics`: a CataBot process is healthy once it is on the bus,
   i.e. its liveliness token `catabot/<world>/live/physics/<zid>` is there (declared when it
   joined: catabot/bus/participant.py; gone when it ends or crashes). One short Zenoh client
@@ -16,6 +18,7 @@ code: a probe costs a Python start-up and one session, not the simulation's impo
 from __future__ import annotations
 
 import argparse
+import socket
 import sys
 
 from catabot.bus.keys import lives_of
@@ -31,6 +34,7 @@ def parser() -> argparse.ArgumentParser:
     p.add_argument("endpoint", help="the router's endpoint, e.g. tcp/router:7447")
     p.add_argument("--name", help="a process that must be on the bus (its liveliness token)")
     p.add_argument("--zenoh-config", metavar="FILE", help="a login of the secure profile")
+    p.add_argument("--http", action="store_true", help="a web server, not Zenoh, answers there")
     return p
 
 
@@ -43,6 +47,20 @@ def speaks_zenoh(endpoint: str, config: str | None) -> None:
     """SessionError unless a Zenoh session opens there: an open port alone was any
     program's (an HTTP server passed for a healthy router)."""
     open_session(_client(endpoint, config)).close()
+
+
+def answers_http(endpoint: str, timeout_s: float = TIMEOUT_S) -> str:
+    """'' when an HTTP server answers a request at the endpoint, else why not."""
+    host, _, port = endpoint.partition("/")[2].rpartition(":")
+    try:
+        with socket.create_connection((host.strip("[]"), int(port)), timeout=timeout_s) as conn:
+            conn.sendall(b"GET / HTTP/1.0\r\nHost: probe\r\n\r\n")
+            head = conn.recv(16)
+    except TimeoutError:
+        head = b""  # it took the connection and said nothing (a Zenoh node waits so)
+    except (OSError, ValueError) as exc:
+        return f"{endpoint}: {exc}"
+    return "" if head.startswith(b"HTTP/") else f"{endpoint}: takes connections but not as HTTP"
 
 
 def on_bus(endpoint: str, name: str, config: str | None, timeout_s: float = TIMEOUT_S) -> str:
@@ -62,7 +80,9 @@ def main(argv: list[str] | None = None) -> int:
     args = parser().parse_args(argv)
     try:
         why = port_open(args.endpoint, TIMEOUT_S)
-        if not why and args.name:
+        if not why and args.http:
+            why = answers_http(args.endpoint)
+        elif not why and args.name:
             why = on_bus(args.endpoint, args.name, args.zenoh_config)
         elif not why:
             speaks_zenoh(args.endpoint, args.zenoh_config)

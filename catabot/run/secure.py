@@ -19,6 +19,7 @@ client (`catabot run --secure DIR`, `--zenoh-config DIR/<name>.json5` for a clie
 
 from __future__ import annotations
 
+import ipaddress
 import json
 import secrets
 import shutil
@@ -87,12 +88,23 @@ def init(
     return written
 
 
+def _is_address(host: str) -> bool:
+    """Whether `host` is an IPv4 or IPv6 address: a certificate names it as `IP:`, and one
+    made with `DNS:10.9.0.1` was refused by every client connecting to 10.9.0.1."""
+    try:
+        ipaddress.ip_address(host.strip("[]"))
+    except ValueError:
+        return False
+    return True
+
+
 def _certificates(folder: Path, host: str) -> None:
     """A test CA and the router's certificate (for a real deployment, your own PKI)."""
     if shutil.which("openssl") is None:
         raise SecureError("openssl is needed to make the test certificates (apt install openssl)")
     ext = folder / "router.ext"
-    ext.write_text(f"subjectAltName=DNS:{host},DNS:localhost,IP:127.0.0.1\n")
+    name = f"IP:{host.strip('[]')}" if _is_address(host) else f"DNS:{host}"  # no DNS name
+    ext.write_text(f"subjectAltName={name},DNS:localhost,IP:127.0.0.1\n")
     steps = [
         ["req", "-x509", "-newkey", "rsa:2048", "-nodes", "-keyout", "ca.key", "-out", "ca.pem",
          "-days", "3650", "-subj", "/CN=catabot-test-ca"],

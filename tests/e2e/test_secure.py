@@ -180,3 +180,24 @@ def test_an_observer_finds_the_world_only_the_conductor_serves(
     finally:
         proc.terminate()
         proc.communicate(timeout=60)
+
+
+def test_a_profile_for_an_address_connects_there(tmp_path: Path) -> None:
+    """`--host 10.9.0.1` wrote the address as a DNS name in the router's certificate, so
+    every client was refused, told to start a router that was running."""
+    folder, port = tmp_path / "ip", free_port()
+    made = catabot("secure", "init", str(folder), "--host", "127.0.0.2", "--port", str(port))
+    assert made.returncode == 0, made.stderr
+    listen = f"tls/0.0.0.0:{port}"
+    router = start("router", "--listen", listen, "--zenoh-config", str(folder / "router.json5"))
+    try:
+        wait_for_line(router, "zenoh router listening")
+        open_session(Connection(file=str(folder / "viewer.json5"))).close()  # IP:127.0.0.2
+        wrong = json.loads((folder / "viewer.json5").read_text())
+        wrong["connect"]["endpoints"] = [f"tls/127.0.0.3:{port}"]  # an address it does not carry
+        (tmp_path / "wrong.json5").write_text(json.dumps(wrong))
+        with pytest.raises(SessionError, match="the TLS handshake or the login failed"):
+            open_session(Connection(file=str(tmp_path / "wrong.json5"), open_timeout_ms=3000))
+    finally:
+        router.terminate()
+        router.wait(timeout=10)

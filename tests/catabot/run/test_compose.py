@@ -74,6 +74,7 @@ def test_a_traffic_scenario_gets_exactly_its_services(tmp_path: Path) -> None:
     assert router["ports"] == ["${CATABOT_PORT:-7447}:7447"]
     assert router["healthcheck"]["test"][:4] == ["CMD", "python", "-m", "catabot.run.probe"]
     assert svcs["viewer"]["profiles"] == ["viewer"] and "--web" in svcs["viewer"]["command"]
+    assert svcs["viewer"]["healthcheck"]["test"][-2:] == ["tcp/127.0.0.1:9090", "--http"]
     assert {s["build"]["context"] for s in svcs.values() if "build" in s} == {
         os.path.relpath(REPO, tmp_path)
     }
@@ -150,7 +151,14 @@ def test_the_secure_variant_mounts_each_process_only_its_own_login(tmp_path: Pat
         "router-config",
         "router-users",
         "router-key",
+        "viewer-login",  # its health check logs in as the observer
     }
+    assert f"{var}/ca.pem:{var}/ca.pem:ro" in router["volumes"]
+    assert router["healthcheck"]["test"][-3:] == [  # its name, not 0.0.0.0: the certificate's
+        "${CATABOT_ROUTER:-tls/sim.example.org:7450}",
+        "--zenoh-config",
+        f"{var}/viewer.json5",
+    ]
     for name in ["conductor", *LOCKSTEP, "viewer"]:
         svc = svcs[name]
         assert svc["command"][-2:] == ["--zenoh-config", f"{var}/{name}.json5"], name

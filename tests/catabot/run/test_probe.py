@@ -4,11 +4,13 @@ conductor's container ends only once every participant has left)."""
 
 from __future__ import annotations
 
+import http.server
 import json
 import signal
 import socket
 import subprocess
 import sys
+import threading
 import time
 from collections.abc import Iterator
 
@@ -124,3 +126,20 @@ def test_a_router_probe_passes_on_a_zenoh_node(
     endpoint, _ = bus
     assert probe.main([endpoint]) == 0
     assert f"healthy: {endpoint}" in capsys.readouterr().out
+
+
+def test_a_web_probe_needs_an_http_answer(
+    bus: tuple[str, zenoh.Session], capsys: pytest.CaptureFixture[str]
+) -> None:
+    """The viewer's health check opened a Zenoh session on its web port, so it never passed."""
+    web = http.server.ThreadingHTTPServer(("127.0.0.1", 0), http.server.SimpleHTTPRequestHandler)
+    thread = threading.Thread(target=web.serve_forever, daemon=True)
+    thread.start()
+    try:
+        assert probe.main([f"tcp/127.0.0.1:{web.server_address[1]}", "--http"]) == 0
+    finally:
+        web.shutdown()
+        web.server_close()
+    endpoint, _ = bus  # a Zenoh node is no web server
+    assert probe.main([endpoint, "--http"]) == 1
+    assert "takes connections but not as HTTP" in capsys.readouterr().err
