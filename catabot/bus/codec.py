@@ -176,7 +176,9 @@ def _check(type_name: str, name: str, kind: str, length: int | None, value: Any)
     """Validate one field; the common cases return before any message is formatted."""
     simple = _SIMPLE.get(kind)
     if simple is not None and type(value) is simple:
-        return value
+        if kind != "int" or -INT64 <= value < INT64:  # type: ignore[operator]
+            return value
+        raise CodecError(f"{type_name}.{name}: {value} is beyond a 64-bit signed integer")
     where = f"{type_name}.{name}"
     if kind == "str" and isinstance(value, str):
         return value
@@ -196,6 +198,7 @@ def _check(type_name: str, name: str, kind: str, length: int | None, value: Any)
 
 
 _SIMPLE = {"int": int, "str": str, "float": float}
+INT64 = 2**63  # stamps, ticks and counts are int64 everywhere they are stored (CSV, MCAP)
 
 
 def finite(values: tuple[float, ...] | float) -> bool:

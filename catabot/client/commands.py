@@ -7,6 +7,7 @@ about to send, with this vessel's thruster count, and raises `CommandError` in t
 
 from __future__ import annotations
 
+import numbers
 from collections.abc import Sequence
 from dataclasses import dataclass
 
@@ -66,24 +67,33 @@ def message(command: Command, vessel: VesselInfo, *, tick: int = -1, stamp_ns: i
             msg: Message = ThrustCmd(_floats(command.values), tick, stamp_ns)
             checks.thrust(vessel.thrusters)(msg)
         elif isinstance(command, Twist):
-            msg = TwistCmd(float(command.surge), float(command.yaw_rate), tick, stamp_ns)
+            surge, rate = _number(command.surge, "surge"), _number(command.yaw_rate, "yaw_rate")
+            msg = TwistCmd(surge, rate, tick, stamp_ns)
             checks.twist(msg)
         else:
             assert isinstance(command, Waypoints)
             points = _floats([c for p in command.points for c in _pair(p)])
-            msg = WaypointsCmd(points, float(command.speed), float(command.tolerance),
-                               str(command.mode), tick, stamp_ns)  # fmt: skip
+            speed, tol = _number(command.speed, "speed"), _number(command.tolerance, "tolerance")
+            msg = WaypointsCmd(points, speed, tol, str(command.mode), tick, stamp_ns)
             checks.waypoints(msg)
     except (TypeError, ValueError) as exc:
         raise CommandError(f"{kind} command for vessel {vessel.id!r}: {exc}") from None
     return msg
 
 
+def _number(value: object, what: str) -> float:
+    """A real number as a float: float("1") had turned a string into a command that the
+    bus refuses from anyone else (and True into 1.0)."""
+    if isinstance(value, bool) or not isinstance(value, numbers.Real):
+        raise TypeError(f"{what} must be a number, not {type(value).__name__} {value!r}")
+    return float(value)
+
+
 def _floats(values: Sequence[float]) -> tuple[float, ...]:
-    return tuple(float(v) for v in values)
+    return tuple(_number(v, "a value") for v in values)
 
 
 def _pair(point: Sequence[float]) -> tuple[float, float]:
     if len(point) != 2:
         raise ValueError(f"a waypoint is (x, y) in m, not {tuple(point)!r}")
-    return float(point[0]), float(point[1])
+    return _number(point[0], "a waypoint's x"), _number(point[1], "a waypoint's y")

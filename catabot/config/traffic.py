@@ -138,6 +138,13 @@ class TrafficConfig(Strict):
         description="traffic processes, each guiding a contiguous block of the boats "
         "(catabot service traffic --shard I/N); the recording is the same for any number",
     )
+    command_timeout_s: float | None = Field(
+        None,
+        gt=0,
+        description="an outside thrust or twist on a boat not renewed for this long hands it "
+        "back to its behaviour (a controller that died stops driving it); null: it holds "
+        "until a release",
+    )
     setpoint_delay_ticks: int = Field(
         0,
         ge=0,

@@ -39,7 +39,7 @@ from catabot.bus.session import (
 from catabot.bus.settings import changes_of
 from catabot.config import live
 from catabot.config.load import load_scenario
-from catabot.config.scenario import Scenario, shard_count
+from catabot.config.scenario import Scenario, services, shard_count
 from catabot.config.sensors import shard_names
 from catabot.errors import CataBotError
 from catabot.run.answer import OneLineParser
@@ -155,8 +155,23 @@ def parse_shard(text: str) -> tuple[int, int]:
     return int(i), int(n)
 
 
+WHY_NOT = {
+    "sensors": "no vessel has sensors",
+    "traffic": "traffic.count is 0",
+    "recorder": "recording.csv and recording.mcap are off",
+    "ros": "it has no ros section",
+}
+
+
 def own_name(service: str, world: World, shard: tuple[int, int] | None) -> str:
-    """This process's participant name: the service's own, or its shard's (`sensors.1`)."""
+    """This process's participant name: the service's own, or its shard's (`sensors.1`).
+    ShardError for a service the scenario does not run (traffic without boats crashed with
+    a KeyError; sensors without sensors joined and stepped nothing)."""
+    needed = services(world.scenario)
+    if service not in {n.partition(".")[0] for n in needed}:
+        raise ShardError(f"scenario {world.scenario.name!r} does not run {service} "
+                         f"({WHY_NOT.get(service, 'not one of its services')}); it runs "
+                         f"{', '.join(needed)}")  # fmt: skip
     n = shard_count(world.scenario, service)
     if shard is None and n == 1:
         return service
@@ -195,7 +210,7 @@ def run_service(
     try:
         batch_scheduling()  # before Zenoh starts its threads, so that they inherit it
         world = World.resolve(load_scenario(args.scenario))  # the same in every process
-        name = own_name(name, world, args.shard) if shardable else name
+        name = own_name(name, world, getattr(args, "shard", None))
         session = open_session(replace(connection_from_args(args), timestamping=timestamping))
     except CataBotError as exc:
         log.critical("%s", exc)

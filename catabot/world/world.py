@@ -271,10 +271,12 @@ def _bodies(scenario: Scenario, plan: TrafficPlan, models: Models) -> tuple[Body
             checked.add(ref)
             where = f"{fields[kind].format(i)} ({bid})"
             _check_floats(where, ref, model(ref), scenario.water.density_kg_m3)
+    boat_timeout = ((), None, Velocity(), scenario.traffic.command_timeout_s)
     return tuple(
-        Body(bid, kind, ref, model(ref), pose, row, *_scenario_part(config))
+        Body(bid, kind, ref, model(ref), pose, row,
+             *(boat_timeout if kind == "boat" else _scenario_part(config)))
         for row, (bid, kind, ref, pose, config) in enumerate(rows)
-    )
+    )  # fmt: skip
 
 
 def _scenario_part(

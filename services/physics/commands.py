@@ -53,6 +53,7 @@ class CommandBook:
         self.scripted = [v.id for v in vessels if v.script]
         self.released: set[str] = set()  # handed back this tick (`take`)
         self.book = Orders(command_timeouts(vessels))  # who holds each: outside, set-points
+        self.boats = {v.id for v in vessels if v.kind == "boat"}  # back to their behaviour
         self.set_point = np.zeros((len(self.ids), 2))  # (surge m/s, yaw rate rad/s)
         self.has_set_point = np.zeros(len(self.ids), dtype=bool)
         self._batch_rows: dict[tuple[str, ...], NDArray[np.intp]] = {}  # a traffic shard's
@@ -77,7 +78,7 @@ class CommandBook:
             self.released.add(vid)
             held_s = self.book.timeouts[vid] / 1e9
             advise(log, f"{vid}: no outside command for {held_s:g} s (command_timeout_s): "
-                        "handed back to its script (rest without one)")  # fmt: skip
+                        f"handed back to {self._own(vid)}")  # fmt: skip
         target, follow = self.set_point.copy(), self.has_set_point.copy()
         thrust: dict[int, tuple[float, ...]] = {}
         for vid in self.scripted:
@@ -103,6 +104,16 @@ class CommandBook:
         if vessels:
             tell(log, f"{participant} left the run at t = {stamp_ns / 1e9:g} s (clock.policy "
                       f"drop): {some(vessels)} back to script (rest without one)")  # fmt: skip
+
+    def _own(self, vessel: str) -> str:
+        """What a vessel follows when nobody outside holds it."""
+        return "the traffic's guidance" if vessel in self.boats else "its script (rest without one)"
+
+    def _or_timeout(self, vessel: str) -> str:
+        timeout_ns = self.book.timeouts.get(vessel)
+        if timeout_ns is None:  # a boat had been told of a command_timeout_s it cannot have
+            return ""
+        return f" or {timeout_ns / 1e9:g} s without one (command_timeout_s)"
 
     def take_batch(self, batch: TwistBatch, expected: tuple[str, ...]) -> None:
         """The traffic service's set-points (rows and shapes checked on arrival): every boat
@@ -133,9 +144,15 @@ class CommandBook:
             now = self.book.held.get(vessel)
             if _outside(now) and not _outside(was):  # another stack drives it: say when
                 kind = "thrust" if isinstance(msg, ThrustCmd) else "twist"
+                until = f"a release (waypoints){self._or_timeout(vessel)}"
                 tell(log, f"{vessel}: taken over by an outside {kind} at t = {stamp_ns / 1e9:g} "
-                          "s; it holds the vessel until a release (waypoints) or its "
-                          "command_timeout_s")  # fmt: skip
+                          f"s; it holds the vessel until {until}")  # fmt: skip
+            elif _outside(was) and now is None:  # a release: said as a take-over is
+                tell(
+                    log,
+                    f"{vessel}: handed back (waypoints) at t = {stamp_ns / 1e9:g} s, to "
+                    f"{self._own(vessel)}",
+                )
             if isinstance(msg, TwistCmd) and msg.tick >= 0:
                 self.set_point[self.row[vessel]] = (msg.surge, msg.yaw_rate)
                 self.has_set_point[self.row[vessel]] = True

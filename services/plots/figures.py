@@ -329,9 +329,9 @@ def metrics(data: RunSeries) -> Figure | None:
     bars.bar(x - 0.2, dist, 0.4, color="#ff8c00", label="distance [m]")
     speed = bars.twinx()
     speed.bar(x + 0.2, top, 0.4, color="#2ca02c", label="top speed [m/s]")
-    bars.set(xticks=x, xticklabels=shown, ylabel="distance travelled [m]",
-             title="Navigation metrics (metrics.json)", ylim=(0, max(dist) * 1.3 or 1))  # fmt: skip
-    speed.set(ylabel="top speed [m/s]", ylim=(0, max(top) * 1.3 or 1))
+    bars.set(xticks=x, xticklabels=shown, ylabel="distance travelled [m]", ylim=(0, max(
+        max(dist) * 1.3, 1.0)), title="Navigation metrics (metrics.json)")  # fmt: skip
+    speed.set(ylabel="top speed [m/s]", ylim=(0, max(max(top) * 1.3, 0.1)))  # 1e-16: at rest
     handles = [bars.get_legend_handles_labels()[0][0], speed.get_legend_handles_labels()[0][0]]
     bars.legend(handles, ["distance [m]", "top speed [m/s]"], loc="upper center", ncol=2,
                 fontsize=8)  # fmt: skip

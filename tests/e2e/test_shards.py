@@ -7,7 +7,7 @@ from pathlib import Path
 from typing import Any
 
 import pytest
-from conftest import catabot, files_of, only_run_dir, scenario_file
+from conftest import basic_scenario, catabot, files_of, only_run_dir, scenario_file
 
 pytestmark = pytest.mark.timeout(240)
 
@@ -56,3 +56,13 @@ def test_a_shard_started_without_its_place_is_refused(tmp_path: Path) -> None:
     assert wrong.returncode == 2 and "--shard 1/3" in wrong.stderr
     junk = catabot("service", "sensors", "--scenario", str(scenario), "--shard", "2/2")
     assert junk.returncode == 2 and "use I/N with 0 <= I < N" in junk.stderr
+
+
+def test_a_service_the_scenario_does_not_run_is_refused(tmp_path: Path) -> None:
+    """Traffic on a scenario without boats crashed with a KeyError traceback; sensors on one
+    without sensors joined, refused the clock's grants and exited 0."""
+    scenario = scenario_file(tmp_path, basic_scenario("bare"))
+    for service, why in (("traffic", "traffic.count is 0"), ("sensors", "no vessel has sensors")):
+        got = catabot("service", service, "--scenario", str(scenario), timeout=60)
+        assert got.returncode == 2, got.stderr
+        assert f"scenario 'bare' does not run {service} ({why}); it runs physics" in got.stderr

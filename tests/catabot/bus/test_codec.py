@@ -94,6 +94,17 @@ def test_integers_are_accepted_where_floats_are_expected() -> None:
     assert codec.decode(_payload(body), ThrustCmd).thrust == (1.0, 0.0)
 
 
+def test_integers_beyond_int64_are_refused() -> None:
+    """A stamp of 2**64 - 1 passed and was taken: every store of a stamp is int64."""
+    body = _body(SAMPLES["twist_cmd"])
+    body["stamp_ns"] = 2**64 - 1
+    with pytest.raises(codec.CodecError, match=r"twist_cmd\.stamp_ns: 18446744073709551615 is "
+                       r"beyond a 64-bit signed integer"):  # fmt: skip
+        codec.decode(_payload(body), TwistCmd)
+    body["stamp_ns"] = -(2**63)
+    assert codec.decode(_payload(body), TwistCmd).stamp_ns == -(2**63)
+
+
 def test_vectors_decode_as_tuples_of_floats() -> None:
     state = codec.decode(codec.encode(SAMPLES["vessel_state"]), VesselState)
     for f in dataclasses.fields(VesselState):

@@ -34,7 +34,10 @@ def test_good_commands_become_their_messages() -> None:
         (Thrust([NAN, 0.0]), "a thrust value is not finite"),
         (Thrust([5.0, -7.0]), r"normalised, each in \[-1, 1\]: \(5.0, -7.0\)"),
         (Thrust([1.0, -1.0001]), r"each in \[-1, 1\]"),
-        (Thrust(["fast", 0.0]), "could not convert string to float"),  # type: ignore[list-item]
+        (Thrust(["fast", 0.0]), "a value must be a number, not str 'fast'"),  # type: ignore[list-item]
+        (Twist("1", 0.0), "surge must be a number, not str '1'"),  # type: ignore[arg-type]
+        (Twist(1.0, True), "yaw_rate must be a number, not bool"),
+        (Waypoints([(1, "2")]), "a waypoint's y must be a number"),  # type: ignore[list-item]
         (Twist(INF, 0.0), "twist command for vessel 'ego': surge inf m/s"),
         (Twist(1.0, NAN), "not finite"),
         (Twist(1e308, 0.0), "surge 1e[+]308 m/s: at most 50 m/s either way"),

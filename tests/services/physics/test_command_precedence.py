@@ -7,7 +7,9 @@ import logging
 import pytest
 
 from catabot.bus.messages import ThrustCmd, TwistCmd, WaypointsCmd
+from catabot.config.load import parse_scenario
 from catabot.run.advice import advice_of
+from catabot.world.world import World
 from services.physics.commands import CommandBook, Order
 from tests.services.physics.helpers import vessels
 
@@ -66,12 +68,32 @@ def test_a_takeover_from_outside_is_told_once_until_the_vessel_is_handed_back(
         book.take("boat_000", [ThrustCmd((0.3, 0.3))], stamp_ns=1_240_000_000)  # still held
         book.take("boat_000", [release, TwistCmd(1.0, 0.0)], stamp_ns=2_000_000_000)
     told = [advice_of(f" INFO {r.getMessage()}") for r in caplog.records]
-    assert told == [
+    assert told == [  # it has no command_timeout_s: none is offered
         "boat_000: taken over by an outside thrust at t = 1.23 s; it holds the vessel until a "
-        "release (waypoints) or its command_timeout_s",
+        "release (waypoints)",
+        "boat_000: handed back (waypoints) at t = 2 s, to its script (rest without one)",
         "boat_000: taken over by an outside twist at t = 2 s; it holds the vessel until a "
-        "release (waypoints) or its command_timeout_s",
+        "release (waypoints)",
     ]
+
+
+def test_a_traffic_boat_taken_over_goes_back_to_its_guidance_after_the_timeout(
+    caplog: pytest.LogCaptureFixture,
+) -> None:
+    """A boat's take-over said it held until "its command_timeout_s", which a boat could not
+    have: a crashed controller left it driving to the end. `traffic.command_timeout_s`."""
+    world = World.resolve(parse_scenario({
+        "vessels": [{"id": "ego"}], "traffic": {"count": 1, "command_timeout_s": 0.5},
+    }))  # fmt: skip
+    book = CommandBook(world.vessels)
+    book.take("boat_000", [TwistCmd(4.0, 0.1, tick=0)])  # the traffic's set-point
+    with caplog.at_level(logging.INFO, logger="physics.commands"):
+        book.take("boat_000", [TwistCmd(1.0, 0.0)], stamp_ns=1_000_000_000)
+        assert book.orders(1_490_000_000)[2].tolist() == [[1.0, 0.0]]
+        assert book.orders(1_510_000_000)[2].tolist() == [[4.0, 0.1]]  # its guidance again
+    told = [advice_of(f" INFO {r.getMessage()}") for r in caplog.records]
+    assert told[0].endswith("until a release (waypoints) or 0.5 s without one (command_timeout_s)")
+    assert "handed back to the traffic's guidance" in caplog.records[-1].getMessage()
 
 
 def test_a_dropped_stacks_vessel_is_handed_back_and_the_console_told(
