@@ -193,17 +193,16 @@ class Behaviours:
     def _keep_clear(
         self, pos: Array, chi: Array, sog: Array, obstacles: Obstacles, order: tuple[Array, Array]
     ) -> tuple[Array, Array, NDArray[np.bool_]]:
-        """The clear turn nearest each blocked boat's own (avoid.py), at half speed where none
-        is clear, backing off while an obstacle is under the bow (holding boats stay put);
-        and which boats it turned."""
+        """The clear turn nearest each blocked boat's own (avoid.py), backing off while an
+        obstacle is under the bow (holding boats stay put); and which boats it turned."""
         surge, rate = order
         speed = np.maximum(np.maximum(sog, np.abs(surge)), 1.0)  # its law slows to turn
         reach, marks = self.clear.lookahead_s * speed, self._own_marks()
         own = (rate / MAX_YAW_RATE, MAX_YAW_RATE / speed)  # its law's turn; a full turn's arc
-        turn, stop, slow = corridor_turn(pos, chi, *own, reach, self.clear.width, obstacles, marks)
+        turn, stop = corridor_turn(pos, chi, *own, reach, self.clear.width, obstacles, marks)
         turn[self.kind == HOLD], stop[self.kind == HOLD] = np.nan, False
         steered = ~np.isnan(turn)
-        surge = np.where(stop, -BACK_OFF_MPS, np.where(slow & steered, 0.5 * surge, surge))
+        surge = np.where(stop, -BACK_OFF_MPS, surge)
         return surge, np.where(steered, turn * MAX_YAW_RATE, rate), steered
 
     def _give_way(

@@ -31,14 +31,14 @@ NO_MARKS = np.full((1, 1, 2), np.nan)
 
 def turn_for(
     xy: tuple[float, float], *, own: int = -1, marks: np.ndarray = NO_MARKS, law: float = 0.0
-) -> tuple[float, bool, bool]:
+) -> tuple[float, bool]:
     """One boat at the origin heading +x at 5 m/s (its law's turn `law`, 40 m ahead, 5 m
-    wide, a full turn 0.35 rad/s), one obstacle: its turn, whether it backs off, slows."""
+    wide, a full turn 0.35 rad/s), one obstacle: its turn and whether it backs off."""
     obstacles = Obstacles.fixed(np.array([xy], dtype=float), np.array([0.3]), np.array([own]))
     zero, one = np.zeros(1), np.ones(1)
     arcs = (law * one, 0.07 * one, 40.0 * one, 5.0 * one)
-    turn, stop, slow = corridor_turn(zeros2(), zero, *arcs, obstacles, marks)
-    return float(turn[0]), bool(stop[0]), bool(slow[0])
+    turn, stop = corridor_turn(zeros2(), zero, *arcs, obstacles, marks)
+    return float(turn[0]), bool(stop[0])
 
 
 def zeros2() -> np.ndarray:
@@ -46,29 +46,28 @@ def zeros2() -> np.ndarray:
 
 
 def test_an_obstacle_dead_ahead_takes_the_clear_turn_nearest_the_law_to_starboard() -> None:
-    assert turn_for((20.0, 0.0)) == (-0.75, False, False)  # a tie: COLREGs, to starboard
-    assert turn_for((20.0, 0.5)) == (-0.75, False, False)
-    assert turn_for((20.0, -4.0)) == (0.5, False, False)  # well to starboard: round it to port
+    assert turn_for((20.0, 0.0)) == (-0.75, False)  # a tie: COLREGs, to starboard
+    assert turn_for((20.0, 0.5)) == (-0.75, False)
+    assert turn_for((20.0, -4.0)) == (0.5, False)  # well to starboard: round it to port
     _, off = _on_arc(np.array([20.0]), np.array([-4.0]), np.array([0.5 * 0.07]))
     assert abs(off[0]) >= MARGIN * 5.3  # the turn taken clears it by the margin
 
 
-def test_a_boat_walled_in_slows_on_the_turn_that_passes_widest() -> None:
-    assert turn_for((10.0, 1.75), law=0.5) == (-1.0, False, True)  # every arc meets it
+def test_a_boat_walled_in_takes_the_turn_that_passes_widest() -> None:
+    assert turn_for((10.0, 1.75), law=0.5) == (-1.0, False)  # every arc meets it
 
 
 def test_what_is_behind_beside_beyond_reach_or_its_own_is_no_threat() -> None:
-    clear = (np.nan, False, False)
     for xy in ((-20.0, 0.0), (20.0, 8.0), (60.0, 0.0)):  # astern, clear, beyond reach
-        assert np.isnan(turn_for(xy)[0]) and turn_for(xy)[1:] == clear[1:]
+        assert np.isnan(turn_for(xy)[0]) and not turn_for(xy)[1]
     assert np.isnan(turn_for((20.0, 0.0), own=0)[0])  # itself
     assert np.isnan(turn_for((20.0, 0.0), marks=np.array([[[20.2, 0.1]]]))[0])  # its mark
 
 
 def test_one_alongside_or_under_the_bow_is_met_at_once() -> None:
-    assert turn_for((0.5, 3.0)) == (-1.0, False, False)  # close on the port beam: away
-    assert turn_for((0.5, -3.0)) == (1.0, False, False)
-    assert turn_for((2.0, 0.3)) == (-1.0, True, False)  # under the bow: back off while turning
+    assert turn_for((0.5, 3.0)) == (-1.0, False)  # close on the port beam: away
+    assert turn_for((0.5, -3.0)) == (1.0, False)
+    assert turn_for((2.0, 0.3)) == (-1.0, True)  # under the bow: back off while turning
 
 
 def test_the_corridor_follows_the_arc_the_law_turns_on() -> None:
