@@ -27,6 +27,7 @@ from catabot.errors import CataBotError
 
 MODES = ("peer", "client", "router")
 LEASE_MS = 1500
+OPEN_TIMEOUT_MS = 2000  # a handshake's limit (_embedded says why)
 FIRST_PORT = 20000  # free_port draws from here to the ephemeral range: above the well-known
 LOOPBACK = "tcp/127.0.0.1:0"
 RETRY = "{period_init_ms: 250, period_max_ms: 1000, period_increase_factor: 2}"  # connect
@@ -95,6 +96,11 @@ def _embedded(mode: str) -> zenoh.Config:
     # Zenoh's default backs off to 4 s, and a short run could end before it joined
     # (measured: 1.5 s late after a 5 s wait with the default, 0.3 s with this).
     cfg.insert_json5("connect/retry", RETRY)
+    # A handshake's limit: Zenoh's 10 s held `session.close()` that long once a link had
+    # gone silent (its reconnect attempt, unanswered, must time out first): a cut cable
+    # left every process of a run alive 11.5 s after it had flushed its files (0.5-0.8 s
+    # with 1-2 s). A TLS handshake and login take well under 1 s, even between continents.
+    cfg.insert_json5("transport/unicast/open_timeout", str(OPEN_TIMEOUT_MS))
     return cfg
 
 

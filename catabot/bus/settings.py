@@ -108,9 +108,12 @@ class Schedule:
         self._by_tick: dict[int, list[Change]] = {}
         self._live = 0
         self._live_at: dict[int, int] = {}
+        self.beyond: list[Change] = []  # a timeline past the run's end never applies
         for change in timeline:
-            if 0 <= change.tick < ticks:  # a timeline past the run's end never applies
+            if 0 <= change.tick < ticks:
                 self._by_tick.setdefault(change.tick, []).append(change)
+            else:
+                self.beyond.append(change)
 
     def propose(self, key: str, value: str) -> Change:
         """Schedule a live change at the first tick not granted; SettingsError if the run
@@ -146,6 +149,13 @@ class Schedule:
         with self._lock:
             done = sorted(k for k in self._by_tick if k <= self._granted)
             return [c for k in done for c in self._by_tick[k]]
+
+    def asked(self) -> list[Change]:
+        """Every change the run was asked for, in tick order: granted, waiting, or past its
+        end (the run folder's scenario.json: an interrupted run's had lost its later ones)."""
+        with self._lock:
+            every = [c for k in sorted(self._by_tick) for c in self._by_tick[k]]
+        return every + sorted(self.beyond, key=lambda c: c.tick)
 
     def in_force(self) -> list[Change]:
         """Every change granted or waiting, in order (what `catabot get` shows)."""

@@ -153,7 +153,7 @@ def main(argv: list[str] | None = None) -> int:
     info.close()
     stop.set()
     rejected = conductor.rejections.totals + desk.rejections.totals
-    settings = [live.entry(c, scenario.dt_ns) for c in schedule.applied()]
+    settings = [live.entry(c, scenario.dt_ns) for c in schedule.asked()]
     emit("result", **asdict(result), rejected=dict(rejected), settings=settings,
          **memory_mb())  # fmt: skip
     if result.error:

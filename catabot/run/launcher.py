@@ -336,9 +336,10 @@ def _watch(scenario: Scenario, run_dir: Path, supervisor: Supervisor, *, quiet: 
 
 
 def record_settings(scenario: Scenario, run_dir: Path, applied: object) -> None:
-    """The run folder's scenario.json gets the settings timeline the run applied (the
-    scenario's own and every `catabot set`, at the ticks they took effect), so running it
-    again replays the same changes and records the same bytes. Untouched without changes."""
+    """The run folder's scenario.json gets the settings timeline of the run (the scenario's
+    own, those due after it ended included, and every `catabot set`, at the ticks they took
+    effect), so running it again replays the same changes and records the same bytes, and
+    an interrupted run's is the whole experiment. Untouched without changes."""
     if not isinstance(applied, list) or applied == scenario.model_dump(mode="json")["settings"]:
         return
     data = scenario.model_dump(mode="json") | {"settings": applied}

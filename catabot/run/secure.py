@@ -29,7 +29,7 @@ from typing import Any
 
 from catabot.bus.clock import CONDUCTOR
 from catabot.bus.keys import check_name, world_infos
-from catabot.bus.session import LEASE_MS
+from catabot.bus.session import LEASE_MS, OPEN_TIMEOUT_MS
 from catabot.config.sensors import shard_names
 from catabot.errors import CataBotError
 
@@ -194,6 +194,7 @@ def _session(folder: Path, endpoint: str, name: str, users: dict[str, str]) -> d
         "connect": {"endpoints": [endpoint]},
         "scouting": {"multicast": {"enabled": False}},
         "transport": {
+            "unicast": {"open_timeout": OPEN_TIMEOUT_MS},  # session.py `_embedded` says why
             "link": {
                 "tls": {"root_ca_certificate": str(folder / "ca.pem")},
                 "tx": {"lease": LEASE_MS, "keep_alive": 4},

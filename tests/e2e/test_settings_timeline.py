@@ -24,7 +24,8 @@ CHANGES = [
 
 
 def test_a_settings_timeline_changes_each_service_at_its_tick(tmp_path: Path) -> None:
-    data = basic_scenario("timeline", duration_s=1.6, settings=CHANGES)
+    late = {"t_s": 5.0, "key": "rain", "value": 20.0}  # after the end: kept, never applied
+    data = basic_scenario("timeline", duration_s=1.6, settings=[*CHANGES, late])
     data["vessels"][0]["sensors"] = [
         {"name": "lidar", "type": "lidar", "rate_hz": 10.0},
         {"name": "cam", "type": "camera", "rate_hz": 5.0, "params": {"width": 64, "height": 48}},
@@ -48,7 +49,8 @@ def test_a_settings_timeline_changes_each_service_at_its_tick(tmp_path: Path) ->
     assert [(int(r[1]), r[2]) for r in changes] == [
         (round(c["t_s"] * 100), str(c["key"])) for c in CHANGES
     ]
-    assert (run / "scenario.json").read_text().count('"key"') == len(CHANGES)
+    # the timeline as asked: an interrupted run's had lost what was still to come
+    assert (run / "scenario.json").read_text().count('"key"') == len(CHANGES) + 1
 
 
 def _stamps(path: Path) -> dict[str, list[int]]:

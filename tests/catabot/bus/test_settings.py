@@ -31,6 +31,7 @@ def test_a_grant_carries_the_changes_of_the_ticks_it_adds() -> None:
     assert schedule.grant(3) == ()  # a repeat of a grant carries nothing again
     assert [from_wire(t).value for t in schedule.grant(9)] == ["2.0"]
     assert [c.tick for c in schedule.applied()] == [0, 5]  # tick 99 is past the run
+    assert [c.tick for c in schedule.asked()] == [0, 5, 99]  # as the scenario asked
 
 
 def test_a_live_change_lands_above_every_grant() -> None:
