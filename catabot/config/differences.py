@@ -1,13 +1,14 @@
 """Where scenarios differ, field by field: what tells the runs of a sweep apart.
 
 `catabot plot RUN RUN ...` names each run by its differences from the first, and `catabot
-results` gives each swept field a column. Both read them here, so a field is spelled the
-same in a plot's legend, a table's header and `catabot run --set` (`water.current.
-velocity_mps`, `vessels.0.pose.x_m`).
+results` gives each swept field a column (and the timelines one, `settings`, where they
+differ). Both read them here, so a field is spelled the same in a plot's legend, a table's
+header and `catabot run --set` (`water.current.velocity_mps`, `vessels.0.pose.x_m`).
 """
 
 from __future__ import annotations
 
+import json
 from typing import Any
 
 from catabot.config.scenario import Scenario
@@ -32,6 +33,12 @@ def flatten(tree: Any, prefix: str = "") -> dict[str, Any]:
     for key, value in tree.items():
         out |= flatten(value, f"{prefix}.{key}" if prefix else str(key))
     return out
+
+
+def timeline(scenario: Scenario) -> list[str]:
+    """Its settings timeline, an entry each (`current=[0.0, 0.5] at 2 s`): a plot's legend
+    and the results' `settings` column spell it alike."""
+    return [f"{c.key}={json.dumps(c.value)} at {c.t_s:g} s" for c in scenario.settings]
 
 
 def differences(first: Scenario, other: Scenario) -> dict[str, Any]:

@@ -115,10 +115,19 @@ def get_main(argv: list[str]) -> int:
                 )
             print(json.dumps(settings[args.key]))
         else:
-            for key, value in settings.items():
-                print(f"{key} = {json.dumps(value)}    # {allowed.get(key, '')}")
+            for key, value in answer.get("now", settings).items():
+                print(f"{key} = {json.dumps(value)}    # {allowed.get(key, '')}{_due(answer, key)}")
 
     return _run("get", args, ask)
+
+
+def _due(answer: dict[str, Any], key: str) -> str:
+    """The changes of `key` scheduled after the last tick granted (a timeline's later
+    entries were shown as if in force already)."""
+    later = [
+        c for c in answer.get("changes", []) if c["key"] == key and c["tick"] > answer["granted"]
+    ]
+    return "".join(f"; {json.dumps(c['value'])} from t = {c['t_s']:g} s" for c in later)
 
 
 def set_main(argv: list[str]) -> int:

@@ -99,14 +99,18 @@ class SettingsDesk:
         for key, spec in specs.items():  # a drawn boat's behaviour, once the plan is known
             if spec.kind == "behaviour" and values[key] == live.AS_PLANNED:
                 values[key] = planned.get(spec.owner, live.AS_PLANNED)
-        changes = self.schedule.in_force()
+        changes, granted = self.schedule.in_force(), self.schedule.granted
+        now = dict(values)
         for change in changes:
             values[change.key] = change.decoded
+            if change.tick <= granted:
+                now[change.key] = change.decoded
         return {
             "world": self.keys.world,
-            "granted": self.schedule.granted,
+            "granted": granted,
             "dt_ns": self.scenario.dt_ns,
-            "settings": values,
+            "settings": values,  # once every change scheduled so far has applied
+            "now": now,  # at the last tick granted: a timeline's later entries not yet
             "allowed": {key: spec.allowed for key, spec in specs.items()},
             "changes": [live.entry(c, self.scenario.dt_ns) | {"tick": c.tick} for c in changes],
         }

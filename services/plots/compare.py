@@ -16,7 +16,7 @@ import numpy as np
 from matplotlib import colormaps
 from matplotlib.figure import Figure
 
-from catabot.config.differences import flat_fields, one_scenario, swept_fields
+from catabot.config.differences import flat_fields, one_scenario, swept_fields, timeline
 from services.plots.figures import draw_task, speed_heading_axes, task_points
 from services.plots.report import table_row, vessel_cells
 from services.plots.series import RunSeries
@@ -46,7 +46,7 @@ def _about(data: RunSeries, swept: list[str], *, kin: bool) -> str:
     values = flat_fields(mine)
     parts = ([f"{k}={json.dumps(values.get(k))}" for k in swept] if kin
              else [f"scenario {mine.name}"])  # fmt: skip
-    parts += [f"{c.key}={json.dumps(c.value)} at {c.t_s:g} s" for c in mine.settings]
+    parts += timeline(mine)
     ended = (data.metrics or {}).get("end_reason", "completed")
     parts += [] if ended == "completed" else [f"ended: {ended}"[:40]]
     return f" ({_short(parts)})" if parts else ""

@@ -9,11 +9,12 @@ was measured, so a sweep's table shows every run it started.
 from __future__ import annotations
 
 import json
+import os
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
-from catabot.config.differences import flat_fields, swept_fields
+from catabot.config.differences import flat_fields, swept_fields, timeline
 from catabot.config.load import load_scenario
 from catabot.config.scenario import Scenario
 from catabot.run.metrics_summary import own_vessels
@@ -60,9 +61,23 @@ def table(records: list[RunRecord]) -> tuple[list[str], list[dict[str, Any]]]:
     swept = [k for k in swept_fields([r.scenario for r in records]) if k not in RUN_COLUMNS]
     values = [flat_fields(r.scenario) for r in records]
     columns = [column for key in swept for column in _split(key, values)]
+    timelines = ["; ".join(timeline(r.scenario)) or None for r in records]
+    if len(set(timelines)) > 1:  # a sweep over the timeline looked like repeats of one run
+        columns.append("settings")
+        for v, text in zip(values, timelines, strict=True):
+            v["settings"] = text
+    names = _names([r.folder for r in records])
     header = ["run", "vessel", *columns, *RUN_COLUMNS, *VESSEL_COLUMNS, *AFTER]
-    rows = zip(records, values, strict=True)
-    return header, [row for r, v in rows for row in _rows(r, v, columns)]
+    rows = zip(records, values, names, strict=True)
+    return header, [row for r, v, n in rows for row in _rows(r, v, columns, n)]
+
+
+def _names(folders: list[Path]) -> list[str]:
+    """Each run folder below the folders' common parent: `tl/a` and `live/a`, not `a`
+    twice (a sweep in one folder: its runs' names)."""
+    parents = [str(f.resolve().parent) for f in folders]
+    common = Path(os.path.commonpath(parents)) if parents else Path()
+    return [os.path.relpath(f.resolve(), common) for f in folders]
 
 
 def _split(key: str, values: list[dict[str, Any]]) -> list[str]:
@@ -80,8 +95,10 @@ def _split(key: str, values: list[dict[str, Any]]) -> list[str]:
     return [f"{key}.{i}" for i in items]
 
 
-def _rows(record: RunRecord, values: dict[str, Any], columns: list[str]) -> list[dict[str, Any]]:
-    common = {"run": record.folder.name, **{k: values.get(k) for k in columns}}
+def _rows(
+    record: RunRecord, values: dict[str, Any], columns: list[str], name: str
+) -> list[dict[str, Any]]:
+    common = {"run": name, **{k: values.get(k) for k in columns}}
     common |= _run_cells(record) | _after(record.metrics)
     vessels = own_vessels(record.metrics)
     if not vessels:  # nothing measured: the run's row alone

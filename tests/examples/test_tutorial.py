@@ -6,6 +6,8 @@ from __future__ import annotations
 
 import json
 import re
+import subprocess
+import sys
 from pathlib import Path
 from typing import Any
 
@@ -14,9 +16,11 @@ import pytest
 from catabot.run.cli import main
 from tests.paths import REPO
 
+TUTORIAL = REPO / "docs" / "TUTORIAL.md"
+
 
 def tutorial_blocks() -> list[str]:
-    return re.findall(r"```json\n(.*?)```", (REPO / "docs" / "TUTORIAL.md").read_text(), re.S)
+    return re.findall(r"```json\n(.*?)```", TUTORIAL.read_text(), re.S)
 
 
 def first(tmp_path: Path, change: dict[str, Any] | None = None) -> Path:
@@ -52,3 +56,14 @@ def test_step_6s_controller_runs_the_bundled_navigator(
     path.write_text(json.dumps(data))
     monkeypatch.chdir(REPO)  # "every command runs from the repository's root"
     assert main(["scenario", "validate", str(path)]) == 0
+
+
+def test_step_3s_summary_is_what_the_run_prints(tmp_path: Path) -> None:
+    """The page quoted 29.52 s after the run had come to print 29.53 s: a reader checks it."""
+    quoted = re.search(r"`(ego: goal reached at [\d.]+ s \([\d.]+ m\));", TUTORIAL.read_text())
+    assert quoted is not None
+    run = subprocess.run([sys.executable, "-m", "catabot", "run", str(first(tmp_path)),
+                          "--quiet", "--out", str(tmp_path / "runs")],
+                         capture_output=True, text=True, timeout=300)  # fmt: skip
+    assert run.returncode == 0, run.stderr
+    assert quoted.group(1) in run.stdout, run.stdout

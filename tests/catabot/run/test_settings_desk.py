@@ -14,6 +14,7 @@ from catabot.bus.keys import Keys
 from catabot.bus.session import Connection, free_port, open_session
 from catabot.bus.settings import Schedule
 from catabot.config.load import parse_scenario
+from catabot.run.settings_cli import _due
 from catabot.run.settings_desk import MAX_QUERY_BYTES, SettingsDesk
 
 KEYS = Keys("desk")
@@ -50,8 +51,11 @@ def test_get_and_set(desk: tuple[SettingsDesk, zenoh.Session]) -> None:
     assert ok and answer["world"] == "desk" and answer["settings"]["rain"] == 0.0
     ok, done = _ask(session, KEYS.config("set"), json.dumps({"key": "rain", "value": 25}))
     assert ok and done == {"key": "rain", "value": 25.0, "tick": 10, "t_s": 0.1}
-    assert _ask(session, KEYS.config("settings"))[1]["settings"]["rain"] == 25.0
+    answer = _ask(session, KEYS.config("settings"))[1]
+    assert answer["settings"]["rain"] == 25.0 and answer["now"]["rain"] == 0.0  # not yet
+    assert _due(answer, "rain") == "; 25.0 from t = 0.1 s" and _due(answer, "current") == ""
     assert d.schedule.grant(10) == ('[10,"rain","25.0"]',)
+    assert _ask(session, KEYS.config("settings"))[1]["now"]["rain"] == 25.0
 
 
 @pytest.mark.parametrize(

@@ -189,3 +189,24 @@ def test_a_swept_list_is_a_numeric_column_per_item_that_differs(tmp_path: Path) 
     table = pd.read_csv(tmp_path / "t.csv")
     assert "water.current.velocity_mps" not in table and "water.current.velocity_mps.0" not in table
     assert table["water.current.velocity_mps.1"].tolist() == [0.0, 0.0, 0.3, 0.3, 0.6, 0.6]
+
+
+def test_a_sweep_over_the_timeline_has_its_column(tmp_path: Path) -> None:
+    """Two onsets of a current looked like repeats of one run: no column told them apart."""
+    for k, onset in enumerate((2.0, 6.0)):
+        run = make_run(tmp_path / "onset" / f"run-{k}")
+        data = json.loads((run / "scenario.json").read_text())
+        data["settings"] = [{"t_s": onset, "key": "current", "value": [0.0, 0.5]}]
+        (run / "scenario.json").write_text(json.dumps(data))
+    assert cli.main([str(tmp_path / "onset"), "--csv", str(tmp_path / "t.csv")]) == 0
+    settings = pd.read_csv(tmp_path / "t.csv")["settings"].tolist()
+    assert settings == ["current=[0.0, 0.5] at 2 s"] * 2 + ["current=[0.0, 0.5] at 6 s"] * 2
+
+
+def test_runs_from_two_folders_are_named_by_their_folder(tmp_path: Path) -> None:
+    """`catabot results tl live` had two rows named `a`."""
+    for where in ("tl", "live"):
+        make_run(tmp_path / where / "a")
+    assert cli.main([str(tmp_path / "tl"), str(tmp_path / "live"), "--csv",
+                     str(tmp_path / "t.csv")]) == 0  # fmt: skip
+    assert set(pd.read_csv(tmp_path / "t.csv")["run"]) == {"tl/a", "live/a"}
