@@ -7,10 +7,10 @@ gives the same page every time it is plotted.
 from __future__ import annotations
 
 import html
-import json
 from pathlib import Path
 from typing import Any
 
+from catabot.config.differences import timeline
 from catabot.run.metrics_summary import vessel_parts
 from services.plots.series import RunSeries
 
@@ -36,13 +36,20 @@ def summary(data: RunSeries) -> list[tuple[str, Any]]:
     return [
         ("scenario", s.name), ("seed", s.seed),
         ("simulated", f"{data.t[-1]:.2f} s recorded ({len(data.t)} ticks of {s.dt_ns / 1e6:g} ms)"),
+        ("ended", _ended(data)),
         ("vessels", ", ".join(data.own)), ("traffic boats", len(world.boat_ids)),
         ("buoys", len(world.buoys)), ("sensors", sensors),
         ("rain", f"{s.rain.rate_mm_h:g} mm/h"), ("waves", waves),
         ("terrain", "none" if world.terrain is None else Path(world.terrain.name).name),
-        ("settings changed", "; ".join(f"{c.key} = {json.dumps(c.value)} at {c.t_s:g} s"
-                                       for c in s.settings) or "none"),
+        ("settings timeline", "; ".join(timeline(s)) or "none"),
     ]  # fmt: skip
+
+
+def _ended(data: RunSeries) -> str:
+    """How the run ended: a report of an interrupted run read as a whole one."""
+    reason = (data.metrics or {}).get("end_reason", "completed")
+    planned = data.run.world.scenario.duration_s
+    return "completed" if reason == "completed" else f"{reason}, of {planned:g} s planned"
 
 
 def vessel_cells(m: dict[str, Any]) -> list[str]:
