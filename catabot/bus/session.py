@@ -196,12 +196,22 @@ def open_session(conn: Connection) -> zenoh.Session:
     except Exception as exc:
         said = re.sub(r"\s+at \S+\.rs:\d+\.?$", "", str(exc).strip())  # Zenoh's source line
         if "Unable to connect" in said:  # the endpoints a config file names too
-            said += _why_unreachable(tuple(json.loads(config.get_json("connect/endpoints"))))
+            said += _why_unreachable(_connect_endpoints(config))
         raise SessionError(
             f"cannot open zenoh (mode {conn.mode or 'peer'}, connect {list(conn.connect)}, "
             f"listen {list(conn.listen)}, config {conn.file or os.environ.get('ZENOH_CONFIG')}): "
             f"{said}"
         ) from None
+
+
+def _connect_endpoints(config: zenoh.Config) -> tuple[str, ...]:
+    """The endpoints a session connects to, in CataBot's plain form: a config file may
+    give them per mode (`{client: [...], peer: [...]}`) or with `#`/`?` metadata, which a
+    probe skips rather than fail on while it explains another failure."""
+    found = json.loads(config.get_json("connect/endpoints"))
+    if isinstance(found, dict):
+        found = [e for v in found.values() if isinstance(v, list) for e in v]
+    return tuple(e for e in found if isinstance(e, str) and _ENDPOINT.match(e))
 
 
 def _why_unreachable(endpoints: tuple[str, ...]) -> str:

@@ -136,9 +136,9 @@ class VesselConfig(Strict):
     velocity: Velocity = Field(Velocity(), description="body-frame velocity at t = 0")
     script: list[ScriptStep] = []
     command_timeout_s: float | None = Field(
-        None, gt=0, description="an outside (free) thrust or twist not renewed for this long "
-        "hands the vessel back to its script, or rest (a stack that died stops steering it); "
-        "null: it holds until a release",
+        None, gt=0, le=86_400, description="an outside (free) thrust or twist not renewed for "
+        "this long hands the vessel back to its script, or rest (a stack that died stops "
+        "steering it); null: it holds until a release",
     )  # fmt: skip
     sensors: list[SensorConfig] = []
     controller: ControllerConfig | None = Field(

@@ -141,6 +141,7 @@ class TrafficConfig(Strict):
     command_timeout_s: float | None = Field(
         None,
         gt=0,
+        le=86_400,  # a day: beyond, its nanoseconds overflowed in physics
         description="an outside thrust or twist on a boat not renewed for this long hands it "
         "back to its behaviour (a controller that died stops driving it); null: it holds "
         "until a release",

@@ -23,10 +23,12 @@ def is_run(folder: Path) -> bool:
 
 
 def run_folders(paths: list[str]) -> list[Path]:
-    """Each path as the runs it names, once each, in the order given."""
+    """Each path as the runs it names, once each (one folder spelled two ways, `tl` and
+    `/abs/tl`, had given each run twice), in the order given."""
     found: list[Path] = []
     for path in paths:
-        found += [f for f in _runs_in(Path(path)) if f not in found]
+        seen = {f.resolve() for f in found}
+        found += [f for f in _runs_in(Path(path)) if f.resolve() not in seen]
     return found
 
 

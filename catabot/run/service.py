@@ -155,23 +155,22 @@ def parse_shard(text: str) -> tuple[int, int]:
     return int(i), int(n)
 
 
-WHY_NOT = {
-    "sensors": "no vessel has sensors",
-    "traffic": "traffic.count is 0",
-    "recorder": "recording.csv and recording.mcap are off",
-    "ros": "it has no ros section",
-}
+WHY_NOT = {"sensors": "no vessel has sensors", "traffic": "traffic.count is 0"}
+
+
+class NotInScenario(CataBotError, ValueError):
+    """A service started for a scenario that does not run it."""
 
 
 def own_name(service: str, world: World, shard: tuple[int, int] | None) -> str:
     """This process's participant name: the service's own, or its shard's (`sensors.1`).
-    ShardError for a service the scenario does not run (traffic without boats crashed with
-    a KeyError; sensors without sensors joined and stepped nothing)."""
+    NotInScenario for sensors or traffic where the scenario has none (traffic without boats
+    crashed with a KeyError; sensors without sensors joined and stepped nothing). The ROS
+    gateway may run on any scenario, with the default ROS settings."""
     needed = services(world.scenario)
-    if service not in {n.partition(".")[0] for n in needed}:
-        raise ShardError(f"scenario {world.scenario.name!r} does not run {service} "
-                         f"({WHY_NOT.get(service, 'not one of its services')}); it runs "
-                         f"{', '.join(needed)}")  # fmt: skip
+    if service in WHY_NOT and not any(n.partition(".")[0] == service for n in needed):
+        raise NotInScenario(f"scenario {world.scenario.name!r} does not run {service} "
+                            f"({WHY_NOT[service]}); it runs {', '.join(needed)}")  # fmt: skip
     n = shard_count(world.scenario, service)
     if shard is None and n == 1:
         return service

@@ -105,7 +105,7 @@ def get_main(argv: list[str]) -> int:
 
     def ask(session: zenoh.Session) -> None:
         answer = _settings(session, args.world, args.timeout)
-        settings, allowed = answer["settings"], answer["allowed"]
+        settings, allowed = answer.get("now", answer["settings"]), answer["allowed"]
         if args.json:
             print(json.dumps(answer if args.key is None else settings.get(args.key), indent=2))
         elif args.key is not None:
@@ -115,7 +115,7 @@ def get_main(argv: list[str]) -> int:
                 )
             print(json.dumps(settings[args.key]))
         else:
-            for key, value in answer.get("now", settings).items():
+            for key, value in settings.items():
                 print(f"{key} = {json.dumps(value)}    # {allowed.get(key, '')}{_due(answer, key)}")
 
     return _run("get", args, ask)

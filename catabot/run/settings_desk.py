@@ -1,6 +1,7 @@
 """The conductor's settings desk: a Zenoh queryable on `catabot/<world>/config/**`.
 
-`config/settings` answers the settings in force as JSON (what `catabot get` prints);
+`config/settings` answers the settings as JSON, now and once the changes scheduled apply
+(what `catabot get` prints);
 `config/set` with a JSON payload `{"key": ..., "value": ...}` checks the change with the
 scenario's own models (catabot/config/live.py) and schedules it on the clock
 (catabot/bus/settings.py), answering the tick it takes effect at. Anything else, and any

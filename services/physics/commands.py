@@ -77,7 +77,8 @@ class CommandBook:
         for vid in self.book.expire(stamp_ns):  # outside commands gone stale: handed back
             self.released.add(vid)
             held_s = self.book.timeouts[vid] / 1e9
-            advise(log, f"{vid}: no outside command for {held_s:g} s (command_timeout_s): "
+            field = "traffic.command_timeout_s" if vid in self.boats else "command_timeout_s"
+            advise(log, f"{vid}: no outside command for {held_s:g} s ({field}): "
                         f"handed back to {self._own(vid)}")  # fmt: skip
         target, follow = self.set_point.copy(), self.has_set_point.copy()
         thrust: dict[int, tuple[float, ...]] = {}
@@ -101,7 +102,7 @@ class CommandBook:
             self.book.drop(vessel)
             self.has_set_point[self.row[vessel]] = False
             self.released.add(vessel)
-        if vessels:
+        if vessels:  # a lockstep controller drives scenario vessels only
             tell(log, f"{participant} left the run at t = {stamp_ns / 1e9:g} s (clock.policy "
                       f"drop): {some(vessels)} back to script (rest without one)")  # fmt: skip
 
@@ -113,7 +114,8 @@ class CommandBook:
         timeout_ns = self.book.timeouts.get(vessel)
         if timeout_ns is None:  # a boat had been told of a command_timeout_s it cannot have
             return ""
-        return f" or {timeout_ns / 1e9:g} s without one (command_timeout_s)"
+        field = "traffic.command_timeout_s" if vessel in self.boats else "command_timeout_s"
+        return f" or {timeout_ns / 1e9:g} s without one ({field})"
 
     def take_batch(self, batch: TwistBatch, expected: tuple[str, ...]) -> None:
         """The traffic service's set-points (rows and shapes checked on arrival): every boat

@@ -37,7 +37,7 @@ Rows = NDArray[np.intp]
 MARK_M = 0.5  # a waypoint this close to a buoy's anchor is that buoy's mark
 PAIRS = 250_000  # boats x obstacles compared at once (bounds the temporaries)
 TURNS = np.linspace(-1.0, 1.0, 9)  # the turns a blocked boat may take, parts of its full rate
-MARGIN = 1.5  # a turn taken instead keeps this much wider clear than the law's arc missed by
+MARGIN = 1.5  # a turn taken instead must pass this many corridor half-widths clear
 
 
 @dataclass(frozen=True)
@@ -147,8 +147,8 @@ def _clear_arc(
 ) -> None:  # fmt: skip
     """Boats whose own arc meets an obstacle within reach take the clear turn nearest their
     law's, to starboard on a tie (COLREGs rule 14); with none clear, the one that passes its
-    obstacles widest (at half speed as well, boats piled up in a trial's four seeds: 22
-    touches between boats against 18).
+    obstacles widest, at its law's speed (slowing to half speed too piled boats up: a
+    trial's four seeds, 22 touches between boats against 18).
     Why not a full turn away, as before: a boat turning for its waypoint met a buoy on that
     arc, turned away, found its arc clear, turned back, and so on at every guidance tick:
     the yaw rate flipped between its limits and the boat never got there."""

@@ -9,6 +9,10 @@ from typing import Any
 import pytest
 from conftest import basic_scenario, catabot, files_of, only_run_dir, scenario_file
 
+from catabot.config.load import parse_scenario
+from catabot.run.service import own_name
+from catabot.world.world import World
+
 pytestmark = pytest.mark.timeout(240)
 
 
@@ -66,3 +70,6 @@ def test_a_service_the_scenario_does_not_run_is_refused(tmp_path: Path) -> None:
         got = catabot("service", service, "--scenario", str(scenario), timeout=60)
         assert got.returncode == 2, got.stderr
         assert f"scenario 'bare' does not run {service} ({why}); it runs physics" in got.stderr
+    world = World.resolve(parse_scenario(basic_scenario("bare")))
+    assert own_name("ros", world, None) == "ros"  # the gateway runs on any scenario
+    assert own_name("recorder", world, None) == "recorder"

@@ -3,8 +3,10 @@ Zenoh itself would fail only inside every process, after all of them had started
 
 from __future__ import annotations
 
+import json
 import socket
 import time
+from pathlib import Path
 
 import pytest
 
@@ -81,3 +83,14 @@ def test_a_free_port_lies_below_the_kernels_ephemeral_range() -> None:
     assert all(session.FIRST_PORT <= p < low for p in ports), ports
     with socket.socket(socket.AF_INET, socket.SOCK_STREAM) as s:
         s.bind(("127.0.0.1", ports.pop()))  # free indeed
+
+
+def test_a_config_files_endpoints_are_read_in_either_form(tmp_path: Path) -> None:
+    """Zenoh's per-mode form in a file raised "zenoh endpoint 'peer': use proto/host:port"
+    from inside the explanation of a plain "nobody listens there"."""
+    port = free_port()
+    config = {"mode": "client", "connect": {"endpoints": {"client": [f"tcp/127.0.0.1:{port}"],
+                                                          "peer": []}}}  # fmt: skip
+    (tmp_path / "z.json5").write_text(json.dumps(config))
+    with pytest.raises(SessionError, match="nothing answers there"):
+        open_session(Connection(file=str(tmp_path / "z.json5"), open_timeout_ms=500))

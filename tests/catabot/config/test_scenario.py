@@ -325,3 +325,11 @@ def test_a_value_is_shown_in_the_files_own_words() -> None:
     msg = _error(data)
     assert "traffic.region: must be an object (got null)" in msg
     assert "duration_s: must be a number (got true)" in msg
+
+
+def test_a_command_timeout_beyond_a_day_is_refused() -> None:
+    """1e300 s passed and overflowed in physics and the recorder (ns in an int)."""
+    vessel = {"vessels": [{"id": "e", "command_timeout_s": 1e300}]}
+    assert "vessels.0.command_timeout_s: must be <= 86400" in _error(vessel)
+    boats = {"vessels": [{"id": "e"}], "traffic": {"count": 1, "command_timeout_s": 1e300}}
+    assert "traffic.command_timeout_s: must be <= 86400" in _error(boats)

@@ -92,7 +92,9 @@ def test_a_traffic_boat_taken_over_goes_back_to_its_guidance_after_the_timeout(
         assert book.orders(1_490_000_000)[2].tolist() == [[1.0, 0.0]]
         assert book.orders(1_510_000_000)[2].tolist() == [[4.0, 0.1]]  # its guidance again
     told = [advice_of(f" INFO {r.getMessage()}") for r in caplog.records]
-    assert told[0].endswith("until a release (waypoints) or 0.5 s without one (command_timeout_s)")
+    assert told[0].endswith(
+        "until a release (waypoints) or 0.5 s without one (traffic.command_timeout_s)"
+    )
     assert "handed back to the traffic's guidance" in caplog.records[-1].getMessage()
 
 

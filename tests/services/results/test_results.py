@@ -210,3 +210,10 @@ def test_runs_from_two_folders_are_named_by_their_folder(tmp_path: Path) -> None
     assert cli.main([str(tmp_path / "tl"), str(tmp_path / "live"), "--csv",
                      str(tmp_path / "t.csv")]) == 0  # fmt: skip
     assert set(pd.read_csv(tmp_path / "t.csv")["run"]) == {"tl/a", "live/a"}
+
+
+def test_one_folder_spelled_two_ways_counts_once(tmp_path: Path) -> None:
+    make_run(tmp_path / "tl" / "a")
+    twice = [str(tmp_path / "tl"), str(tmp_path / "tl" / ".." / "tl")]
+    assert cli.main([*twice, "--csv", str(tmp_path / "t.csv")]) == 0
+    assert pd.read_csv(tmp_path / "t.csv")["run"].tolist() == ["a", "a"]  # ego and b, once
