@@ -221,10 +221,14 @@ def run_service(
         session.close()
 
 
+class Terminated(SystemExit):
+    """SIGTERM: exit 143, as before, once the conductor has been told why (it had named a
+    stopped service as one that left "without a word")."""
+
+
 def _stopped(*_: object) -> None:
-    """SIGTERM: exit 143, saying so (a stopped service left only "left the run" behind)."""
     log.warning("stopped by SIGTERM (exit 143)")
-    sys.exit(143)
+    raise Terminated(143)
 
 
 def with_switches(ctx: ServiceContext, runner: Runner, step: StepFn) -> StepFn:
@@ -257,6 +261,11 @@ def _serve(ctx: ServiceContext, build: BuildFn) -> int:
         end = _profiled(ctx.name, ctx.run_dir, lambda: participant.run(step, on_end))
         write_usage(ctx.name, ctx.run_dir, time.process_time() - cpu_start)
         participant.rejections.write(ctx.run_dir / "log" / f"{ctx.name}.rejected.json")
+    except Terminated:
+        if isinstance(participant, Participant):
+            participant.report_fault("stopped by SIGTERM (exit 143)")
+            time.sleep(FAULT_SENT_S)  # the put leaves before the session closes
+        raise
     except ClockError as exc:
         log.error("%s", exc)
         return EXIT_CLOCK

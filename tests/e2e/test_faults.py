@@ -66,6 +66,20 @@ def test_sigkill_of_a_service_ends_the_run_naming_it(tmp_path: Path, out: Path) 
     assert _assert_readable(run) > 0
 
 
+def test_sigterm_of_a_service_is_named_as_such(tmp_path: Path, out: Path) -> None:
+    """A process manager's SIGTERM: the service said so in its own log only, and the
+    conductor named it as one that left "without a word"."""
+    proc = start("run", str(_long(tmp_path)), "--out", str(out), "--quiet")
+    wait_for_line(proc, "zenoh:")
+    _wait_for_rows(out, 20)
+    os.kill(service_pid(proc.pid, "services.physics"), signal.SIGTERM)
+    _, err = proc.communicate(timeout=30)
+    assert proc.returncode == 1
+    log = (only_run_dir(out) / "log" / "conductor.log").read_text()
+    assert "participant 'physics' " in log and "stopped by SIGTERM (exit 143)" in log, log
+    assert "without a word" not in log and "stopped by SIGTERM" in err
+
+
 def test_killed_participant_is_detected_within_one_second(tmp_path: Path, out: Path) -> None:
     endpoint = f"tcp/127.0.0.1:{free_port()}"
     scenario = _long(tmp_path, external_participants=["autopilot"])
