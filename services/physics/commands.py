@@ -78,8 +78,8 @@ class CommandBook:
             self.released.add(vid)
             held_s = self.book.timeouts[vid] / 1e9
             field = "traffic.command_timeout_s" if vid in self.boats else "command_timeout_s"
-            advise(log, f"{vid}: no outside command for {held_s:g} s ({field}): "
-                        f"handed back to {self._own(vid)}")  # fmt: skip
+            advise(log, f"{vid}: no outside command for {held_s:g} s ({field}): handed back "
+                        f"at t = {stamp_ns / 1e9:g} s to {self._own(vid)}")  # fmt: skip
         target, follow = self.set_point.copy(), self.has_set_point.copy()
         thrust: dict[int, tuple[float, ...]] = {}
         for vid in self.scripted:

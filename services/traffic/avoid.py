@@ -22,7 +22,7 @@ scenario's vessels only with `traffic.avoid.vessels`), each a footprint circle:
   marks on a boat's own path are left to the first rule. Boats under way ahead are not
   corridor obstacles: reacting to where another boat is now, both boats of a pair turned,
   each to the side the other bore on, and still met; colregs.py gives such meetings to one
-  of the two.
+  of the two, and its pick is what the corridor checks (behaviours.py: the rules first).
 """
 
 from __future__ import annotations

@@ -121,14 +121,23 @@ class Behaviours:
         self.step = np.ones(n, dtype=np.int64)
         self.loop = np.zeros(n, dtype=bool)
         self.tol = np.array([b.tolerance_m for b in boats], dtype=np.float64)
+        self._away: dict[int, tuple[int, int]] = {}  # off their own: their place on it
         for i, b in enumerate(boats):
             if b.behaviour == "waypoints":
-                self.set_path(i, np.array(b.path), b.speed_mps, loop=b.loop, tol=b.tolerance_m)
+                self._follow(i, np.array(b.path), b.speed_mps, loop=b.loop, tol=b.tolerance_m)
 
     def set_path(self, i: int, points: Array, speed: float, *, loop: bool, tol: float) -> None:
-        """Boat i follows `points` (K, 2) from the first one on."""
+        """Boat i follows `points` (K, 2) from the first one on, in place of its own."""
+        self._leave(i)
+        self._follow(i, points, speed, loop=loop, tol=tol)
+
+    def _follow(self, i: int, points: Array, speed: float, *, loop: bool, tol: float) -> None:
         self.kind[i], self.speed[i], self.loop[i], self.tol[i] = WAYPOINTS, speed, loop, tol
         self._store_path(i, np.asarray(points, dtype=np.float64).reshape(-1, 2))
+
+    def _leave(self, i: int) -> None:
+        """Boat i leaves its scenario behaviour: where it was on its path, for a release."""
+        self._away.setdefault(i, (int(self.index[i]), int(self.step[i])))
 
     def _store_path(self, i: int, points: Array) -> None:
         """Boat i's path into the padded array (widened when a longer path arrives)."""
@@ -145,11 +154,17 @@ class Behaviours:
         self.index[i], self.step[i] = 0, 1
 
     def release(self, i: int) -> None:
-        """Boat i goes back to its scenario behaviour, from where it is now."""
+        """Boat i goes back to its scenario behaviour, from where it is now, at the point of
+        its path it had left for (one only taken by a twist or thrust, as by a timeout, goes
+        on: a release had sent it back to its first point, passed long before)."""
+        place = self._away.pop(i, None)
+        if place is None:
+            return
         b = self.boats[i]
         self.kind[i], self.speed[i] = KINDS[b.behaviour], b.speed_mps
         self.tol[i], self.loop[i] = b.tolerance_m, b.loop
         self._store_path(i, np.array(b.path, dtype=np.float64).reshape(-1, 2))
+        self.index[i], self.step[i] = place
 
     def set_behaviour(
         self, i: int, behaviour: str, here: Array, yaw: float, cfg: TrafficConfig
@@ -159,6 +174,7 @@ class Behaviours:
         own circle's radius (else the smallest drawn) and sense; follow its path, else the
         scenario's points, else back and forth between here and `PATROL_M` ahead."""
         boat, x, y = self.boats[i], float(here[0]), float(here[1])
+        self._leave(i)
         if behaviour == "hold":
             self.kind[i], self.speed[i], self.hold_yaw[i] = HOLD, cfg.hold.max_speed_mps, yaw
             self.centre[i] = (x, y)
@@ -186,15 +202,17 @@ class Behaviours:
             if rows.size:
                 surge[rows], rate[rows] = law(rows, pos[rows], yaw[rows], chi[rows], sog[rows])
         if obstacles is not None and len(obstacles.xy):
-            surge, rate, turned = self._keep_clear(pos, chi, sog, obstacles, (surge, rate))
-            surge, rate = self._give_way(pos, chi, sog, obstacles, (surge, rate), turned)
+            # The rules of the road first, then the buoys: the turn a rule picks is checked
+            # against them (a give-way turn had steered a boat onto a buoy and pinned it).
+            surge, rate = self._give_way(pos, chi, sog, obstacles, (surge, rate))
+            surge, rate = self._keep_clear(pos, chi, sog, obstacles, (surge, rate))
         return surge, rate
 
     def _keep_clear(
         self, pos: Array, chi: Array, sog: Array, obstacles: Obstacles, order: tuple[Array, Array]
-    ) -> tuple[Array, Array, NDArray[np.bool_]]:
+    ) -> tuple[Array, Array]:
         """The clear turn nearest each blocked boat's own (avoid.py), backing off while an
-        obstacle is under the bow (holding boats stay put); and which boats it turned."""
+        obstacle is under the bow (holding boats stay put)."""
         surge, rate = order
         speed = np.maximum(np.maximum(sog, np.abs(surge)), 1.0)  # its law slows to turn
         reach, marks = self.clear.lookahead_s * speed, self._own_marks()
@@ -203,7 +221,7 @@ class Behaviours:
         turn[self.kind == HOLD], stop[self.kind == HOLD] = np.nan, False
         steered = ~np.isnan(turn)
         surge = np.where(stop, -BACK_OFF_MPS, surge)
-        return surge, np.where(steered, turn * MAX_YAW_RATE, rate), steered
+        return surge, np.where(steered, turn * MAX_YAW_RATE, rate)
 
     def _give_way(
         self,
@@ -212,11 +230,9 @@ class Behaviours:
         sog: Array,
         obstacles: Obstacles,
         order: tuple[Array, Array],
-        turned: NDArray[np.bool_],
     ) -> tuple[Array, Array]:
         """Boats meeting boats: each takes the course change and speed that keeps clear at
-        least cost under the rules of the road (colregs.py), unless the corridor already
-        turns it (a buoy, a hull alongside)."""
+        least cost under the rules of the road (colregs.py); the buoys are checked after."""
         surge, rate = order
         vel = sog[:, None] * np.column_stack((np.cos(chi), np.sin(chi)))
         own = Movers(pos, vel, chi, rate, self.clear.width)  # on its own law's arc
@@ -228,7 +244,7 @@ class Behaviours:
         offset, part = OFFSETS[pick], SPEEDS[pick]
         self._last_pick = pick
         act = pick != 0
-        steer = act & ~turned & (offset != 0.0)
+        steer = act & (offset != 0.0)
         surge = np.where(act & (surge > 0.0), surge * part, surge)
         rate = np.where(steer, np.clip(YAW_GAIN * offset, -MAX_YAW_RATE, MAX_YAW_RATE), rate)
         return surge, rate

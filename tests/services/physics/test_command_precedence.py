@@ -95,7 +95,7 @@ def test_a_traffic_boat_taken_over_goes_back_to_its_guidance_after_the_timeout(
     assert told[0].endswith(
         "until a release (waypoints) or 0.5 s without one (traffic.command_timeout_s)"
     )
-    assert "handed back to the traffic's guidance" in caplog.records[-1].getMessage()
+    assert "handed back at t = 1.51 s to the traffic's guidance" in caplog.records[-1].getMessage()
 
 
 def test_a_dropped_stacks_vessel_is_handed_back_and_the_console_told(

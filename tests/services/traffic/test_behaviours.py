@@ -179,3 +179,20 @@ def test_path_points_advance_for_many_boats_at_once() -> None:
                         loop=False, tol=1.0)  # fmt: skip
     assert behaviours.paths.shape[1] == 4 and behaviours.length.tolist() == [3, 3, 4]
     assert behaviours.paths[0, :3].tolist() == [[0, 0], [50, 0], [50, 50]]
+
+
+def test_a_release_resumes_the_boats_own_path_where_it_left_it() -> None:
+    """A release sent a waypoint boat back to its first point, passed long before; one only
+    held by a twist (the traffic never replaced its path) goes on as it was."""
+    path = ((0.0, 0.0), (50.0, 0.0), (50.0, 50.0))
+    behaviours = Behaviours([Boat("b", "monohull", Pose(), "waypoints", 5.0, path=path)])
+    for _ in range(2):  # at each point in turn: now steering for the third
+        behaviours.command(behaviours.paths[[0], behaviours.index], np.zeros(1), np.zeros((1, 2)))
+    assert behaviours.index.tolist() == [2]
+    behaviours.release(0)  # held by a twist only: nothing of its own was replaced
+    assert behaviours.index.tolist() == [2]
+    behaviours.set_path(0, np.array([(9.0, 9.0), (8.0, 8.0)]), 2.0, loop=True, tol=1.0)
+    assert behaviours.index.tolist() == [0] and behaviours.speed.tolist() == [2.0]
+    behaviours.release(0)
+    assert behaviours.index.tolist() == [2] and behaviours.speed.tolist() == [5.0]
+    assert behaviours.paths[0, :3].tolist() == [list(p) for p in path]
