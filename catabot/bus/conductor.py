@@ -28,7 +28,7 @@ from catabot.bus.settings import Schedule
 log = logging.getLogger("catabot.bus.conductor")
 WAITING_NOTE_S = 5.0  # how often the log names who has not joined yet
 GONE_GRACE_S = 0.2  # after a participant's token goes, for others gone with it
-WORDS_S = 0.6  # under abort, how long (from its token going) its fault may still come
+WORDS_S = 0.6  # how long (from its token going) its fault may still come
 LEFT = "left the run"  # a participant's token went without its words
 BEFORE = " before it stepped one (its own log says why)"
 SILENT = f" without a word: its process ended, or stopped answering for {LEASE_MS / 1000:g} s \
@@ -289,8 +289,8 @@ class Conductor:
 
     def _settled_gone(self) -> list[str]:
         """Who is gone once their words had time to come (a fault told before leaving may land
-        after the token went); under abort the run ends here anyway: it waits WORDS_S."""
-        limit = time.monotonic() + (WORDS_S if self.spec.policy is Policy.ABORT else 0.0)
+        after the token went): WORDS_S under drop too (a loaded machine lost a crash's cause)."""
+        limit = time.monotonic() + WORDS_S
         time.sleep(GONE_GRACE_S)
         while True:
             self._take_queued()
