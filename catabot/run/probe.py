@@ -32,9 +32,10 @@ TIMEOUT_S = 3.0
 def parser() -> argparse.ArgumentParser:
     p = OneLineParser(prog="catabot deploy probe", description=__doc__.split("\n")[0])
     p.add_argument("endpoint", help="the router's endpoint, e.g. tcp/router:7447")
-    p.add_argument("--name", help="a process that must be on the bus (its liveliness token)")
+    what = p.add_mutually_exclusive_group()
+    what.add_argument("--name", help="a process that must be on the bus (its liveliness token)")
+    what.add_argument("--http", action="store_true", help="a web server, not Zenoh, answers there")
     p.add_argument("--zenoh-config", metavar="FILE", help="a login of the secure profile")
-    p.add_argument("--http", action="store_true", help="a web server, not Zenoh, answers there")
     return p
 
 
