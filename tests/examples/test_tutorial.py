@@ -63,7 +63,7 @@ def test_step_3s_summary_is_what_the_run_prints(tmp_path: Path) -> None:
     quoted = re.search(r"`(ego: goal reached at [\d.]+ s \([\d.]+ m\));", TUTORIAL.read_text())
     assert quoted is not None
     run = subprocess.run([sys.executable, "-m", "catabot", "run", str(first(tmp_path)),
-                          "--quiet", "--out", str(tmp_path / "runs")],
+                          "--duration", "30", "--quiet", "--out", str(tmp_path / "runs")],
                          capture_output=True, text=True, timeout=300)  # fmt: skip
     assert run.returncode == 0, run.stderr
     assert quoted.group(1) in run.stdout, run.stdout
