@@ -234,14 +234,19 @@ def port_open(endpoint: str, timeout_s: float = 3.0) -> str:
     """'' when the endpoint's TCP port takes a connection, else why not (any protocol: a
     TLS port is probed the same way). A listening address (0.0.0.0, [::]) is probed on this
     host's loopback."""
-    host, _, port = check_endpoint(endpoint).partition("/")[2].rpartition(":")
-    host = host.strip("[]")
-    host = {"0.0.0.0": "127.0.0.1", "::": "::1"}.get(host, host)
     try:
-        with socket.create_connection((host, int(port)), timeout=timeout_s):
+        with socket.create_connection(dial_address(endpoint), timeout=timeout_s):
             return ""
     except OSError as exc:
         return f"{endpoint}: {exc.strerror or exc}"
+
+
+def dial_address(endpoint: str) -> tuple[str, int]:
+    """The (host, port) a socket connects to for an endpoint of any protocol, a listening
+    address (0.0.0.0, [::]) meaning this host's loopback."""
+    host, _, port = check_endpoint(endpoint).partition("/")[2].rpartition(":")
+    host = host.strip("[]")
+    return {"0.0.0.0": "127.0.0.1", "::": "::1"}.get(host, host), int(port)
 
 
 def alone(session: zenoh.Session) -> str:

@@ -153,9 +153,7 @@ class Schedule:
     def asked(self) -> list[Change]:
         """Every change the run was asked for, in tick order: granted, waiting, or past its
         end (the run folder's scenario.json: an interrupted run's had lost its later ones)."""
-        with self._lock:
-            every = [c for k in sorted(self._by_tick) for c in self._by_tick[k]]
-        return every + sorted(self.beyond, key=lambda c: c.tick)
+        return self.in_force() + sorted(self.beyond, key=lambda c: c.tick)
 
     def in_force(self) -> list[Change]:
         """Every change granted or waiting, in order (what `catabot get` shows)."""

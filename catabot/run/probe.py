@@ -22,7 +22,7 @@ import socket
 import sys
 
 from catabot.bus.keys import lives_of
-from catabot.bus.session import Connection, open_session, port_open
+from catabot.bus.session import Connection, dial_address, open_session, port_open
 from catabot.errors import CataBotError
 from catabot.run.answer import OneLineParser
 
@@ -52,9 +52,8 @@ def speaks_zenoh(endpoint: str, config: str | None) -> None:
 
 def answers_http(endpoint: str, timeout_s: float = TIMEOUT_S) -> str:
     """'' when an HTTP server answers a request at the endpoint, else why not."""
-    host, _, port = endpoint.partition("/")[2].rpartition(":")
     try:
-        with socket.create_connection((host.strip("[]"), int(port)), timeout=timeout_s) as conn:
+        with socket.create_connection(dial_address(endpoint), timeout=timeout_s) as conn:
             conn.sendall(b"GET / HTTP/1.0\r\nHost: probe\r\n\r\n")
             head = conn.recv(16)
     except TimeoutError:

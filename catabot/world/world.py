@@ -271,21 +271,21 @@ def _bodies(scenario: Scenario, plan: TrafficPlan, models: Models) -> tuple[Body
             checked.add(ref)
             where = f"{fields[kind].format(i)} ({bid})"
             _check_floats(where, ref, model(ref), scenario.water.density_kg_m3)
-    boat_timeout = ((), None, Velocity(), scenario.traffic.command_timeout_s)
+    boats = scenario.traffic.command_timeout_s  # a boat's only scenario part
     return tuple(
         Body(bid, kind, ref, model(ref), pose, row,
-             *(boat_timeout if kind == "boat" else _scenario_part(config)))
+             *_scenario_part(config, timeout_s=boats if kind == "boat" else None))
         for row, (bid, kind, ref, pose, config) in enumerate(rows)
     )  # fmt: skip
 
 
 def _scenario_part(
-    config: VesselConfig | None,
+    config: VesselConfig | None, *, timeout_s: float | None
 ) -> tuple[tuple[ScriptStep, ...], ControllerConfig | None, Velocity, float | None]:
     """What only a scenario vessel has: its script, its controller, its start velocity, how
-    long an outside command holds it."""
+    long an outside command holds it (another body: `timeout_s`, a boat's from traffic)."""
     if config is None:
-        return (), None, Velocity(), None
+        return (), None, Velocity(), timeout_s
     script = tuple(sorted(config.script, key=lambda s: s.t_s))
     return script, config.controller, config.velocity, config.command_timeout_s
 

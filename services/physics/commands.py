@@ -77,9 +77,8 @@ class CommandBook:
         for vid in self.book.expire(stamp_ns):  # outside commands gone stale: handed back
             self.released.add(vid)
             held_s = self.book.timeouts[vid] / 1e9
-            field = "traffic.command_timeout_s" if vid in self.boats else "command_timeout_s"
-            advise(log, f"{vid}: no outside command for {held_s:g} s ({field}): handed back "
-                        f"at t = {stamp_ns / 1e9:g} s to {self._own(vid)}")  # fmt: skip
+            advise(log, f"{vid}: no outside command for {held_s:g} s ({self._field(vid)}): "
+                        f"handed back at t = {stamp_ns / 1e9:g} s to {self._own(vid)}")  # fmt: skip
         target, follow = self.set_point.copy(), self.has_set_point.copy()
         thrust: dict[int, tuple[float, ...]] = {}
         for vid in self.scripted:
@@ -114,8 +113,11 @@ class CommandBook:
         timeout_ns = self.book.timeouts.get(vessel)
         if timeout_ns is None:  # a boat had been told of a command_timeout_s it cannot have
             return ""
-        field = "traffic.command_timeout_s" if vessel in self.boats else "command_timeout_s"
-        return f" or {timeout_ns / 1e9:g} s without one ({field})"
+        return f" or {timeout_ns / 1e9:g} s without one ({self._field(vessel)})"
+
+    def _field(self, vessel: str) -> str:
+        """The scenario field of a vessel's command timeout."""
+        return "traffic.command_timeout_s" if vessel in self.boats else "command_timeout_s"
 
     def take_batch(self, batch: TwistBatch, expected: tuple[str, ...]) -> None:
         """The traffic service's set-points (rows and shapes checked on arrival): every boat

@@ -15,10 +15,10 @@ scenario's vessels only with `traffic.avoid.vessels`), each a footprint circle:
   speed and closer to that arc than both footprints plus the clearance, makes it take the
   clear arc nearest its law's among nine turns from full starboard to full port (to
   starboard on a tie; clear by half as much again, for the boat's lag in turning); with
-  none clear, the one that passes its obstacles widest. First,
-  anything closer than the corridor's half-width anywhere but astern (a boat turning at
-  low speed, two boats alongside), buoy or boat, which it simply turns away from, backing
-  off while it lies under the bow. The boat's own law resumes when its arc is clear. The
+  none clear, the one that passes its obstacles widest. First, anything closer than the
+  corridor's half-width anywhere but astern (a boat turning at low speed, two boats
+  alongside), buoy or boat, which it simply turns away from, backing off while it lies
+  under the bow. The boat's own law resumes when its arc is clear. The
   marks on a boat's own path are left to the first rule. Boats under way ahead are not
   corridor obstacles: reacting to where another boat is now, both boats of a pair turned,
   each to the side the other bore on, and still met; colregs.py gives such meetings to one
