@@ -96,7 +96,8 @@ def unpack(payload: bytes | bytearray | memoryview) -> Any:
     except CodecError:
         raise
     except Exception as exc:
-        raise CodecError(f"not a msgpack payload: {exc}") from None
+        why = str(exc) or f"{type(exc).__name__} in bytes {bytes(payload[:8]).hex(' ')} ..."
+        raise CodecError(f"not a msgpack payload: {why}") from None
 
 
 def encode(msg: Message) -> bytes:

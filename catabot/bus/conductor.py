@@ -16,7 +16,7 @@ import zenoh
 
 from catabot.bus import clock, codec
 from catabot.bus.clock import CONDUCTOR, ClockError, ClockSpec, Policy, Progress, RunResult
-from catabot.bus.identity import Roster, sender_of
+from catabot.bus.identity import Roster, sender_of, shown
 from catabot.bus.keys import Keys
 from catabot.bus.members import Members, claim
 from catabot.bus.messages import Ack, End, Tick
@@ -239,7 +239,7 @@ class Conductor:
         if name not in self._acked:
             raise Rejected("ack of no participant", name)
         if not self._members.sender_is(name, sender_of(sample)):
-            raise Rejected("ack from a stranger", f"sender {sender_of(sample) or '?'}")
+            raise Rejected("ack from a stranger", shown(sender_of(sample)))
         try:
             ack = codec.decode(sample.payload.to_bytes(), Ack)
         except codec.CodecError as exc:

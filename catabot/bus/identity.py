@@ -51,6 +51,12 @@ def sender_of(sample: zenoh.Sample) -> str:
     return str(info.source_id.zid) if info is not None else ""
 
 
+def shown(sender: str) -> str:
+    """A sender as every refusal names it: a sample without Zenoh source info was shown as
+    `sender ?` by some refusals and as `sender ` (blank) by others."""
+    return f"sender {sender or 'unsaid (no Zenoh source info)'}"
+
+
 class Roster:
     """Participant name -> zid, fixed entries first, then bindings learnt from tokens."""
 

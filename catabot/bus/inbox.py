@@ -17,11 +17,11 @@ its tick (`ORDERS`).
 
 from __future__ import annotations
 
-from collections.abc import Iterable, Mapping, Sequence
+from collections.abc import Callable, Iterable, Mapping, Sequence
 
 from catabot.bus import codec
 from catabot.bus.clock import Stream
-from catabot.bus.identity import Roster
+from catabot.bus.identity import Roster, shown
 from catabot.bus.messages import Message, ThrustCmd, TwistCmd, WaypointsCmd
 from catabot.bus.rejections import Rejected
 from catabot.errors import CataBotError
@@ -31,6 +31,7 @@ MAX_PENDING = 10_000  # samples held while their producer's session is not yet k
 MAX_PENDING_BYTES = 64 * 2**20  # and their bytes: 2,500 junk samples of 1 MB took 3.2 GB
 MAX_FREE_BYTES = 64 * 2**10  # a free-running command (a 1000-point path is 18 KB)
 OPEN = 2**62  # an off interval not closed yet
+WILDCARD = "a put on a key expression with wildcards; a command goes to one key"
 # A lockstep stack's order that fails its check (a NaN, a thrust beyond 1) is refused like a
 # free one, and its tick counts as answered: every consumer refuses it alike, so every run
 # goes on the same way (the order in force stays), where waiting for a valid one held the
@@ -59,6 +60,9 @@ class Inbox:
         self._holding: set[str] = set()
         self._order = {key: i for i, key in enumerate(self.streams)}  # release in stream order
         self._off: dict[str, list[tuple[int, int]]] = {}  # [start, end) tags not produced
+        # A wildcard put reaches every stream under it: refused once by a watch over them
+        # all (strays.py) when one says so, else here, by each stream it reached.
+        self.spoken_for: Callable[[str], bool] = lambda _key: False
 
     @property
     def keys(self) -> list[str]:
@@ -69,7 +73,9 @@ class Inbox:
         no tag may reach it (the clock cannot have granted that far)."""
         stream = self.streams.get(key)
         if stream is None:
-            raise Rejected("not a stream key", f"{key!r} (a wildcard or another vessel's key)")
+            if "*" in key and self.spoken_for(key):
+                return
+            raise Rejected("not a stream key", f"{key!r}: {WILDCARD}" if "*" in key else repr(key))
         if stream.period is None and len(payload) > MAX_FREE_BYTES:  # before decoding it
             raise Rejected(
                 "too large", f"{len(payload)} bytes; a command: {MAX_FREE_BYTES} at most"
@@ -105,7 +111,7 @@ class Inbox:
             kind, whose = key.rsplit("/", 1)[-1], "vessel's" if "/vessel/" in key else "fleet's"
             driven = (f" (the {whose} {kind} is driven in lockstep by it: a free command "
                       "would change the run)") if "/cmd/" in key else ""  # fmt: skip
-            why = f"sender {sender or '?'} is not {stream.producer}{driven}"
+            why = f"{shown(sender)} is not {stream.producer}{driven}"
             raise Rejected("not from its producer", why)
         return True
 

@@ -20,7 +20,7 @@ import zenoh
 
 from catabot.bus import codec
 from catabot.bus.clock import CONDUCTOR, ClockError, ClockLimits, EndRun, Stream, blames, end_reason
-from catabot.bus.identity import Roster, sender_of
+from catabot.bus.identity import Roster, sender_of, shown
 from catabot.bus.inbox import Inbox, Inputs
 from catabot.bus.keys import Keys
 from catabot.bus.members import Members, claim
@@ -248,7 +248,7 @@ class Participant(Outputs):
             return None
         try:
             if not self.members.sender_is(CONDUCTOR, sender):
-                raise Rejected("clock message from a stranger", f"sender {sender or '?'}")
+                raise Rejected("clock message from a stranger", shown(sender))
             if kind == "tick":
                 self._take_tick(codec.decode(payload, Tick))
                 return None

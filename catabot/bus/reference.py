@@ -131,17 +131,24 @@ sample and ack is believed only from the session that owns its participant name:
    `kind`, `row`, start `pose`), `vessels` (a list: `id`, `row`, `model`, `thrusters`,
    `state_key`, `commands` by kind, `controller` with `participant`, `command`, `key` and
    `period_ticks`, `sensors` with `key`, `message`, `period_ticks`, `frame`, `mount`),
-   `traffic`, `buoys`, `scenario`, and `granted` (the last tick granted, -1 before the start).
+   `traffic`, `buoys`, `start` (every body's state at tick 0, the `world/states` batch
+   no tick is tagged with), `scenario`, and `granted` (the last tick granted, -1 before the
+   start).
 2. Declare the Zenoh liveliness token `catabot/<world>/live/<participant>/<zid>`, `<zid>`
    being your session's id as Zenoh prints it (lower-case hex): the first token that claims
    the name binds it to your session.
 3. Put **every** clocked sample and every ack with Zenoh source info naming your session
    (zenoh-python: `put(payload, source_info=zenoh.SourceInfo(publisher.id, sequence))`):
-   a sample without it is refused as `not from its producer: sender ?`.
+   a sample without it is refused as `not from its producer: sender unsaid (no Zenoh source info)`.
 4. Subscribe to `catabot/<world>/clock/tick`: each `tick` message grants every tick up to its
    `tick`. For each granted tick k: at your controller's ticks (k a multiple of
-   `period_ticks`) put one command tagged `tick` k, `stamp_ns` k x `dt_ns` (it is applied
-   from tick k + 1); then ack on `catabot/<world>/clock/ack/<participant>` with `run` from
+   `period_ticks`) first **wait for your inputs**: the state at the start of tick k is the
+   batch on `states.key` (`world/states`, not the observers' `vessel/<id>/state`) tagged
+   `tick` k - 1 (`start` at k = 0); a sensor's sample is the newest tagged before k, so wait
+   for the one tagged at its last period before k. A command computed from whatever arrived
+   last is not reproducible: the same scenario and seed record other bytes, unwarned. Then
+   put one command tagged `tick` k, `stamp_ns` k x `dt_ns` (it is applied from tick k +
+   1); then ack on `catabot/<world>/clock/ack/<participant>` with `run` from
    the tick message and `tick` k, at least every `ack_every` ticks and at the grant's last.
    An ack says every output up to its tick is out: a stack that acks a tick without its
    command holds physics and the recorder up until the deadline, which then names them.

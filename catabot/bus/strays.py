@@ -9,6 +9,7 @@ from collections.abc import Callable
 import zenoh
 
 from catabot.bus.identity import sender_of
+from catabot.bus.inbox import WILDCARD
 from catabot.bus.participant import Participant
 
 
@@ -16,6 +17,8 @@ def watch_strays(participant: Participant, pattern: str, why: Callable[[str], st
     """Refuse, by `why(key)`, puts under `pattern` on no stream of `participant`."""
     known = frozenset(participant.inbox.keys)
     events = participant.events
+    watched = zenoh.KeyExpr(pattern)
+    participant.inbox.spoken_for = lambda key: watched.intersects(zenoh.KeyExpr(key))
 
     def on_sample(sample: zenoh.Sample) -> None:
         key = str(sample.key_expr)
@@ -31,7 +34,7 @@ def shape_problem(key: str, pattern: str) -> str:
     (`vessel/**`) reaches the subscriber as that expression, of any depth, and `why` reads
     a key's segments (a hostile client's put made physics log a traceback per sample)."""
     if "*" in key:
-        return f"a put on a key expression with wildcards; a command goes to one key ({pattern})"
+        return f"{WILDCARD} ({pattern})"
     if key.count("/") != pattern.count("/"):
         return f"not a key of the form {pattern}"
     return ""

@@ -21,7 +21,7 @@ import zenoh
 
 from catabot.bus import codec
 from catabot.bus.clock import CONDUCTOR, Stream
-from catabot.bus.identity import Roster, sender_of
+from catabot.bus.identity import Roster, sender_of, shown
 from catabot.bus.inbox import checked
 from catabot.bus.keys import Keys
 from catabot.bus.members import Members
@@ -62,7 +62,7 @@ class Watch:
         key = str(sample.key_expr)
         try:
             if not self.members.sender_is(CONDUCTOR, sender_of(sample)):
-                raise Rejected("clock message from a stranger", f"sender {sender_of(sample)}")
+                raise Rejected("clock message from a stranger", shown(sender_of(sample)))
             end = codec.decode(sample.payload.to_bytes(), End)
         except codec.CodecError as exc:
             self.rejections.add(key, Rejected("malformed", str(exc)))
@@ -101,7 +101,7 @@ class Watch:
                 if stream.producer != "external" and not self.members.sender_is(
                     stream.producer, sender
                 ):
-                    raise Rejected("not from its producer", f"sender {sender or '?'}")
+                    raise Rejected("not from its producer", shown(sender))
                 msg = checked(sample.payload.to_bytes(), stream)
             except Rejected as exc:
                 self.rejections.add(key, exc)

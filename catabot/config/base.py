@@ -220,7 +220,7 @@ def describe(err: Any, *, model: type[BaseModel], where: str = "") -> str:
         limit = str(bound) if isinstance(bound, int) else f"{bound:g}"
         return f"{path}: must be {_BOUNDS[kind]} {limit}{shown}"
     if kind in _TYPES:
-        return f"{path}: must be {_TYPES[kind]}{shown}"
+        return f"{path}: must be {_TYPES[kind]}{shown}{_nanoseconds(path, got)}"
     if kind in ("too_short", "too_long"):
         most = "at least" if kind == "too_short" else "at most"
         count = ctx.get("min_length" if kind == "too_short" else "max_length")
@@ -228,6 +228,13 @@ def describe(err: Any, *, model: type[BaseModel], where: str = "") -> str:
     if kind == "finite_number":
         return f"{path}: must be a finite number{shown}"
     return f"{path}: {str(err['msg']).removeprefix('Value error, ')}{shown}"
+
+
+def _nanoseconds(path: str, got: Any) -> str:
+    """A fraction given to a `_ns` field was meant in seconds (`dt_ns: 0.01`): say so."""
+    if not path.endswith("_ns") or not isinstance(got, float) or not 0 < got < 1e3:
+        return ""
+    return f"; {path.rsplit('.', 1)[-1]} is in nanoseconds: {got:g} s is {round(got * 1e9)}"
 
 
 def _short(value: Any) -> str:

@@ -15,8 +15,8 @@ from pathlib import Path
 from catabot.bus.session import Connection, SessionError, add_connection_args, open_session
 from catabot.config.load import json_schema, model_schema
 from catabot.config.notes import late_settings, late_steps, scenario_notes
-from catabot.config.scenario import WaterConfig
-from catabot.config.vessel import VesselModelError, load_vessel_model
+from catabot.config.scenario import Scenario, WaterConfig
+from catabot.config.vessel import VesselModel, VesselModelError, load_vessel_model
 from catabot.errors import CataBotError
 from catabot.run import compose, conduct, console, launcher, secure, settings_cli
 from catabot.run.answer import OneLineParser, answered, output_file
@@ -97,6 +97,8 @@ def _service(args: argparse.Namespace, rest: list[str]) -> int:
     return int(main(rest))
 
 
+# fields a vessel model has and a scenario has not (`description` is any file's note)
+MODEL_ONLY = frozenset(VesselModel.model_fields) - {*Scenario.model_fields, "description"}
 TOOLS = {  # `catabot <tool> ...`: programs over a run folder, each in its own service folder
     "view": ("services.viewer.cli", "replay a run or attach to one in the rerun viewer"),
     "dataset": ("services.datasets.cli", "export a run: YOLO, COCO, SemanticKITTI, segmentation"),
@@ -168,13 +170,14 @@ def _scenario(args: argparse.Namespace) -> int:
 
 
 def _is_model(path: Path) -> bool:
-    """A vessel model file given to `validate` (its `hulls`, no `vessels`): checked as one,
-    not refused field by field as a scenario."""
+    """A vessel model file given to `validate` (a field only a model has, no `vessels`):
+    checked as one, not refused field by field as a scenario; by any such field, so a model
+    missing its `hulls` hears that, not a dozen scenario fields."""
     try:
         data = json.loads(path.read_text())
     except (OSError, ValueError, RecursionError):
         return False  # the scenario path says what is wrong with it
-    return isinstance(data, dict) and "hulls" in data and "vessels" not in data
+    return isinstance(data, dict) and "vessels" not in data and bool(MODEL_ONLY & data.keys())
 
 
 def _validate_options(args: argparse.Namespace) -> launcher.RunOptions:

@@ -196,17 +196,26 @@ class Terrain:
         k = math.ceil(footprint_m / self._mpp) + 1
         ok = ~any_in_window(self._z >= -need, k)
         if not ok.any():
-            raise TerrainError(
-                f"terrain {self.name}: no open water deeper than draft {draft_m:g} m + "
-                f"clearance {clearance_m:g} m within {footprint_m:g} m (deepest point "
-                f"{-float(self._z.min()):.2f} m)"
-            )
+            raise TerrainError(self._no_open_water(draft_m, clearance_m, footprint_m))
         iy, ix = np.nonzero(ok)
         w, h = self.size_m
         tx, ty = (w / 2, h / 2) if near is None else near
         cx, cy = (ix + 0.5) * self._mpp, (iy + 0.5) * self._mpp
         best = int(np.argmin((cx - tx) ** 2 + (cy - ty) ** 2))  # ties: first, deterministic
         return float(cx[best]), float(cy[best])
+
+    def _no_open_water(self, draft_m: float, clearance_m: float, footprint_m: float) -> str:
+        """Why no start was found; a map smaller than the hull (metres_per_pixel in km, or
+        a pixel's size mistyped) said only "deepest point 35 m", which read as nonsense."""
+        (w, h), depth = self.size_m, -float(self._z.min())
+        text = (
+            f"terrain {self.name} ({w:g} x {h:g} m, {self._mpp:g} m a pixel): no open water "
+            f"deeper than draft {draft_m:g} m + clearance {clearance_m:g} m over a whole hull "
+            f"footprint of radius {footprint_m:g} m (deepest point {depth:.2f} m)"
+        )
+        if min(w, h) < 4 * footprint_m:
+            text += "; the map is hardly larger than one hull: is metres_per_pixel right?"
+        return text
 
     def check_water(self, x: float, y: float, *, what: str, depth_m: float = 0.0) -> None:
         """Refuse a point (`what`, as the error names it) outside the map, on land, or in

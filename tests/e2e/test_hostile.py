@@ -154,7 +154,7 @@ def impostor_tokens(client: zenoh.Session, n: int) -> None:
 
 ATTACKS = [wildcard_puts, clock_forgeries, lockstep_forgeries, bad_commands, impostor_tokens]
 REFUSED = {  # who must have counted what, per attack
-    "wildcard_puts": [("physics", "not a stream key")],
+    "wildcard_puts": [("physics", "no such stream")],  # once, by its watch on every command
     "clock_forgeries": [("conductor", "ack from a stranger")],
     "lockstep_forgeries": [("recorder", "not from its producer"),
                            ("traffic", "not from its producer")],  # its copy of the states

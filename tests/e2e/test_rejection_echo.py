@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import json
 import subprocess
 import time
 from pathlib import Path
@@ -75,4 +76,7 @@ def test_a_command_to_no_vessel_or_of_no_kind_is_said_not_dropped_unheard(tmp_pa
     assert (
         f"physics refused {wild}: no such stream: a put on a key expression with wildcards" in said
     )
+    rejected = json.loads((only_run_dir(out) / "log" / "run.json").read_text())["rejected"]
+    assert rejected == {"physics": {"no such stream": 4}}  # once a put: the streams it reached
+    # under the wildcard (the ego's) left it to the watch over every command key
     assert "Traceback" not in (only_run_dir(out) / "log" / "physics.log").read_text()

@@ -69,8 +69,11 @@ def test_malformed_array_extension(payload: bytes, words: list[str]) -> None:
 
 def test_non_msgpack_bytes() -> None:
     for junk in (b"\xc1", b"\xc1\xc1garbage", b""):
-        with pytest.raises(CodecError, match="not a msgpack payload"):
+        with pytest.raises(CodecError, match=r"not a msgpack payload: .") as info:
             codec.decode(junk, Ack)
+        assert not str(info.value).endswith(": ")  # msgpack's FormatError says nothing
+    with pytest.raises(CodecError, match=r"payload: FormatError in bytes c1 c1 c1 \.\.\."):
+        codec.decode(b"\xc1\xc1\xc1", Ack)
 
 
 def test_truncated_payload() -> None:

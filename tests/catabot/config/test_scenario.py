@@ -262,6 +262,14 @@ def test_a_setpoint_delay_that_is_not_a_whole_number_of_ticks(delay: object) -> 
     assert "traffic.setpoint_delay_ticks:" in _error(data)
 
 
+def test_seconds_given_to_a_nanosecond_field_are_named_as_such() -> None:
+    data = _base() | {"dt_ns": 0.01}
+    assert "dt_ns: must be an integer (got 0.01); dt_ns is in nanoseconds: 0.01 s is 10000000" in (
+        _error(data)
+    )
+    assert "nanoseconds" not in _error(_base() | {"dt_ns": 2.5e6})  # a fraction of a ns only
+
+
 @pytest.mark.parametrize(
     ("path", "value", "message"),
     [

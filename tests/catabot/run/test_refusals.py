@@ -219,6 +219,10 @@ def test_validate_checks_a_vessel_model_file_as_one(
     (tmp_path / "typo.json").write_text(json.dumps(typo))
     assert main(["scenario", "validate", str(tmp_path / "typo.json")]) == 2
     assert "damping: required field missing; dampng: unknown field" in capsys.readouterr().err
+    hull = {k: v for k, v in heavy.items() if k != "hulls"} | {"hull": heavy["hulls"]}
+    (tmp_path / "hull.json").write_text(json.dumps(hull))  # no `hulls`: still a model
+    assert main(["scenario", "validate", str(tmp_path / "hull.json")]) == 2
+    assert "hulls: required field missing; hull: unknown field" in capsys.readouterr().err
 
 
 def test_realtime_zero_undoes_a_files_pace_and_a_negative_one_is_refused(

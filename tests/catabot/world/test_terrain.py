@@ -172,8 +172,16 @@ def test_open_water_search_and_start_checks() -> None:
         terrain.check_start(x, y, draft_m=0.5, footprint_m=4.0, z_m=-depth)
     terrain.check_start(x, y, draft_m=0.5, footprint_m=4.0, z_m=-2.0)  # under water, clear
     terrain.check_start(60.0 + 29.5, 40.0, draft_m=0.06, footprint_m=1.0, z_m=5.0)  # a drop
-    with pytest.raises(TerrainError, match="no open water deeper than"):
+    with pytest.raises(TerrainError, match="no open water deeper than") as deep:
         terrain.find_open_water(30.0)
+    assert "metres_per_pixel" not in str(deep.value)  # a map far larger than a hull
+    river = np.full((16, 10), -35.0)
+    river[:, :2] = 5.0  # a bank
+    tiny = Terrain(river, 0.005)  # a 10 km river's scale typed in km
+    with pytest.raises(TerrainError) as small:
+        tiny.find_open_water(0.06, footprint_m=1.08)
+    assert "(0.05 x 0.08 m, 0.005 m a pixel)" in str(small.value)
+    assert "is metres_per_pixel right?" in str(small.value)
 
 
 def test_auto_resolution_keeps_the_triangle_budget() -> None:
