@@ -115,7 +115,7 @@ def resting_buoys(buoys: int) -> tuple[Callable[[], object], int]:
         wind=WindField(WindConfig(speed_mps=3.0), seed=1),
         buoys=[(f"b{i}", (float(x), float(y))) for i, (x, y) in enumerate(xy)],
     )
-    for _ in range(2500):  # the moorings' swing dies down in ~20 s
+    for _ in range(4500):  # the moorings' slow swing (loads.py) dies down in 35-40 s
         world.step()
 
     def step() -> None:
