@@ -12,9 +12,10 @@ from __future__ import annotations
 import gymnasium
 
 from catabot.gym.env import ActionError, CataBotEnv
+from catabot.gym.link import LinkError
 from catabot.gym.options import EnvOptions, EnvOptionsError
 
-__all__ = ["ActionError", "CataBotEnv", "EnvOptions", "EnvOptionsError"]
+__all__ = ["ActionError", "CataBotEnv", "EnvOptions", "EnvOptionsError", "LinkError"]
 
 ENTRY_POINT = "catabot.gym.env:CataBotEnv"
 MAX_STEPS = 600  # 60 s at 10 Hz; the env truncates itself at `max_steps` (no TimeLimit:

@@ -145,6 +145,13 @@ class RecordedRun:
         path = self.folder / "metrics.json"
         return json.loads(path.read_text()) if path.is_file() else None
 
+    def ended(self) -> str:
+        """How the run ended, for a tool's report: a tool that read an interrupted run as a
+        whole one said nothing of it."""
+        reason = (self.metrics() or {}).get("end_reason", "killed (no metrics.json)")
+        planned = self.world.scenario.duration_s
+        return "completed" if reason == "completed" else f"{reason}, of {planned:g} s planned"
+
     def states(self) -> StateTrack:
         """Every body's recorded state (see `StateTrack`)."""
         tf = self.mcap.channel(TF)

@@ -8,6 +8,7 @@ shared by the dataset export and the viewer's replay (the MCAP holds colour and 
 from __future__ import annotations
 
 import json
+import logging
 from dataclasses import dataclass
 from functools import cached_property
 from pathlib import Path
@@ -20,6 +21,8 @@ from PIL import Image
 from catabot.bus.messages import LABEL_CLASSES
 from catabot.run.recorded import RunFolderError
 from catabot.world.world import MountedSensor
+
+log = logging.getLogger("catabot.run.recorded_camera")
 
 BOX_CLASSES = ("vessel", "buoy")
 """The classes that have boxes (the camera boxes bodies only), in detection-index order."""
@@ -91,11 +94,16 @@ def labelled_frames(run: Path, sensor: MountedSensor) -> list[LabelledFrame]:
     labels = folder / "labels.jsonl"
     if not labels.is_file():
         return []
-    frames = []
-    for n, line in enumerate(labels.read_text().splitlines(), start=1):
+    frames, text = [], labels.read_text()
+    lines = text.splitlines()
+    for n, line in enumerate(lines, start=1):
         try:
             frames.append(LabelledFrame(folder, json.loads(line)))
         except json.JSONDecodeError:
+            if n == len(lines) and not text.endswith("\n"):  # a run killed mid-line
+                log.warning("%s: its last line is cut off (the run was killed?); the %d whole "
+                            "frames before it are read", labels, len(frames))  # fmt: skip
+                break
             raise RunFolderError(f"{labels}:{n}: not a JSON line") from None
     return sorted(frames, key=lambda f: f.tick)
 

@@ -111,7 +111,9 @@ def main(argv: list[str] | None = None) -> int:
             raise
         if args.action == "preview":
             return f"preview in {out}: {summary}"
-        return f"{args.format} dataset in {out}: {summary}{_one_set(args)}"
+        ended = run.ended()
+        early = "" if ended == "completed" else f" (the run did not complete: {ended})"
+        return f"{args.format} dataset in {out}: {summary}{_one_set(args)}{early}"
 
     return answered(f"dataset {args.action}", export)
 

@@ -5,7 +5,8 @@ damping dragged it: a third as far as the water it floats in (a naval architect'
 regular 2.55 s wave; 0.5-0.7 in the `medium` preset). In linear deep-water waves the water at
 the surface accelerates at -g grad(eta), so the undisturbed pressure pushes a floating hull
 (displaced mass m) with -m g grad(eta), and its added mass A takes the same share (Morison):
-F = -(m + A) g <grad(eta)>, horizontal, at the origin.
+F = -(m + A) g <grad(eta)>, horizontal: m's share at the centre of buoyancy, A's at the
+origin, where the model's added mass acts (`wave_pull`).
 
 <grad(eta)> is the slope of the plane fitted, by least squares weighted by waterplane area,
 to the surface at the hull's buoyancy columns, which the buoyancy samples anyway: for waves
@@ -64,33 +65,41 @@ def surface_slopes(rot: Array, bottom: Array, area: Array, eta: Array) -> Array:
 
 @dataclass(frozen=True)
 class PullTable:
-    """Per hull: what the waves pull, (m + A11, A22, A33) along the body axes (N, 3), and
-    where, its centre of buoyancy at rest (N, 3, body frame)."""
+    """Per hull: what the waves pull, the displaced mass m (N,) at its centre of buoyancy at
+    rest `at` (N, 3, body frame), and the added masses (A11, A22, A33) (N, 3) at the origin."""
 
     mass: Array
     at: Array
+    added: Array
 
     @classmethod
     def of(cls, models: Sequence[VesselModel], cols: Columns) -> PullTable:
-        mass = np.array([[m.mass_kg + a for a in m.added_mass[:3]] for m in models])
-        return cls(mass.reshape(-1, 3), centres_of_buoyancy(cols))
+        mass = np.array([m.mass_kg for m in models], dtype=np.float64)
+        added = np.array([m.added_mass[:3] for m in models], dtype=np.float64).reshape(-1, 3)
+        return cls(mass, centres_of_buoyancy(cols), added)
 
     def take(self, rows: NDArray[np.intp]) -> PullTable:
-        return PullTable(self.mass[rows], self.at[rows])
+        return PullTable(self.mass[rows], self.at[rows], self.added[rows])
 
 
 def wave_pull(
     table: PullTable, cols: Columns, rot: Array, eta: Array, *, gravity: float,
     wet: Array | None,
 ) -> Array:  # fmt: skip
-    """Body-frame wrench (N, 6) about the origin: the table's masses times the water's
-    acceleration -g <grad(eta)>, acting at each hull's centre of buoyancy, scaled by its
-    wetness (None: all wet). At the origin (the waterline) it heeled a buoyed mark off the
-    surface normal, its ballast below."""
+    """Body-frame wrench (N, 6) about the origin: the water's acceleration -g <grad(eta)>
+    times the displaced mass at each hull's centre of buoyancy (the undisturbed pressure's
+    push), plus times the added masses at the origin, scaled by its wetness (None: all wet).
+    The added-mass share acts where the model's added mass is (a diagonal matrix about the
+    origin), so that it cancels its own reaction as the hull moves with the water: put at the
+    centre of buoyancy, 0.08 m under the buoy's origin, it tilted the buoy against the wave
+    slope (a third of the slope's pitch in a 6 s wave); all of it at the origin heeled a
+    buoyed mark off the surface normal, its ballast below."""
     slopes = surface_slopes(rot, cols.bottom_m, cols.area_m2, np.ascontiguousarray(eta))
+    accel = kernels.to_body(rot, -gravity * slopes)
     out = np.zeros((len(rot), 6))
-    out[:, :3] = table.mass * kernels.to_body(rot, -gravity * slopes)
-    out[:, 3:] = rotations.cross(table.at, out[:, :3])
+    push = table.mass[:, None] * accel
+    out[:, :3] = push + table.added * accel
+    out[:, 3:] = rotations.cross(table.at, push)
     if wet is not None:
         out *= wet[:, None]
     return out

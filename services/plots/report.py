@@ -36,20 +36,13 @@ def summary(data: RunSeries) -> list[tuple[str, Any]]:
     return [
         ("scenario", s.name), ("seed", s.seed),
         ("simulated", f"{data.t[-1]:.2f} s recorded ({len(data.t)} ticks of {s.dt_ns / 1e6:g} ms)"),
-        ("ended", _ended(data)),
+        ("ended", data.run.ended()),
         ("vessels", ", ".join(data.own)), ("traffic boats", len(world.boat_ids)),
         ("buoys", len(world.buoys)), ("sensors", sensors),
         ("rain", f"{s.rain.rate_mm_h:g} mm/h"), ("waves", waves),
         ("terrain", "none" if world.terrain is None else Path(world.terrain.name).name),
         ("settings timeline", "; ".join(timeline(s)) or "none"),
     ]  # fmt: skip
-
-
-def _ended(data: RunSeries) -> str:
-    """How the run ended: a report of an interrupted run read as a whole one."""
-    reason = (data.metrics or {}).get("end_reason", "completed")
-    planned = data.run.world.scenario.duration_s
-    return "completed" if reason == "completed" else f"{reason}, of {planned:g} s planned"
 
 
 def vessel_cells(m: dict[str, Any]) -> list[str]:

@@ -15,6 +15,7 @@ until Ctrl-C (a browser that opens it late still gets everything logged so far).
 from __future__ import annotations
 
 import argparse
+import json
 import logging
 import os
 import signal
@@ -27,6 +28,7 @@ from urllib.parse import quote
 import rerun as rr
 import zenoh
 
+from catabot.bus.messages import End
 from catabot.bus.session import (
     SessionError,
     add_connection_args,
@@ -41,7 +43,7 @@ from catabot.run.answer import OneLineParser, output_file
 from catabot.run.recorded import RecordedRun
 from catabot.world.world import World
 from services.viewer.blueprint import blueprint
-from services.viewer.live import LiveView
+from services.viewer.live import LOST_S, LiveView
 from services.viewer.replay import replay
 
 log = logging.getLogger("viewer")
@@ -119,6 +121,10 @@ class ViewerError(CataBotError, OSError):
     """The viewer could not be shown: no display, no viewer program."""
 
 
+class RunLost(ViewerError):
+    """The live view's run went away, no End seen, and no run folder says how it ended."""
+
+
 class ViewerPortError(ViewerError):
     """The web viewer could not serve on its ports."""
 
@@ -148,17 +154,36 @@ def _live(args: argparse.Namespace) -> rr.RecordingStream:
         world = _world(args, session)
         view = LiveView(session, world)  # subscribed before anything is logged
         rec = recording(world, args, live=True)
-        if view.linked(session) and args.ready_file is not None:
-            args.ready_file.touch()  # catabot run starts its services now
+        if args.ready_file is not None and view.linked(session):  # only then: a late view
+            args.ready_file.touch()  # catabot run starts its services now  # waited 20 s
         end = view.run(rec, _run_folder(args))
         rec.flush()
     finally:
         session.close()
-    print(f"run ended: {end.reason}" if end else "stopped before the run ended", flush=True)
+    print(_ending(args, end, lost=view.lost), flush=True)
     shown = ", ".join(f"{n} {what}" for what, n in sorted(view.shown.items()))
     cpu = time.process_time()  # every thread of the viewer process, start-up included
     print(f"shown: {shown or 'nothing'}; viewer CPU {cpu:.1f} s", flush=True)
     return rec
+
+
+def _ending(args: argparse.Namespace, end: End | None, *, lost: bool) -> str:
+    """How the view's run ended: its End, or, the link lost first, its run folder's word."""
+    if end is not None:
+        return f"run ended: {end.reason}"
+    if not lost:
+        return "stopped before the run ended"
+    folder = _run_folder(args)
+    try:
+        if folder is None:
+            raise OSError
+        reason = json.loads((folder / "log" / "run.json").read_text())["reason"]
+    except (TypeError, OSError, ValueError, KeyError):
+        where = list(args.connect)
+        raise RunLost(f"the run at {where} went away (or never answered) before its end "
+                      f"reached the view: no peer for {LOST_S:g} s; what it drew is kept"
+                      ) from None  # fmt: skip
+    return f"run ended: {reason} (its run folder says: the view lost it before its End came)"
 
 
 def _replay(args: argparse.Namespace) -> rr.RecordingStream:

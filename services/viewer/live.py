@@ -35,12 +35,14 @@ FPS = 20.0
 HELD = {"lidar": 2, "camera": 2, "radar": 256, "imu": 1024}  # samples a ring keeps
 METRICS_WAIT_S = 5.0
 LINK_S = 20.0  # the recorder writes metrics.json just after the run's end
+LOST_S = 3.0  # no peer and no router this long: the run is gone, its End may never come
 
 
 class LiveView:
     def __init__(self, session: zenoh.Session, world: World) -> None:
         keys = world.keys
-        self.world = world
+        self.world, self.session = world, session
+        self.lost, self._linked_at = False, time.monotonic()  # lost: the run, before its End
         ring = zenoh.handlers.RingChannel
         self.states = session.declare_subscriber(keys.world_states(), ring(2))
         self.end = session.declare_subscriber(keys.end(), ring(1))
@@ -75,12 +77,23 @@ class LiveView:
                 started = time.monotonic()
                 end = _newest(self.end, End)
                 self._tick(logger)
+                if end is None and self._gone():
+                    self.lost = True
+                    break
                 time.sleep(max(0.0, 1.0 / FPS - (time.monotonic() - started)))
         except KeyboardInterrupt:
             return None
         self._tick(logger)
         _final_metrics(logger, run_dir, self._stamp_ns)
         return end
+
+    def _gone(self) -> bool:
+        """Whether the link has been down LOST_S: a view that attached as the run ended (its
+        End already sent), or whose link was cut, waited for the End forever."""
+        info, now = self.session.info, time.monotonic()
+        if list(info.peers_zid()) or list(info.routers_zid()):
+            self._linked_at = now
+        return now - self._linked_at > LOST_S
 
     def _tick(self, logger: RunLogger) -> None:
         batch = _newest(self.states, BodyStates)

@@ -30,8 +30,11 @@ def test_neither_set_is_empty_with_two_blocks_or_more() -> None:
     assert split(stamps, seed=0, val_fraction=0.0, block_s=10.0) == ["train", "train"]
 
 
-def test_short_runs_get_blocks_of_a_tenth_of_their_span() -> None:
-    assert block_ns([0, 2 * S], None) == S // 5
+def test_short_runs_get_ten_blocks_from_the_start() -> None:
+    assert block_ns([0, 2 * S - 1], None) == S // 5
+    perception = [k * S // 5 for k in range(1, 150)]  # its frames: 0.2-29.8 s at 5 Hz
+    blocks = {s // block_ns(perception, None) for s in perception}
+    assert blocks == set(range(10))  # a tenth of the span made an eleventh of 2 frames
     assert block_ns([0, 600 * S], None) == 10 * S
     assert block_ns([0, 600 * S], 2.5) == 5 * S // 2
 
@@ -43,5 +46,5 @@ def test_the_val_share_is_the_one_asked_for_to_within_a_block() -> None:
         for seed in range(5):
             subsets = split(stamps, seed=seed, val_fraction=fraction, block_s=1.0)
             assert subsets.count("val") / len(stamps) == fraction, (fraction, seed)
-            blocks = split(stamps, seed=seed, val_fraction=fraction)  # 11 blocks of 0.98 s
+            blocks = split(stamps, seed=seed, val_fraction=fraction)  # 10 blocks of 0.98 s
             assert abs(blocks.count("val") / len(stamps) - fraction) <= 0.1, (fraction, seed)
