@@ -96,7 +96,8 @@ def unpack(payload: bytes | bytearray | memoryview) -> Any:
     except CodecError:
         raise
     except Exception as exc:
-        why = str(exc) or f"{type(exc).__name__} in bytes {bytes(payload[:8]).hex(' ')} ..."
+        more = " ..." if len(payload) > 8 else ""
+        why = str(exc) or f"{type(exc).__name__} in bytes {bytes(payload[:8]).hex(' ')}{more}"
         raise CodecError(f"not a msgpack payload: {why}") from None
 
 

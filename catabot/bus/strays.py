@@ -18,7 +18,6 @@ def watch_strays(participant: Participant, pattern: str, why: Callable[[str], st
     known = frozenset(participant.inbox.keys)
     events = participant.events
     watched = zenoh.KeyExpr(pattern)
-    participant.inbox.spoken_for = lambda key: watched.intersects(zenoh.KeyExpr(key))
 
     def on_sample(sample: zenoh.Sample) -> None:
         key = str(sample.key_expr)
@@ -27,6 +26,8 @@ def watch_strays(participant: Participant, pattern: str, why: Callable[[str], st
             events.put(("stray", key, reason.encode(), sender_of(sample)))
 
     participant.keep(participant.session.declare_subscriber(pattern, on_sample))
+    # only now, the watch declared: a wildcard put the inbox leaves to it is heard by it
+    participant.inbox.spoken_for = lambda key: watched.intersects(zenoh.KeyExpr(key))
 
 
 def shape_problem(key: str, pattern: str) -> str:

@@ -33,6 +33,7 @@ from catabot.config.ros import RosConfig
 from catabot.errors import CataBotError
 from catabot.ros2.names import TF, Names
 from catabot.run import cdr_columns, recorded_poses
+from catabot.run.ending import end_reason, run_record
 from catabot.run.mcap_index import Channel, McapIndex
 from catabot.world.world import MountedSensor, World
 
@@ -83,9 +84,9 @@ def _check_ticked(folder: Path) -> None:
     """A run stopped before its first tick recorded nothing: say so, not that its run.mcap
     is cut off and has no /tf channel (`log/run.json`; a killed run's folder has none)."""
     try:
-        record = json.loads((folder / "log" / "run.json").read_text())
+        record = run_record(folder) or {}
         ticks, reason = int(record["ticks"]), str(record["reason"])
-    except (OSError, ValueError, TypeError, KeyError):
+    except (ValueError, TypeError, KeyError):
         return
     if ticks == 0:
         how = {"fault": "ended by a fault", "interrupted": "was interrupted"}.get(reason, reason)
@@ -145,11 +146,13 @@ class RecordedRun:
         path = self.folder / "metrics.json"
         return json.loads(path.read_text()) if path.is_file() else None
 
+    def end_reason(self) -> str:
+        return end_reason(run_record(self.folder), self.metrics())
+
     def ended(self) -> str:
         """How the run ended, for a tool's report: a tool that read an interrupted run as a
         whole one said nothing of it."""
-        reason = (self.metrics() or {}).get("end_reason", "killed (no metrics.json)")
-        planned = self.world.scenario.duration_s
+        reason, planned = self.end_reason(), self.world.scenario.duration_s
         return "completed" if reason == "completed" else f"{reason}, of {planned:g} s planned"
 
     def states(self) -> StateTrack:

@@ -100,7 +100,7 @@ def labelled_frames(run: Path, sensor: MountedSensor) -> list[LabelledFrame]:
         try:
             frames.append(LabelledFrame(folder, json.loads(line)))
         except json.JSONDecodeError:
-            if n == len(lines) and not text.endswith("\n"):  # a run killed mid-line
+            if n == len(lines) > 1 and not text.endswith("\n"):  # a run killed mid-line
                 log.warning("%s: its last line is cut off (the run was killed?); the %d whole "
                             "frames before it are read", labels, len(frames))  # fmt: skip
                 break

@@ -3,12 +3,12 @@
 Neighbouring frames of one camera are near-duplicates, so frames are split in blocks of
 simulated time, not one by one: a frame-by-frame split would put almost the same picture in
 both sets and make the validation score meaningless. A block is `block_s` long (default: 10 s,
-or a tenth of the time to the last frame if that is shorter, so a short run still gives both
-sets). Each block draws u from its own generator, `seeding.rng(seed, "dataset/split/<block>")`
-(DESIGN.md §2), and the round(`val_fraction` x blocks) blocks of least u go to val, so the
-share is the one asked for to within a block (each block going to val on its own draw, a
-run of ten blocks gave 40 % and 82 % for 0.2 and 0.5); with two blocks or more neither set
-stays empty.
+or a tenth of the frames' span if that is shorter, so a short run still gives both sets),
+counted from the first frame. Each block draws u from its own generator,
+`seeding.rng(seed, "dataset/split/<block>")` (DESIGN.md §2), and the round(`val_fraction` x
+blocks) blocks of least u go to val, so the share is the one asked for to within a block
+(each block going to val on its own draw, a run of ten blocks gave 40 % and 82 % for 0.2 and
+0.5); with two blocks or more neither set stays empty.
 """
 
 from __future__ import annotations
@@ -21,13 +21,13 @@ DEFAULT_BLOCK_S = 10.0
 
 
 def block_ns(stamps_ns: Sequence[int], block_s: float | None) -> int:
-    """The block length: as given, else 10 s or a tenth of the time to the last frame,
-    whichever is shorter: ten blocks from t = 0, the last frame in the tenth. A tenth of the
-    frames' span (0.2-29.8 s: 2.96 s) made an eleventh block of the last two frames alone."""
+    """The block length: as given, else 10 s or a tenth of the frames' span, whichever is
+    shorter: ten blocks from the first frame, the last frame in the tenth (a tenth rounded
+    down, 0.2-29.8 s: 2.96 s, made an eleventh block of the last two frames alone)."""
     if block_s is not None:
         return max(1, round(block_s * 1e9))
-    tenth = -(-(max(stamps_ns, default=0) + 1) // 10)  # ceil: the last frame in block 9
-    return max(1, min(round(DEFAULT_BLOCK_S * 1e9), tenth))
+    span = max(stamps_ns, default=0) - min(stamps_ns, default=0) + 1
+    return max(1, min(round(DEFAULT_BLOCK_S * 1e9), -(-span // 10)))  # ceil
 
 
 def split(
@@ -35,7 +35,8 @@ def split(
 ) -> list[str]:
     """ "train" or "val" for each frame stamp."""
     length = block_ns(stamps_ns, block_s)
-    blocks = [int(s // length) for s in stamps_ns]
+    first = min(stamps_ns, default=0)  # a camera switched on late: blocks from its start
+    blocks = [int((s - first) // length) for s in stamps_ns]
     draws = {b: float(seeding.rng(seed, f"dataset/split/{b}").random()) for b in set(blocks)}
     ordered = sorted(draws, key=lambda b: (draws[b], b))
     val = set(ordered[: _val_blocks(len(ordered), val_fraction)])

@@ -29,7 +29,7 @@ from services.physics.added_mass import AddedMass
 from services.physics.hydro import Array
 from services.physics.wind import wind_gains, wind_wrench
 
-MOORING_PERIOD_S = 30.0  # a moored body's surge period on its mooring: twice the longest preset's
+MOORING_PERIOD_S = 30.0  # a moored body's surge period on its mooring: 3 x the longest preset's
 MOORING_SCOPE_M = 3.0  # offset at which the mooring pulls twice as hard as its linear part
 
 

@@ -47,7 +47,7 @@ def _about(data: RunSeries, swept: list[str], *, kin: bool) -> str:
     parts = ([f"{k}={json.dumps(values.get(k))}" for k in swept] if kin
              else [f"scenario {mine.name}"])  # fmt: skip
     parts += timeline(mine)
-    ended = (data.metrics or {}).get("end_reason", "completed")
+    ended = data.run.end_reason()
     parts += [] if ended == "completed" else [f"ended: {ended}"[:40]]
     return f" ({_short(parts)})" if parts else ""
 
@@ -136,7 +136,7 @@ def report(path: Path, runs: list[RunSeries], files: dict[str, str]) -> None:
     rows = []
     for data, label in zip(runs, run_labels(runs), strict=True):
         vessels = (data.metrics or {}).get("vessels", {})
-        ended = str((data.metrics or {}).get("end_reason", "?"))
+        ended = data.run.end_reason()
         rows += [_row(label, vid, vessels[vid], ended) for vid in data.own if vid in vessels]
     head = ("<tr><th>run</th><th>vessel</th><th>distance [m]</th><th>top speed [m/s]</th>"
             "<th>goal, nearest, contacts, thrust</th><th>ended</th></tr>")  # fmt: skip

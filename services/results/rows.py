@@ -17,6 +17,7 @@ from typing import Any
 from catabot.config.differences import flat_fields, swept_fields, timeline
 from catabot.config.load import load_scenario
 from catabot.config.scenario import Scenario
+from catabot.run.ending import end_reason
 from catabot.run.metrics_summary import own_vessels
 
 # The measured columns: name -> (where in a vessel's metrics, or the run's), in table order.
@@ -108,10 +109,9 @@ def _rows(
 
 def _run_cells(record: RunRecord) -> dict[str, Any]:
     run = record.run or {}
-    reason = run.get("reason") or (record.metrics or {}).get("end_reason")
     return {
         "seed": record.scenario.seed,
-        "reason": reason or "unknown (no log/run.json)",
+        "reason": end_reason(record.run, record.metrics),
         "error": run.get("error") or None,
         "sim_s": run.get("sim_s", (record.metrics or {}).get("sim_time_s")),
         "wall_s": run.get("wall_s"),

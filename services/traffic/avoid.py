@@ -60,6 +60,7 @@ class Obstacles:
     velocity: Array  # (M, 2) over ground, map frame
     turn_rate: Array  # (M,) rad/s, to port positive
     under_way: NDArray[np.bool_]  # (M,): boats and vessels, whose meetings colregs.py rules
+    home: Array | None = None  # (M, 2) where each was at the start (a buoy's anchor); None: xy
 
     @classmethod
     def fixed(cls, xy: Array, radius: Array, own: Rows) -> Obstacles:
@@ -74,6 +75,22 @@ def marks_on(path: Array, anchors: Array) -> NDArray[np.bool_]:
         return np.zeros(len(path), dtype=bool)
     gap = np.hypot(*np.subtract(path[:, None, :], anchors[None, :, :]).transpose(2, 0, 1))
     return np.asarray(gap.min(axis=1) < MARK_M)
+
+
+def drifted(points: Array, obstacles: Obstacles | None) -> Array:
+    """Where the buoy moored at each of `points` (k, 2) rides now, the point itself where no
+    buoy is: a mark is rounded where its buoy is, metres off its anchor in a current."""
+    if obstacles is None or not len(points):
+        return points
+    fixed = np.flatnonzero(~obstacles.under_way)
+    if fixed.size == 0:
+        return points
+    home = obstacles.xy if obstacles.home is None else obstacles.home
+    gap = points[:, None, :] - home[fixed][None, :, :]
+    d2 = gap[..., 0] ** 2 + gap[..., 1] ** 2
+    nearest = d2.argmin(axis=1)
+    hit = d2[np.arange(len(points)), nearest] < MARK_M**2
+    return np.where(hit[:, None], obstacles.xy[fixed[nearest]], points)
 
 
 def mark_aim(pos: Array, mark: Array, pass_m: Array) -> Array:
@@ -178,8 +195,10 @@ def _others(
     near = rel[:, 0] ** 2 + rel[:, 1] ** 2 < (width[boat] + obstacles.radius[obs]) ** 2
     keep = (obs != obstacles.own[boat]) & (near | ~obstacles.under_way[obs])
     boat, obs = boat[keep], obs[keep]
-    gap = obstacles.xy[obs][:, None, :] - marks[boat]  # (pairs, K, 2); nan: no mark
-    mark = np.any(gap[..., 0] ** 2 + gap[..., 1] ** 2 < MARK_M**2, axis=1)
+    home = obstacles.xy if obstacles.home is None else obstacles.home  # a buoy by its anchor:
+    gap = home[obs][:, None, :] - marks[boat]  # metres off it in a current (pairs, K, 2)
+    near = np.any(gap[..., 0] ** 2 + gap[..., 1] ** 2 < MARK_M**2, axis=1)  # nan: no mark
+    mark = near & ~obstacles.under_way[obs]
     return boat[~mark], obs[~mark]
 
 

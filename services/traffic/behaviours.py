@@ -23,6 +23,7 @@ from services.traffic.avoid import (
     KeepClear,
     Obstacles,
     corridor_turn,
+    drifted,
     mark_aim,
     marks_on,
     near_pairs,
@@ -122,6 +123,7 @@ class Behaviours:
         self.loop = np.zeros(n, dtype=bool)
         self.tol = np.array([b.tolerance_m for b in boats], dtype=np.float64)
         self._away: dict[int, tuple[int, int]] = {}  # off their own: their place on it
+        self._buoys: Obstacles | None = None  # the last command's obstacles (_target)
         for i, b in enumerate(boats):
             if b.behaviour == "waypoints":
                 self._follow(i, np.array(b.path), b.speed_mps, loop=b.loop, tol=b.tolerance_m)
@@ -196,6 +198,7 @@ class Behaviours:
         under way keep clear of `obstacles` (avoid.py)."""
         chi = course(yaw, velocity_b)
         sog = np.hypot(velocity_b[:, 0], velocity_b[:, 1])
+        self._buoys = obstacles  # where the marks' buoys ride now (_target)
         surge, rate = np.zeros(len(yaw)), np.zeros(len(yaw))
         for kind, law in ((CIRCLE, self._circle), (WAYPOINTS, self._path), (HOLD, self._hold)):
             rows = np.flatnonzero(self.kind == kind)
@@ -294,9 +297,12 @@ class Behaviours:
         return pursuit_law(pos, chi, target, self.speed[rows])
 
     def _target(self, rows: NDArray[np.intp]) -> tuple[Array, Array]:
-        """Each boat's waypoint now, and how far off it passes it (0 unless it is a mark)."""
+        """Each boat's waypoint now (a mark: where its buoy rides), and how far off it passes
+        it (0 unless it is a mark)."""
         k = self.index[rows]
-        return self.paths[rows, k], np.where(self.marked[rows, k], self.clear.pass_m[rows], 0.0)
+        marked, points = self.marked[rows, k], self.paths[rows, k]
+        points = np.where(marked[:, None], drifted(points, self._buoys), points)
+        return points, np.where(marked, self.clear.pass_m[rows], 0.0)
 
     def _advance(self, rows: NDArray[np.intp]) -> None:
         """Next point: wrap round when looping, turn back at either end otherwise."""

@@ -140,7 +140,7 @@ def keep_clear(
     itself = np.array([where.get(vid, -1) for vid in ids], np.intp)  # a boat's own obstacle
     under_way = np.array([b.kind != "buoy" for b in bodies])
     still = np.zeros(len(bodies))
-    return clear, Obstacles(xy, r, itself, np.zeros_like(xy), still, under_way), rows
+    return clear, Obstacles(xy, r, itself, np.zeros_like(xy), still, under_way, home=xy), rows
 
 
 def build(ctx: ServiceContext) -> Built:

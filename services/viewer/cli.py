@@ -15,7 +15,6 @@ until Ctrl-C (a browser that opens it late still gets everything logged so far).
 from __future__ import annotations
 
 import argparse
-import json
 import logging
 import os
 import signal
@@ -40,10 +39,11 @@ from catabot.client.discover import find_world
 from catabot.config.load import load_scenario, parse_scenario
 from catabot.errors import CataBotError
 from catabot.run.answer import OneLineParser, output_file
+from catabot.run.ending import end_reason, run_record
 from catabot.run.recorded import RecordedRun
 from catabot.world.world import World
 from services.viewer.blueprint import blueprint
-from services.viewer.live import LOST_S, LiveView
+from services.viewer.live import LiveView
 from services.viewer.replay import replay
 
 log = logging.getLogger("viewer")
@@ -121,10 +121,6 @@ class ViewerError(CataBotError, OSError):
     """The viewer could not be shown: no display, no viewer program."""
 
 
-class RunLost(ViewerError):
-    """The live view's run went away, no End seen, and no run folder says how it ended."""
-
-
 class ViewerPortError(ViewerError):
     """The web viewer could not serve on its ports."""
 
@@ -148,42 +144,41 @@ def _world(args: argparse.Namespace, session: zenoh.Session) -> World:
     return World.resolve(load_scenario(source))
 
 
-def _live(args: argparse.Namespace) -> rr.RecordingStream:
+def _live(args: argparse.Namespace) -> tuple[rr.RecordingStream, int]:
     session = open_zenoh(connection_from_args(args))
     try:
         world = _world(args, session)
         view = LiveView(session, world)  # subscribed before anything is logged
         rec = recording(world, args, live=True)
-        if args.ready_file is not None and view.linked(session):  # only then: a late view
-            args.ready_file.touch()  # catabot run starts its services now  # waited 20 s
+        if args.ready_file is not None and view.linked(session):  # not otherwise: a view
+            args.ready_file.touch()  # come late waited 20 s; catabot run starts its services
         end = view.run(rec, _run_folder(args))
         rec.flush()
     finally:
         session.close()
-    print(_ending(args, end, lost=view.lost), flush=True)
+    text, code = _ending(args, end, lost=view.lost)
+    print(text, file=sys.stderr if code else sys.stdout, flush=True)
     shown = ", ".join(f"{n} {what}" for what, n in sorted(view.shown.items()))
     cpu = time.process_time()  # every thread of the viewer process, start-up included
     print(f"shown: {shown or 'nothing'}; viewer CPU {cpu:.1f} s", flush=True)
-    return rec
+    return rec, code
 
 
-def _ending(args: argparse.Namespace, end: End | None, *, lost: bool) -> str:
-    """How the view's run ended: its End, or, the link lost first, its run folder's word."""
+def _ending(args: argparse.Namespace, end: End | None, *, lost: bool) -> tuple[str, int]:
+    """How the view's run ended, and the exit code: its End, or, the link lost first, its
+    run folder's word (exit 2 when no folder says it)."""
     if end is not None:
-        return f"run ended: {end.reason}"
+        return f"run ended: {end.reason}", 0
     if not lost:
-        return "stopped before the run ended"
+        return "stopped before the run ended", 0
     folder = _run_folder(args)
-    try:
-        if folder is None:
-            raise OSError
-        reason = json.loads((folder / "log" / "run.json").read_text())["reason"]
-    except (TypeError, OSError, ValueError, KeyError):
-        where = list(args.connect)
-        raise RunLost(f"the run at {where} went away (or never answered) before its end "
-                      f"reached the view: no peer for {LOST_S:g} s; what it drew is kept"
-                      ) from None  # fmt: skip
-    return f"run ended: {reason} (its run folder says: the view lost it before its End came)"
+    record = run_record(folder) if folder is not None else None
+    if record is None:
+        return (f"catabot view: the run at {list(args.connect)} went away (or never answered) "
+                "before its end reached the view, and no run folder says how it ended; what "
+                "it drew is kept"), 2  # fmt: skip
+    reason = end_reason(record, None)
+    return f"run ended: {reason} (its run folder says: the view lost it before its End came)", 0
 
 
 def _replay(args: argparse.Namespace) -> rr.RecordingStream:
@@ -220,15 +215,15 @@ def main(argv: list[str] | None = None) -> int:
     try:
         if args.save:
             output_file(args.save, flag="--save")  # before the replay, not after it
-        rec = _live(args) if args.connect else _replay(args)
+        rec, code = _live(args) if args.connect else (_replay(args), 0)
     except (CataBotError, SessionError) as exc:
         print(f"catabot view: {exc}", file=sys.stderr)
         return 2
     except OSError as exc:
         print(f"catabot view: {exc.filename or ''} {exc.strerror}", file=sys.stderr)
         return 2
-    _serve(args, rec)
-    return 0
+    _serve(args, rec)  # a lost run's view too: what it drew is kept, saved or served
+    return code
 
 
 if __name__ == "__main__":

@@ -27,15 +27,16 @@ import zenoh
 from catabot.bus import codec
 from catabot.bus.messages import BodyStates, End, Message, ThrustCmd, TwistCmd
 from catabot.config.sensors import SENSOR_TYPES
+from catabot.run.ending import run_record
 from catabot.world.world import MountedSensor, World
 from services.viewer.logger import RunLogger
 
 log = logging.getLogger("viewer")
 FPS = 20.0
 HELD = {"lidar": 2, "camera": 2, "radar": 256, "imu": 1024}  # samples a ring keeps
-METRICS_WAIT_S = 5.0
-LINK_S = 20.0  # the recorder writes metrics.json just after the run's end
-LOST_S = 3.0  # no peer and no router this long: the run is gone, its End may never come
+METRICS_WAIT_S = 5.0  # the recorder writes metrics.json just after the run's end
+LINK_S = 20.0  # how long a view waits for a link (a first one, or one lost mid-run)
+LOST_S = 3.0  # no peer nor router this long, its run.json written: the run is gone
 
 
 class LiveView:
@@ -77,7 +78,7 @@ class LiveView:
                 started = time.monotonic()
                 end = _newest(self.end, End)
                 self._tick(logger)
-                if end is None and self._gone():
+                if end is None and self._gone(run_dir):
                     self.lost = True
                     break
                 time.sleep(max(0.0, 1.0 / FPS - (time.monotonic() - started)))
@@ -87,13 +88,17 @@ class LiveView:
         _final_metrics(logger, run_dir, self._stamp_ns)
         return end
 
-    def _gone(self) -> bool:
-        """Whether the link has been down LOST_S: a view that attached as the run ended (its
-        End already sent), or whose link was cut, waited for the End forever."""
+    def _gone(self, run_dir: Path | None) -> bool:
+        """Whether the link has been down LOST_S once the run folder says the run is over,
+        LINK_S else (a slow first link, a flap mid-run): a view that attached as the run
+        ended, its End already sent, or whose link was cut, waited for the End forever.
+        Through a standalone router the link stays: such a view waits for an End."""
         info, now = self.session.info, time.monotonic()
         if list(info.peers_zid()) or list(info.routers_zid()):
             self._linked_at = now
-        return now - self._linked_at > LOST_S
+            return False
+        over = run_dir is not None and run_record(run_dir) is not None
+        return now - self._linked_at > (LOST_S if over else LINK_S)
 
     def _tick(self, logger: RunLogger) -> None:
         batch = _newest(self.states, BodyStates)

@@ -72,7 +72,7 @@ def test_non_msgpack_bytes() -> None:
         with pytest.raises(CodecError, match=r"not a msgpack payload: .") as info:
             codec.decode(junk, Ack)
         assert not str(info.value).endswith(": ")  # msgpack's FormatError says nothing
-    with pytest.raises(CodecError, match=r"payload: FormatError in bytes c1 c1 c1 \.\.\."):
+    with pytest.raises(CodecError, match=r"payload: FormatError in bytes c1 c1 c1$"):
         codec.decode(b"\xc1\xc1\xc1", Ack)
 
 

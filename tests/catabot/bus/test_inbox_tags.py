@@ -35,3 +35,16 @@ def test_what_a_run_ended_without_names_each_stream_and_its_last_tag() -> None:
     assert inbox.unarrived(6) == f"{STATE} from 'physics' after its tick 3"
     both = f"{STATE} from 'physics' after its tick 3; {GPS} from 'sensors' after its tick 0"
     assert inbox.unarrived(12) == both
+
+
+def test_a_wildcard_put_is_refused_once_by_whoever_watches_every_key_under_it() -> None:
+    """A put on `vessel/*/cmd/thrust` reached each stream under it and physics' watch over
+    every command key: counted twice, under two reasons. A watch that speaks for it (strays.py)
+    takes it; with none, each stream refuses it, saying it was a wildcard."""
+    inbox, wild = _inbox(), f"{STATE.rsplit('/', 2)[0]}/*/state"
+    with pytest.raises(Rejected, match=r"not a stream key: '.*\*/state': a put on a key exp"):
+        inbox.add(wild, b"\x80", sender="x")
+    inbox.spoken_for = lambda key: key == wild
+    inbox.add(wild, b"\x80", sender="x")  # left to the watch: no refusal here
+    with pytest.raises(Rejected, match=r"not a stream key: 'elsewhere'$"):
+        inbox.add("elsewhere", b"\x80", sender="x")  # no wildcard: this inbox's to refuse

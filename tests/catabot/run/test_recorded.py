@@ -27,7 +27,7 @@ def test_an_interrupted_or_killed_run_says_so(tmp_path: Path) -> None:
     for name, metrics, said in [
         ("a", {"end_reason": "interrupted"}, "interrupted, of 30 s planned"),
         ("b", {"end_reason": "completed"}, "completed"),
-        ("c", None, "killed (no metrics.json), of 30 s planned"),
+        ("c", None, "killed (no log/run.json), of 30 s planned"),
     ]:
         (tmp_path / name).mkdir()
         assert _folder(tmp_path / name, metrics).ended() == said
@@ -45,5 +45,8 @@ def test_a_labels_file_cut_mid_line_gives_its_whole_frames(tmp_path: Path) -> No
     frames = labelled_frames(tmp_path, camera)  # type: ignore[arg-type]
     assert [f.tick for f in frames] == [20, 40]
     (folder / "labels.jsonl").write_text('{"tick": 6\n' + "\n".join(lines) + "\n")
+    with pytest.raises(RunFolderError, match=r"labels.jsonl:1: not a JSON line"):
+        labelled_frames(tmp_path, camera)  # type: ignore[arg-type]
+    (folder / "labels.jsonl").write_text('{"tick": 6')  # cut with no whole frame: said
     with pytest.raises(RunFolderError, match=r"labels.jsonl:1: not a JSON line"):
         labelled_frames(tmp_path, camera)  # type: ignore[arg-type]

@@ -30,11 +30,17 @@ def test_neither_set_is_empty_with_two_blocks_or_more() -> None:
     assert split(stamps, seed=0, val_fraction=0.0, block_s=10.0) == ["train", "train"]
 
 
-def test_short_runs_get_ten_blocks_from_the_start() -> None:
+def test_short_runs_get_ten_blocks_from_their_first_frame() -> None:
     assert block_ns([0, 2 * S - 1], None) == S // 5
     perception = [k * S // 5 for k in range(1, 150)]  # its frames: 0.2-29.8 s at 5 Hz
-    blocks = {s // block_ns(perception, None) for s in perception}
-    assert blocks == set(range(10))  # a tenth of the span made an eleventh of 2 frames
+    length = block_ns(perception, None)
+    assert {(s - S // 5) // length for s in perception} == set(range(10))  # not eleven
+    for late in (
+        [95 * S + k * S // 5 for k in range(26)],
+        [100 * S + k * S // 5 for k in range(51)],
+    ):
+        sets = split(late, seed=1, val_fraction=0.2)  # a camera on late: 25 of 26 went to val
+        assert 0.1 <= sets.count("val") / len(sets) <= 0.3, sets.count("val")
     assert block_ns([0, 600 * S], None) == 10 * S
     assert block_ns([0, 600 * S], 2.5) == 5 * S // 2
 

@@ -139,8 +139,8 @@ def test_compared_runs_are_named_by_what_differs_from_the_first() -> None:
     }
     ends = ("completed", "completed", "fault", "completed")
     runs = [SimpleNamespace(run=SimpleNamespace(folder=Path(f"runs/{n}"),
-                                                world=World.resolve(parse_scenario(d))),
-                            metrics={"end_reason": e})
+                                                world=World.resolve(parse_scenario(d)),
+                                                end_reason=lambda e=e: e))
             for n, d, e in zip("abcd", (calm, drift, live, other), ends, strict=True)]  # fmt: skip
     assert run_labels(runs) == [  # type: ignore[arg-type]
         "a (water.current.velocity_mps=[0.0, 0.0])", "b (water.current.velocity_mps=[0.0, 0.5])",

@@ -21,6 +21,7 @@ from services.traffic.avoid import (
     Obstacles,
     _on_arc,
     corridor_turn,
+    drifted,
     mark_aim,
     marks_on,
 )
@@ -76,6 +77,22 @@ def test_the_corridor_follows_the_arc_the_law_turns_on() -> None:
     law = 0.1 / 0.07  # the law's arc through (10, 10), a full turn's curvature 0.07
     assert not np.isnan(turn_for((10.0, 10.0), law=law)[0])  # met on the arc
     assert np.isnan(turn_for((10.0, 10.0))[0])  # not on the line
+
+
+def test_a_mark_whose_buoy_drifted_off_its_anchor_is_still_a_mark() -> None:
+    """A soft mooring lets a buoy ride 3 m off its anchor in a 0.5 m/s current: it was then
+    taken for an obstacle on the boat's own way, while the boat aimed beside its anchor."""
+    anchor, buoy = np.array([[20.0, 0.0]]), np.array([[20.0, 3.0]])
+    drifting = Obstacles(buoy, np.array([0.3]), np.array([-1]), np.zeros((1, 2)), np.zeros(1),
+                         np.zeros(1, dtype=bool), home=anchor)  # fmt: skip
+    zero, one = np.zeros(1), np.ones(1)
+    arcs = (zero, 0.07 * one, 40.0 * one, 5.0 * one)
+    turn, _ = corridor_turn(zeros2(), zero, *arcs, drifting, anchor[None])  # its own mark
+    assert np.isnan(turn[0])
+    turn, _ = corridor_turn(zeros2(), zero, *arcs, drifting, NO_MARKS)  # a stranger's buoy
+    assert not np.isnan(turn[0])
+    np.testing.assert_array_equal(drifted(np.array([[20.2, 0.1], [50.0, 0.0]]), drifting),
+                                  [[20.0, 3.0], [50.0, 0.0]])  # fmt: skip
 
 
 def test_marks_are_aimed_at_to_their_right() -> None:
