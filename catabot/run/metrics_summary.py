@@ -51,7 +51,8 @@ def _traffic(record: dict[str, Any]) -> list[str]:
     boats = any(isinstance(m, dict) and "nearest_vessel" not in m for m in vessels)
     if not isinstance(hits, list) or not (boats or hits):
         return []
-    return [f"  traffic: {len(hits)} collisions among its boats and buoys"]
+    noun = "collision" if len(hits) == 1 else "collisions"
+    return [f"  traffic: {len(hits)} {noun} among its boats and buoys"]
 
 
 def vessel_parts(m: dict[str, Any]) -> list[str]:

@@ -156,7 +156,7 @@ def _live(args: argparse.Namespace) -> tuple[rr.RecordingStream, int]:
         rec.flush()
     finally:
         session.close()
-    text, code = _ending(args, end, lost=view.lost)
+    text, code = _ending(args, end, view)
     print(text, file=sys.stderr if code else sys.stdout, flush=True)
     shown = ", ".join(f"{n} {what}" for what, n in sorted(view.shown.items()))
     cpu = time.process_time()  # every thread of the viewer process, start-up included
@@ -164,20 +164,23 @@ def _live(args: argparse.Namespace) -> tuple[rr.RecordingStream, int]:
     return rec, code
 
 
-def _ending(args: argparse.Namespace, end: End | None, *, lost: bool) -> tuple[str, int]:
+def _ending(args: argparse.Namespace, end: End | None, view: LiveView) -> tuple[str, int]:
     """How the view's run ended, and the exit code: its End, or, the link lost first, its
-    run folder's word (exit 2 when no folder says it)."""
+    run folder's word (exit 2 when no folder says it, or when nothing ever answered)."""
     if end is not None:
         return f"run ended: {end.reason}", 0
-    if not lost:
+    if not view.lost:
         return "stopped before the run ended", 0
-    folder = _run_folder(args)
+    folder, where = _run_folder(args), list(args.connect)
     record = run_record(folder) if folder is not None else None
     if record is None:
-        return (f"catabot view: the run at {list(args.connect)} went away (or never answered) "
-                "before its end reached the view, and no run folder says how it ended; what "
-                "it drew is kept"), 2  # fmt: skip
+        return (f"catabot view: the run at {where} went away (or never answered) before its "
+                "end reached the view, and no run folder says how it ended; what it drew is "
+                "kept"), 2  # fmt: skip
     reason = end_reason(record, None)
+    if not view.ever_linked:  # a finished run's folder, and an endpoint nobody listens on
+        return (f"catabot view: nothing answers at {where}; the run in {folder} has ended "
+                f"({reason}): `catabot view {folder}` replays it"), 2  # fmt: skip
     return f"run ended: {reason} (its run folder says: the view lost it before its End came)", 0
 
 

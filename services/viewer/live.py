@@ -44,6 +44,7 @@ class LiveView:
         keys = world.keys
         self.world, self.session = world, session
         self.lost, self._linked_at = False, time.monotonic()  # lost: the run, before its End
+        self.ever_linked = False  # a view of nothing: an endpoint where nothing answered
         ring = zenoh.handlers.RingChannel
         self.states = session.declare_subscriber(keys.world_states(), ring(2))
         self.end = session.declare_subscriber(keys.end(), ring(1))
@@ -95,7 +96,7 @@ class LiveView:
         Through a standalone router the link stays: such a view waits for an End."""
         info, now = self.session.info, time.monotonic()
         if list(info.peers_zid()) or list(info.routers_zid()):
-            self._linked_at = now
+            self._linked_at, self.ever_linked = now, True
             return False
         over = run_dir is not None and run_record(run_dir) is not None
         return now - self._linked_at > (LOST_S if over else LINK_S)

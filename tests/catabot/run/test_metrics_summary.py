@@ -70,6 +70,8 @@ def test_the_traffic_collisions_have_a_line_where_there_is_traffic(tmp_path: Pat
     record = {"vessels": {"ego": EGO, "boat_0": boat}, "traffic_collisions": [hit, hit]}
     (tmp_path / "metrics.json").write_text(json.dumps(record))
     assert metrics_lines(tmp_path)[-1] == "  traffic: 2 collisions among its boats and buoys"
+    (tmp_path / "metrics.json").write_text(json.dumps(record | {"traffic_collisions": [hit]}))
+    assert metrics_lines(tmp_path)[-1] == "  traffic: 1 collision among its boats and buoys"
     alone = {"vessels": {"ego": EGO}, "traffic_collisions": []}
     (tmp_path / "metrics.json").write_text(json.dumps(alone))
     assert len(metrics_lines(tmp_path)) == 1  # no traffic: no line
