@@ -79,6 +79,13 @@ class Connection:
             cfg.insert_json5("transport/unicast/open_timeout", str(self.open_timeout_ms))
         return cfg
 
+    def described(self) -> str:
+        """Where it connects and in which mode, a config file's own settings included (the
+        flags alone said "connect none, mode peer" of a file's client on tls/...)."""
+        cfg = self.config()
+        mode = json.loads(cfg.get_json("mode"))
+        return f"connect {list(_connect_endpoints(cfg)) or 'none'}, mode {mode}"
+
 
 def _embedded(mode: str) -> zenoh.Config:
     cfg = zenoh.Config()

@@ -24,6 +24,7 @@ from catabot.bus.messages import End
 from catabot.bus.outputs import Outputs
 from catabot.bus.session import (
     Connection,
+    SessionError,
     add_connection_args,
     connection_from_args,
     open_session,
@@ -35,6 +36,7 @@ from catabot.client.errors import (
     NotItsVessel,
     RunEnded,
     SeveralVessels,
+    SimulatorNotFound,
     TooLate,
     UnknownVessel,
 )
@@ -84,8 +86,11 @@ class Client:
 
     @classmethod
     def open(cls, conn: Connection, *, world: str | None, timeout_s: float) -> Client:
-        where = f"connect {list(conn.connect) or 'none'}, mode {conn.mode or 'peer'}"
-        session = open_session(conn)
+        where = conn.described()
+        try:
+            session = open_session(conn)
+        except SessionError as exc:  # one line under `except ClientError`, as the rest
+            raise SimulatorNotFound(str(exc)) from None
         try:
             info = find_world(session, world, timeout_s, where)
         except BaseException:
@@ -288,16 +293,19 @@ def add_stack_args(parser: argparse.ArgumentParser) -> None:
 
 
 def _controller_of(info: WorldInfo, vessel: str | None) -> str:
-    """The participant named by the vessel's `controller.participant`, the default of a
-    stack's `--participant`; NotAParticipant names what to give when there is none."""
-    own = info.vessels.get(vessel or "")
-    if own is not None and own.controller is not None and own.controller.participant:
-        return own.controller.participant
-    raise NotAParticipant(
-        f"no participant named and vessel {vessel!r} of world {info.name!r} has no controller "
-        f"participant: give one (--participant NAME; it expects "
-        f"{', '.join(info.external) or 'none'})"
-    )
+    """The participant named by the vessel's `controller.participant` (no vessel named: the
+    world's only such seat), the default of a stack's `--participant`; NotAParticipant
+    names what to give when there is none."""
+    seats = {v.id: v.controller.participant for v in info.vessels.values()
+             if v.controller is not None and v.controller.participant}  # fmt: skip
+    if vessel in seats or (vessel is None and len(seats) == 1):
+        return seats[vessel] if vessel is not None else next(iter(seats.values()))
+    why = (f"vessel {vessel!r} of world {info.name!r} has no controller participant"
+           if vessel is not None else
+           f"no vessel named, and world {info.name!r} has {len(seats)} controller participants, "
+           "not one")  # fmt: skip
+    raise NotAParticipant(f"no participant named and {why}: give one (--participant NAME; it "
+                          f"expects {', '.join(info.external) or 'none'})")  # fmt: skip
 
 
 def _told(exc: BaseException) -> str:

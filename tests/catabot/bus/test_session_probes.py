@@ -94,3 +94,14 @@ def test_a_config_files_endpoints_are_read_in_either_form(tmp_path: Path) -> Non
     (tmp_path / "z.json5").write_text(json.dumps(config))
     with pytest.raises(SessionError, match="nothing answers there"):
         open_session(Connection(file=str(tmp_path / "z.json5"), open_timeout_ms=500))
+
+
+def test_a_connection_is_described_with_its_config_files_settings(tmp_path: Path) -> None:
+    """A stack given a secure profile's config file was told it had tried "connect none,
+    mode peer", and advised to listen on tcp/: the file's client mode and tls/ endpoint."""
+    config = tmp_path / "autopilot.json5"
+    config.write_text('{mode: "client", connect: {endpoints: ["tls/127.0.0.1:7447"]}}')
+    assert Connection(file=str(config)).described() == (
+        "connect ['tls/127.0.0.1:7447'], mode client"
+    )
+    assert Connection().described() == "connect none, mode peer"

@@ -9,7 +9,8 @@ import numpy as np
 import pytest
 
 from catabot.bus.messages import LidarScan, TwistCmd
-from catabot.client import ClientError, UnknownSensor
+from catabot.client import ClientError, NotAParticipant, UnknownSensor
+from catabot.client.client import _controller_of
 from catabot.client.free import unpaced
 from catabot.client.info import parse
 from catabot.config.load import parse_scenario
@@ -125,3 +126,17 @@ def test_a_free_stack_is_told_when_the_run_is_not_paced_to_the_wall_clock() -> N
     assert "--realtime 1" in unpaced(fast)
     paced = parse(describe(World.resolve(scenario(clock={"realtime_factor": 1.0})), ROSTER), "t")
     assert unpaced(paced) == ""
+
+
+def test_no_participant_named_is_the_worlds_only_controller_seat() -> None:
+    """`run_lockstep(None, step)` on a one-stack world failed: "vessel None has no
+    controller participant"; with no vessel named, the world's only seat is taken."""
+    info = parse(answer(), "test")
+    assert _controller_of(info, None) == "stack" and _controller_of(info, "ego") == "stack"
+    with pytest.raises(NotAParticipant, match="vessel 'other' of world 'info' has no controller"):
+        _controller_of(info, "other")
+    seats = [{"id": v, "controller": {"participant": f"{v}_stack"}} for v in ("a", "b")]
+    two = parse_scenario({"name": "two", "vessels": seats}, source="test")
+    data = describe(World.resolve(two), ROSTER)
+    with pytest.raises(NotAParticipant, match="has 2 controller participants, not one"):
+        _controller_of(parse({**data, "granted": -1}, "test"), None)
