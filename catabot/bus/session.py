@@ -80,11 +80,7 @@ class Connection:
         return cfg
 
     def described(self) -> str:
-        """Where it connects and in which mode, a config file's own settings included (the
-        flags alone said "connect none, mode peer" of a file's client on tls/...)."""
-        cfg = self.config()
-        mode = json.loads(cfg.get_json("mode"))
-        return f"connect {list(_connect_endpoints(cfg)) or 'none'}, mode {mode}"
+        return _described(self.config())
 
 
 def _embedded(mode: str) -> zenoh.Config:
@@ -205,10 +201,16 @@ def open_session(conn: Connection) -> zenoh.Session:
         if "Unable to connect" in said:  # the endpoints a config file names too
             said += _why_unreachable(_connect_endpoints(config))
         raise SessionError(
-            f"cannot open zenoh (mode {conn.mode or 'peer'}, connect {list(conn.connect)}, "
-            f"listen {list(conn.listen)}, config {conn.file or os.environ.get('ZENOH_CONFIG')}): "
-            f"{said}"
+            f"cannot open zenoh ({_described(config)}, listen {list(conn.listen)}, "
+            f"config {conn.file or os.environ.get('ZENOH_CONFIG')}): {said}"
         ) from None
+
+
+def _described(config: zenoh.Config) -> str:
+    """Where a session connects and in which mode, a config file's own settings included
+    (the flags alone said "connect none, mode peer" of a file's client on tls/...)."""
+    mode = json.loads(config.get_json("mode"))
+    return f"connect {list(_connect_endpoints(config)) or 'none'}, mode {mode}"
 
 
 def _connect_endpoints(config: zenoh.Config) -> tuple[str, ...]:
@@ -256,10 +258,15 @@ def dial_address(endpoint: str) -> tuple[str, int]:
     return {"0.0.0.0": "127.0.0.1", "::": "::1"}.get(host, host), int(port)
 
 
+def linked(session: zenoh.Session) -> bool:
+    """Whether the session reaches another Zenoh node now (a router or a peer)."""
+    return bool(list(session.info.routers_zid()) or list(session.info.peers_zid()))
+
+
 def alone(session: zenoh.Session) -> str:
     """A note for a process that waits for others while its session reaches no other Zenoh
     node (a peer told to --connect where nobody listens retries quietly forever), else ""."""
-    if list(session.info.routers_zid()) or list(session.info.peers_zid()):
+    if linked(session):
         return ""
     return ("; this process reaches no other Zenoh node: is anything listening where it "
             "connects? (to a router, give --mode client: it then fails at once)")  # fmt: skip

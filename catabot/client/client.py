@@ -86,9 +86,8 @@ class Client:
 
     @classmethod
     def open(cls, conn: Connection, *, world: str | None, timeout_s: float) -> Client:
-        where = conn.described()
         try:
-            session = open_session(conn)
+            where, session = conn.described(), open_session(conn)
         except SessionError as exc:  # one line under `except ClientError`, as the rest
             raise SimulatorNotFound(str(exc)) from None
         try:
@@ -298,8 +297,10 @@ def _controller_of(info: WorldInfo, vessel: str | None) -> str:
     names what to give when there is none."""
     seats = {v.id: v.controller.participant for v in info.vessels.values()
              if v.controller is not None and v.controller.participant}  # fmt: skip
-    if vessel in seats or (vessel is None and len(seats) == 1):
-        return seats[vessel] if vessel is not None else next(iter(seats.values()))
+    if vessel is None and len(seats) == 1:
+        vessel = next(iter(seats))
+    if vessel in seats:
+        return seats[vessel]
     why = (f"vessel {vessel!r} of world {info.name!r} has no controller participant"
            if vessel is not None else
            f"no vessel named, and world {info.name!r} has {len(seats)} controller participants, "

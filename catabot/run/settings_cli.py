@@ -122,11 +122,9 @@ def get_main(argv: list[str]) -> int:
 
 
 def _due(answer: dict[str, Any], key: str) -> str:
-    """The changes of `key` scheduled after the last tick granted (a timeline's later
-    entries were shown as if in force already)."""
-    later = [
-        c for c in answer.get("changes", []) if c["key"] == key and c["tick"] > answer["granted"]
-    ]
+    """The changes of `key` the desk says are still to come (a timeline's later entries
+    were shown as if in force already)."""
+    later = [c for c in answer.get("due", []) if c["key"] == key]
     return "".join(f"; {json.dumps(c['value'])} from t = {c['t_s']:g} s" for c in later)
 
 

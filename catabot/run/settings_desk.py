@@ -106,6 +106,7 @@ class SettingsDesk:
             values[change.key] = change.decoded
             if change.tick <= granted:
                 now[change.key] = change.decoded
+        entries = [live.entry(c, self.scenario.dt_ns) | {"tick": c.tick} for c in changes]
         return {
             "world": self.keys.world,
             "granted": granted,
@@ -113,7 +114,8 @@ class SettingsDesk:
             "settings": values,  # once every change scheduled so far has applied
             "now": now,  # at the last tick granted: a timeline's later entries not yet
             "allowed": {key: spec.allowed for key, spec in specs.items()},
-            "changes": [live.entry(c, self.scenario.dt_ns) | {"tick": c.tick} for c in changes],
+            "changes": entries,
+            "due": [e for e in entries if e["tick"] > granted],  # what `now` leaves out
         }
 
     def close(self) -> None:

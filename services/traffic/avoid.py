@@ -62,6 +62,11 @@ class Obstacles:
     under_way: NDArray[np.bool_]  # (M,): boats and vessels, whose meetings colregs.py rules
     home: Array | None = None  # (M, 2) where each was at the start (a buoy's anchor); None: xy
 
+    @property
+    def moored_at(self) -> Array:
+        """Where each is moored (`home`), else where it is: how a mark's buoy is known."""
+        return self.xy if self.home is None else self.home
+
     @classmethod
     def fixed(cls, xy: Array, radius: Array, own: Rows) -> Obstacles:
         """Obstacles that do not move and are not boats (buoys, marks)."""
@@ -85,8 +90,7 @@ def drifted(points: Array, obstacles: Obstacles | None) -> Array:
     fixed = np.flatnonzero(~obstacles.under_way)
     if fixed.size == 0:
         return points
-    home = obstacles.xy if obstacles.home is None else obstacles.home
-    gap = points[:, None, :] - home[fixed][None, :, :]
+    gap = points[:, None, :] - obstacles.moored_at[fixed][None, :, :]
     d2 = gap[..., 0] ** 2 + gap[..., 1] ** 2
     nearest = d2.argmin(axis=1)
     hit = d2[np.arange(len(points)), nearest] < MARK_M**2
@@ -195,8 +199,8 @@ def _others(
     near = rel[:, 0] ** 2 + rel[:, 1] ** 2 < (width[boat] + obstacles.radius[obs]) ** 2
     keep = (obs != obstacles.own[boat]) & (near | ~obstacles.under_way[obs])
     boat, obs = boat[keep], obs[keep]
-    home = obstacles.xy if obstacles.home is None else obstacles.home  # a buoy by its anchor:
-    gap = home[obs][:, None, :] - marks[boat]  # metres off it in a current (pairs, K, 2)
+    gap = obstacles.moored_at[obs][:, None, :] - marks[boat]  # a buoy by its anchor, metres
+    # off it in a current (pairs, K, 2)
     near = np.any(gap[..., 0] ** 2 + gap[..., 1] ** 2 < MARK_M**2, axis=1)  # nan: no mark
     mark = near & ~obstacles.under_way[obs]
     return boat[~mark], obs[~mark]

@@ -26,6 +26,7 @@ import zenoh
 
 from catabot.bus import codec
 from catabot.bus.messages import BodyStates, End, Message, ThrustCmd, TwistCmd
+from catabot.bus.session import linked
 from catabot.config.sensors import SENSOR_TYPES
 from catabot.run.ending import run_record
 from catabot.world.world import MountedSensor, World
@@ -64,7 +65,7 @@ class LiveView:
         subscriptions are known to the run (Zenoh sends declarations in order on each link)."""
         limit = time.monotonic() + timeout_s
         while time.monotonic() < limit:
-            if list(session.info.peers_zid()) or list(session.info.routers_zid()):
+            if linked(session):
                 return True
             time.sleep(0.05)
         return False
@@ -94,8 +95,8 @@ class LiveView:
         LINK_S else (a slow first link, a flap mid-run): a view that attached as the run
         ended, its End already sent, or whose link was cut, waited for the End forever.
         Through a standalone router the link stays: such a view waits for an End."""
-        info, now = self.session.info, time.monotonic()
-        if list(info.peers_zid()) or list(info.routers_zid()):
+        now = time.monotonic()
+        if linked(self.session):
             self._linked_at, self.ever_linked = now, True
             return False
         over = run_dir is not None and run_record(run_dir) is not None
