@@ -9,7 +9,7 @@ from __future__ import annotations
 
 import argparse
 import sys
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 from pathlib import Path
 from typing import NoReturn
 
@@ -22,6 +22,27 @@ class OneLineParser(argparse.ArgumentParser):
 
     def error(self, message: str) -> NoReturn:
         self.exit(2, f"{self.prog}: {message} (--help for usage)\n")
+
+    def parse_args(  # type: ignore[override]
+        self, args: Sequence[str] | None = None, namespace: None = None
+    ) -> argparse.Namespace:
+        parsed, rest = self.parse_known_args(args, namespace)
+        self.refuse_extra(parsed, rest)
+        return parsed
+
+    def refuse_extra(self, parsed: argparse.Namespace, rest: Sequence[str]) -> None:
+        """Arguments nobody took, refused by the subcommand they were given to: argparse
+        named the top command (`catabot: unrecognized arguments` for `catabot run s --x`)."""
+        if rest:
+            self._leaf(parsed).error(f"unrecognized arguments: {' '.join(rest)}")
+
+    def _leaf(self, parsed: argparse.Namespace) -> argparse.ArgumentParser:
+        for action in self._actions:
+            if isinstance(action, argparse._SubParsersAction):
+                chosen = action.choices.get(str(getattr(parsed, action.dest, "")))
+                if isinstance(chosen, OneLineParser):
+                    return chosen._leaf(parsed)
+        return self
 
 
 class OutputPathError(CataBotError, ValueError):

@@ -205,7 +205,7 @@ def _valid_model(file: str) -> str:
             f"{displacement(model, density)}{notes}")  # fmt: skip
 
 
-def parser() -> argparse.ArgumentParser:
+def parser() -> OneLineParser:
     p = OneLineParser(prog="catabot", description=__doc__)
     sub = p.add_subparsers(dest="command", required=True)
     run = sub.add_parser("run", help="run a scenario: conductor and services as processes")
@@ -306,8 +306,7 @@ def _command(argv: list[str] | None) -> int:
         return LIVE[args.command][0](rest)
     if args.command in DEPLOY:
         return DEPLOY[args.command][0](rest)
-    if rest:
-        parser().error(f"unrecognized arguments: {' '.join(rest)}")
+    parser().refuse_extra(args, rest)
     handlers = {"run": _run, "router": _router, "scenario": _scenario, "secure": _secure}
     return handlers[args.command](args)
 

@@ -15,7 +15,6 @@ deploy/docker-compose.yml is this command's output for deploy/scenario.json.
 
 from __future__ import annotations
 
-import argparse
 import math
 import os
 import sys
@@ -236,7 +235,7 @@ def text(scenario_arg: str, output: Path, secure_dir: Path | None = None) -> str
     return render(document(plan(scenario_arg, output, secure_dir)), command)
 
 
-def parser() -> argparse.ArgumentParser:
+def parser() -> OneLineParser:
     p = OneLineParser(prog="catabot deploy", description="containers for a scenario")
     sub = p.add_subparsers(dest="action", required=True)
     c = sub.add_parser("compose", help="write the compose file a scenario needs")
@@ -253,8 +252,7 @@ def main(argv: list[str]) -> int:
     args, rest = parser().parse_known_args(argv)
     if args.action == "probe":
         return probe.main(rest)
-    if rest:
-        parser().error(f"unrecognized arguments: {' '.join(rest)}")
+    parser().refuse_extra(args, rest)
     output = Path(args.output)
     try:
         body = text(args.scenario, output, Path(args.secure) if args.secure else None)

@@ -29,7 +29,7 @@ FORMATS: dict[str, Callable[[RecordedRun, Path, ExportOptions], str]] = {
 }
 
 
-def parser() -> argparse.ArgumentParser:
+def parser() -> OneLineParser:
     p = OneLineParser(prog="catabot dataset", description=__doc__.split("\n")[0])
     sub = p.add_subparsers(dest="action", required=True)
     exp = sub.add_parser("export", help="convert a recorded run into a training dataset")
