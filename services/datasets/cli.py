@@ -37,7 +37,7 @@ def parser() -> OneLineParser:
     exp.add_argument("--format", "-f", required=True, choices=list(FORMATS))
     exp.add_argument("--output", "-o", required=True, help="folder to write (new or empty)")
     exp.add_argument(
-        "--val-fraction", type=float, default=0.2, help="share of validation (default 0.2)"
+        "--val-fraction", type=float, default=None, help="share of validation (default 0.2)"
     )
     exp.add_argument(
         "--split-block-s", type=float, default=None,
@@ -77,7 +77,12 @@ class ExportOptionError(CataBotError, ValueError):
 
 def _check(args: argparse.Namespace) -> Path:
     """Options refused in one line, as every tool refuses (argparse's error printed the
-    parent command's usage first)."""
+    parent command's usage first); a split asked of KITTI, which has none, is refused too."""
+    if args.format == "kitti" and (args.val_fraction, args.split_block_s) != (None, None):
+        flag = "--val-fraction" if args.val_fraction is not None else "--split-block-s"
+        raise ExportOptionError(f"{flag}: a kitti export is not split (every sequence is in "
+                                "catabot.yaml's train; move some to valid there)")  # fmt: skip
+    args.val_fraction = 0.2 if args.val_fraction is None else args.val_fraction
     if not 0.0 <= args.val_fraction <= 1.0:
         raise ExportOptionError(f"--val-fraction must be in [0, 1] (got {args.val_fraction})")
     if args.split_block_s is not None and not args.split_block_s > 0:

@@ -45,6 +45,17 @@ def test_a_bad_option_is_one_line(
     assert err.count("\n") == 1 and why in err and "usage" not in err
 
 
+@pytest.mark.parametrize("option", [["--val-fraction", "0.5"], ["--split-block-s", "5"]])
+def test_a_split_asked_of_kitti_is_refused(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str], option: list[str]
+) -> None:
+    """KITTI's export puts every sequence in train: a split asked of it was taken silently."""
+    out = tmp_path / "dataset"
+    assert main(["export", str(tmp_path), "-f", "kitti", "-o", str(out), *option]) == 2
+    err = capsys.readouterr().err
+    assert f"{option[0]}: a kitti export is not split" in err and not out.exists()
+
+
 def test_an_output_that_is_a_file_is_named_as_one(
     tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
