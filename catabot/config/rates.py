@@ -9,6 +9,8 @@ from catabot.bus.clock import NS_PER_S, ClockError, period_in_ticks
 from catabot.config.base import ScenarioError
 from catabot.config.scenario import Scenario
 
+MAX_PERIOD_NS = 2**63 - 1  # the clock counts in signed 64-bit nanoseconds (msgpack, numpy)
+
 
 def check_rates(scenario: Scenario) -> None:
     """Refuse sensor and guidance rates that are not a whole number of ticks (DESIGN.md §4),
@@ -46,7 +48,12 @@ def check_rates(scenario: Scenario) -> None:
 
 
 def rate_in_ticks(rate_hz: float, dt_ns: int, *, where: str) -> int:
-    """The period of a rate in ticks; ScenarioError naming `where` unless it is whole."""
+    """The period of a rate in ticks; ScenarioError naming `where` unless it is whole, or
+    too long for the clock's nanosecond integers (1e-300 Hz overflowed to a traceback)."""
+    if not NS_PER_S / rate_hz <= MAX_PERIOD_NS:
+        raise ScenarioError(f"{where}: {rate_hz:g} Hz is too slow: one sample in "
+                            f"{1 / rate_hz:.3g} s, past the clock's {MAX_PERIOD_NS / NS_PER_S:.3g} "
+                            "s of nanoseconds")  # fmt: skip
     try:  # first, so that e.g. 30 Hz at 10 ms names the allowed rates
         ticks = period_in_ticks(round(NS_PER_S / rate_hz), dt_ns, what=where)
     except ClockError as exc:

@@ -123,3 +123,13 @@ def test_a_rate_faster_than_the_clock_is_told_the_fastest() -> None:
     data = _base()
     data["vessels"][0]["sensors"][1]["rate_hz"] = 400.0
     assert "the fastest is 100 Hz (every tick)" in _error(data)
+
+
+@pytest.mark.parametrize("rate", [1e-300, 1e-12])
+def test_a_rate_too_slow_for_the_clock_is_named(rate: float) -> None:
+    """1e-300 Hz overflowed to a traceback; 1e-12 Hz gave one sample, at tick 0."""
+    data = _base()
+    data["vessels"][0]["sensors"][0]["rate_hz"] = rate
+    msg = _error(data)
+    assert "vessels.0.sensors.0.rate_hz (ego/imu): " in msg
+    assert f"{rate:g} Hz is too slow" in msg
