@@ -299,8 +299,9 @@ def _ephemeral_low() -> int:
     return max(low, FIRST_PORT + 1)
 
 
-def add_connection_args(parser: argparse.ArgumentParser) -> None:
-    """The connection flags every CataBot program shares."""
+def add_connection_args(parser: argparse.ArgumentParser, *, router: bool = False) -> None:
+    """The connection flags every CataBot program shares; a router has no --mode (it is one:
+    `catabot router --mode peer` was taken and ignored) and listens on 7447 by default."""
     parser.add_argument(
         "--connect",
         "-e",
@@ -315,9 +316,11 @@ def add_connection_args(parser: argparse.ArgumentParser) -> None:
         action="append",
         default=[],
         metavar="ENDPOINT",
-        help="zenoh endpoint to listen on (default tcp/127.0.0.1:0 in peer mode)",
+        help="zenoh endpoint to listen on (default "
+        + ("tcp/127.0.0.1:7447)" if router else "tcp/127.0.0.1:0 in peer mode)"),
     )
-    parser.add_argument("--mode", choices=MODES, help="zenoh session mode (default: peer)")
+    if not router:
+        parser.add_argument("--mode", choices=MODES, help="zenoh session mode (default: peer)")
     parser.add_argument("--zid", help="this session's Zenoh id (hex; default: random)")
     parser.add_argument(
         "--zenoh-config",

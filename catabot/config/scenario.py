@@ -1,7 +1,6 @@
 """The scenario (DESIGN.md §6): one model per section, and the rules that span sections
 (rates in whole ticks, which services and participants a scenario needs). Reading files
-is `catabot.config.load`; what a scenario means for a run is `catabot.world.World`.
-"""
+is `catabot.config.load`; what a scenario means for a run is `catabot.world.World`."""
 
 from __future__ import annotations
 
@@ -99,7 +98,8 @@ class SensorConfig(Strict):
     rate_hz: float = Field(gt=0)
     noise: StrictBool = Field(True, description="false: ideal, without its random noise and "
                               "biases; the world's effects stay (rain, occlusion)")  # fmt: skip
-    params: dict[str, Any] = Field({}, description="the type's parameters (defaults if empty)")
+    params: dict[str, Any] = Field({}, validate_default=True,  # filled when left out too
+        description="the type's parameters (defaults if empty)")  # fmt: skip
 
     @field_validator("type")
     @classmethod

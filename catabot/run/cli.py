@@ -268,7 +268,7 @@ def parser() -> OneLineParser:
     )
     svc.add_argument("name", nargs="?", help="conductor, or a service: physics, sensors, ...")
     rtr = sub.add_parser("router", help="run a zenoh router for distributed runs")
-    add_connection_args(rtr)
+    add_connection_args(rtr, router=True)
     scen = sub.add_parser("scenario", help="scenario tools")
     scen.add_argument("action", choices=["schema", "model-schema", "validate", "generate"])
     scen.add_argument("file", nargs="?", help="scenario to validate")

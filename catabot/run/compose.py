@@ -170,7 +170,10 @@ def _bridge(p: Plan, ros: RosConfig) -> Service:
         "image": BRIDGE_IMAGE,
         "profiles": ["ros2dds"],
         "network_mode": "host",  # DDS discovery is multicast on the host's network
-        "environment": {"ROS_DOMAIN_ID": f"${{ROS_DOMAIN_ID:-{ros.domain_id}}}"},
+        "environment": {  # the bridge takes an unset ROS_DISTRO for iron (type hashes)
+            "ROS_DOMAIN_ID": f"${{ROS_DOMAIN_ID:-{ros.domain_id}}}",
+            "ROS_DISTRO": "${ROS_DISTRO:-jazzy}",
+        },
         "command": [
             "-m",
             "client",

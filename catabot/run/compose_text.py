@@ -38,7 +38,7 @@ NOTES = {
     "http://localhost:9090/?url=rerun%2Bhttp://localhost:9876/proxy (served until `down`)",
     "services.zenoh-bridge-ros2dds": "ROS 2 on DDS on this host (multicast discovery): "
     "docker compose -f FILE --profile ros2dds up -d\nzenoh-bridge-ros2dds; ROS_DOMAIN_ID "
-    "must match your nodes'",
+    "and ROS_DISTRO (jazzy unless set; humble for Humble's nodes) must match your nodes'",
     "secrets": "the secure profile's passwords: each process gets its own login only",
 }
 

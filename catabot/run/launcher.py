@@ -20,11 +20,11 @@ from catabot.bus.session import check_listen, check_router, free_port
 from catabot.config import overrides
 from catabot.config.base import ScenarioError
 from catabot.config.load import load_scenario, parse_scenario, scenario_data, scenario_json
-from catabot.config.notes import scenario_notes
 from catabot.config.scenario import Scenario
 from catabot.config.sensors import service_of
 from catabot.errors import CataBotError
 from catabot.run import programs
+from catabot.run.announce import announce
 from catabot.run.child import Child
 from catabot.run.companions import Viewer, after_run, start_viewer
 from catabot.run.progress import PlanningProgress, ProgressBar
@@ -210,36 +210,13 @@ def run(opts: RunOptions) -> int:
             print(f"catabot run: cannot make {where}: {exc.strerror}", file=sys.stderr)
             return 2
         cond_flags, svc_flags = _endpoints(opts)
-        print(
-            f"run folder: {run_dir}\nzenoh: clients connect to {svc_flags[1]} (world "
-            f"{scenario.name!r}, keys catabot/{scenario.name}/...)",
-            flush=True,
-        )
-        _tell_external(world, opts, svc_flags[1])
+        print(f"run folder: {run_dir}", flush=True)
         supervisor, viewer = _start(world, run_dir, opts, stops, (cond_flags, svc_flags))
+        embedded = not opts.connect
+        announce(world, scenario_file=opts.scenario, endpoint=svc_flags[1], embedded=embedded)
         code = _watch(scenario, run_dir, supervisor, quiet=opts.quiet)
     _close_viewer(viewer)
     return code
-
-
-def _tell_external(world: World, opts: RunOptions, endpoint: str) -> None:
-    """The clock starts only once the participants started outside the run have joined:
-    say so, or the console shows a progress bar standing at zero until the start timeout."""
-    for note in scenario_notes(world.scenario):
-        print(note, flush=True)
-    launched = {p.participant for p in programs.programs(world.scenario, opts.scenario)}
-    outside = [p for p in world.participants if p not in {*world.services, *launched}]
-    if outside:
-        print(
-            f"waiting for {', '.join(outside)} to join (started by you, connecting to "
-            f"{endpoint}); the run gives up after {world.scenario.clock.start_timeout_s:g} s",
-            flush=True,
-        )
-    for vessel in world.scenario.vessels:  # the flags of the README's stack (add_stack_args)
-        c = vessel.controller
-        if c is not None and c.participant in outside:
-            print(f"  {c.participant}: e.g. python my_stack.py --connect {endpoint} "
-                  f"--participant {c.participant} --vessel {vessel.id}", flush=True)  # fmt: skip
 
 
 def _start(

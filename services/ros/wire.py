@@ -124,6 +124,7 @@ class Outlet:
     def __init__(self, wire: Wire, topic: str, typename: str, qos: Qos = DATA) -> None:
         self.topic, self.type, self.wire = topic, typename, wire
         self.sends: list[Callable[[bytes], None]] = []
+        self.routes: list[_Route] = []  # a route's listener may fire before the list is made
         self.routes = [
             _Route(wire, c, topic, typename, qos, self._refresh) for c in wire.conventions
         ]

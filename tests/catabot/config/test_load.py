@@ -12,7 +12,14 @@ import jsonschema
 import pytest
 
 from catabot.config.base import ScenarioError
-from catabot.config.load import BUNDLED, TERRAINS, json_schema, load_scenario, parse_scenario
+from catabot.config.load import (
+    BUNDLED,
+    TERRAINS,
+    json_schema,
+    load_scenario,
+    parse_scenario,
+    scenario_json,
+)
 from catabot.config.notes import scenario_notes
 from tests.paths import BAY
 
@@ -137,3 +144,11 @@ def test_json_schema_checks_each_sensor_types_params_and_allows_a_schema_hook() 
     data["$schema"] = "../scenario.schema.json"
     assert validator.is_valid(data)
     assert parse_scenario(data).vessels[0].sensors[0].params["channels"] == 16
+
+
+def test_a_scenario_read_once_is_written_as_resolved_as_one_read_twice() -> None:
+    """A sensor without `params` had {} in a split run's scenario.json (each service reads
+    the file once) and every default in `catabot run`'s (which parses its own dump again)."""
+    once = parse_scenario(_base())
+    assert once.vessels[0].sensors[0].params["gyro_sigma"] == 0.009
+    assert scenario_json(once) == scenario_json(parse_scenario(once.model_dump()))

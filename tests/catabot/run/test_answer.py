@@ -25,3 +25,11 @@ def test_an_extra_argument_is_named_with_its_subcommand(
     assert stop.value.code == 2
     err = capsys.readouterr().err
     assert err == f"{prog}: unrecognized arguments: --bogus (--help for usage)\n"
+
+
+def test_a_router_takes_no_mode(capsys: pytest.CaptureFixture[str]) -> None:
+    """It is a router: `--mode peer` was taken and ignored, and its help said peer."""
+    with pytest.raises(SystemExit):
+        main(["router", "--mode", "peer"])
+    err = capsys.readouterr().err
+    assert err == "catabot router: unrecognized arguments: --mode peer (--help for usage)\n"

@@ -104,7 +104,10 @@ def test_a_ros_scenario_gets_the_gateway_and_the_bridge_profile(tmp_path: Path) 
     assert svcs["conductor"]["depends_on"]["ros"] == {"condition": "service_started"}
     bridge = svcs["zenoh-bridge-ros2dds"]
     assert bridge["profiles"] == ["ros2dds"] and bridge["network_mode"] == "host"
-    assert bridge["environment"] == {"ROS_DOMAIN_ID": "${ROS_DOMAIN_ID:-7}"}
+    assert bridge["environment"] == {  # the bridge takes an unset distro for iron
+        "ROS_DOMAIN_ID": "${ROS_DOMAIN_ID:-7}",
+        "ROS_DISTRO": "${ROS_DISTRO:-jazzy}",
+    }
     assert bridge["image"].startswith("eclipse/zenoh-bridge-ros2dds:1.")
     assert "-n" not in bridge["command"]
 

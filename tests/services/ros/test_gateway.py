@@ -73,6 +73,24 @@ def test_wants_only_what_someone_subscribes_to(sessions: Any) -> None:
         gateway.close()
 
 
+def test_a_subscriber_there_before_the_gateway_is_served_without_an_error(
+    sessions: Any, caplog: pytest.LogCaptureFixture
+) -> None:
+    """A route's matching listener fired while its topic's routes were still being made:
+    a trial's ROS side, subscribed first, got seven AttributeError tracebacks in ros.log."""
+    ours, ros = sessions
+    sub = ros.declare_subscriber("**", lambda s: None)
+    world = World.resolve(parse_scenario(scenario(mode="both")))
+    with caplog.at_level(logging.ERROR):
+        gateway = Gateway(world, world.scenario.ros, ours, rejections=_refused())  # type: ignore[arg-type]
+        try:
+            assert _until(lambda: world.keys.world_states() in gateway.wanted())
+        finally:
+            gateway.close()
+            sub.undeclare()
+    assert not [r for r in caplog.records if r.levelno >= logging.ERROR]
+
+
 def test_free_commands_go_to_the_bus_and_bad_ones_are_refused(
     sessions: Any, caplog: pytest.LogCaptureFixture
 ) -> None:
