@@ -25,6 +25,7 @@ import rerun as rr
 import zenoh
 
 from catabot.bus import codec
+from catabot.bus.clock import CONDUCTOR
 from catabot.bus.messages import BodyStates, End, Message, ThrustCmd, TwistCmd
 from catabot.bus.session import linked
 from catabot.config.sensors import SENSOR_TYPES
@@ -55,6 +56,11 @@ class LiveView:
             for s in world.sensors
             if s.config.type in HELD
         ]
+        self._conductors: set[str] = set()  # its liveliness tokens: held while the run is on
+        self._conductor_left: float | None = None  # when the last one went (monotonic s)
+        self.clock = session.liveliness().declare_subscriber(
+            keys.live(CONDUCTOR, "*"), self._on_conductor, history=True
+        )
         self._rate: deque[tuple[float, int]] = deque(maxlen=64)  # (wall s, stamp ns)
         self._stamp_ns = 0
         self.shown: Counter[str] = Counter()  # what was drawn: states, each sensor's samples
@@ -90,12 +96,26 @@ class LiveView:
         _final_metrics(logger, run_dir, self._stamp_ns)
         return end
 
+    def _on_conductor(self, sample: zenoh.Sample) -> None:
+        """The conductor's token: a run killed outright sends no End, and through a router
+        the view's link stays up, so the token's going is how such a view learns the run is
+        gone. Gone when every token seen has gone (a stranger's token cannot end the view)."""
+        key = str(sample.key_expr)
+        if sample.kind == zenoh.SampleKind.PUT:
+            self._conductors.add(key)
+            self._conductor_left = None
+        elif key in self._conductors:
+            self._conductors.discard(key)
+            self._conductor_left = None if self._conductors else time.monotonic()
+
     def _gone(self, run_dir: Path | None) -> bool:
-        """Whether the link has been down LOST_S once the run folder says the run is over,
-        LINK_S else (a slow first link, a flap mid-run): a view that attached as the run
-        ended, its End already sent, or whose link was cut, waited for the End forever.
-        Through a standalone router the link stays: such a view waits for an End."""
-        now = time.monotonic()
+        """Whether the run is gone without an End: its conductor left LOST_S ago (its End had
+        time to come), or the link has been down LOST_S once the run folder says the run is
+        over, LINK_S else (a slow first link, a flap mid-run): a view that attached as the run
+        ended, its End already sent, or whose link was cut, waited for the End forever."""
+        now, left = time.monotonic(), self._conductor_left
+        if left is not None and now - left > LOST_S:
+            return True
         if linked(self.session):
             self._linked_at, self.ever_linked = now, True
             return False

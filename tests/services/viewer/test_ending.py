@@ -6,10 +6,15 @@ from __future__ import annotations
 import argparse
 import json
 import time
+from collections.abc import Callable
 from pathlib import Path
 from types import SimpleNamespace
 
+from catabot.bus.clock import CONDUCTOR
 from catabot.bus.messages import End
+from catabot.bus.session import Connection, free_port, open_session
+from catabot.config.load import parse_scenario
+from catabot.world.world import World
 from services.viewer.cli import _ending
 from services.viewer.live import LINK_S, LOST_S, LiveView
 
@@ -52,9 +57,43 @@ def test_a_lost_link_ends_the_view_at_once_only_when_the_run_folder_says_it_is_o
     nobody = SimpleNamespace(info=SimpleNamespace(peers_zid=list, routers_zid=list))
     view = object.__new__(LiveView)
     view.session, view.ever_linked = nobody, False  # type: ignore[assignment]
+    view._conductor_left = None
     view._linked_at = time.monotonic() - LOST_S - 1.0
     assert not view._gone(_folder(tmp_path / "going", ended=False))
     assert not view._gone(None)
     assert view._gone(_folder(tmp_path / "done", ended=True))
     view._linked_at = time.monotonic() - LINK_S - 1.0
     assert view._gone(None)
+
+
+def _until(check: Callable[[], bool], limit_s: float) -> bool:
+    end = time.monotonic() + limit_s
+    while not check() and time.monotonic() < end:
+        time.sleep(0.05)
+    return check()
+
+
+def test_a_view_through_a_router_sees_its_run_go_when_its_conductor_leaves() -> None:
+    """Through a standalone router the view's link stays up after a run killed outright
+    (no End): it waited for an End forever. A stranger's token coming and going is not it."""
+    endpoint = f"tcp/127.0.0.1:{free_port()}"
+    router = open_session(Connection(listen=(endpoint,), mode="router"))
+    world = World.resolve(parse_scenario({"name": "routed", "vessels": [{"id": "ego"}]}))
+    sessions = [open_session(Connection(connect=(endpoint,), mode="client")) for _ in range(3)]
+    viewer, conductor, stranger = sessions
+    try:
+        view = LiveView(viewer, world)
+        token = conductor.liveliness().declare_token(world.keys.live(CONDUCTOR, "a1"))
+        assert _until(lambda: bool(view._conductors), 5.0)
+        fake = stranger.liveliness().declare_token(world.keys.live(CONDUCTOR, "b2"))
+        assert _until(lambda: len(view._conductors) == 2, 5.0)
+        fake.undeclare()
+        assert _until(lambda: len(view._conductors) == 1, 5.0)
+        time.sleep(LOST_S + 0.5)
+        assert not view._gone(None)
+        token.undeclare()
+        assert _until(lambda: view._gone(None), LOST_S + 5.0)
+        assert view.ever_linked  # the link itself never dropped
+    finally:
+        for session in (*sessions, router):
+            session.close()
