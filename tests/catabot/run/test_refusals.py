@@ -1,17 +1,13 @@
 """What `catabot` refuses before anything starts, with one line naming why (exit 2): a
 script that does not fit its vessel's thrusters or gives one time two steps, a controller's
 missing program (validate says what run would), an output file in a folder that is not
-there, an endpoint nobody listens on or that cannot be listened on. And the line a run
-prints while it waits for a stack the user starts."""
+there, an endpoint nobody listens on or that cannot be listened on."""
 
 from __future__ import annotations
 
 import json
 import math
-import re
 import socket
-import subprocess
-import sys
 from pathlib import Path
 from typing import Any
 
@@ -127,26 +123,6 @@ def test_a_listen_port_in_use_is_refused_before_any_start(
         assert main(["run", "--duration", "1", "--listen", endpoint, "--out", str(tmp_path)]) == 2
     assert f"cannot listen on {endpoint}: Address already in use" in capsys.readouterr().err
     assert not any(tmp_path.iterdir())
-
-
-def test_a_run_says_it_waits_for_a_stack_started_outside_it(tmp_path: Path) -> None:
-    data = {
-        "name": "waits", "duration_s": 1.0, "clock": {"start_timeout_s": 4.0},
-        "vessels": [{"id": "ego", "controller": {"participant": "stack", "rate_hz": 10.0}}],
-    }  # fmt: skip
-    path = tmp_path / "waits.json"
-    path.write_text(json.dumps(data))
-    argv = ["run", str(path), "--quiet", "--out", str(tmp_path / "runs")]
-    done = subprocess.run(
-        [sys.executable, "-m", "catabot", *argv], capture_output=True, text=True, timeout=120
-    )
-    assert "waiting for stack to join (started by you, connecting to tcp/" in done.stdout
-    assert "the run gives up after 4 s" in done.stdout
-    assert re.search(r"stack: e\.g\. python my_stack\.py --connect tcp/[\d.:]+ --participant "
-                     r"stack --vessel ego\n", done.stdout), done.stdout  # fmt: skip
-    assert done.returncode == 1  # under load a service may be late as well: named with it
-    assert re.search(r"never joined within 4 s: (\w+, )*stack\n", done.stderr), done.stderr
-    assert "0 ticks" in done.stdout and "ego:" not in done.stdout  # no metrics of 0 ticks
 
 
 def test_validate_checks_a_sweeps_changes_before_any_run(
