@@ -173,7 +173,28 @@ _TYPES = {
 def explain(exc: ValidationError, *, model: type[BaseModel], where: str = "") -> str:
     """One line per problem, joined by '; ': `path.to.field: rule (got value)`."""
     lines = [describe(err, model=model, where=where) for err in _short_tuples(exc.errors())]
-    return "; ".join(dict.fromkeys(lines))
+    return "; ".join(dict.fromkeys(_allowed_once(lines)))
+
+
+UNKNOWN = ": unknown field (allowed: "
+
+
+def _allowed_once(lines: list[str]) -> list[str]:
+    """Unknown fields of one place said together, its allowed names once: a file with 20
+    misnamed keys repeated the list 20 times (4 kB on one line)."""
+    paths: dict[str, list[str]] = {}
+    for line in lines:
+        path, found, allowed = line.partition(UNKNOWN)
+        if found:
+            paths.setdefault(allowed, []).append(path)
+    out = []
+    for line in lines:
+        path, found, allowed = line.partition(UNKNOWN)
+        if found and path == paths[allowed][0] and len(paths[allowed]) > 1:
+            line = f"{', '.join(paths[allowed])}: unknown fields (allowed: {allowed}"
+        if not found or path == paths[allowed][0]:
+            out.append(line)
+    return out
 
 
 def _short_tuples(errors: list[Any]) -> list[Any]:
@@ -212,13 +233,13 @@ def describe(err: Any, *, model: type[BaseModel], where: str = "") -> str:
         return f"{path}: needs {ctx['wanted']} values, got {ctx['got']}"
     if kind == "extra_forbidden":
         allowed = ctx.get("allowed") or ", ".join(_allowed_fields(model, err["loc"][:-1]))
-        return f"{path}: unknown field (allowed: {allowed})"
+        return f"{path}{UNKNOWN}{allowed})"
     if kind == "literal_error":
         return f"{path}: must be one of {ctx.get('expected')}{shown}"
     if kind in _BOUNDS:
         bound = next(v for k, v in ctx.items() if k in ("gt", "ge", "lt", "le"))
         limit = str(bound) if isinstance(bound, int) else f"{bound:g}"
-        return f"{path}: must be {_BOUNDS[kind]} {limit}{shown}"
+        return f"{path}: must be {_BOUNDS[kind]} {limit}{shown}{_degrees(path, got)}"
     if kind in _TYPES:
         return f"{path}: must be {_TYPES[kind]}{shown}{_nanoseconds(path, got)}"
     if kind in ("too_short", "too_long"):
@@ -235,6 +256,13 @@ def _nanoseconds(path: str, got: Any) -> str:
     if not path.endswith("_ns") or not isinstance(got, float) or not 0 < got < 1e3:
         return ""
     return f"; {path.rsplit('.', 1)[-1]} is in nanoseconds: {got:g} s is {round(got * 1e9)}"
+
+
+def _degrees(path: str, got: Any) -> str:
+    """Degrees given to a bounded `_rad` field (`roll_rad: 30`), said as an Angle's are."""
+    if not path.endswith("_rad") or not isinstance(got, int | float) or isinstance(got, bool):
+        return ""
+    return f" (degrees? {got:g}° is {math.radians(got):.4g} rad)"
 
 
 def _short(value: Any) -> str:

@@ -274,7 +274,7 @@ def parser() -> OneLineParser:
     scen.add_argument("file", nargs="?", help="scenario to validate")
     scen.add_argument("--output", "-o", help="write the schema (or generated scenario) here")
     scen.add_argument("--set", action="append", default=[], metavar="FIELD=VALUE",
-                      help="validate: with these changes, as catabot run --set")  # fmt: skip
+                      help="changes, as catabot run --set (generate: to what it made)")  # fmt: skip
     add_generate_arguments(scen)
     for name, (_, text) in [*TOOLS.items(), *LIVE.items(), *DEPLOY.items()]:
         sub.add_parser(name, help=text, add_help=False)

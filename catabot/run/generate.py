@@ -12,6 +12,7 @@ import sys
 from pathlib import Path
 from typing import Any
 
+from catabot.config import overrides
 from catabot.config.load import absolute_paths, parse_scenario
 from catabot.config.traffic import BEHAVIOURS
 from catabot.errors import CataBotError
@@ -55,7 +56,20 @@ def scenario_data(args: argparse.Namespace) -> dict[str, Any]:
     return absolute_paths(data, Path.cwd())
 
 
+def _with_sets(args: argparse.Namespace, data: dict[str, Any]) -> tuple[dict[str, Any], str]:
+    """`--set`'s changes made to what the flags made (they were taken and dropped), a field
+    that a flag given also sets refused; paths from the current folder, as the flags'."""
+    if not args.set:
+        return data, "from the flags"
+    resolved = parse_scenario(data, source="from the flags").model_dump(mode="json")
+    flagged = {f: f"--{flag}" for flag, f in FLAG_FIELDS.items() if getattr(args, flag) is not None}
+    flags = overrides.apply(data, list(args.set), resolved=resolved, flagged=flagged)
+    return absolute_paths(data, Path.cwd()), f"from the flags with {' '.join(flags)}"
+
+
 DEFAULTS = {"boats": 10, "mix": "circle=1", "seed": 0, "duration": 60.0, "name": "traffic"}
+FLAG_FIELDS = {"name": "name", "seed": "seed", "duration": "duration_s", "boats": "traffic.count",
+               "mix": "traffic.behaviour_mix", "terrain": "terrain.elevation_image"}  # fmt: skip
 ONLY_GENERATE = ("boats", "mix", "terrain", "name")  # `validate` takes --seed and --duration
 
 
@@ -84,11 +98,11 @@ def generate(args: argparse.Namespace) -> int:
 
 def _write(args: argparse.Namespace) -> str | None:
     output = output_file(args.output, flag="--output") if args.output else None
-    data = scenario_data(args)
-    World.resolve(parse_scenario(data, source="from the flags"))  # refuse what cannot run
+    data, source = _with_sets(args, scenario_data(args))
+    World.resolve(parse_scenario(data, source=source))  # refuse what cannot run
     text = json.dumps(data, indent=2) + "\n"
     if output is None:
         sys.stdout.write(text)
         return None
     output.write_text(text)
-    return f"{args.output}: {given(args, 'boats')} boat(s), seed {given(args, 'seed')}"
+    return f"{args.output}: {data['traffic']['count']} boat(s), seed {data['seed']}"  # --set's

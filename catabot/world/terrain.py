@@ -68,9 +68,9 @@ def _where_looked() -> str:
     """Where a name is looked for: a bare name that is not beside the scenario may be a
     bundled image (config/load.py)."""
     names = ", ".join(sorted(p.name for p in TERRAINS.glob("*.png")))
-    return (f" (a relative path is taken from the scenario file's folder, `scenario "
-            f"generate`'s from the current one; a bare name not there from the bundled images: "
-            f"{names})")  # fmt: skip
+    return (f" (a relative path is taken from the scenario file's folder, a `--set`'s and "
+            f"`scenario generate`'s from the current one; a bare name not there from the "
+            f"bundled images: {names})")  # fmt: skip
 
 
 class Terrain:

@@ -126,12 +126,14 @@ def _load_map(config: CurrentMapConfig, base_dir: Path | None) -> Array:
                 f"current map {path}: scale_mps is only for images (.npy holds m/s already)"
             )
         return _checked_grid(_read_npy(path), str(path))
-    if suffix in IMAGE_SUFFIXES:
+    if suffix in IMAGE_SUFFIXES:  # read first: a file that is no image hears that first
+        pixels = _read_pixels(path)
         if config.scale_mps is None:
             raise CurrentMapError(
                 f"current map {path}: an image needs scale_mps (m/s for channel value 255)"
             )
-        return _checked_grid(_read_image(path, config.scale_mps), str(path))
+        uv = (pixels[::-1, :, :2] - 128.0) / 127.0 * config.scale_mps  # row 0: south edge
+        return _checked_grid(np.ascontiguousarray(uv), str(path))
     raise CurrentMapError(
         f"current map {path}: unknown file type {suffix or '(none)'!r} "
         f"(allowed: .npy, {', '.join(IMAGE_SUFFIXES)})"
@@ -139,6 +141,15 @@ def _load_map(config: CurrentMapConfig, base_dir: Path | None) -> Array:
 
 
 def _read_npy(path: Path) -> Array:
+    """Refused before NumPy reads it when it is no .npy file (NumPy's own words advised
+    `allow_pickle=True`, unsafe for a file of unknown origin)."""
+    try:
+        with path.open("rb") as file:
+            magic = file.read(6)
+    except OSError as exc:
+        raise CurrentMapError(f"current map {path}: cannot read: {exc.strerror or exc}") from None
+    if magic != b"\x93NUMPY":
+        raise CurrentMapError(f"current map {path}: not a .npy file (NumPy's np.save format)")
     try:
         data = np.load(path, allow_pickle=False)
     except (OSError, ValueError) as exc:
@@ -148,8 +159,8 @@ def _read_npy(path: Path) -> Array:
     return np.asarray(data, dtype=np.float64)
 
 
-def _read_image(path: Path, scale_mps: float) -> Array:
-    """R -> u, G -> v, (c - 128) / 127 * scale; flipped so that row 0 is the south edge."""
+def _read_pixels(path: Path) -> Array:
+    """The RGB pixels (R -> u, G -> v, (c - 128) / 127 * scale_mps), row 0 at the top."""
     from PIL import Image, UnidentifiedImageError
 
     try:
@@ -160,11 +171,9 @@ def _read_image(path: Path, scale_mps: float) -> Array:
                     f"current map {path}: image mode {mode!r}; need 8-bit RGB or RGBA "
                     "(R: u east, G: v north)"
                 )
-            pixels = np.asarray(image.convert("RGB"), dtype=np.float64)
+            return np.asarray(image.convert("RGB"), dtype=np.float64)
     except (OSError, UnidentifiedImageError) as exc:
         raise CurrentMapError(f"current map {path}: cannot read image: {exc}") from None
-    uv = (pixels[::-1, :, :2] - 128.0) / 127.0 * scale_mps
-    return np.ascontiguousarray(uv)
 
 
 def _checked_grid(grid: Array, what: str) -> Array:

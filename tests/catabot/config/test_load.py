@@ -152,3 +152,20 @@ def test_a_scenario_read_once_is_written_as_resolved_as_one_read_twice() -> None
     once = parse_scenario(_base())
     assert once.vessels[0].sensors[0].params["gyro_sigma"] == 0.009
     assert scenario_json(once) == scenario_json(parse_scenario(once.model_dump()))
+
+
+def test_unknown_fields_of_one_place_are_said_together() -> None:
+    """20 misnamed keys repeated the allowed names 20 times, 4 kB on one line."""
+    data = {**_base(), "foo": 1, "bar": 2}
+    data["vessels"][0].update(colour=1, speed=2)
+    message = _refusal(data)
+    assert "vessels.0.colour, vessels.0.speed: unknown fields (allowed: id, model," in message
+    assert "foo, bar: unknown fields (allowed: name, seed," in message
+    assert message.count("allowed:") == 2
+
+
+def test_degrees_given_to_a_bounded_radians_field_are_named_as_such() -> None:
+    """`yaw_rad: 90` had the hint; `roll_rad: 30` only heard its bound."""
+    data = _base()
+    data["vessels"][0]["pose"] = {"x_m": 0.0, "y_m": 0.0, "roll_rad": 30}
+    assert "roll_rad: must be <= 3.14159 (got 30) (degrees? 30° is 0.5236 rad)" in _refusal(data)

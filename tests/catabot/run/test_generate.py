@@ -34,3 +34,17 @@ def test_the_bundled_bay_comes_with_the_harbours_heights_and_scale(tmp_path: Pat
     terrain, harbour = load_scenario(out).terrain, load_scenario("harbour").terrain
     assert terrain is not None and harbour is not None
     assert terrain.model_dump() == harbour.model_dump()
+
+
+def test_set_changes_what_it_made_and_a_field_a_flag_gives_is_refused(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """`--set` was taken and dropped: the file had no rain and exit was 0."""
+    out = tmp_path / "set.json"
+    argv = ["scenario", "generate", "--set", "rain.rate_mm_h=10", "--set", "traffic.count=3"]
+    assert main([*argv, "-o", str(out)]) == 0
+    assert f"{out}: 3 boat(s), seed 0" in capsys.readouterr().out
+    scenario = load_scenario(out)
+    assert scenario.rain.rate_mm_h == 10.0 and scenario.traffic.count == 3
+    assert main(["scenario", "generate", "--boats", "2", "--set", "traffic.count=3"]) == 2
+    assert "traffic.count is given by --boats too" in capsys.readouterr().err

@@ -211,7 +211,7 @@ def test_current_map_from_npy_and_from_image(tmp_path: Path) -> None:
         ("m.npy", np.zeros((1, 3, 2)), None, "at least 2 x 2"),
         ("m.npy", np.full((2, 2, 2), np.nan), None, "row 0, col 0, comp 0 not finite"),
         ("m.npy", np.zeros((2, 2, 2)), 1.0, "scale_mps is only for images"),
-        ("m.png", None, None, "an image needs scale_mps"),
+        ("m.png", None, 1.0, "cannot read image"),
         ("m.csv", None, None, "unknown file type '.csv'"),
         ("missing.npy", None, None, "cannot read"),
     ],
@@ -231,3 +231,22 @@ def test_grey_image_is_refused(tmp_path: Path) -> None:
     config = CurrentMapConfig(path=str(tmp_path / "g.png"), spacing_m=1.0, scale_mps=1.0)
     with pytest.raises(CurrentMapError, match=r"^water\.current\.map: current map .* mode 'L'"):
         CurrentField.from_config(CurrentConfig(map=config))  # named as the field, as others
+
+
+@pytest.mark.parametrize(
+    ("name", "message"),
+    [("t.png", "cannot read image"), ("t.npy", r"not a \.npy file \(NumPy's np\.save format\)")],
+)
+def test_a_text_file_is_refused_as_not_a_map(tmp_path: Path, name: str, message: str) -> None:
+    """It was told to give scale_mps (.png), or NumPy's advice to allow pickles (.npy)."""
+    (tmp_path / name).write_text("not a map")
+    config = CurrentMapConfig(path=name, spacing_m=1.0)
+    with pytest.raises(CurrentMapError, match=message):
+        CurrentField.from_config(CurrentConfig(map=config), base_dir=tmp_path)
+
+
+def test_an_image_without_its_scale_is_refused(tmp_path: Path) -> None:
+    Image.fromarray(np.zeros((2, 2, 3), dtype=np.uint8), "RGB").save(tmp_path / "m.png")
+    config = CurrentMapConfig(path="m.png", spacing_m=1.0)
+    with pytest.raises(CurrentMapError, match="an image needs scale_mps"):
+        CurrentField.from_config(CurrentConfig(map=config), base_dir=tmp_path)
