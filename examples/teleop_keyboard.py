@@ -14,6 +14,7 @@ from __future__ import annotations
 import contextlib
 import curses
 import math
+import textwrap
 from pathlib import Path
 
 from common import clear_errors, parser
@@ -51,7 +52,7 @@ def press(thrust: tuple[float, ...], key: str) -> tuple[float, ...]:
 
 def screen(state: VesselState | None, thrust: tuple[float, ...], note: str) -> list[str]:
     """The lines shown: speed over ground, heading (compass, from north, clockwise), thrust."""
-    lines = [f"CataBot teleop   {HELP}", ""]
+    lines = ["CataBot teleop", HELP, ""]
     if state is None:
         lines.append("waiting for the vessel's state...")
     else:
@@ -127,7 +128,9 @@ def _keys(win: curses.window, ego: Vessel, camera: str, folder: Path, rate_hz: f
             state = ego.state(timeout_s=0.0 if state is not None else 1.0)
         win.erase()
         height, width = win.getmaxyx()
-        for row, line in enumerate(screen(state, thrust, note)[: height - 1]):
+        lines = [part for line in screen(state, thrust, note)
+                 for part in textwrap.wrap(line, width - 1) or [""]]  # fmt: skip
+        for row, line in enumerate(lines[: height - 1]):  # 80 columns cut "Q quit" off
             win.addnstr(row, 0, line, width - 1)
         win.refresh()
 

@@ -2,10 +2,13 @@
 
 from __future__ import annotations
 
+import os
 import sys
 import time
 from collections.abc import Mapping
 from typing import Any
+
+MIN_BAR = 8  # the narrowest bar kept before the line is cut
 
 
 class ProgressBar:
@@ -15,10 +18,11 @@ class ProgressBar:
         self.last_print = 0.0
         self.shown = False
 
-    def line(self, event: Mapping[str, Any]) -> str:
+    def line(self, event: Mapping[str, Any], *, width: int | None = None) -> str:
+        width = self.width if width is None else width
         frac = min(event["stamp_ns"] / self.total_ns, 1.0)
-        filled = int(frac * self.width)
-        bar = "#" * filled + "-" * (self.width - filled)
+        filled = int(frac * width)
+        bar = "#" * filled + "-" * (width - filled)
         return (
             f"[{bar}] {event['stamp_ns'] / 1e9:8.2f}/{self.total_ns / 1e9:.2f} s sim"
             f" | {event['ticks_per_s']:8.0f} ticks/s | RTF {event['realtime_factor']:7.2f}x"
@@ -29,12 +33,22 @@ class ProgressBar:
             return
         now = time.monotonic()
         if self.tty:
-            sys.stderr.write("\r" + self.line(event))
+            sys.stderr.write("\r" + self.fitted(event, _columns()) + "\033[K")
             sys.stderr.flush()
             self.shown = True
         elif now - self.last_print >= 2.0 or event["stamp_ns"] >= self.total_ns:
             sys.stderr.write(self.line(event) + "\n")
             self.last_print = now
+
+    def fitted(self, event: Mapping[str, Any], columns: int) -> str:
+        """The line within a terminal's width: the bar gives way first, then the line is cut.
+        A line that wrapped (85 characters at 80 columns) left a copy at every update, as `\r`
+        goes back to the start of the last row only."""
+        room = columns - 1  # the last column would wrap on some terminals
+        text = self.line(event)
+        if len(text) > room:
+            text = self.line(event, width=max(self.width - (len(text) - room), MIN_BAR))
+        return text[:room]
 
     def note(self, text: str) -> None:
         """A line for the person at the console while the run goes (a refused command),
@@ -47,6 +61,14 @@ class ProgressBar:
     def close(self) -> None:
         if self.enabled and self.tty and self.shown:
             sys.stderr.write("\n")
+
+
+def _columns() -> int:
+    """The width of the terminal stderr writes to (80 where it cannot be told)."""
+    try:
+        return os.get_terminal_size(sys.stderr.fileno()).columns or 80
+    except (OSError, ValueError):
+        return 80
 
 
 class PlanningProgress:
