@@ -129,7 +129,7 @@ def _keys(win: curses.window, ego: Vessel, camera: str, folder: Path, rate_hz: f
         win.erase()
         height, width = win.getmaxyx()
         lines = [part for line in screen(state, thrust, note)
-                 for part in textwrap.wrap(line, width - 1) or [""]]  # fmt: skip
+                 for part in textwrap.wrap(line, max(width - 1, 1)) or [""]]  # fmt: skip
         for row, line in enumerate(lines[: height - 1]):  # 80 columns cut "Q quit" off
             win.addnstr(row, 0, line, width - 1)
         win.refresh()

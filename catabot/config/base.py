@@ -40,10 +40,13 @@ Seed = Annotated[
 
 def _radians(value: float) -> float:
     if abs(value) > 2.0 * math.pi:
-        raise ValueError(
-            f"angles are radians, within ±2π (degrees? {value:g}° is {math.radians(value):.4g} rad)"
-        )
+        raise ValueError(f"angles are radians, within ±2π{degrees_hint(value)}")
     return value
+
+
+def degrees_hint(value: float) -> str:
+    """A radians value that may be degrees, said one way for every such field."""
+    return f" (degrees? {value:g}° is {math.radians(value):.4g} rad)"
 
 
 Angle = Annotated[float, AfterValidator(_radians)]
@@ -173,7 +176,7 @@ _TYPES = {
 def explain(exc: ValidationError, *, model: type[BaseModel], where: str = "") -> str:
     """One line per problem, joined by '; ': `path.to.field: rule (got value)`."""
     lines = [describe(err, model=model, where=where) for err in _short_tuples(exc.errors())]
-    return "; ".join(dict.fromkeys(_allowed_once(lines)))
+    return "; ".join(_allowed_once(list(dict.fromkeys(lines))))
 
 
 UNKNOWN = ": unknown field (allowed: "
@@ -262,7 +265,7 @@ def _degrees(path: str, got: Any) -> str:
     """Degrees given to a bounded `_rad` field (`roll_rad: 30`), said as an Angle's are."""
     if not path.endswith("_rad") or not isinstance(got, int | float) or isinstance(got, bool):
         return ""
-    return f" (degrees? {got:g}° is {math.radians(got):.4g} rad)"
+    return degrees_hint(got)
 
 
 def _short(value: Any) -> str:

@@ -5,7 +5,7 @@ from __future__ import annotations
 
 import json
 from collections.abc import Sequence
-from typing import Literal, Protocol
+from typing import Literal
 
 from pydantic import Field, field_validator, model_validator
 
@@ -51,31 +51,18 @@ class ControllerConfig(Strict):
         return self
 
 
-class Driven(Protocol):
-    """A scenario vessel, as far as who commands it goes."""
-
-    @property
-    def controller(self) -> ControllerConfig | None: ...
-
-    @property
-    def script(self) -> Sequence[object]: ...
-
-
-def check_programs(vessels: Sequence[Driven], taken: Sequence[str], *, bridge: str) -> None:
+def check_programs(
+    controllers: Sequence[ControllerConfig | None], taken: Sequence[str], *, bridge: str
+) -> None:
     """A controller is not a CataBot process (one named `physics` passed validation, then
     held the run: physics waited for its own commands), but `bridge`, the ROS gateway, may
     drive a vessel for a ROS stack; a participant started from a program is one process,
-    the same program and arguments wherever it is named (it may drive several vessels).
-    A vessel has a script or a controller, not both (both were taken, the script unused)."""
+    the same program and arguments wherever it is named (it may drive several vessels)."""
     seen: dict[str, tuple[str | None, list[str]]] = {}
-    for index, vessel in enumerate(vessels):
-        c = vessel.controller
+    for index, c in enumerate(controllers):
         if c is None:
             continue
         field = f"vessels.{index}.controller"
-        if vessel.script:
-            raise FieldProblem(field, "the vessel has a script too: its controller commands "
-                               "it from the first tick on, so give one or the other")  # fmt: skip
         base = c.participant.partition(".")[0]  # or a shard's
         if base in taken and (c.program is not None or base != bridge):
             raise FieldProblem(

@@ -15,6 +15,7 @@ from typing import Any
 
 from pydantic import ValidationError
 
+from catabot.config import overrides
 from catabot.config.base import ScenarioError, did_you_mean, explain, read_json
 from catabot.config.rates import check_rates
 from catabot.config.scenario import Scenario
@@ -40,6 +41,16 @@ def parse_scenario(data: Any, *, source: str = "<data>") -> Scenario:
     except ScenarioError as exc:  # named like every other scenario error: which file
         raise ScenarioError(f"scenario {source}: {exc}") from None
     return scenario
+
+
+def with_sets(
+    data: dict[str, Any], items: list[str], *, source: str, flagged: dict[str, str]
+) -> list[str]:
+    """`--set`'s changes made to `data` (a scenario's own), each path checked against the
+    scenario it makes now, defaults filled (overrides.py); the flags, as messages name them.
+    `flagged`: fields a flag of their own gives (`--seed`, generate's `--boats`)."""
+    resolved = parse_scenario(data, source=source).model_dump(mode="json")
+    return overrides.apply(data, items, resolved=resolved, flagged=flagged)
 
 
 def load_scenario(path: str | Path | None = None) -> Scenario:

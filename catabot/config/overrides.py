@@ -42,9 +42,10 @@ def apply(
     for item in items:
         path, text = _split(item)
         where = ".".join(path)
-        if where in flagged:
-            raise OverrideError(f"--set {item}: {where} is given by {flagged[where]} too (which "
-                                "one wins was not said): give it once")  # fmt: skip
+        both = [f for f in flagged if f"{where}.".startswith(f"{f}.") or f.startswith(f"{where}.")]
+        if both:  # the field itself, a part of it, or a whole it is part of (`traffic={...}`)
+            raise OverrideError(f"--set {item}: {both[0]} is given by {flagged[both[0]]} too "
+                                "(which one wins was not said): give it once")  # fmt: skip
         _set(data, resolved, path, text, item=item)
         _set(resolved, copy.deepcopy(resolved), path, text, item=item)  # for the next --set
         flags.append(f"--set {item}")

@@ -255,7 +255,7 @@ class Scenario(Strict):
 
     @model_validator(mode="after")
     def _controller_programs(self) -> Scenario:
-        check_programs(self.vessels, SERVICE_NAMES, bridge=GATEWAY)
+        check_programs([v.controller for v in self.vessels], SERVICE_NAMES, bridge=GATEWAY)
         return self
 
     @model_validator(mode="after")

@@ -63,7 +63,7 @@ def twist(payload: bytes) -> TwistCmd:
     except Malformed as exc:
         raise Malformed(f"{exc}{_stamped_hint(payload)}") from None
     surge, yaw_rate = float(msg.linear.x), float(msg.angular.z)
-    if not math.isfinite(surge + yaw_rate):  # "out of range: nan" read oddly
+    if not (math.isfinite(surge) and math.isfinite(yaw_rate)):  # "out of range: nan" read oddly
         raise CommandError(f"twist not finite: linear.x {surge}, angular.z {yaw_rate}")
     if not (abs(surge) <= MAX_SURGE_MPS and abs(yaw_rate) <= MAX_YAW_RATE_RADPS):
         raise CommandError(

@@ -4,6 +4,7 @@ and which participants started outside the run it waits for."""
 from __future__ import annotations
 
 import time
+from subprocess import Popen
 
 from catabot.bus.session import port_open
 from catabot.config.notes import scenario_notes
@@ -13,12 +14,15 @@ from catabot.world.world import World
 LISTEN_WAIT_S = 10.0  # the conductor's endpoint opens ≈1-2 s after start on a busy machine
 
 
-def announce(world: World, *, scenario_file: str | None, endpoint: str, embedded: bool) -> None:
+def announce(
+    world: World, *, scenario_file: str | None, endpoint: str, listener: Popen[str] | None
+) -> None:
     """The `zenoh:` line, then the scenario's notes and who the run waits for. On the
-    embedded mesh the line waits until the conductor's endpoint takes connections: printed
-    at once, it came 1.7 s early, and a script that connected on reading it was refused."""
-    if embedded:
-        _until_listening(endpoint)
+    embedded mesh (`listener`: the conductor, which listens there) the line waits until the
+    endpoint takes connections: printed at once, it came 1.7 s early, and a script that
+    connected on reading it was refused; a conductor that died says nothing to connect to."""
+    if listener is not None and not _listening(endpoint, listener):
+        return  # the supervisor reports why the conductor ended
     name = world.scenario.name
     print(f"zenoh: clients connect to {endpoint} (world {name!r}, keys catabot/{name}/...)",
           flush=True)  # fmt: skip
@@ -27,14 +31,17 @@ def announce(world: World, *, scenario_file: str | None, endpoint: str, embedded
     _waits_for(world, scenario_file, endpoint)
 
 
-def _until_listening(endpoint: str) -> None:
-    """Until the endpoint's port takes a connection, LISTEN_WAIT_S at most (a conductor that
-    failed to start is the supervisor's to report, not a wait's). UDP ones are not probed."""
+def _listening(endpoint: str, listener: Popen[str]) -> bool:
+    """Whether the endpoint's port takes a connection (LISTEN_WAIT_S at most) while its
+    listener lives; UDP ones are not probed."""
     if endpoint.startswith(("udp/", "quic/")):
-        return
+        return listener.poll() is None
     limit = time.monotonic() + LISTEN_WAIT_S
     while port_open(endpoint, timeout_s=0.5) and time.monotonic() < limit:
+        if listener.poll() is not None:
+            return False
         time.sleep(0.05)
+    return listener.poll() is None
 
 
 def _waits_for(world: World, scenario_file: str | None, endpoint: str) -> None:

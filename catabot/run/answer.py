@@ -37,6 +37,7 @@ class OneLineParser(argparse.ArgumentParser):
             self._leaf(parsed).error(f"unrecognized arguments: {' '.join(rest)}")
 
     def _leaf(self, parsed: argparse.Namespace) -> argparse.ArgumentParser:
+        """The deepest subcommand's parser that `parsed` chose (this one without any)."""
         for action in self._actions:
             if isinstance(action, argparse._SubParsersAction):
                 chosen = action.choices.get(str(getattr(parsed, action.dest, "")))

@@ -12,8 +12,7 @@ import sys
 from pathlib import Path
 from typing import Any
 
-from catabot.config import overrides
-from catabot.config.load import absolute_paths, parse_scenario
+from catabot.config.load import absolute_paths, parse_scenario, with_sets
 from catabot.config.traffic import BEHAVIOURS
 from catabot.errors import CataBotError
 from catabot.run.answer import answered, output_file
@@ -61,9 +60,8 @@ def _with_sets(args: argparse.Namespace, data: dict[str, Any]) -> tuple[dict[str
     that a flag given also sets refused; paths from the current folder, as the flags'."""
     if not args.set:
         return data, "from the flags"
-    resolved = parse_scenario(data, source="from the flags").model_dump(mode="json")
     flagged = {f: f"--{flag}" for flag, f in FLAG_FIELDS.items() if getattr(args, flag) is not None}
-    flags = overrides.apply(data, list(args.set), resolved=resolved, flagged=flagged)
+    flags = with_sets(data, list(args.set), source="from the flags", flagged=flagged)
     return absolute_paths(data, Path.cwd()), f"from the flags with {' '.join(flags)}"
 
 
@@ -99,10 +97,11 @@ def generate(args: argparse.Namespace) -> int:
 def _write(args: argparse.Namespace) -> str | None:
     output = output_file(args.output, flag="--output") if args.output else None
     data, source = _with_sets(args, scenario_data(args))
-    World.resolve(parse_scenario(data, source=source))  # refuse what cannot run
+    scenario = parse_scenario(data, source=source)
+    World.resolve(scenario)  # refuse what cannot run
     text = json.dumps(data, indent=2) + "\n"
     if output is None:
         sys.stdout.write(text)
         return None
     output.write_text(text)
-    return f"{args.output}: {data['traffic']['count']} boat(s), seed {data['seed']}"  # --set's
+    return f"{args.output}: {scenario.traffic.count} boat(s), seed {scenario.seed}"  # --set's

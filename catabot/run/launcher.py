@@ -17,9 +17,14 @@ from catabot.bus.clock import CONDUCTOR
 from catabot.bus.identity import Roster, new_zid
 from catabot.bus.scheduling import requested_policy
 from catabot.bus.session import check_listen, check_router, free_port
-from catabot.config import overrides
 from catabot.config.base import ScenarioError
-from catabot.config.load import load_scenario, parse_scenario, scenario_data, scenario_json
+from catabot.config.load import (
+    load_scenario,
+    parse_scenario,
+    scenario_data,
+    scenario_json,
+    with_sets,
+)
 from catabot.config.scenario import Scenario
 from catabot.config.sensors import service_of
 from catabot.errors import CataBotError
@@ -107,8 +112,7 @@ def _with_sets(opts: RunOptions) -> Scenario:
     if not opts.sets:
         return load_scenario(opts.scenario)
     data, file = scenario_data(opts.scenario)
-    resolved = parse_scenario(data, source=str(file)).model_dump(mode="json")
-    flags = overrides.apply(data, list(opts.sets), resolved=resolved, flagged=_flagged(opts))
+    flags = with_sets(data, list(opts.sets), source=str(file), flagged=_flagged(opts))
     return parse_scenario(data, source=f"{opts.scenario or 'default'} with {' '.join(flags)}")
 
 
@@ -212,8 +216,8 @@ def run(opts: RunOptions) -> int:
         cond_flags, svc_flags = _endpoints(opts)
         print(f"run folder: {run_dir}", flush=True)
         supervisor, viewer = _start(world, run_dir, opts, stops, (cond_flags, svc_flags))
-        embedded = not opts.connect
-        announce(world, scenario_file=opts.scenario, endpoint=svc_flags[1], embedded=embedded)
+        listener = None if opts.connect else supervisor.conductor.proc  # it listens there
+        announce(world, scenario_file=opts.scenario, endpoint=svc_flags[1], listener=listener)
         code = _watch(scenario, run_dir, supervisor, quiet=opts.quiet)
     _close_viewer(viewer)
     return code

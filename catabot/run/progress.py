@@ -42,7 +42,7 @@ class ProgressBar:
 
     def fitted(self, event: Mapping[str, Any], columns: int) -> str:
         """The line within a terminal's width: the bar gives way first, then the line is cut.
-        A line that wrapped (85 characters at 80 columns) left a copy at every update, as `\r`
+        A line that wrapped (85-86 characters at 80 columns) left a copy at every update, as `\r`
         goes back to the start of the last row only."""
         room = columns - 1  # the last column would wrap on some terminals
         text = self.line(event)

@@ -19,7 +19,7 @@ from catabot.errors import CataBotError
 from catabot.run.answer import OneLineParser, answered
 from catabot.run.recorded import RecordedRun
 from services.datasets import coco, kitti, preview, segmentation, yolo
-from services.datasets.frames import ExportOptions
+from services.datasets.frames import VAL_FRACTION, ExportOptions
 
 FORMATS: dict[str, Callable[[RecordedRun, Path, ExportOptions], str]] = {
     "yolo": yolo.export,
@@ -37,7 +37,10 @@ def parser() -> OneLineParser:
     exp.add_argument("--format", "-f", required=True, choices=list(FORMATS))
     exp.add_argument("--output", "-o", required=True, help="folder to write (new or empty)")
     exp.add_argument(
-        "--val-fraction", type=float, default=None, help="share of validation (default 0.2)"
+        "--val-fraction",
+        type=float,
+        default=None,
+        help=f"share of validation (default {VAL_FRACTION:g})",
     )
     exp.add_argument(
         "--split-block-s", type=float, default=None,
@@ -50,7 +53,7 @@ def parser() -> OneLineParser:
     look.add_argument("run", help="the run folder (runs/<world>-<time>)")
     look.add_argument("--output", "-o", required=True, help="folder to write (new or empty)")
     _box_options(look)
-    look.set_defaults(format="preview", val_fraction=0.2, split_block_s=None)  # no split
+    look.set_defaults(format="preview", val_fraction=VAL_FRACTION, split_block_s=None)
     return p
 
 
@@ -82,7 +85,7 @@ def _check(args: argparse.Namespace) -> Path:
         flag = "--val-fraction" if args.val_fraction is not None else "--split-block-s"
         raise ExportOptionError(f"{flag}: a kitti export is not split (every sequence is in "
                                 "catabot.yaml's train; move some to valid there)")  # fmt: skip
-    args.val_fraction = 0.2 if args.val_fraction is None else args.val_fraction
+    args.val_fraction = VAL_FRACTION if args.val_fraction is None else args.val_fraction
     if not 0.0 <= args.val_fraction <= 1.0:
         raise ExportOptionError(f"--val-fraction must be in [0, 1] (got {args.val_fraction})")
     if args.split_block_s is not None and not args.split_block_s > 0:

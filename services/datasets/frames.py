@@ -25,6 +25,9 @@ class ExportError(CataBotError, ValueError):
     """A run that cannot give the asked-for dataset (no camera, no LiDAR, no labels)."""
 
 
+VAL_FRACTION = 0.2  # the share of frames for validation when none is asked
+
+
 @dataclass(frozen=True)
 class ExportOptions:
     """How a run becomes a dataset: the train/val split (split.py), the smallest box kept,
@@ -33,7 +36,7 @@ class ExportOptions:
     bow in every frame, a box a detector would learn to find there (Cityscapes' "ego
     vehicle", left out of training the same way)."""
 
-    val_fraction: float = 0.2
+    val_fraction: float = VAL_FRACTION
     block_s: float | None = None
     min_box_px: int = 0
     keep_own: bool = False

@@ -3,7 +3,8 @@ topics the gateway publishes (catabot/ros2/convert.py, one conversion for both),
 has no ROS 2 type as JSON beside it.
 
 Topics of `run.mcap` (namespaces as `ros.namespaces`, default `/<vessel id>`):
-`/tf` (every body, a tick), `/tf_static` (base_link -> every sensor frame, once at t = 0),
+`/tf` (the scenario vessels every tick, the traffic's boats and buoys with them at
+`recording.traffic_rate_hz`), `/tf_static` (base_link -> every sensor frame, once at t = 0),
 `/buoys` (MarkerArray, once), `/<ns>/odom` for every vessel and traffic boat,
 `/<ns>/cmd_vel` and `/<ns>/thrust` (commands and the boats' set-points), and per sensor
 `/<ns>/<sensor>/imu`, `fix`, `points`, `ppi`, `image_raw`, `depth`, `segmentation`,

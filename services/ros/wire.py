@@ -12,6 +12,7 @@ their TRANSIENT_LOCAL subscribers, so a late subscriber still gets the message.
 
 from __future__ import annotations
 
+import threading
 import time
 from collections.abc import Callable
 from typing import Any
@@ -124,16 +125,24 @@ class Outlet:
     def __init__(self, wire: Wire, topic: str, typename: str, qos: Qos = DATA) -> None:
         self.topic, self.type, self.wire = topic, typename, wire
         self.sends: list[Callable[[bytes], None]] = []
-        self.routes: list[_Route] = []  # a route's listener may fire before the list is made
+        self._lock, self._ready = threading.Lock(), False  # listeners fire from Zenoh's threads
         self.routes = [
             _Route(wire, c, topic, typename, qos, self._refresh) for c in wire.conventions
         ]
+        with self._lock:
+            self._ready = True
         self._refresh()
 
     def _refresh(self) -> None:
-        sends = [(r.put if r.gid else r.publisher.put) for r in self.routes if r.matching]
-        self.sends = sends  # one assignment: the gateway's thread sees the old or the new list
-        self.wire.version += 1
+        """One refresh at a time, none before every route is made: a listener that fired
+        while they were made (a ROS subscriber there first) read no routes, AttributeError
+        in ros.log, or could have written its empty list over the finished one."""
+        with self._lock:
+            if not self._ready:
+                return
+            sends = [(r.put if r.gid else r.publisher.put) for r in self.routes if r.matching]
+            self.sends = sends  # one assignment: the gateway's thread sees old or new
+            self.wire.version += 1
 
     @property
     def watched(self) -> bool:

@@ -26,6 +26,8 @@ import zenoh
 
 from catabot.bus import codec
 from catabot.bus.clock import CONDUCTOR
+from catabot.bus.identity import Roster
+from catabot.bus.members import Members
 from catabot.bus.messages import BodyStates, End, Message, ThrustCmd, TwistCmd
 from catabot.bus.session import linked
 from catabot.config.sensors import SENSOR_TYPES
@@ -56,8 +58,8 @@ class LiveView:
             for s in world.sensors
             if s.config.type in HELD
         ]
-        self._conductors: set[str] = set()  # its liveliness tokens: held while the run is on
-        self._conductor_left: float | None = None  # when the last one went (monotonic s)
+        self._members = Members(keys, Roster())  # the first conductor's token binds its name
+        self._conductor_left: float | None = None  # when it went (monotonic s)
         self.clock = session.liveliness().declare_subscriber(
             keys.live(CONDUCTOR, "*"), self._on_conductor, history=True
         )
@@ -99,14 +101,13 @@ class LiveView:
     def _on_conductor(self, sample: zenoh.Sample) -> None:
         """The conductor's token: a run killed outright sends no End, and through a router
         the view's link stays up, so the token's going is how such a view learns the run is
-        gone. Gone when every token seen has gone (a stranger's token cannot end the view)."""
-        key = str(sample.key_expr)
-        if sample.kind == zenoh.SampleKind.PUT:
-            self._conductors.add(key)
-            self._conductor_left = None
-        elif key in self._conductors:
-            self._conductors.discard(key)
-            self._conductor_left = None if self._conductors else time.monotonic()
+        gone. Only the first conductor's counts (members.py: another session's token, a
+        second run's or a stranger's, neither holds nor ends the view), and only while the
+        view is linked: its own link's drop takes every token away (LINK_S rides that out)."""
+        alive = sample.kind == zenoh.SampleKind.PUT
+        if self._members.token(str(sample.key_expr), alive=alive) != CONDUCTOR:
+            return
+        self._conductor_left = None if alive or not linked(self.session) else time.monotonic()
 
     def _gone(self, run_dir: Path | None) -> bool:
         """Whether the run is gone without an End: its conductor left LOST_S ago (its End had
@@ -114,11 +115,12 @@ class LiveView:
         over, LINK_S else (a slow first link, a flap mid-run): a view that attached as the run
         ended, its End already sent, or whose link was cut, waited for the End forever."""
         now, left = time.monotonic(), self._conductor_left
-        if left is not None and now - left > LOST_S:
-            return True
         if linked(self.session):
+            if left is not None and now - left > LOST_S:
+                return True
             self._linked_at, self.ever_linked = now, True
             return False
+        self._conductor_left = None  # a token lost with the link is no word on the run
         over = run_dir is not None and run_record(run_dir) is not None
         return now - self._linked_at > (LOST_S if over else LINK_S)
 

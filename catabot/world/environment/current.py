@@ -120,12 +120,13 @@ def _load_map(config: CurrentMapConfig, base_dir: Path | None) -> Array:
     if not path.is_absolute() and base_dir is not None:
         path = Path(base_dir) / path
     suffix = path.suffix.lower()
-    if suffix == ".npy":
+    if suffix == ".npy":  # read first: a file that is no .npy hears that first
+        grid = _read_npy(path)
         if config.scale_mps is not None:
             raise CurrentMapError(
                 f"current map {path}: scale_mps is only for images (.npy holds m/s already)"
             )
-        return _checked_grid(_read_npy(path), str(path))
+        return _checked_grid(grid, str(path))
     if suffix in IMAGE_SUFFIXES:  # read first: a file that is no image hears that first
         pixels = _read_pixels(path)
         if config.scale_mps is None:
@@ -160,7 +161,7 @@ def _read_npy(path: Path) -> Array:
 
 
 def _read_pixels(path: Path) -> Array:
-    """The RGB pixels (R -> u, G -> v, (c - 128) / 127 * scale_mps), row 0 at the top."""
+    """The image's RGB pixels as floats, row 0 at the top (the caller scales and flips)."""
     from PIL import Image, UnidentifiedImageError
 
     try:

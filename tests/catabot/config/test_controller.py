@@ -103,12 +103,3 @@ def test_numbers_in_args_are_taken_as_their_text() -> None:
     assert scenario.vessels[0].controller.args == ["--gain", "2", "0.5"]
     with pytest.raises(ScenarioError, match="must be a string"):
         parse_scenario({"vessels": [{"id": "ego", "controller": {**program, "args": [True]}}]})
-
-
-def test_a_vessel_with_a_controller_takes_no_script() -> None:
-    """Both were taken (validate said valid), the script never used."""
-    data = _data({"participant": "stack"})
-    data["vessels"][0]["script"] = [{"t_s": 0.0, "thrust": [0.5, 0.5]}]
-    with pytest.raises(ScenarioError) as info:
-        parse_scenario(data)
-    assert "vessels.0.controller: the vessel has a script too" in str(info.value)

@@ -48,3 +48,8 @@ def test_set_changes_what_it_made_and_a_field_a_flag_gives_is_refused(
     assert scenario.rain.rate_mm_h == 10.0 and scenario.traffic.count == 3
     assert main(["scenario", "generate", "--boats", "2", "--set", "traffic.count=3"]) == 2
     assert "traffic.count is given by --boats too" in capsys.readouterr().err
+    whole = 'traffic={"behaviour_mix": {"circle": 1}}'  # a whole that holds a flag's field
+    assert main(["scenario", "generate", "--boats", "2", "--set", whole]) == 2
+    assert "traffic.count is given by --boats too" in capsys.readouterr().err
+    assert main(["scenario", "generate", "--set", whole, "-o", str(out)]) == 0  # no KeyError
+    assert f"{out}: 0 boat(s)" in capsys.readouterr().out
