@@ -22,6 +22,7 @@ from typing import TypeVar
 
 import zenoh
 
+from catabot.bus import tls
 from catabot.bus.identity import check_zid
 from catabot.errors import CataBotError
 
@@ -32,6 +33,7 @@ FIRST_PORT = 20000  # free_port draws from here to the ephemeral range: above th
 LOOPBACK = "tcp/127.0.0.1:0"
 RETRY = "{period_init_ms: 250, period_max_ms: 1000, period_increase_factor: 2}"  # connect
 ASK_AGAIN_S = 0.2  # between two queries nobody answered (until_answered)
+UNKNOWN_HOST = "its host name is not known here"  # port_open, _why_unreachable
 A = TypeVar("A", bound=Sized)  # a batch of answers: empty when nobody answered
 BLOCK = zenoh.CongestionControl.BLOCK  # lockstep data and clock messages are never dropped
 
@@ -111,9 +113,12 @@ def _from_file(path: str) -> zenoh.Config:
     if not Path(path).is_file():
         raise SessionError(f"zenoh config file {path!r} does not exist")
     try:
-        return zenoh.Config.from_file(path)
+        config = zenoh.Config.from_file(path)
     except Exception as exc:
         raise SessionError(f"zenoh config file {path}: {exc}") from None
+    if missing := tls.missing_file(config):
+        raise SessionError(f"zenoh config file {path}: {missing}")
+    return config
 
 
 _ENDPOINT = re.compile(r"^(tcp|udp|tls|quic|ws)/(\[[0-9a-fA-F:.]+\]|[A-Za-z0-9_.\-]+):(\d{1,5})$")
@@ -197,11 +202,11 @@ def open_session(conn: Connection) -> zenoh.Session:
     try:
         return zenoh.open(config)
     except Exception as exc:
-        said = re.sub(r"\s+at \S+\.rs:\d+\.?$", "", str(exc).strip())  # Zenoh's source line
+        said = re.sub(r"\s+at \S+\.rs:\d+\.?", "", str(exc).strip())  # Zenoh's source line
         if "Unable to connect" in said:  # the endpoints a config file names too
-            said += _why_unreachable(_connect_endpoints(config))
+            said += _why_unreachable(_endpoints(config, "connect"))
         raise SessionError(
-            f"cannot open zenoh ({_described(config)}, listen {list(conn.listen)}, "
+            f"cannot open zenoh ({_described(config)}, listen {[*_endpoints(config, 'listen')]}, "
             f"config {conn.file or os.environ.get('ZENOH_CONFIG')}): {said}"
         ) from None
 
@@ -210,14 +215,15 @@ def _described(config: zenoh.Config) -> str:
     """Where a session connects and in which mode, a config file's own settings included
     (the flags alone said "connect none, mode peer" of a file's client on tls/...)."""
     mode = json.loads(config.get_json("mode"))
-    return f"connect {list(_connect_endpoints(config)) or 'none'}, mode {mode}"
+    return f"connect {list(_endpoints(config, 'connect')) or 'none'}, mode {mode}"
 
 
-def _connect_endpoints(config: zenoh.Config) -> tuple[str, ...]:
-    """The endpoints a session connects to, in CataBot's plain form: a config file may
+def _endpoints(config: zenoh.Config, kind: str) -> tuple[str, ...]:
+    """The endpoints a session connects to or listens on (`kind`), in CataBot's plain form
+    (a router's error said "listen []" of its file's endpoints): a config file may
     give them per mode (`{client: [...], peer: [...]}`) or with `#`/`?` metadata, which a
     probe skips rather than fail on while it explains another failure."""
-    found = json.loads(config.get_json("connect/endpoints"))
+    found = json.loads(config.get_json(f"{kind}/endpoints"))
     if isinstance(found, dict):
         found = [e for v in found.values() if isinstance(v, list) for e in v]
     return tuple(e for e in found if isinstance(e, str) and _ENDPOINT.match(e))
@@ -230,12 +236,15 @@ def _why_unreachable(endpoints: tuple[str, ...]) -> str:
     if taken:
         return (f" ({', '.join(taken)} takes connections but does not answer as Zenoh: "
                 "another program listens there, or it wants tls/)")  # fmt: skip
-    tls = [e for e in endpoints if e.startswith("tls/") and not port_open(e, 1.0)]
-    if tls:  # a secure router is there: its certificate or the login was refused
-        return (f" ({', '.join(tls)} takes connections, but the TLS handshake or the login "
-                "failed: the router's certificate must name the host you connect to, an "
-                "address included (catabot secure init --host), and the login must be one "
-                "of its profile's)")  # fmt: skip
+    secured = [e for e in endpoints if e.startswith("tls/") and not port_open(e, 1.0)]
+    if secured:  # a secure router is there: its certificate or the login was refused
+        return (f" ({', '.join(secured)} takes connections, but the TLS handshake or the "
+                "login failed: the router's certificate must be signed by your ca.pem, be in "
+                "date and name the host you connect to, an address included (catabot secure "
+                "init --host); the login must be one of its profile's)")  # fmt: skip
+    unknown = [e for e in endpoints if port_open(e, 1.0).endswith(UNKNOWN_HOST)]
+    if unknown:
+        return f" ({', '.join(unknown)}: {UNKNOWN_HOST})"
     return " (nothing answers there: start a router first, catabot router --listen ...)"
 
 
@@ -246,6 +255,8 @@ def port_open(endpoint: str, timeout_s: float = 3.0) -> str:
     try:
         with socket.create_connection(dial_address(endpoint), timeout=timeout_s):
             return ""
+    except socket.gaierror:  # not "nothing answers there: start a router"
+        return f"{endpoint}: {UNKNOWN_HOST}"
     except OSError as exc:
         return f"{endpoint}: {exc.strerror or exc}"
 

@@ -21,6 +21,7 @@ from __future__ import annotations
 
 import ipaddress
 import json
+import os
 import secrets
 import shutil
 import subprocess
@@ -74,11 +75,21 @@ def init(
     if len(set(names)) != len(names):
         raise SecureError(f"names must differ from each other and from {', '.join(own)}")
     folder = folder.resolve()  # the config files name the certificates from anywhere
+    if (folder / "users.txt").exists():  # a second init replaced every login and the CA
+        raise SecureError(
+            f"{folder} already holds a profile: a new one would change its CA "
+            "and every login (give another folder, or remove this one first)"
+        )
     folder.mkdir(parents=True, exist_ok=True)
-    _certificates(folder, host)
-    users = {name: secrets.token_urlsafe(18) for name in ["router", *names]}
-    (folder / "users.txt").write_text("".join(f"{u}:{p}\n" for u, p in users.items()))
-    (folder / "users.txt").chmod(0o600)
+    umask = os.umask(0o077)  # secrets are made private, never readable for a moment
+    try:
+        _certificates(folder, host)
+        users = {name: secrets.token_urlsafe(18) for name in ["router", *names]}
+        (folder / "users.txt").write_text("".join(f"{u}:{p}\n" for u, p in users.items()))
+    finally:
+        os.umask(umask)
+    for public in ("ca.pem", "router.pem"):
+        (folder / public).chmod(0o644)
     endpoint = f"tls/{host}:{port}"
     router = _router(folder, endpoint, users, clients, observers, own)
     pki = [folder / f for f in ("ca.pem", "ca.key", "router.pem", "router.key")]
@@ -205,8 +216,9 @@ def _session(folder: Path, endpoint: str, name: str, users: dict[str, str]) -> d
 
 
 def _write(path: Path, config: dict[str, Any]) -> Path:
-    path.write_text(json.dumps(config, indent=2) + "\n")
-    path.chmod(0o600)  # it holds a password
+    """A config file holding a password: private from its creation."""
+    with os.fdopen(os.open(path, os.O_WRONLY | os.O_CREAT | os.O_TRUNC, 0o600), "w") as out:
+        out.write(json.dumps(config, indent=2) + "\n")
     return path
 
 

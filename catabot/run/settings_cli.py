@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import argparse
 import json
+import os
 import queue
 import sys
 import time
@@ -146,8 +147,10 @@ def set_main(argv: list[str]) -> int:
         world = args.world or _settings(session, None, args.timeout)["world"]
         request = json.dumps({"key": args.key, "value": value})
         answers = _ask(session, Keys(world).config("set"), args.timeout, request)
-        if not answers:
-            raise AskError(f"world {world!r} did not answer within {args.timeout:g} s")
+        if not answers:  # a secure profile's router drops an observer's query unanswered
+            login = args.zenoh_config or os.environ.get("ZENOH_CONFIG")
+            hint = " (an observer's login may read settings, not change them)" if login else ""
+            raise AskError(f"world {world!r} did not answer within {args.timeout:g} s{hint}")
         done = answers[0][1]
         print(f"{done['key']} = {json.dumps(done['value'])} from tick {done['tick']} "
               f"(t = {done['t_s']:g} s)")  # fmt: skip

@@ -105,3 +105,20 @@ def test_a_connection_is_described_with_its_config_files_settings(tmp_path: Path
         "connect ['tls/127.0.0.1:7447'], mode client"
     )
     assert Connection().described() == "connect none, mode peer"
+
+
+def test_a_tls_file_the_config_names_that_is_not_there_is_named(tmp_path: Path) -> None:
+    """A missing ca.pem was reported as a failed TLS handshake or login."""
+    tls = {"root_ca_certificate": str(tmp_path / "ca.pem")}
+    config = {"mode": "client", "connect": {"endpoints": ["tls/localhost:7449"]},
+              "transport": {"link": {"tls": tls}}}  # fmt: skip
+    (tmp_path / "c.json5").write_text(json.dumps(config))
+    with pytest.raises(SessionError, match=r"root_ca_certificate .*ca\.pem does not exist"):
+        open_session(Connection(file=str(tmp_path / "c.json5")))
+
+
+def test_a_host_name_not_known_is_said_so() -> None:
+    """It was told to start a router there."""
+    endpoint = "tls/nosuchhost.invalid:7462"
+    assert session.port_open(endpoint, 1.0) == f"{endpoint}: its host name is not known here"
+    assert "host name is not known" in session._why_unreachable((endpoint,))
