@@ -10,8 +10,9 @@ import zenoh
 
 from catabot.bus.keys import Keys
 from catabot.bus.session import connection_from_args, open_session
-from catabot.client import ClientError, add_stack_args
+from catabot.client import End, add_stack_args
 from catabot.client.discover import find_world
+from catabot.errors import CataBotError
 
 
 def parser(description: str | None) -> argparse.ArgumentParser:
@@ -43,11 +44,20 @@ def keys(s: zenoh.Session, args: argparse.Namespace) -> Keys:
 
 @contextmanager
 def clear_errors(program: str) -> Iterator[None]:
-    """A client's error (no simulation, no such vessel or sensor, the run ended...) ends the
-    program with its message, and Ctrl-C with exit 130, not a traceback."""
+    """A client's error (no simulation, no such vessel or sensor, the run ended, a malformed
+    --connect...) ends the program with its message, and Ctrl-C with exit 130, not a
+    traceback."""
     try:
         yield
-    except ClientError as e:
+    except CataBotError as e:
         raise SystemExit(f"{program}: {e}") from None
     except KeyboardInterrupt:
         raise SystemExit(130) from None
+
+
+def report(end: End | None, text: str) -> None:
+    """How the run ended, then `text`; a run that ended in a fault exits 1 with the fault's
+    words, as `catabot run` does (a stack printed "(fault)" and exited 0)."""
+    print(f"{'stopped' if end is None else f'run ended at tick {end.tick} ({end.reason})'}; {text}")
+    if end is not None and end.error:
+        raise SystemExit(f"the run's fault: {end.error}")

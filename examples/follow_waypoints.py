@@ -4,14 +4,14 @@ leg to steer at, and the cross-track error reported as it goes and summed up at 
 
 catabot run examples/follow_waypoints.json    # the scenario starts this stack
 # or by hand, free-running beside any run (a vessel with no controller):
-python examples/follow_waypoints.py --connect tcp/127.0.0.1:7447 --waypoints 0 0 25 0 25 20
+python examples/follow_waypoints.py --connect tcp/127.0.0.1:7447 --waypoints 0 0 20 0 20 15
 """
 
 from __future__ import annotations
 
 import math
 
-from common import clear_errors, parser
+from common import clear_errors, parser, report
 from guidance import Catamaran, LocalFrame, line_of_sight, next_leg, route_of, steer, wrap, yaw_of
 
 from catabot.client import Client, End, Observation, Thrust, Twist
@@ -97,8 +97,7 @@ def main() -> None:
         else:
             end = sim.run_free(follower.step, rate_hz=args.rate, vessel=vessel.id,
                                sensors=["gps", "imu"])  # fmt: skip
-    ended = f"run ended at tick {end.tick} ({end.reason})" if end is not None else "stopped"
-    print(f"{ended}; {follower.summary()}")
+    report(end, follower.summary())
 
 
 if __name__ == "__main__":

@@ -12,7 +12,7 @@ python examples/lockstep_stack.py --connect tcp/127.0.0.1:7447 --goal 40 20
 
 import math
 
-from common import clear_errors, parser
+from common import clear_errors, parser, report
 from guidance import yaw_of
 
 from catabot.client import Client, EndRun, Observation, Thrust
@@ -24,12 +24,11 @@ def decide(x: float, y: float, yaw: float, goal: tuple[float, float]) -> tuple[f
     error = math.remainder(math.atan2(dy, dx) - yaw, math.tau)
     ahead = min(math.hypot(dx, dy) / 10.0, 0.8) * max(math.cos(error), 0.0)
     turn = max(-0.5, min(0.5, 1.2 * error))  # positive: turn left, starboard pushes harder
-    return max(ahead - turn, -1.0), min(ahead + turn, 1.0)
+    return max(-1.0, min(ahead - turn, 1.0)), max(-1.0, min(ahead + turn, 1.0))
 
 
 def main() -> None:
     p = parser(__doc__)
-    p.add_argument("--name", default="stack", help="the participant name the scenario expects")
     p.add_argument("--goal", type=float, nargs=2, default=(40.0, 20.0), metavar=("X", "Y"))
     p.add_argument(
         "--end-within",
@@ -51,9 +50,8 @@ def main() -> None:
         return Thrust(decide(x, y, yaw_of(obs.state.orientation), goal))
 
     with clear_errors("lockstep_stack.py"), Client.from_args(args) as sim:
-        end = sim.run_lockstep(args.name, step, vessel=args.vessel)
-        x, y = seen[0]
-        print(f"run ended at tick {end.tick} ({end.reason}); {args.vessel} at ({x:.2f}, {y:.2f})")
+        end = sim.run_lockstep(args.participant, step, vessel=args.vessel)  # None: its seat
+    report(end, f"{args.vessel} at ({seen[0][0]:.2f}, {seen[0][1]:.2f})")
 
 
 if __name__ == "__main__":

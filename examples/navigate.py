@@ -17,7 +17,7 @@ import math
 import time
 
 import numpy as np
-from common import clear_errors, parser
+from common import clear_errors, parser, report
 from guidance import Catamaran, LocalFrame, goal_of, yaw_of
 from planning import GridSpec, Planner, choose, reflectivity, world_offsets
 from tracking import Obstacles, Tracker
@@ -107,9 +107,11 @@ def main() -> None:
         name = args.participant or control.participant
         end = sim.run_lockstep(name, nav.step, vessel=vessel.id, sensors=["gps", "imu", "lidar"])
     arrived = f"arrived at t={nav.arrived_s:.1f} s" if nav.arrived_s is not None else "not arrived"
-    print(f"run ended at tick {end.tick} ({end.reason}); {vessel.id} at {nav.where()}, {arrived}, "
-          f"nearest obstacle seen {nav.closest_m:.1f} m; "
-          f"{1e3 * nav.busy_s / max(nav.steps, 1):.1f} ms a period")  # fmt: skip
+    report(
+        end,
+        f"{vessel.id} at {nav.where()}, {arrived}, nearest obstacle seen "
+        f"{nav.closest_m:.1f} m; {1e3 * nav.busy_s / max(nav.steps, 1):.1f} ms a period",
+    )
 
 
 if __name__ == "__main__":

@@ -1,5 +1,9 @@
 """Drive a vessel from outside the lockstep: one thrust command per thruster, -1..1.
 
+The last command holds after the program ends, until a release or the scenario's
+`command_timeout_s` hands the vessel back (README, Commanding); physics refuses a command of
+the wrong length on its own console, as it refuses any other sender's.
+
 catabot run --realtime 1 --listen tcp/127.0.0.1:7447 &
 python examples/send_thrust.py --connect tcp/127.0.0.1:7447 --thrust 0.5 0.9
 """
@@ -7,7 +11,7 @@ python examples/send_thrust.py --connect tcp/127.0.0.1:7447 --thrust 0.5 0.9
 import time
 
 import zenoh
-from common import keys, parser, session
+from common import clear_errors, keys, parser, session
 
 from catabot.bus import codec
 from catabot.bus.messages import ThrustCmd
@@ -28,7 +32,9 @@ def main() -> None:
     p.add_argument("--thrust", type=float, nargs="+", required=True)
     p.add_argument("--repeat", type=int, default=10, help="send this many times, 0.1 s apart")
     args = p.parse_args()
-    with session(args) as s:
+    if not all(-1.0 <= v <= 1.0 for v in args.thrust):  # physics refuses it, on its console
+        p.error(f"--thrust {args.thrust}: each value in [-1, 1]")
+    with clear_errors("send_thrust.py"), session(args) as s:
         at = keys(s, args)
         pub = s.declare_publisher(at.cmd_thrust(args.vessel))
         states = s.declare_subscriber(at.vessel_state(args.vessel), zenoh.handlers.RingChannel(1))

@@ -43,15 +43,14 @@ def main() -> None:
                 wait = None if gone_at is None else max(gone_at + GRACE_S - time.monotonic(), 0)
                 sample = got.get(timeout=wait)
             except queue.Empty:
-                print("the conductor left without ending the run")
-                return
+                raise SystemExit("the conductor left without ending the run") from None
             if sample.kind == zenoh.SampleKind.DELETE:
                 gone_at = time.monotonic()
                 continue
             if str(sample.key_expr) == k.end():
                 end = codec.decode(sample.payload.to_bytes(), End)
-                print(f"the run ended at tick {end.tick} ({end.error or end.reason})")
-                return
+                print(f"the run ended at tick {end.tick} ({end.reason})")
+                raise SystemExit(f"the run's fault: {end.error}" if end.error else 0)
             if n % args.every == 0:
                 show(codec.decode(sample.payload.to_bytes(), VesselState))
                 shown += 1
