@@ -313,6 +313,7 @@ def _watch(scenario: Scenario, run_dir: Path, supervisor: Supervisor, *, quiet: 
         stopped=supervisor.stopped,
         lingered=supervisor.lingered,
         after_fault=supervisor.after_fault,
+        progress=supervisor.progress,
     )
 
 

@@ -96,12 +96,18 @@ def summarise(
     stopped: set[str] | frozenset[str] = frozenset(),
     lingered: set[str] | frozenset[str] = frozenset(),
     after_fault: set[str] | frozenset[str] = frozenset(),
+    progress: Mapping[str, object] | None = None,
 ) -> int:
     """`stopped`: services stopped before they joined an interrupted run; `lingered`:
     programs still running after a clean end; `after_fault`: services still running after a
-    fault had ended the run (SIGTERM, exit 143): none of them is a failure of its own."""
+    fault had ended the run (SIGTERM, exit 143): none of them is a failure of its own.
+    `progress`: the conductor's last progress line, what a killed one leaves (its summary
+    said "0 ticks" of 800 run)."""
     ticks = int(result.get("ticks_done", 0))  # type: ignore[call-overload]
     wall = float(result.get("wall_s", 0.0))  # type: ignore[arg-type]
+    if not result and progress:
+        ticks = int(progress["tick"]) + 1  # type: ignore[call-overload]
+        wall = ticks / float(progress["ticks_per_s"])  # type: ignore[arg-type]
     sim_s = ticks * scenario.dt_ns / 1e9
     error = str(result.get("error", "") or "")
     interrupted = result.get("reason") == "interrupted" or conductor_code == 130

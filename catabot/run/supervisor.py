@@ -83,7 +83,7 @@ class Supervisor:
         self.conductor, self.services, self.stops = conductor, services, stops
         self.goes_on = goes_on
         self.result: dict[str, object] = {}
-        self.progress: dict[str, object] = {}
+        self.progress: dict[str, object] = {}  # the conductor's last progress line
         self.stopped: set[str] = set()  # services stopped before they joined an interrupted run
         self.hung: list[str] = []  # processes found hung and killed
         self.lingered: set[str] = set()  # programs stopped, still running after a clean end
@@ -162,7 +162,7 @@ class Supervisor:
                 self.stops.ready.set()
                 self.stops.forward()
             elif kind == "progress":
-                self._ticking = True
+                self._ticking, self.progress = True, event
                 if callable(on_progress):
                     on_progress(event)
             elif kind == "result":

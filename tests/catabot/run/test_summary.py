@@ -79,3 +79,16 @@ def test_the_conductors_refusals_are_counted_in_the_file_its_console_line_names(
     assert json.loads((tmp_path / "log" / "run.json").read_text())["rejected"] == {
         "conductor": written
     }
+
+
+def test_a_killed_conductor_is_told_by_its_last_progress_line(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """No result comes from a conductor killed outright: the summary said "0 ticks" of 800."""
+    (tmp_path / "log").mkdir()
+    progress = {"kind": "progress", "tick": 799, "stamp_ns": 8_000_000_000,
+                "ticks_per_s": 400.0, "realtime_factor": 4.0}  # fmt: skip
+    assert summarise(SCENARIO, tmp_path, {}, -9, {"physics": 143}, progress=progress) == 1
+    assert capsys.readouterr().out.startswith("800 ticks, 8.00 s simulated in 2.00 s")
+    record = json.loads((tmp_path / "log" / "run.json").read_text())
+    assert record["ticks"] == 800 and "the conductor ended without a result" in record["error"]
