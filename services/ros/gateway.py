@@ -34,6 +34,7 @@ from catabot.ros2.convert import Converter
 from catabot.ros2.convert_sensors import Out
 from catabot.ros2.names import CLOCK, TF
 from catabot.ros2.wire import topic_qos
+from catabot.run.advice import advise
 from catabot.world.world import World
 from services.ros.inbound import Command, Inbound
 from services.ros.wire import Outlet, Wire
@@ -88,6 +89,7 @@ class Gateway:
         streams = world.streams
         self._checks = {s.key: s.check for s in (*streams.commands, *streams.waypoints)}
         self.controls = _controls(world)
+        self._silent_ticks = 0  # controller ticks the stack did not answer in time
         self._odom_version = self._wanted_version = -1
         self._odom_watched: list[int] = []
         self._wanted_keys: frozenset[str] = frozenset()
@@ -220,7 +222,12 @@ class Gateway:
     def _route(self, cmd: Command) -> None:
         control = self.controls.get(cmd.vessel)
         if control is not None and cmd.name == control.command:
-            control.fresh = cmd.message  # the newest since the last controller tick
+            if control.fresh is None:  # the first reply to this /clock: a second one won
+                control.fresh = cmd.message  # as it happened to arrive, run to run
+            else:
+                why = ValueError("a second reply to one /clock: the first is taken (a "
+                                 "lockstep stack replies once per /clock)")  # fmt: skip
+                self.inbound.refuse(self.convert.names.topic(cmd.vessel, cmd.name), why)
             return
         key = {
             "cmd_vel": self.keys.cmd_twist,
@@ -254,18 +261,21 @@ class Gateway:
         while not self.clock.watched and time.monotonic() < until:
             time.sleep(0.01)
         if not self.clock.watched:
-            log.warning("nobody subscribes to /clock: the controlled vessels hold their last "
+            advise(log, "nobody subscribes to /clock: the controlled vessels hold their last "
                         "command (at first: rest) until a stack does")  # fmt: skip
 
     def _await(self, vessel: str, control: Control, tick: Tick, until: float) -> None:
         while control.fresh is None:
             left = until - time.monotonic()
             if left <= 0:
-                log.warning(
-                    "no %s for %s at tick %d within %g s: the last one holds (this run is "
-                    "no longer reproducible)", control.command, vessel, tick.tick,
-                    self.ros.reply_timeout_s,
-                )  # fmt: skip
+                said = (f"no {control.command} for {vessel} at tick {tick.tick} within "
+                        f"{self.ros.reply_timeout_s:g} s: the last one holds (this run is no "
+                        "longer reproducible)")  # fmt: skip
+                if self._silent_ticks == 0:  # on the console once; each one in the log
+                    advise(log, f"{said}; every tick without a reply waits as long again")
+                else:
+                    log.warning("%s", said)
+                self._silent_ticks += 1
                 return
             for cmd in self.inbound.wait(left):
                 self._route(cmd)

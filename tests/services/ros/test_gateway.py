@@ -188,6 +188,32 @@ def test_a_lockstep_controller_takes_the_reply_to_its_tick(sessions: Any) -> Non
         gateway.close()
 
 
+def test_a_second_reply_to_one_clock_is_refused_and_the_first_taken(sessions: Any) -> None:
+    """The newest reply was taken: which of two came last varied, and so did the run."""
+    ours, ros = sessions
+    data = scenario(mode="bridge", lockstep=True, reply_timeout_s=0.3)
+    data["vessels"][1]["controller"] = {"participant": "ros", "rate_hz": 10, "command": "thrust"}
+    world = World.resolve(parse_scenario(data))
+    sent: list[tuple[str, Message]] = []
+    refused = _refused()
+    gateway = Gateway(world, world.scenario.ros, ours, lambda k, m: sent.append((k, m)),  # type: ignore[arg-type]
+                      rejections=refused)  # fmt: skip
+    layout = ROSBAGS.types["std_msgs/msg/MultiArrayLayout"](dim=[], data_offset=0)
+    array = ROSBAGS.types["std_msgs/msg/Float64MultiArray"]
+    try:
+        for value in (0.5, 0.25):
+            msg = array(layout=layout, data=np.array([value, value]))
+            ros.put(
+                "other/thrust", bytes(ROSBAGS.serialize_cdr(msg, "std_msgs/msg/Float64MultiArray"))
+            )
+        time.sleep(0.3)  # both here before the tick takes them
+        gateway.commands(Tick("r", 0, 0, 10_000_000))
+        assert sent[-1][1] == ThrustCmd((0.5, 0.5), 0, 0)
+        assert refused.totals == {REFUSED: 1}
+    finally:
+        gateway.close()
+
+
 def _path(points: list[tuple[float, float]]) -> bytes:
     t = ROSBAGS.types
     header = t["std_msgs/msg/Header"](
