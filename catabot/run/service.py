@@ -174,7 +174,8 @@ def own_name(service: str, world: World, shard: tuple[int, int] | None) -> str:
     n = shard_count(world.scenario, service)
     if shard is None and n == 1:
         return service
-    split = f"the scenario splits {service} over {n} processes ({service}.shards)"
+    split = (f"the scenario runs {service} as one process ({service}.shards 1)" if n == 1 else
+             f"the scenario splits {service} over {n} processes ({service}.shards)")  # fmt: skip
     if shard is None:
         raise ShardError(f"{split}: start each with --shard I/{n}")
     if shard[1] != n:
