@@ -63,6 +63,7 @@ class McapWriter:
         self._compression = COMPRESSIONS[compression]
         self._chunk_bytes = chunk_bytes
         self._open = (OpenChunk(), OpenChunk())  # small messages, bulk (>= BULK_BYTES)
+        self._times = [-1, -1]  # the log time each of them took last
         self._chunk_indexes: list[ChunkIndex] = []
         self._crc = 0
         self._schemas: list[Schema] = []
@@ -129,7 +130,7 @@ class McapWriter:
             parts.append(data)
         lengths = np.fromiter(map(len, payloads), np.int64, len(payloads))
         self._note_times(log_time, len(payloads))
-        chunk = self._chunk(int(lengths.max()))
+        chunk = self._chunk(int(lengths.max()), log_time)
         chunk.add(parts, ids, lengths + _MESSAGE_HEAD.size, log_time)
 
     def written(self, channels: NDArray[np.integer]) -> NDArray[np.int64]:
@@ -170,14 +171,19 @@ class McapWriter:
         records[:, : _MESSAGE_HEAD.size] = head.view(np.uint8).reshape(k, -1)
         records[:, _MESSAGE_HEAD.size :] = payloads
         self._note_times(log_time, k)
-        chunk = self._chunk(length)
+        chunk = self._chunk(length, log_time)
         chunk.add(records.tobytes(), channels, np.full(k, records.shape[1], np.int64), log_time)
 
-    def _chunk(self, longest: int) -> OpenChunk:
-        """The open chunk for messages up to `longest` bytes, written out first if full."""
-        chunk = self._open[int(longest >= BULK_BYTES)]
-        if chunk.size >= self._chunk_bytes:
+    def _chunk(self, longest: int, log_time: int) -> OpenChunk:
+        """The open chunk for messages up to `longest` bytes, written out first if full, and
+        only before a message of another log time: the messages of one time stay in one
+        chunk however they come in blocks (the traffic's set-points in one block or in one a
+        shard: `run.mcap`'s bytes differed with `traffic.shards`)."""
+        kind = int(longest >= BULK_BYTES)
+        chunk = self._open[kind]
+        if chunk.size >= self._chunk_bytes and log_time != self._times[kind]:
             self._close(chunk)
+        self._times[kind] = log_time
         return chunk
 
     def _close(self, chunk: OpenChunk) -> None:

@@ -184,3 +184,25 @@ def test_the_tail_is_the_open_chunks_readable_without_a_summary(tmp_path: Path) 
     messages = read_mcap_messages(tmp_path / "killed.mcap")  # no DataEnd, no summary
     assert [m.sequence for m in messages] == [0, 1, 2, 3, 4]
     assert messages[-1].decoded == {"x": 4}
+
+
+def _split_file(blocks: int) -> bytes:
+    """Three ticks of 12 messages each, every tick's messages added in `blocks` blocks, in
+    chunks of 100 bytes (as traffic set-points come in one block, or in one a shard)."""
+    out = io.BytesIO()
+    writer = McapWriter(out, profile="", library="test", compression="none", chunk_bytes=100)
+    schema = writer.register_schema("s", "jsonschema", b"{}")
+    channels = np.array([writer.register_channel(f"/{i}", "json", schema, metadata={})
+                         for i in range(12)])  # fmt: skip
+    payloads = np.zeros((12, 20), np.uint8)
+    for tick in range(3):
+        for part in np.array_split(np.arange(12), blocks):
+            writer.add_block(channels[part], np.full(len(part), tick), tick * 10, payloads[part])
+    writer.finish()
+    return out.getvalue()
+
+
+def test_the_bytes_do_not_depend_on_how_a_ticks_messages_came_in_blocks() -> None:
+    """A chunk closed between two blocks of one tick: `run.mcap` differed with the number
+    of traffic shards."""
+    assert _split_file(1) == _split_file(3) == _split_file(12)
