@@ -157,14 +157,22 @@ def test_an_rmw_command_without_its_attachment_is_taken_and_said_once(
         gateway.close()
 
 
-def test_a_lockstep_controller_takes_the_reply_to_its_tick(sessions: Any) -> None:
-    ours, ros = sessions
+def _lockstep(
+    ours: zenoh.Session, refused: Rejections
+) -> tuple[World, Gateway, list[tuple[str, Message]]]:
+    """A gateway that drives vessel `other` by thrust in the lockstep, and what it sends."""
     data = scenario(mode="bridge", lockstep=True, reply_timeout_s=0.3)
     data["vessels"][1]["controller"] = {"participant": "ros", "rate_hz": 10, "command": "thrust"}
     world = World.resolve(parse_scenario(data))
     sent: list[tuple[str, Message]] = []
     gateway = Gateway(world, world.scenario.ros, ours, lambda k, m: sent.append((k, m)),  # type: ignore[arg-type]
-                      rejections=_refused())  # fmt: skip
+                      rejections=refused)  # fmt: skip
+    return world, gateway, sent
+
+
+def test_a_lockstep_controller_takes_the_reply_to_its_tick(sessions: Any) -> None:
+    ours, ros = sessions
+    world, gateway, sent = _lockstep(ours, _refused())
     try:
         gateway.commands(Tick("r", 0, 0, 10_000_000))  # nobody on /clock: neutral, at once
         assert sent == [(world.keys.cmd_thrust("other"), ThrustCmd((0.0, 0.0), 0, 0))]
@@ -191,13 +199,8 @@ def test_a_lockstep_controller_takes_the_reply_to_its_tick(sessions: Any) -> Non
 def test_a_second_reply_to_one_clock_is_refused_and_the_first_taken(sessions: Any) -> None:
     """The newest reply was taken: which of two came last varied, and so did the run."""
     ours, ros = sessions
-    data = scenario(mode="bridge", lockstep=True, reply_timeout_s=0.3)
-    data["vessels"][1]["controller"] = {"participant": "ros", "rate_hz": 10, "command": "thrust"}
-    world = World.resolve(parse_scenario(data))
-    sent: list[tuple[str, Message]] = []
     refused = _refused()
-    gateway = Gateway(world, world.scenario.ros, ours, lambda k, m: sent.append((k, m)),  # type: ignore[arg-type]
-                      rejections=refused)  # fmt: skip
+    _, gateway, sent = _lockstep(ours, refused)
     layout = ROSBAGS.types["std_msgs/msg/MultiArrayLayout"](dim=[], data_offset=0)
     array = ROSBAGS.types["std_msgs/msg/Float64MultiArray"]
     try:
