@@ -34,6 +34,7 @@ from catabot.bus.keys import Keys
 from catabot.bus.messages import BodyStates, CameraFrame, End, LidarScan, Message, Tick
 from catabot.bus.participant import VANISHED, EndFn, StepFn
 from catabot.bus.rejections import Rejected, Rejections
+from catabot.bus.vanished import ConductorWatch
 
 log = logging.getLogger("ros.observer")
 DEPTH = 100  # samples held per key: a simulated second of states at 10 ms ticks
@@ -69,14 +70,10 @@ class Observer:
         self._warned = dict.fromkeys(self._held, 0.0)
         self._end: bytes | None = None
         self._refused: list[tuple[str, Rejected]] = []  # from Zenoh's threads, counted here
-        self._conductor_gone_at = 0.0
         self._latest = Tick("", -1, 0, 0)
-        self._subs = [
-            session.declare_subscriber(keys.end(), self._on_end),
-            session.liveliness().declare_subscriber(
-                keys.live(CONDUCTOR, self.roster.zid(CONDUCTOR) or "*"), self._on_live
-            ),
-        ]
+        self._conductor = ConductorWatch(session, keys, self.roster, on_left=wake.set)
+        self._subs = [session.declare_subscriber(keys.end(), self._on_end),
+                      self._conductor.subscriber]  # fmt: skip
 
     def _on_data(self, sample: zenoh.Sample) -> None:
         """Queue the sample; wake the gateway for the states (every tick: the pace), or for
@@ -103,11 +100,6 @@ class Observer:
             return
         self._end = sample.payload.to_bytes()
         self.wake.set()
-
-    def _on_live(self, sample: zenoh.Sample) -> None:
-        if sample.kind == zenoh.SampleKind.DELETE:
-            self._conductor_gone_at = time.monotonic()
-            self.wake.set()
 
     def run(self, step: StepFn, on_end: EndFn | None = None) -> End:
         """Hand `step` what arrived, as it arrives, until the run ends."""
@@ -136,8 +128,7 @@ class Observer:
             except codec.CodecError as exc:
                 log.warning("malformed end of run ignored: %s", exc)
                 self._end = None
-        gone = self._conductor_gone_at
-        if gone and time.monotonic() - gone > ORPHAN_GRACE_S:
+        if self._conductor.gone(ORPHAN_GRACE_S):
             raise ClockError(f"ros: {VANISHED}")
         return None
 

@@ -25,11 +25,10 @@ import rerun as rr
 import zenoh
 
 from catabot.bus import codec
-from catabot.bus.clock import CONDUCTOR
 from catabot.bus.identity import Roster
-from catabot.bus.members import Members
 from catabot.bus.messages import BodyStates, End, Message, ThrustCmd, TwistCmd
 from catabot.bus.session import linked
+from catabot.bus.vanished import ConductorWatch
 from catabot.config.sensors import SENSOR_TYPES
 from catabot.run.ending import run_record
 from catabot.world.world import MountedSensor, World
@@ -58,11 +57,7 @@ class LiveView:
             for s in world.sensors
             if s.config.type in HELD
         ]
-        self._members = Members(keys, Roster())  # the first conductor's token binds its name
-        self._conductor_left: float | None = None  # when it went (monotonic s)
-        self.clock = session.liveliness().declare_subscriber(
-            keys.live(CONDUCTOR, "*"), self._on_conductor, history=True
-        )
+        self.conductor = ConductorWatch(session, keys, Roster())  # a killed run: no End
         self._rate: deque[tuple[float, int]] = deque(maxlen=64)  # (wall s, stamp ns)
         self._stamp_ns = 0
         self.shown: Counter[str] = Counter()  # what was drawn: states, each sensor's samples
@@ -98,29 +93,18 @@ class LiveView:
         _final_metrics(logger, run_dir, self._stamp_ns)
         return end
 
-    def _on_conductor(self, sample: zenoh.Sample) -> None:
-        """The conductor's token: a run killed outright sends no End, and through a router
-        the view's link stays up, so the token's going is how such a view learns the run is
-        gone. Only the first conductor's counts (members.py: another session's token, a
-        second run's or a stranger's, neither holds nor ends the view), and only while the
-        view is linked: its own link's drop takes every token away (LINK_S rides that out)."""
-        alive = sample.kind == zenoh.SampleKind.PUT
-        if self._members.token(str(sample.key_expr), alive=alive) != CONDUCTOR:
-            return
-        self._conductor_left = None if alive or not linked(self.session) else time.monotonic()
-
     def _gone(self, run_dir: Path | None) -> bool:
         """Whether the run is gone without an End: its conductor left LOST_S ago (its End had
         time to come), or the link has been down LOST_S once the run folder says the run is
         over, LINK_S else (a slow first link, a flap mid-run): a view that attached as the run
         ended, its End already sent, or whose link was cut, waited for the End forever."""
-        now, left = time.monotonic(), self._conductor_left
+        now = time.monotonic()
         if linked(self.session):
-            if left is not None and now - left > LOST_S:
+            if self.conductor.gone(LOST_S):
                 return True
             self._linked_at, self.ever_linked = now, True
             return False
-        self._conductor_left = None  # a token lost with the link is no word on the run
+        self.conductor.left_at = None  # a token lost with the link is no word on the run
         over = run_dir is not None and run_record(run_dir) is not None
         return now - self._linked_at > (LOST_S if over else LINK_S)
 

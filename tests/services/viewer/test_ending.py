@@ -57,7 +57,7 @@ def test_a_lost_link_ends_the_view_at_once_only_when_the_run_folder_says_it_is_o
     nobody = SimpleNamespace(info=SimpleNamespace(peers_zid=list, routers_zid=list))
     view = object.__new__(LiveView)
     view.session, view.ever_linked = nobody, False  # type: ignore[assignment]
-    view._conductor_left = None
+    view.conductor = SimpleNamespace(gone=lambda _: False, left_at=None)  # type: ignore[assignment]
     view._linked_at = time.monotonic() - LOST_S - 1.0
     assert not view._gone(_folder(tmp_path / "going", ended=False))
     assert not view._gone(None)
@@ -84,12 +84,12 @@ def test_a_view_through_a_router_sees_its_run_go_when_its_conductor_leaves() -> 
     try:
         view = LiveView(viewer, world)
         token = conductor.liveliness().declare_token(world.keys.live(CONDUCTOR, "a1"))
-        assert _until(lambda: view._members.present.get(CONDUCTOR) == "a1", 5.0)
+        assert _until(lambda: view.conductor.members.present.get(CONDUCTOR) == "a1", 5.0)
         fake = stranger.liveliness().declare_token(world.keys.live(CONDUCTOR, "b2"))
         time.sleep(0.5)
         fake.undeclare()
         time.sleep(LOST_S + 0.5)
-        assert not view._gone(None) and view._members.present.get(CONDUCTOR) == "a1"
+        assert not view._gone(None) and view.conductor.members.present.get(CONDUCTOR) == "a1"
         token.undeclare()
         assert _until(lambda: view._gone(None), LOST_S + 5.0)
         assert view.ever_linked  # the link itself never dropped
