@@ -232,18 +232,18 @@ def _endpoints(config: zenoh.Config, kind: str) -> tuple[str, ...]:
 def _why_unreachable(endpoints: tuple[str, ...]) -> str:
     """A port that takes a TCP connection but no Zenoh handshake is another program's (an
     HTTP server, a TLS endpoint given as tcp/): "start a router" sent people the wrong way."""
-    taken = [e for e in endpoints if _tcp(e)[0] is not None and not port_open(e, 1.0)]
+    said = {e: port_open(e, 1.0) for e in endpoints}  # one probe each (up to 1 s)
+    taken = [e for e in endpoints if _tcp(e)[0] is not None and not said[e]]
     if taken:
         return (f" ({', '.join(taken)} takes connections but does not answer as Zenoh: "
                 "another program listens there, or it wants tls/)")  # fmt: skip
-    secured = [e for e in endpoints if e.startswith("tls/") and not port_open(e, 1.0)]
+    secured = [e for e in endpoints if e.startswith("tls/") and not said[e]]
     if secured:  # a secure router is there: its certificate or the login was refused
         return (f" ({', '.join(secured)} takes connections, but the TLS handshake or the "
                 "login failed: the router's certificate must be signed by your ca.pem, be in "
                 "date and name the host you connect to, an address included (catabot secure "
                 "init --host); the login must be one of its profile's)")  # fmt: skip
-    unknown = [e for e in endpoints if port_open(e, 1.0).endswith(UNKNOWN_HOST)]
-    if unknown:
+    if unknown := [e for e in endpoints if said[e].endswith(UNKNOWN_HOST)]:
         return f" ({', '.join(unknown)}: {UNKNOWN_HOST})"
     return " (nothing answers there: start a router first, catabot router --listen ...)"
 

@@ -81,21 +81,22 @@ def init(
             "and every login (give another folder, or remove this one first)"
         )
     folder.mkdir(parents=True, exist_ok=True)
-    umask = os.umask(0o077)  # secrets are made private, never readable for a moment
+    umask = os.umask(0o077)  # every file private from its creation, never readable a moment
     try:
         _certificates(folder, host)
         users = {name: secrets.token_urlsafe(18) for name in ["router", *names]}
         (folder / "users.txt").write_text("".join(f"{u}:{p}\n" for u, p in users.items()))
+        endpoint = f"tls/{host}:{port}"
+        router = _router(folder, endpoint, users, clients, observers, own)
+        pki = [folder / f for f in ("ca.pem", "ca.key", "router.pem", "router.key")]
+        written = [*pki, folder / "users.txt", _write(folder / "router.json5", router)]
+        for name in names:
+            config = _session(folder, endpoint, name, users)
+            written.append(_write(folder / f"{name}.json5", config))
     finally:
         os.umask(umask)
-    for public in ("ca.pem", "router.pem"):
+    for public in ("ca.pem", "router.pem"):  # the certificates every machine reads
         (folder / public).chmod(0o644)
-    endpoint = f"tls/{host}:{port}"
-    router = _router(folder, endpoint, users, clients, observers, own)
-    pki = [folder / f for f in ("ca.pem", "ca.key", "router.pem", "router.key")]
-    written = [*pki, folder / "users.txt", _write(folder / "router.json5", router)]
-    for name in names:
-        written.append(_write(folder / f"{name}.json5", _session(folder, endpoint, name, users)))
     return written
 
 
@@ -130,8 +131,6 @@ def _certificates(folder: Path, host: str) -> None:
             raise SecureError(f"openssl {step[0]}: {done.stderr.strip()[-300:]}")
     for scratch in ("router.ext", "router.csr", "ca.srl"):
         (folder / scratch).unlink(missing_ok=True)
-    for secret in ("ca.key", "router.key"):
-        (folder / secret).chmod(0o600)
 
 
 def _router(
@@ -216,9 +215,7 @@ def _session(folder: Path, endpoint: str, name: str, users: dict[str, str]) -> d
 
 
 def _write(path: Path, config: dict[str, Any]) -> Path:
-    """A config file holding a password: private from its creation."""
-    with os.fdopen(os.open(path, os.O_WRONLY | os.O_CREAT | os.O_TRUNC, 0o600), "w") as out:
-        out.write(json.dumps(config, indent=2) + "\n")
+    path.write_text(json.dumps(config, indent=2) + "\n")  # it holds a password: init's umask
     return path
 
 
