@@ -5,14 +5,19 @@ view that looks like radians: `hfov_deg: 1.5708` is a legal 1.6° camera, but fa
 90° one written in radians (a trial user's scenario); refusing it would refuse the rare
 telephoto lens, and saying nothing leaves a dataset of sky to be found afterwards. And entries
 of the timeline and of scripts after the run's end (late_settings, late_steps): taken, since a
-sweep's `--duration` may cut a file short on purpose, but said.
+sweep's `--duration` may cut a file short on purpose, but said. And a copy of a bundled
+elevation image (`bay.png`, copied to edit it): it silently lost the scale its bundled
+`bay.json` gives (2 m a pixel, not the defaults' 5), a bay 2.5 times wider.
 """
 
 from __future__ import annotations
 
+import json
 import math
+from pathlib import Path
 
 from catabot.config import live
+from catabot.config.load import TERRAINS
 from catabot.config.scenario import Scenario
 
 FIELDS_OF_VIEW = ("hfov_deg", "vertical_fov_deg")
@@ -20,7 +25,7 @@ FIELDS_OF_VIEW = ("hfov_deg", "vertical_fov_deg")
 
 def scenario_notes(scenario: Scenario) -> list[str]:
     """Every note, said by `scenario validate` and before a run alike."""
-    return [*shared_notes(scenario), *angle_notes(scenario)]
+    return [*shared_notes(scenario), *angle_notes(scenario), *terrain_notes(scenario)]
 
 
 def shared_notes(scenario: Scenario) -> list[str]:
@@ -56,6 +61,40 @@ def angle_notes(scenario: Scenario) -> list[str]:
                         f"{math.degrees(value):.4g} degrees: give that"
                     )
     return notes
+
+
+SCALE_FIELDS = ("metres_per_pixel", "min_elevation_m", "max_elevation_m")
+
+
+def terrain_notes(scenario: Scenario) -> list[str]:
+    """A copy of a bundled image (`bay.png`, to edit it) whose scale is not the bundled
+    one's: a bare name the scenario's folder has is that file, and the bundled scale file
+    only comes with the bundled image."""
+    terrain = scenario.terrain
+    original = _bundled_original(Path(terrain.elevation_image)) if terrain else None
+    if terrain is None or original is None:
+        return []
+    own = json.loads(original.with_suffix(".json").read_text())
+    if all(getattr(terrain, k) == own.get(k, getattr(terrain, k)) for k in SCALE_FIELDS):
+        return []
+    now = ", ".join(f"{k} {getattr(terrain, k):g}" for k in SCALE_FIELDS)
+    scale = ", ".join(f"{k} {own[k]:g}" for k in SCALE_FIELDS if k in own)
+    return [f"note: terrain.elevation_image {terrain.elevation_image} is a copy of the bundled "
+            f"{original.name}, whose scale ({scale}) comes in {original.stem}.json beside it; "
+            f"this run's is {now}: give the terrain those fields if the copy is to be the "
+            "same bay"]  # fmt: skip
+
+
+def _bundled_original(image: Path) -> Path | None:
+    """The bundled image with a scale file that `image` is a byte-for-byte copy of."""
+    if not image.is_file():
+        return None
+    size = image.stat().st_size
+    for bundled in sorted(TERRAINS.glob("*.png")):
+        same_size = bundled.stat().st_size == size and bundled.with_suffix(".json").is_file()
+        if same_size and bundled.read_bytes() == image.read_bytes():
+            return bundled
+    return None
 
 
 def late_settings(scenario: Scenario) -> list[str]:

@@ -61,6 +61,36 @@ def test_an_image_beside_the_scenario_comes_before_the_bundled_one(tmp_path: Pat
     assert load_scenario(path).terrain.elevation_image == str(tmp_path / "bay.png")  # type: ignore[union-attr]
 
 
+def _copied_bay(tmp_path: Path, **scale: float) -> list[str]:
+    shutil.copy(BAY, tmp_path / "bay.png")
+    path = tmp_path / "s.json"
+    terrain = {"elevation_image": "bay.png", **scale}
+    path.write_text(json.dumps({"name": "s", "terrain": terrain, "vessels": [{"id": "ego"}]}))
+    return scenario_notes(load_scenario(path))
+
+
+def test_a_copy_of_the_bundled_image_without_its_scale_is_said(tmp_path: Path) -> None:
+    """A copy (to edit it) takes the defaults, a bay 2.5 times wider than the bundled
+    one's: said, with the scale bay.json gives the bundled image."""
+    (note,) = _copied_bay(tmp_path)
+    assert "is a copy of the bundled bay.png" in note
+    assert "metres_per_pixel 2, min_elevation_m -15, max_elevation_m 25" in note
+    assert "this run's is metres_per_pixel 5, min_elevation_m -35, max_elevation_m 60" in note
+
+
+def test_a_copy_given_the_bundled_scale_or_an_edited_copy_is_not_said(tmp_path: Path) -> None:
+    bundled = {"metres_per_pixel": 2.0, "min_elevation_m": -15.0, "max_elevation_m": 25.0}
+    assert _copied_bay(tmp_path, **bundled) == []
+    (tmp_path / "s.json").write_text(
+        json.dumps(
+            {"name": "s", "terrain": {"elevation_image": "bay.png"}, "vessels": [{"id": "e"}]}
+        )
+    )
+    assert len(scenario_notes(load_scenario(tmp_path / "s.json"))) == 1
+    (tmp_path / "bay.png").write_bytes((tmp_path / "bay.png").read_bytes() + b"edited")
+    assert scenario_notes(load_scenario(tmp_path / "s.json")) == []  # its own image now
+
+
 def test_relative_paths_are_written_without_dot_dot(tmp_path: Path) -> None:
     (tmp_path / "maps").mkdir()
     shutil.copy(BAY, tmp_path / "maps" / "coast.png")
