@@ -191,13 +191,15 @@ class ClockLimits:
         grants at most a window past that. No participant can end the run before it."""
         return granted - self.window
 
-    def check_digest(self, tick: Tick) -> None:
+    def check_digest(self, theirs: str, *, waiting: bool = False) -> None:
         """A conductor that runs another scenario than this process (hosts given different
-        files) is fatal here, not a sample to refuse: waiting would only time out."""
-        if self.digest and tick.digest and tick.digest != self.digest:
+        files) is fatal here, not a sample to refuse: waiting would only time out. `theirs`:
+        a Tick's digest, or (`waiting`: no tick yet) its world/info's (start_wait.py)."""
+        if self.digest and theirs and theirs != self.digest:
+            why = " and gives no tick: it waits for the participants of its file" if waiting else ""
             raise WorldMismatch(
-                f"the conductor runs another scenario (digest {tick.digest}, this process's "
-                f"{self.digest}): give every process of the run the same scenario file"
+                f"the conductor runs another scenario (digest {theirs}, this process's "
+                f"{self.digest}){why}: give every process of the run the same scenario file"
             )
 
     def problem(self, tick: Tick, *, next_tick: int, grant: int) -> str:

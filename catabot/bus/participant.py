@@ -27,14 +27,12 @@ from catabot.bus.members import Members, claim
 from catabot.bus.messages import Ack, End, Tick
 from catabot.bus.outputs import Outputs
 from catabot.bus.rejections import Rejected, Rejections
-from catabot.bus.session import alone
 from catabot.bus.settings import from_wire, settings_problem
+from catabot.bus.start_wait import StartWait
 
 log = logging.getLogger("catabot.bus.participant")
 WAITED = "waited at tick"  # the fault line `_waited` logs, which the launcher quotes
 ORPHAN_GRACE_S = 0.5
-NOTE_EVERY_S = 10.0  # before tick 0, how often a participant says it still waits
-NO_CLOCK = "; is its conductor on this router (--connect), or has its run ended?"
 LOST = "conductor lost"  # the reason of the End a participant makes when the clock vanished
 VANISHED = "the conductor vanished without an End reaching it: the conductor stopped, or \
 this process lost its link or was frozen (the conductor's own error says which)"
@@ -80,7 +78,9 @@ class Participant(Outputs):
         self.events: queue.SimpleQueue[Event] = queue.SimpleQueue()
         self.run_id, self._orphaned_at = "", 0.0
         self._warned_tick, self._met = -1, False  # _met: every peer seen present once
-        self._waiting_since, self._notes = time.monotonic(), 0  # "no tick yet" lines logged
+        self._waiting_since = time.monotonic()
+        self._start = StartWait(session, keys, name, roster=self.roster, events=self.events,
+                                digest=limits.digest if limits else "")  # fmt: skip
         self._subs = [
             session.declare_subscriber(keys.tick(), self._push("tick")),
             session.declare_subscriber(keys.end(), self._push("end")),
@@ -139,6 +139,8 @@ class Participant(Outputs):
             self.rejections.add(key, Rejected("no such stream", payload.decode()))
         elif kind in ("tick", "end"):
             return self._take_clock(event)
+        elif kind == "digest" and self.limits is not None:
+            self.limits.check_digest(payload.decode(), waiting=True)
         return None
 
     def _step_ready(self, step: StepFn) -> None:
@@ -181,17 +183,9 @@ class Participant(Outputs):
         run is ending): ack them now, or a missed deadline names whoever waits for data."""
         grant, done = self._grant, self.next_tick - 1
         if grant is None:
-            self._note_no_clock()
+            self._start.idle(self.present)
         elif done > self._acked:
             self._ack_through(grant, done)
-
-    def _note_no_clock(self) -> None:
-        waited = time.monotonic() - self._waiting_since  # said nothing, however long
-        if waited > NOTE_EVERY_S * (self._notes + 1):
-            self._notes += 1
-            log.warning("%s: no tick from the conductor of world %r after %.0f s (present: %s)%s",
-                        self.name, self.keys.world, waited, sorted(self.present),
-                        alone(self.session) or NO_CLOCK)  # fmt: skip
 
     def _tick_of(self, grant: Tick, k: int) -> Tick:
         stamp = grant.stamp_ns - (grant.tick - k) * grant.dt_ns
@@ -264,7 +258,7 @@ class Participant(Outputs):
             raise Rejected("tick of another run", tick.run)
         self.run_id = tick.run  # the conductor's (its session checked): a fault names this run
         if self.limits is not None:
-            self.limits.check_digest(tick)  # raises: another scenario than the conductor's
+            self.limits.check_digest(tick.digest)  # raises: another scenario than the conductor's
         problem = self._tick_problem(tick)
         if problem:
             raise Rejected("tick the clock cannot send", problem)

@@ -4,6 +4,8 @@ what a user gets wrong there is refused at once and named, not left to a deadlin
 - a process given another scenario file than the conductor's (a pose, a rate) stops with
   the reason, which the conductor's error repeats; before, the run completed with a world
   nobody described;
+- one whose file names other participants than the conductor's (no tick would ever come)
+  stops at its first note that no tick came;
 - a second physics, or a second conductor, of a world already running stops; the run that
   was there goes on;
 - the recorder leaves the scenario in its run folder, so `catabot plot` and the other tools
@@ -66,6 +68,30 @@ def test_a_process_given_another_scenario_stops_and_says_why(tmp_path: Path) -> 
         )  # its own words, on the clock's host
     finally:
         for proc in (conductor, physics, recorder):
+            proc.kill()
+            proc.communicate()
+
+
+def test_a_process_whose_file_needs_other_participants_stops_while_waiting(
+    tmp_path: Path,
+) -> None:
+    """The conductor's file needs a sensors service the other host's file does not (or
+    another `traffic.shards`): the conductor waits for it, no tick comes, and physics sat
+    out the whole start timeout saying only that no tick came. At its first note (10 s) it
+    asks the conductor's world/info and stops on the digest."""
+    needs_sensors = json.loads(json.dumps(SCENARIO))
+    needs_sensors["vessels"][0]["sensors"] = [{"name": "imu", "type": "imu", "rate_hz": 10.0}]
+    endpoint = f"tcp/127.0.0.1:{free_port()}"
+    conductor = _conductor(scenario_file(tmp_path, needs_sensors), endpoint)
+    other = scenario_file(tmp_path, SCENARIO, "other.json")
+    physics = _service("physics", other, endpoint, "--run-dir", str(tmp_path / "run"))
+    try:
+        _, err = physics.communicate(timeout=50)  # the conductor would wait 60 s
+        assert physics.returncode == 2, err
+        assert "the conductor runs another scenario (digest " in err
+        assert "and gives no tick: it waits for the participants of its file" in err
+    finally:
+        for proc in (conductor, physics):
             proc.kill()
             proc.communicate()
 

@@ -8,8 +8,7 @@ import time
 
 import pytest
 
-from catabot.bus import codec, conductor
-from catabot.bus import participant as participant_module
+from catabot.bus import codec, conductor, start_wait
 from catabot.bus.clock import Policy, Stream
 from catabot.bus.conductor import SILENT
 from catabot.bus.inbox import Inputs
@@ -303,7 +302,7 @@ def test_a_participant_without_a_conductor_says_what_it_waits_for(
     world: World, monkeypatch: pytest.MonkeyPatch, caplog: pytest.LogCaptureFixture
 ) -> None:
     """A service started alone (or in the wrong world) said nothing, however long."""
-    monkeypatch.setattr(participant_module, "NOTE_EVERY_S", 0.3)
+    monkeypatch.setattr(start_wait, "NOTE_EVERY_S", 0.3)
     lonely = world.member("lonely")
     with caplog.at_level(logging.WARNING, logger="catabot.bus.participant"):
         lonely.thread.start()
