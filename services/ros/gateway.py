@@ -50,7 +50,8 @@ class Control:
     stream: Stream
     command: str  # the ROS command that feeds it: cmd_vel or thrust
     last: Message
-    fresh: Message | None = None
+    fresh: Message | None = None  # the reply to this tick's /clock; None if refused
+    replied: bool = False  # a reply came (refused or not): the wait for it is over
 
 
 class Gateway:
@@ -193,7 +194,7 @@ class Gateway:
             self._route(cmd)
         for control in self.controls.values():
             if takes and tick.tick % (control.stream.period or 1) == 0:
-                control.fresh = None
+                control.fresh, control.replied = None, False
         self.tick_clock(tick.tick, tick.stamp_ns, force=takes)
         self.commands(tick, until=until)
 
@@ -211,10 +212,10 @@ class Gateway:
         for vessel, control in self.controls.items():
             if tick.tick % (control.stream.period or 1):
                 continue
-            if control.fresh is None and self.clock.watched:
+            if not control.replied and self.clock.watched:
                 self._await(vessel, control, tick, until)
             msg = control.fresh or control.last
-            control.last, control.fresh = msg, None
+            control.last, control.fresh, control.replied = msg, None, False
             assert self._publish is not None, "a lockstep gateway publishes its controls"
             clocked = replace(msg, tick=tick.tick, stamp_ns=tick.stamp_ns)  # type: ignore[call-arg]
             self._publish(control.stream.key, clocked)
@@ -222,12 +223,14 @@ class Gateway:
     def _route(self, cmd: Command) -> None:
         control = self.controls.get(cmd.vessel)
         if control is not None and cmd.name == control.command:
-            if control.fresh is None:  # the first reply to this /clock: a second one won
-                control.fresh = cmd.message  # as it happened to arrive, run to run
+            if not control.replied:  # the first reply to this /clock: a second one won
+                control.fresh, control.replied = cmd.message, True  # as it happened to arrive
             else:
                 why = ValueError("a second reply to one /clock: the first is taken (a "
                                  "lockstep stack replies once per /clock)")  # fmt: skip
                 self.inbound.refuse(self.convert.names.topic(cmd.vessel, cmd.name), why)
+            return
+        if cmd.message is None:  # refused, and counted, where it arrived
             return
         key = {
             "cmd_vel": self.keys.cmd_twist,
@@ -265,7 +268,7 @@ class Gateway:
                         "command (at first: rest) until a stack does")  # fmt: skip
 
     def _await(self, vessel: str, control: Control, tick: Tick, until: float) -> None:
-        while control.fresh is None:
+        while not control.replied:
             left = until - time.monotonic()
             if left <= 0:
                 said = (f"no {control.command} for {vessel} at tick {tick.tick} within "

@@ -38,11 +38,12 @@ REFUSED = "ROS command refused"
 
 @dataclass(frozen=True)
 class Command:
-    """A checked command for one vessel: the ROS command name and its bus message."""
+    """A checked command for one vessel: the ROS command name and its bus message, None
+    for one refused (already counted): a lockstep stack's refused reply is still its reply."""
 
     vessel: str
     name: str  # cmd_vel, thrust, waypoints
-    message: Message
+    message: Message | None
 
 
 @dataclass(frozen=True)
@@ -123,7 +124,7 @@ class Inbound:
             )
         except CommandError as exc:
             self.refuse(route.topic, exc)
-            return []
+            return [Command(route.vessel, route.name, None)]
         return [Command(route.vessel, route.name, msg)]
 
     def _check_attachment(self, topic: str, attached: bytes | None) -> None:

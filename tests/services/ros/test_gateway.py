@@ -158,10 +158,10 @@ def test_an_rmw_command_without_its_attachment_is_taken_and_said_once(
 
 
 def _lockstep(
-    ours: zenoh.Session, refused: Rejections
+    ours: zenoh.Session, refused: Rejections, *, reply_timeout_s: float = 0.3
 ) -> tuple[World, Gateway, list[tuple[str, Message]]]:
     """A gateway that drives vessel `other` by thrust in the lockstep, and what it sends."""
-    data = scenario(mode="bridge", lockstep=True, reply_timeout_s=0.3)
+    data = scenario(mode="bridge", lockstep=True, reply_timeout_s=reply_timeout_s)
     data["vessels"][1]["controller"] = {"participant": "ros", "rate_hz": 10, "command": "thrust"}
     world = World.resolve(parse_scenario(data))
     sent: list[tuple[str, Message]] = []
@@ -209,11 +209,32 @@ def test_a_second_reply_to_one_clock_is_refused_and_the_first_taken(sessions: An
             ros.put(
                 "other/thrust", bytes(ROSBAGS.serialize_cdr(msg, "std_msgs/msg/Float64MultiArray"))
             )
-        time.sleep(0.3)  # both here before the tick takes them
+        both = lambda: (gateway.commands(), refused.totals == {REFUSED: 1})[1]  # noqa: E731
+        assert _until(both)  # both here before the tick takes them (0.3 s was not, loaded)
         gateway.commands(Tick("r", 0, 0, 10_000_000))
         assert sent[-1][1] == ThrustCmd((0.5, 0.5), 0, 0)
         assert refused.totals == {REFUSED: 1}
     finally:
+        gateway.close()
+
+
+def test_a_malformed_reply_is_the_reply_the_last_command_holds_at_once(sessions: Any) -> None:
+    """A refused reply left the gateway waiting the whole reply_timeout_s (here 8 s) at
+    every such tick, for a reply that had come; it is now the reply, refused and counted."""
+    ours, ros = sessions
+    refused = _refused()
+    world, gateway, sent = _lockstep(ours, refused, reply_timeout_s=8.0)
+    clock = ros.declare_subscriber("clock", lambda _: None)  # the stack, on sim time
+    try:
+        assert _until(lambda: gateway.clock.watched)
+        ros.put("other/thrust", b"junk")  # the reply to tick 10's /clock, malformed
+        start = time.monotonic()
+        gateway.commands(Tick("r", 10, 100_000_000, 10_000_000))
+        assert time.monotonic() - start < 4.0
+        assert sent[-1] == (world.keys.cmd_thrust("other"), ThrustCmd((0.0, 0.0), 10, 100_000_000))
+        assert refused.totals == {MALFORMED: 1}
+    finally:
+        clock.undeclare()
         gateway.close()
 
 
