@@ -29,6 +29,7 @@ from pydantic.types import FiniteFloat
 
 from catabot.config.base import ConfigError, FieldProblem, Strict, explain, read_json
 from catabot.config.vessel_shape import HullPart, Shape
+from catabot.config.waves import GRAVITY
 
 BUNDLED_DIR = Path(__file__).parents[1] / "data" / "vessels"
 
@@ -190,6 +191,9 @@ class WindArea(Strict):
     length_m: PositiveFloat
 
 
+MAX_THRUST_TO_WEIGHT = 5.0  # racing craft stay under 2 (a jet ski with its rider near 1)
+
+
 class VesselModel(Strict):
     """One vessel model file. Inertia is about the centre of gravity, in body axes."""
 
@@ -215,6 +219,22 @@ class VesselModel(Strict):
                 "principal moments must satisfy the triangle inequality "
                 f"(Ixx + Iyy >= Izz and cyclic), got {list(self.inertia_kgm2)}",
             )
+        return self
+
+    @model_validator(mode="after")
+    def _plausible_thrust(self) -> VesselModel:
+        """Thrust in another unit than the mass (kN, tonnes): 1 GN on a 55 kg boat passed,
+        and its first tick ended the run blaming buoyancy; 10 kN threw it 25 m up."""
+        weight = self.mass_kg * GRAVITY
+        for field in ("max_forward_n", "max_reverse_n"):
+            forces = [getattr(t, field) for t in self.thrusters]
+            if sum(forces) > MAX_THRUST_TO_WEIGHT * weight:
+                raise FieldProblem(
+                    f"thrusters.{int(np.argmax(forces))}.{field}",
+                    f"the thrusters together give {sum(forces):g} N, {sum(forces) / weight:.3g} "
+                    f"times the boat's weight ({weight:.4g} N for mass_kg {self.mass_kg:g}); no "
+                    f"surface vessel has over {MAX_THRUST_TO_WEIGHT:g}: a figure in another unit?",
+                )
         return self
 
     @model_validator(mode="after")

@@ -199,7 +199,7 @@ def _valid_model(file: str) -> str:
     sinks = model.sinks_in(density)
     if sinks:
         raise VesselModelError(f"vessel model {file!r} {sinks}")
-    notes = "".join(f"\nnote: {n}" for n in model_notes(model, source=file))
+    notes = "".join(f"\nnote: {n}" for n in model_notes(model, source=file, density=density))
     return (f"{file}: a valid vessel model {model.name!r} ({model.mass_kg:g} kg, "
             f"{len(model.hulls)} hull(s), {len(model.thrusters)} thruster(s)); "
             f"{displacement(model, density)}{notes}")  # fmt: skip

@@ -15,6 +15,7 @@ import numpy as np
 from catabot.config.vessel import VesselModel
 from catabot.world.course import top_speed_mps, unstable_above_mps
 from catabot.world.shapes import vessel_mesh
+from catabot.world.stability import metacentric_heights
 
 SPREAD = 3.0  # a mesh this many times larger (or smaller) than the hulls is suspect
 THRUSTER_ROOM_M = 0.5  # a thruster this far outside every hull's box is suspect
@@ -31,9 +32,19 @@ def displacement(model: VesselModel, density: float) -> str:
     )
 
 
-def model_notes(model: VesselModel, *, source: str) -> list[str]:
+def model_notes(model: VesselModel, *, source: str, density: float) -> list[str]:
+    """`density`: of the water it is said to float in (kg/m^3)."""
     return [*_mesh(model, source), *_thrusters(model), *_masses(model), *_course(model),
-            *_balance(model)]  # fmt: skip
+            *_balance(model), *_stability(model, density)]  # fmt: skip
+
+
+def _stability(model: VesselModel, density: float) -> list[str]:
+    """A centre of gravity above the metacentre (stability.py): it capsizes at rest."""
+    heights = metacentric_heights(model, density)
+    return [f"its metacentric height in {axis} is {gm:.3g} m (floating upright): its "
+            f"centre of gravity (z {model.cog_m[2]:g} m) is above its metacentre "
+            f"(z {model.cog_m[2] + gm:.3g} m), so it capsizes; lower cog_m or spread the hulls"
+            for axis, gm in zip(("roll", "pitch"), heights, strict=True) if gm < 0]  # fmt: skip
 
 
 def _balance(model: VesselModel) -> list[str]:
