@@ -185,6 +185,15 @@ class ClockLimits:
     ticks: int
     window: int
     digest: str = ""  # the scenario's (config/load.py); "" checks none
+    deadline_s: float = 10.0  # the conductor's per-tick deadline (a waiting participant acks
+    # within a quarter of it: participant.py)
+
+    @property
+    def idle_s(self) -> float:
+        """How long a participant waits for an event before it acks what it has stepped:
+        at 1 s, a participant waiting for a slow stack's command under a 1 s deadline had not
+        acked its stepped ticks yet, and the conductor named it, not the stack."""
+        return min(1.0, self.deadline_s / 4)
 
     def acked_by_all(self, granted: int) -> int:
         """A tick every participant has acked, known from the last grant: the conductor

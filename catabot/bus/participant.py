@@ -195,7 +195,8 @@ class Participant(Outputs):
     def _next(self) -> Event:
         """The next event; an End may trail the conductor's token, so allow it a grace."""
         try:
-            event = self.events.get(timeout=0.1 if self._orphaned_at else 1.0)
+            idle = self.limits.idle_s if self.limits else 1.0
+            event = self.events.get(timeout=0.1 if self._orphaned_at else idle)
         except queue.Empty:
             return ("idle", "", b"", "")
         if event[0] in ("join", "leave"):

@@ -163,7 +163,11 @@ def _parse(d: Mapping[str, Any]) -> WorldInfo:
         dt_ns=int(d["dt_ns"]),
         duration_s=float(d["duration_s"]),
         limits=ClockLimits(
-            int(c["dt_ns"]), int(c["ticks"]), int(c["window"]), str(c.get("digest", ""))
+            int(c["dt_ns"]),
+            int(c["ticks"]),
+            int(c["window"]),
+            str(c.get("digest", "")),
+            float(c.get("deadline_s") or 10.0),
         ),
         participants=tuple(map(str, p["stepping"])),
         external=tuple(map(str, p["external"])),

@@ -10,6 +10,7 @@ every observed sensor (any rate at or above the control rate's period) has a sam
 
 from __future__ import annotations
 
+import dataclasses
 import itertools
 import os
 import threading
@@ -18,6 +19,7 @@ from typing import Any
 
 import gymnasium as gym
 import numpy as np
+from gymnasium.envs.registration import EnvSpec
 from gymnasium.error import ResetNeeded
 
 from catabot.client import Thrust, Twist
@@ -40,6 +42,7 @@ class ActionError(CataBotError, ValueError):
 
 class CataBotEnv(gym.Env[Obs, np.ndarray]):
     metadata: dict[str, Any] = {"render_modes": []}
+    _spec: EnvSpec | None = None
 
     def __init__(self, render_mode: str | None = None, **kwargs: Any) -> None:
         if render_mode is not None:
@@ -66,6 +69,18 @@ class CataBotEnv(gym.Env[Obs, np.ndarray]):
         self._steps = 0
         self._upcoming: int | None = None  # the next seedless episode's seed (prelaunch)
         self._over = True  # no episode to step: reset first
+
+    @property
+    def spec(self) -> EnvSpec | None:
+        return self._spec
+
+    @spec.setter
+    def spec(self, value: EnvSpec | None) -> None:
+        """`gym.make` sets a spec without a horizon (the env truncates itself, no TimeLimit):
+        RL libraries that read `spec.max_episode_steps` found None; it is `max_steps`."""
+        if value is not None and value.max_episode_steps is None:
+            value = dataclasses.replace(value, max_episode_steps=self.options.max_steps)
+        self._spec = value
 
     # -- Gymnasium's API ---------------------------------------------------------------
 

@@ -209,7 +209,7 @@ class World:
     def clock_limits(self) -> ClockLimits:
         """What participants check every Tick against (catabot/bus/clock.py)."""
         s = self.scenario
-        return ClockLimits(s.dt_ns, s.ticks, s.clock.window_ticks, self.digest)
+        return ClockLimits(s.dt_ns, s.ticks, s.clock.window_ticks, self.digest, s.clock.deadline_s)
 
     @property
     def participants(self) -> list[str]:

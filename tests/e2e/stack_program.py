@@ -30,6 +30,7 @@ def main() -> None:
     p.add_argument("--crash-at", type=int, default=-1)
     p.add_argument("--nan-at", type=int, default=-1)
     p.add_argument("--skip-at", type=int, default=-1)
+    p.add_argument("--sleep-at", type=float, nargs=2, default=(-1, 0.0))  # tick, seconds
     p.add_argument("--leave", action="store_true")
     p.add_argument("--linger", action="store_true")
     args = p.parse_args()
@@ -50,6 +51,8 @@ def main() -> None:
             nonlocal latest
             if tick.tick == args.crash_at:
                 raise ZeroDivisionError(f"the stack fell over at tick {tick.tick}")
+            if tick.tick == args.sleep_at[0]:
+                time.sleep(args.sleep_at[1])
             for batch in inputs.get(world.streams.states.key, []):
                 assert isinstance(batch, BodyStates)
                 latest = batch

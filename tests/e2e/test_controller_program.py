@@ -87,6 +87,17 @@ def test_a_program_that_acks_a_tick_without_its_command_is_named(tmp_path: Path)
     assert "waited at tick 101 for catabot/program/vessel/ego/cmd/thrust from 'stack'" in cause
 
 
+def test_a_program_slower_than_a_short_deadline_is_named_not_physics(tmp_path: Path) -> None:
+    """Under a 1 s deadline a stack asleep in tick 100 had physics named: waiting at 101 for
+    its command, physics acked the ticks it had stepped only after a second without events.
+    A waiting participant now acks within a quarter of the deadline."""
+    scenario = _scenario(tmp_path, "--sleep-at", "100", "1.5", clock={"deadline_s": 1.0})
+    code, said, _ = _run(tmp_path, scenario, "slow")
+    assert code == 1, said
+    cause = next(line for line in said.splitlines() if line.startswith("run failed:"))
+    assert cause.startswith("run failed: participant 'stack' missed the 1 s deadline of tick 100")
+
+
 def test_a_program_that_ends_before_joining_fails_the_run_at_once(tmp_path: Path) -> None:
     """It exited 0, and the run waited out the 60 s start timeout for it."""
     code, said, run = _run(tmp_path, _scenario(tmp_path, "--leave"), "leave")

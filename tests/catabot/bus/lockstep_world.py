@@ -17,7 +17,7 @@ from typing import Any
 import zenoh
 
 from catabot.bus import codec
-from catabot.bus.clock import Stream
+from catabot.bus.clock import ClockLimits, Stream
 from catabot.bus.conductor import ClockSpec, Conductor, RunResult
 from catabot.bus.inbox import Inputs
 from catabot.bus.keys import Keys
@@ -53,11 +53,12 @@ class Member:
         step: Step | None,
         inputs: Sequence[Stream],
         peers: Sequence[str],
+        limits: ClockLimits | None = None,
     ) -> None:
         self.world, self.name, self.user_step = world, name, step
         self.session = world.open()
         self.participant = Participant(
-            self.session, world.keys, name, inputs=inputs, peers=peers, drain_s=1.0
+            self.session, world.keys, name, inputs=inputs, peers=peers, drain_s=1.0, limits=limits
         )
         self.ticks: list[int] = []
         self.released: dict[int, Inputs] = {}
@@ -120,8 +121,9 @@ class World:
         *,
         inputs: Sequence[Stream] = (),
         peers: Sequence[str] = (),
+        limits: ClockLimits | None = None,
     ) -> Member:
-        m = self.members[name] = Member(self, name, step, inputs, peers)
+        m = self.members[name] = Member(self, name, step, inputs, peers, limits)
         return m
 
     def run(

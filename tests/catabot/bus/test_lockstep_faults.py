@@ -9,12 +9,12 @@ import time
 import pytest
 
 from catabot.bus import codec, conductor, start_wait
-from catabot.bus.clock import Policy, Stream
+from catabot.bus.clock import ClockLimits, Policy, Stream
 from catabot.bus.conductor import SILENT
 from catabot.bus.inbox import Inputs
 from catabot.bus.messages import Tick, VesselState
 from catabot.bus.participant import Participant, Stopped
-from tests.catabot.bus.lockstep_world import Step, World, _fix, _state
+from tests.catabot.bus.lockstep_world import DT_NS, Step, World, _fix, _state
 
 # -- (c) deadline -------------------------------------------------------------------------
 
@@ -53,11 +53,15 @@ def test_a_step_past_the_deadline_ends_the_run_naming_it(
     world.members["stuck"].join()
 
 
-def test_a_participant_waiting_for_a_late_ones_data_is_not_named(world: World) -> None:
+@pytest.mark.parametrize("deadline_s", [2.5, 1.0])
+def test_a_participant_waiting_for_a_late_ones_data_is_not_named(
+    world: World, deadline_s: float
+) -> None:
     """`cons` needs `slow`'s output of each tick before; `slow` sleeps in tick 13. Acks come
     every half window, so `cons` had stepped 12 and 13 unacknowledged and looked as late as
     `slow`: the deadline named it, the first in the list (as physics for a slow stack). A
-    second without events, it acks what it has stepped."""
+    quarter of the deadline (at most a second) without events, it acks what it has stepped
+    (a second, under a trial's 1 s deadline: physics was named for the stack)."""
     release = threading.Event()
     key = world.keys.vessel_state("ego")
     names = ["cons", "slow"]
@@ -68,13 +72,14 @@ def test_a_participant_waiting_for_a_late_ones_data_is_not_named(world: World) -
             release.wait(6.0)
         holder["p"].publish(key, _state(tick.tick))
 
-    world.member("cons", inputs=[Stream(key, VesselState, "slow", 1)], peers=names)
+    limits = ClockLimits(DT_NS, 100, 8, deadline_s=deadline_s)
+    world.member("cons", inputs=[Stream(key, VesselState, "slow", 1)], peers=names, limits=limits)
     holder["p"] = world.member("slow", slow, peers=names).participant
     try:
-        result = world.run(names, 100, deadline_s=2.5, start_timeout_s=5.0, window_ticks=8)
+        result = world.run(names, 100, deadline_s=deadline_s, start_timeout_s=5.0, window_ticks=8)
     finally:
         release.set()
-    assert result.error == "participant 'slow' missed the 2.5 s deadline of tick 12"
+    assert result.error == f"participant 'slow' missed the {deadline_s:g} s deadline of tick 12"
 
 
 def test_the_late_one_does_not_blame_whom_it_waited_for(
