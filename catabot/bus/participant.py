@@ -34,6 +34,7 @@ log = logging.getLogger("catabot.bus.participant")
 WAITED = "waited at tick"  # the fault line `_waited` logs, which the launcher quotes
 ORPHAN_GRACE_S = 0.5
 LOST = "conductor lost"  # the reason of the End a participant makes when the clock vanished
+DROPPED = "dropped"  # ... when a grant names it dropped
 VANISHED = "the conductor vanished without an End reaching it: the conductor stopped, or \
 this process lost its link or was frozen (the conductor's own error says which)"
 MAX_HELD_CLOCK = 64  # clock messages held while the conductor's session is not known yet
@@ -78,7 +79,7 @@ class Participant(Outputs):
         self.events: queue.SimpleQueue[Event] = queue.SimpleQueue()
         self.run_id, self._orphaned_at = "", 0.0
         self._warned_tick, self._met = -1, False  # _met: every peer seen present once
-        self._waiting_since = time.monotonic()
+        self._waiting_since, self._idle_s = time.monotonic(), limits.idle_s if limits else 1.0
         self._start = StartWait(session, keys, name, roster=self.roster, events=self.events,
                                 digest=limits.digest if limits else "")  # fmt: skip
         self._subs = [
@@ -179,13 +180,12 @@ class Participant(Outputs):
             self.put(self._ack, codec.encode(ack))
 
     def _ack_waiting(self) -> None:
-        """Ticks stepped since the last ack wait for inputs (a second without events, or the
+        """Ticks stepped since the last ack wait for inputs (no events for `idle_s`, or the
         run is ending): ack them now, or a missed deadline names whoever waits for data."""
-        grant, done = self._grant, self.next_tick - 1
-        if grant is None:
+        if self._grant is None:
             self._start.idle(self.present)
-        elif done > self._acked:
-            self._ack_through(grant, done)
+        elif self.next_tick - 1 > self._acked:
+            self._ack_through(self._grant, self.next_tick - 1)
 
     def _tick_of(self, grant: Tick, k: int) -> Tick:
         stamp = grant.stamp_ns - (grant.tick - k) * grant.dt_ns
@@ -195,8 +195,7 @@ class Participant(Outputs):
     def _next(self) -> Event:
         """The next event; an End may trail the conductor's token, so allow it a grace."""
         try:
-            idle = self.limits.idle_s if self.limits else 1.0
-            event = self.events.get(timeout=0.1 if self._orphaned_at else idle)
+            event = self.events.get(timeout=0.1 if self._orphaned_at else self._idle_s)
         except queue.Empty:
             return ("idle", "", b"", "")
         if event[0] in ("join", "leave"):
@@ -246,7 +245,7 @@ class Participant(Outputs):
                 raise Rejected("clock message from a stranger", shown(sender))
             if kind == "tick":
                 self._take_tick(codec.decode(payload, Tick))
-                return None
+                return self._dropped()
             return self._checked_end(codec.decode(payload, End))
         except codec.CodecError as exc:
             self.rejections.add(key, Rejected("malformed", str(exc)))
@@ -272,6 +271,14 @@ class Participant(Outputs):
         was = self._grant  # the same grant again, no one dropped: the run is ending
         self._asked |= was is not None and (was.tick, was.dropped) == (tick.tick, tick.dropped)
         self._grant = tick  # grants only grow (checked); a repeat carries a new dropped list
+
+    def _dropped(self) -> End | None:
+        """Its own End once a grant names it dropped (policy drop): a slow stack had stepped
+        45 s of queued ticks whose commands nobody took, then heard "completed"."""
+        if self._grant is not None and self.name in self._grant.dropped:
+            why = f"{self.name} was dropped (clock.policy drop): the run goes on without it"
+            return End(self.run_id, self.next_tick - 1, DROPPED, why)
+        return None
 
     def _tick_problem(self, tick: Tick) -> str:
         grant = self._grant.tick if self._grant is not None else -1
@@ -309,7 +316,7 @@ class Participant(Outputs):
 
     def _finish(self, end: End, on_end: EndFn | None) -> End:
         """Collect samples due up to the last complete tick, bounded in time."""
-        own = blames(end.error, self.name)  # its own lateness held the others
+        own = blames(end.error, self.name) or end.reason == DROPPED  # its lateness held others
         if end.error and not own:
             self._waited(self.next_tick)
         limit = time.monotonic() + (self.drain_s if not end.error else 1.0)
@@ -329,14 +336,12 @@ class Participant(Outputs):
     def _waited(self, tick: int) -> None:
         """Whose data held this participant at a fault (the launcher quotes it in the cause):
         one waiting for a stack that acked a tick without its command looked hung."""
-        missing = self.inbox.missing(tick)
-        if missing:
+        if missing := self.inbox.missing(tick):
             whose = ", ".join(f"{key} from {self.inbox.streams[key].producer!r}" for key in missing)
             log.error("%s %s %d for %s", self.name, WAITED, tick, whose)
 
     def stop(self) -> None:
-        """Make `run()` raise `Stopped` at its next event (from another thread: a client
-        stack leaving mid-run); the services never call it."""
+        """`run()` raises `Stopped` at its next event (another thread's: a client leaving)."""
         self.events.put(("stop", "", b"", ""))
 
     def close(self) -> None:

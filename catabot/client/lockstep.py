@@ -100,6 +100,7 @@ class Joined:
         self._observations: queue.SimpleQueue[tuple[str, Any]] = queue.SimpleQueue()
         self._commands: queue.SimpleQueue[Any] = queue.SimpleQueue()
         self._pending: Observation | None = None  # observed, not yet acted on
+        self._acted = -1  # the tick of the observation last acted on
         self.end: End | None = None
         self._closed = False
         self._thread = threading.Thread(target=self._run, name=f"lockstep-{name}", daemon=True)
@@ -204,7 +205,8 @@ class Joined:
         self._check_running()
         obs = self._pending
         if obs is None:
-            raise ClientError(f"{self.name}: act() before observe(): nothing to answer")
+            again = f"act() again for tick {self._acted}" if self._acted >= 0 else "act() first"
+            raise ClientError(f"{self.name}: {again}: one act() answers each observe()")
         msg = self._message(command, obs) if self._control is not None else None
         if command is not None and self._control is None:
             raise CommandError(
@@ -212,7 +214,7 @@ class Joined:
                 "(a vessel's controller.participant names the one that does); send free "
                 "commands with Client.vessel(id).send()"
             )
-        self._pending = None
+        self._pending, self._acted = None, obs.tick
         self._last = msg if msg is not None else self._last
         self._commands.put(msg)
 

@@ -18,6 +18,7 @@ from catabot.bus.messages import GpsFix, ImuSample, VesselState
 from catabot.bus.session import free_port
 from catabot.client import (
     Client,
+    ClientError,
     CommandError,
     NotAParticipant,
     Observation,
@@ -159,9 +160,15 @@ def test_a_stack_leaving_mid_run_is_named_and_the_run_ends(tmp_path: Path) -> No
     try:
         with Client.connect([run.endpoint], timeout_s=30) as sim:
             stack = sim.join("stack")
+            with pytest.raises(ClientError, match=r"stack: act\(\) first: one act\(\) answers"):
+                stack.act(Thrust([0.2, 0.2]))
             for _ in range(3):
                 stack.observe()
                 stack.act(Thrust([0.2, 0.2]))
+            with pytest.raises(
+                ClientError, match=r"act\(\) again for tick 20: one act\(\) answers"
+            ):
+                stack.act(Thrust([0.2, 0.2]))  # said "act() before observe()"
             stack.observe()
             started = time.monotonic()
             stack.close()  # while the participant waits for this period's command

@@ -98,6 +98,19 @@ def test_a_program_slower_than_a_short_deadline_is_named_not_physics(tmp_path: P
     assert cause.startswith("run failed: participant 'stack' missed the 1 s deadline of tick 100")
 
 
+def test_a_slow_program_dropped_under_policy_drop_is_told_and_stops(tmp_path: Path) -> None:
+    """It stepped on through every queued tick, its commands taken by nobody, and heard
+    "completed" at the end; a grant naming it dropped now ends its own run there."""
+    clock = {"deadline_s": 1.0, "policy": "drop"}
+    code, said, run = _run(
+        tmp_path, _scenario(tmp_path, "--sleep-at", "100", "1.5", clock=clock), "d"
+    )
+    assert code == 0 and run is not None, said
+    assert "stack: dropped, the run went on without it" in said
+    log = (run / "log" / "stack.log").read_text()
+    assert re.search(r"^stack ended at tick 10\d \(dropped\)$", log, re.M) and "waited" not in log
+
+
 def test_a_program_that_ends_before_joining_fails_the_run_at_once(tmp_path: Path) -> None:
     """It exited 0, and the run waited out the 60 s start timeout for it."""
     code, said, run = _run(tmp_path, _scenario(tmp_path, "--leave"), "leave")

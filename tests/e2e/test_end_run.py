@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import contextlib
 import json
+import math
 import threading
 from pathlib import Path
 from typing import Any
@@ -14,7 +15,15 @@ import pytest
 from conftest import files_of
 from test_client import SENSORS, Run
 
-from catabot.client import Client, ClientError, EndRun, Observation, RunEnded, Thrust
+from catabot.client import (
+    Client,
+    ClientError,
+    CommandError,
+    EndRun,
+    Observation,
+    RunEnded,
+    Thrust,
+)
 
 pytestmark = pytest.mark.timeout(180)
 CONTROLLER = {"participant": "stack", "rate_hz": 10.0, "command": "thrust"}
@@ -152,6 +161,24 @@ def test_a_stack_that_raises_is_the_runs_cause_in_its_own_words(tmp_path: Path) 
         assert (record["error"], record["ticks"]) == (cause, 50)  # every tick it stepped
         state = (run_dir / "vessel.ego.state.csv").read_text().splitlines()
         assert state[-1].split(",")[1] == "49"  # it had 40: the fault's ack did not count
+    finally:
+        run.kill()
+
+
+def test_a_command_the_client_refuses_is_the_runs_cause_too(tmp_path: Path) -> None:
+    """A NaN returned from a step: act() refused it outside the step's guard, and the run
+    said only that the stack left without a word."""
+    run = Run(tmp_path, SCENARIO)
+
+    def step(obs: Observation) -> Thrust:
+        return Thrust([math.nan if obs.tick == 50 else 0.5, 0.6])
+
+    try:
+        with Client.connect([run.endpoint], timeout_s=30) as sim, pytest.raises(CommandError):
+            sim.run_lockstep("stack", step)
+        out, err = run.proc.communicate(timeout=60)
+        cause = "participant 'stack' stopped at tick 50: CommandError: "
+        assert run.proc.returncode != 0 and cause in err and "not finite" in err, out + err
     finally:
         run.kill()
 

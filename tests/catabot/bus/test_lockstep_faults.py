@@ -147,6 +147,10 @@ def test_policy_drop_goes_on_without_the_hanging_participant(world: World) -> No
         assert m.error is None
     assert cons.ticks == list(range(20))
     assert world.members["other"].ticks == list(range(20))
+    hung = world.members["hang"]  # told, it stops: it had stepped on to 19 and heard "completed"
+    assert hung.end is not None and (hung.end.reason, hung.end.tick) == ("dropped", 5), hung.end
+    assert hung.end.error == "hang was dropped (clock.policy drop): the run goes on without it"
+    assert hung.ticks == list(range(6))
     for k in range(1, 6):  # before the drop, the consumer had every state
         assert [m.tick for m in cons.released[k][key]] == [k - 1]
 
