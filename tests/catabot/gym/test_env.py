@@ -158,10 +158,15 @@ def test_a_run_that_fails_mid_episode_is_a_clear_error_and_reset_recovers(env: g
 
 
 def test_max_steps_above_the_default_is_not_cut_by_a_time_limit() -> None:
-    """Registered with max_episode_steps=600, a TimeLimit ended max_steps=700 at 600."""
+    """Registered with max_episode_steps=600, a TimeLimit ended max_steps=700 at 600. No
+    TimeLimit, but the spec gives the horizon (it said None: RL libraries read it there)."""
     env = gym.make("CataBot/Navigate-v0", max_steps=700)
     try:
-        assert env.spec is not None and env.spec.max_episode_steps is None
+        assert not isinstance(env, gym.wrappers.TimeLimit)
+        assert env.spec is not None and env.spec.max_episode_steps == 700
         assert env.unwrapped.options.max_steps == 700  # type: ignore[attr-defined]
     finally:
         env.close()
+    default = gym.make("CataBot/StationKeep-v0")
+    assert default.spec is not None and default.spec.max_episode_steps == 600
+    default.close()
