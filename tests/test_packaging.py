@@ -32,6 +32,7 @@ def test_package_data_covers_every_bundled_file() -> None:
         assert files <= covered, sorted(str(p) for p in files - covered)
         bundled |= files
     assert REPO / "catabot" / "data" / "terrain" / "bay.png" in bundled
+    assert REPO / "catabot" / "py.typed" in bundled  # a stack's mypy reads catabot's hints
 
 
 def test_every_module_is_in_a_package() -> None:

@@ -31,6 +31,7 @@ from catabot.client.errors import (
     TooLate,
     UnknownSensor,
     UnknownVessel,
+    WrongRate,
 )
 from catabot.client.info import Buoy, ControllerInfo, SensorInfo, VesselInfo, WorldInfo
 from catabot.client.lockstep import Joined, Observation
@@ -72,5 +73,6 @@ __all__ = [
     "VesselState",
     "Waypoints",
     "WorldInfo",
+    "WrongRate",
     "add_stack_args",
 ]

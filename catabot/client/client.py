@@ -39,6 +39,7 @@ from catabot.client.errors import (
     SimulatorNotFound,
     TooLate,
     UnknownVessel,
+    WrongRate,
 )
 from catabot.client.free import run_free
 from catabot.client.info import SensorInfo, VesselInfo, WorldInfo
@@ -184,14 +185,20 @@ class Client:
     def _period(self, info: WorldInfo, name: str, target: VesselInfo | None,
                 rate_hz: float | None) -> int:  # fmt: skip
         c = target.controller if target is not None else None
-        if c is not None and c.participant == name:
-            return c.period_ticks
         if rate_hz is None:
-            return 1
+            return c.period_ticks if c is not None and c.participant == name else 1
         try:  # the rule every rate follows (DESIGN.md §4)
-            return period_in_ticks(round(NS_PER_S / rate_hz), info.dt_ns, what=f"rate_hz {rate_hz}")
+            period = period_in_ticks(
+                round(NS_PER_S / rate_hz), info.dt_ns, what=f"rate_hz {rate_hz}"
+            )
         except ClockError as exc:
-            raise ValueError(str(exc)) from None
+            raise WrongRate(str(exc)) from None
+        if c is not None and c.participant == name and period != c.period_ticks:
+            assert target is not None
+            raise WrongRate(f"rate_hz {rate_hz:g}: {name!r} steps as {target.id}'s "
+                            f"controller, at its controller.rate_hz {c.rate_hz:g} Hz; leave "
+                            "rate_hz out")  # fmt: skip
+        return period
 
     def run_lockstep(
         self, name: str | None, step: Step, *, vessel: str | None = None,

@@ -44,6 +44,11 @@ class NotItsVessel(ClientError, ValueError):
     command its own, and the run would stop at the deadline blaming physics."""
 
 
+class WrongRate(ClientError, ValueError):
+    """A join's `rate_hz` the clock cannot step, or not the controller's own rate (the
+    participant steps at that one whatever it asks: it was taken silently)."""
+
+
 class TooLate(ClientError, RuntimeError):
     """The run started without this participant, or another session holds its name."""
 

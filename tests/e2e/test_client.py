@@ -28,6 +28,7 @@ from catabot.client import (
     TooLate,
     UnknownSensor,
     UnknownVessel,
+    WrongRate,
 )
 
 pytestmark = pytest.mark.timeout(180)
@@ -159,7 +160,12 @@ def test_a_stack_leaving_mid_run_is_named_and_the_run_ends(tmp_path: Path) -> No
     run = _run(tmp_path, {"name": "leaves", "duration_s": 60.0, "vessels": [ego]})
     try:
         with Client.connect([run.endpoint], timeout_s=30) as sim:
-            stack = sim.join("stack")
+            with pytest.raises(WrongRate, match=r"rate_hz 5: 'stack' steps as ego's controller, "
+                               r"at its controller.rate_hz 10 Hz; leave rate_hz out"):  # fmt: skip
+                sim.join("stack", rate_hz=5)  # taken silently, and stepped at 10 Hz
+            with pytest.raises(WrongRate, match=r"rate_hz 7: period 142857143 ns is not a whole"):
+                sim.join("stack", rate_hz=7)  # a plain ValueError, not a ClientError
+            stack = sim.join("stack", rate_hz=10)
             with pytest.raises(ClientError, match=r"stack: act\(\) first: one act\(\) answers"):
                 stack.act(Thrust([0.2, 0.2]))
             for _ in range(3):
