@@ -7,6 +7,7 @@ about to send, with this vessel's thruster count, and raises `CommandError` in t
 
 from __future__ import annotations
 
+import math
 import numbers
 from collections.abc import Sequence
 from dataclasses import dataclass
@@ -72,7 +73,7 @@ def message(command: Command, vessel: VesselInfo, *, tick: int = -1, stamp_ns: i
             checks.twist(msg)
         else:
             assert isinstance(command, Waypoints)
-            points = _floats([c for p in command.points for c in _pair(p)])
+            points = _path(command)
             speed, tol = _number(command.speed, "speed"), _number(command.tolerance, "tolerance")
             msg = WaypointsCmd(points, speed, tol, str(command.mode), tick, stamp_ns)
             checks.waypoints(msg)
@@ -93,7 +94,20 @@ def _floats(values: Sequence[float]) -> tuple[float, ...]:
     return tuple(_number(v, "a value") for v in values)
 
 
-def _pair(point: Sequence[float]) -> tuple[float, float]:
-    if len(point) != 2:
-        raise ValueError(f"a waypoint is (x, y) in m, not {tuple(point)!r}")
-    return _number(point[0], "a waypoint's x"), _number(point[1], "a waypoint's y")
+def _path(command: Waypoints) -> tuple[float, ...]:
+    """The points as the wire's flat x0, y0, x1, ... after checking them as given: the
+    bus's words for a flat list ("need x0, y0, x1, ...") answered a list of pairs."""
+    pairs = [_pair(i, p) for i, p in enumerate(command.points)]
+    if not pairs and command.mode != "release":
+        raise ValueError("points: give at least one (x, y) point, or mode 'release'")
+    for i, (x, y) in enumerate(pairs):
+        if not (math.isfinite(x) and math.isfinite(y)):
+            raise ValueError(f"points.{i}: ({x}, {y}) is not finite")
+    return tuple(c for pair in pairs for c in pair)
+
+
+def _pair(i: int, point: object) -> tuple[float, float]:
+    if isinstance(point, str | bytes) or not isinstance(point, Sequence) or len(point) != 2:
+        raise ValueError(f"points.{i}: a waypoint is (x, y) in m, not {point!r}; give "
+                         "points as [(x0, y0), (x1, y1), ...]")  # fmt: skip
+    return _number(point[0], f"points.{i}'s x"), _number(point[1], f"points.{i}'s y")

@@ -37,7 +37,7 @@ def test_good_commands_become_their_messages() -> None:
         (Thrust(["fast", 0.0]), "a value must be a number, not str 'fast'"),  # type: ignore[list-item]
         (Twist("1", 0.0), "surge must be a number, not str '1'"),  # type: ignore[arg-type]
         (Twist(1.0, True), "yaw_rate must be a number, not bool"),
-        (Waypoints([(1, "2")]), "a waypoint's y must be a number"),  # type: ignore[list-item]
+        (Waypoints([(1, "2")]), "points.0's y must be a number"),  # type: ignore[list-item]
         (Twist(INF, 0.0), "twist command for vessel 'ego': surge inf m/s"),
         (Twist(1.0, NAN), "not finite"),
         (Twist(1e308, 0.0), "surge 1e[+]308 m/s: at most 50 m/s either way"),
@@ -46,12 +46,20 @@ def test_good_commands_become_their_messages() -> None:
         (Waypoints([(1, 2)], speed=1e308), "speed 1e[+]308 m/s and tolerance 2.0 m: at most 50"),
         (Waypoints([(1, 2)], tolerance=5e3), "at most 50 m/s and 1000 m"),
         (Waypoints([(1e300, 2)]), "each coordinate within ±1e[+]07 m of the origin"),
-        (Waypoints([(1, 2, 3)]), r"a waypoint is \(x, y\) in m"),
+        (Waypoints([(1, 2, 3)]), r"points.0: a waypoint is \(x, y\) in m, not \(1, 2, 3\)"),
+        (
+            Waypoints([10, 0, 20, 0]),  # type: ignore[list-item]
+            r"points.0: a waypoint is \(x, y\) in m, not 10; give points as \[\(x0, y0\), ",
+        ),  # it said "object of type 'int' has no len()"
+        (
+            Waypoints([], mode="loop"),
+            r"points: give at least one \(x, y\) point, or mode 'release'",
+        ),
         (Waypoints([(1, 2)], speed=0), "speed 0.0 must be a finite number >= 0.01"),
         (Waypoints([(1, 2)], tolerance=-1), "tolerance -1.0 must be a finite number >= 0.1"),
         (Waypoints([(1, 2)], tolerance=1e-300), "tolerance 1e-300 must be"),  # circles for ever
         (Waypoints([(1, 2)], speed=5e-324), "speed 5e-324 must be"),  # parks the boat
-        (Waypoints([(1, NAN)]), "an even number of finite values"),
+        (Waypoints([(1, NAN)]), r"points.0: \(1.0, nan\) is not finite"),  # not the wire's words
         (Waypoints([(1, 2)], mode="zigzag"), "mode 'zigzag' is not one of"),
         (Waypoints([(k, 0) for k in range(1001)]), "1001 waypoints: at most 1000 in one path"),
     ],
