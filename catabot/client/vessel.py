@@ -32,6 +32,8 @@ class Sensor:
         self._latest = Latest(watch, stream, f"sample of sensor {vessel}/{info.name}")
 
     def latest(self, timeout_s: float = 2.0) -> Any:
+        """The newest sample, waiting up to `timeout_s` for a first one (NoData): this Sensor
+        subscribed when it was made, so keep it; a fresh one's `latest(0)` has none yet."""
         return self._latest.wait(timeout_s)
 
     def on_sample(self, callback: Callable[[Any], None]) -> None:
