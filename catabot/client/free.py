@@ -100,7 +100,7 @@ def _loop(
     max_steps: int | None,
 ) -> End | None:
     states.wait(FIRST_STATE_S)
-    steps, next_at = 0, time.monotonic()
+    steps, next_at, told = 0, time.monotonic(), False
     while max_steps is None or steps < max_steps:
         if watch.end is not None:
             return watch.end
@@ -112,13 +112,26 @@ def _loop(
         newest, since = samples.take()
         state = bodies.row(vessel.info.row)
         obs = Observation(bodies.tick + 1, bodies.stamp_ns, state, bodies, newest, since)
+        began = time.monotonic()
         command = step(obs)
         if command is not None:
             vessel.send(command)
         steps += 1
+        told = told or _overran(time.monotonic() - began, period)
         next_at = max(next_at + period, time.monotonic())
         _sleep_until(watch, next_at)
     return None
+
+
+def _overran(took_s: float, period_s: float) -> bool:
+    """Said once: a step longer than its period (a 0.35 s step at 10 Hz ran at 2.9 Hz,
+    unsaid)."""
+    if took_s <= period_s:
+        return False
+    log.warning("a step took %.3g s, longer than its period (%.3g s, rate_hz %.3g): this "
+                "stack steps at about %.3g Hz", took_s, period_s, 1 / period_s,
+                1 / took_s)  # fmt: skip
+    return True
 
 
 def _sleep_until(watch: Watch, when: float) -> None:

@@ -5,6 +5,7 @@ stack reading sensors whose run records the same bytes twice."""
 from __future__ import annotations
 
 import json
+import logging
 import os
 import signal
 import time
@@ -66,7 +67,9 @@ def test_no_simulation_running_is_simulator_not_found_after_the_timeout() -> Non
     assert 1.0 <= time.monotonic() - started < 5.0
 
 
-def test_a_free_running_stack_observes_and_commands(tmp_path: Path) -> None:
+def test_a_free_running_stack_observes_and_commands(
+    tmp_path: Path, caplog: pytest.LogCaptureFixture
+) -> None:
     data = {"name": "free", "seed": 1, "duration_s": 16.0, "clock": {"realtime_factor": 2.0},
             "vessels": [{"id": "ego", "sensors": SENSORS}]}  # fmt: skip
     run = _run(tmp_path, data)
@@ -94,6 +97,11 @@ def test_a_free_running_stack_observes_and_commands(tmp_path: Path) -> None:
             )
             assert len(seen) == 5 and all(o.state is not None for o in seen)
             assert seen[-1].tick > seen[0].tick and isinstance(seen[-1].sensors["gps"], GpsFix)
+            slow = lambda _: time.sleep(0.15)  # noqa: E731  # ran at 1/0.15 Hz, unsaid
+            with caplog.at_level(logging.WARNING, logger="catabot.client"):
+                sim.run_free(slow, rate_hz=10, vessel="ego", max_steps=3)
+            said = [r.getMessage() for r in caplog.records if "a step took" in r.getMessage()]
+            assert len(said) == 1 and "longer than its period (0.1 s, rate_hz 10)" in said[0]
             assert len(imu) > 10 and all(isinstance(s, ImuSample) for s in imu)
             started = time.monotonic()
             with pytest.raises(RunEnded, match=r"ended at tick 1599 \(completed\)"):
