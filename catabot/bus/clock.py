@@ -13,7 +13,7 @@ consumer step up to L ticks ahead of the producer instead of waiting for it ever
 
 from __future__ import annotations
 
-from collections.abc import Callable
+from collections.abc import Callable, Collection
 from dataclasses import dataclass, field
 from enum import StrEnum
 from typing import Any
@@ -72,15 +72,23 @@ def blames(error: str, name: str) -> bool:
     return f"participant {name!r} " in error
 
 
-def never_joined(missing: list[str], timeout_s: float) -> str:
-    """The conductor's fault when participants never came (`who_never_joined` reads it)."""
-    return f"participant(s) {NEVER_JOINED} {timeout_s:g} s: {', '.join(missing)}"
+def never_joined(missing: list[str], timeout_s: float, *, came: Collection[str] = ()) -> str:
+    """The conductor's fault when participants never came (`who_never_joined` reads it);
+    `came`: those seen present during the wait."""
+    names = ", ".join(missing)
+    return f"participant(s) {NEVER_JOINED} {timeout_s:g} s: {names}{came_and_went(missing, came)}"
+
+
+def came_and_went(missing: list[str], came: Collection[str]) -> str:
+    """Those of `missing` that joined and left before the start, said ("" for none)."""
+    gone = [name for name in missing if name in came]
+    return f" ({', '.join(gone)} joined, then left before the start: ended?)" if gone else ""
 
 
 def who_never_joined(error: str) -> list[str]:
     """The participants a run's error names as never joined; none for any other error."""
     _, found, rest = error.partition(NEVER_JOINED)
-    return rest.partition(": ")[2].split(", ") if found else []
+    return rest.partition(": ")[2].split(" (")[0].split(", ") if found else []
 
 
 class Policy(StrEnum):

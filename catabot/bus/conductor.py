@@ -60,8 +60,7 @@ class Conductor:
         self._told = ""  # the fault a participant told (Ack.fault): the run's error
         self._done, self._granted = 0, -1  # ticks every active one acked; the last granted
         self._acked = {name: -1 for name in spec.participants}
-        self._t0 = self._created
-        self._out = Outputs(session)  # ticks and ends, signed with this session's id
+        self._t0, self._out = self._created, Outputs(session)  # ticks and ends, signed
         self._token = session.liveliness().declare_token(keys.live(CONDUCTOR, str(session.zid())))
         # Acks arrive on a FIFO channel (no Python callback per ack: the hot path); rare
         # events (a participant leaving, a deadline passing, a stop) go to `events`, and the
@@ -73,10 +72,8 @@ class Conductor:
             keys.lives(), self._on_live, history=True
         )
         self._deadline: float | None = None
-        self._closed = threading.Event()
-        self._watchdog = threading.Thread(
-            target=self._watch, name="conductor-watchdog", daemon=True
-        )
+        self._closed = threading.Event()  # the watchdog's end
+        self._watchdog = threading.Thread(target=self._watch, name="watchdog", daemon=True)
         self._watchdog.start()
 
     def _on_live(self, sample: zenoh.Sample) -> None:
@@ -118,16 +115,19 @@ class Conductor:
         return RunResult(done, wall, error, [*dropped], reason, joined - self._created, dropped)
 
     def _await_members(self) -> None:
-        """Every token; who is missing every WAITING_NOTE_S (by hand, it said nothing)."""
-        expected, limit_s = set(self.spec.participants), self.spec.start_timeout_s
+        """Every token; who is missing every WAITING_NOTE_S (by hand, it said nothing), and
+        who came and went (a stack that crashed after its join was "never joined")."""
+        expected, limit_s, came = set(self.spec.participants), self.spec.start_timeout_s, set[str]()
         limit, note = time.monotonic() + limit_s, time.monotonic() + WAITING_NOTE_S
         while not expected <= self.members and not self._stop_reason:
-            if self._next_event(min(limit, note))[0] == "late":
+            late, came = self._next_event(min(limit, note))[0] == "late", came | self.members
+            if late:
                 now, missing = time.monotonic(), sorted(expected - self.members)
                 if now >= limit:
-                    raise ClockError(clock.never_joined(missing, limit_s))
+                    raise ClockError(clock.never_joined(missing, limit_s, came=came))
                 note = now + WAITING_NOTE_S
-                log.info("waiting for %s to join (%.0f s left)", ", ".join(missing), limit - now)
+                log.info("waiting for %s to join (%.0f s left)%s", ", ".join(missing),
+                         limit - now, clock.came_and_went(missing, came))  # fmt: skip
 
     def _tick_loop(self, on_progress: Callable[[Progress], None] | None, start: float) -> None:
         """Grant ticks while the window and the pace allow, take acks, report progress.

@@ -8,7 +8,7 @@ import time
 
 import pytest
 
-from catabot.bus import codec, conductor, start_wait
+from catabot.bus import clock, codec, conductor, start_wait
 from catabot.bus.clock import ClockLimits, Policy, Stream
 from catabot.bus.conductor import SILENT
 from catabot.bus.inbox import Inputs
@@ -184,6 +184,21 @@ def test_a_participant_that_never_joins_is_named(world: World) -> None:
     here.join()
     assert here.ticks == []
     assert here.end is not None and here.end.error == result.error
+
+
+def test_one_that_joined_and_left_before_the_start_is_said_so(world: World) -> None:
+    """A stack that crashed after its join was reported as never joined, 60 s later."""
+    world.member("here")
+    gone = world.open()
+    token = gone.liveliness().declare_token(world.keys.live("gone", str(gone.zid())))
+    threading.Timer(0.3, token.undeclare).start()  # its process ended before the start
+    result = world.run(["here", "gone", "late"], 10, deadline_s=1.0, start_timeout_s=1.5)
+    assert result.error == (
+        "participant(s) never joined within 1.5 s: gone, late (gone joined, then left before "
+        "the start: ended?)"
+    )  # "late" never came: the run had not started when "gone" left
+    assert clock.who_never_joined(result.error) == ["gone", "late"]
+    world.members["here"].join()
 
 
 # -- (f) a crash mid-run ------------------------------------------------------------------
