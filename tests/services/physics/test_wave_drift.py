@@ -37,7 +37,7 @@ def _drift(model: str, *, period_s: float, heading: float) -> np.ndarray:
 @pytest.mark.parametrize(
     ("model", "period_s", "heading", "limit"),
     [
-        ("monohull", 2.0, 0.0, 0.3),  # head sea, waves as long as the hull: was 0.77 m/s
+        ("monohull", 2.0, 0.0, 0.3),  # following sea, waves as long as the hull: was 0.77 m/s
         ("monohull", 3.0, 0.0, 0.03),  # was 0.12
         ("monohull", 2.0, math.pi / 2, 0.08),  # beam sea: 0.05 before and after
         ("catabot", 2.0, 0.0, 0.05),  # was 0.08
