@@ -30,12 +30,17 @@ def _waiter(world: World, roster: Roster) -> tuple[StartWait, queue.SimpleQueue[
     return waiter, events
 
 
-def _heard(events: queue.SimpleQueue[Any], wait_s: float = 3.0) -> list[Any]:
+def _heard(events: queue.SimpleQueue[Any], wait_s: float = 2.0) -> list[Any]:
     time.sleep(wait_s)
     got = []
     while not events.empty():
         got.append(events.get())
     return got
+
+
+def _first(events: queue.SimpleQueue[Any], limit_s: float = 15.0) -> Any:
+    """The first event, however loaded the machine (a fixed 3 s lost it under CI's load)."""
+    return events.get(timeout=limit_s)
 
 
 def test_the_conductors_other_digest_is_told_and_a_strangers_is_not(
@@ -51,7 +56,7 @@ def test_the_conductors_other_digest_is_told_and_a_strangers_is_not(
     assert _heard(events) == []  # the stranger's answer, not the conductor's
     keep.append(_answer(world.conductor_session, key, "bbbbbbbbbbbb"))
     waiter.idle(set())
-    assert ("digest", "", b"bbbbbbbbbbbb", "") in _heard(events)
+    assert _first(events) == ("digest", "", b"bbbbbbbbbbbb", "")
 
 
 def test_the_same_digest_or_no_conductor_yet_is_no_news(
