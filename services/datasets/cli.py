@@ -20,6 +20,7 @@ from catabot.run.answer import OneLineParser, answered
 from catabot.run.recorded import RecordedRun
 from services.datasets import coco, kitti, preview, segmentation, yolo
 from services.datasets.frames import VAL_FRACTION, ExportOptions
+from services.datasets.split import MAX_BLOCK_S
 
 FORMATS: dict[str, Callable[[RecordedRun, Path, ExportOptions], str]] = {
     "yolo": yolo.export,
@@ -88,8 +89,10 @@ def _check(args: argparse.Namespace) -> Path:
     args.val_fraction = VAL_FRACTION if args.val_fraction is None else args.val_fraction
     if not 0.0 <= args.val_fraction <= 1.0:
         raise ExportOptionError(f"--val-fraction must be in [0, 1] (got {args.val_fraction})")
-    if args.split_block_s is not None and not args.split_block_s > 0:
-        raise ExportOptionError(f"--split-block-s must be > 0 (got {args.split_block_s})")
+    block = args.split_block_s
+    if block is not None and not 0 < block <= MAX_BLOCK_S:  # inf: OverflowError, traced
+        raise ExportOptionError(f"--split-block-s must be > 0 and at most {MAX_BLOCK_S:g} s "
+                                f"(got {block})")  # fmt: skip
     if args.min_box_px < 0:
         raise ExportOptionError(f"--min-box-px must be >= 0 (got {args.min_box_px})")
     if not 0.0 <= args.min_visible <= 1.0:

@@ -16,7 +16,7 @@ from numpy.typing import NDArray
 from catabot.errors import CataBotError
 from catabot.run.recorded import RecordedRun
 from catabot.run.recorded_camera import LabelledFrame, cameras, labelled_frames
-from services.datasets.split import split
+from services.datasets.split import empty_set, split
 
 NAMES = {"color": "colour", "class": "class", "instance": "instance"}  # as said
 
@@ -125,7 +125,8 @@ def camera_frames(
         Frame(f"{cam}_{f.tick:08d}", cam, f, subset, mine, options)
         for (cam, f, mine), subset in zip(pairs, subsets, strict=True)
     ]
-    return frames, _note(frames, without, what, options if boxes else None)
+    note = _note(frames, without, what, options if boxes else None)
+    return frames, note + empty_set(subsets, options.val_fraction)
 
 
 def _note(frames: list[Frame], without: list[str], what: str, options: ExportOptions | None) -> str:

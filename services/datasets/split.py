@@ -18,6 +18,7 @@ from collections.abc import Sequence
 from catabot.world import seeding
 
 DEFAULT_BLOCK_S = 10.0
+MAX_BLOCK_S = 9.2e9  # the clock's int64 of nanoseconds
 
 
 def block_ns(stamps_ns: Sequence[int], block_s: float | None) -> int:
@@ -41,6 +42,18 @@ def split(
     ordered = sorted(draws, key=lambda b: (draws[b], b))
     val = set(ordered[: _val_blocks(len(ordered), val_fraction)])
     return ["val" if b in val else "train" for b in blocks]
+
+
+def empty_set(subsets: Sequence[str], val_fraction: float) -> str:
+    """A note when a split asked for both sets left one empty (a 30 s run in one 100 s
+    block gave 150 train, 0 val, unsaid); --val-fraction 0 or 1 is the CLI's to say."""
+    if not 0.0 < val_fraction < 1.0 or not subsets:
+        return ""
+    for empty in ("train", "val"):
+        if empty not in subsets:
+            return (f"; the {empty} set is empty: the frames fall in one block of the split "
+                    "(--split-block-s; give a shorter one)")  # fmt: skip
+    return ""
 
 
 def _val_blocks(n: int, fraction: float) -> int:

@@ -1,4 +1,4 @@
-"""Faults in the real lockstep: deadline, drop policy, start timeout, crash, bad input."""
+"""Faults in the real lockstep: deadline, drop policy, crash, bad input (the start: its file)."""
 
 from __future__ import annotations
 

@@ -28,7 +28,8 @@ def test_a_run_without_a_camera_is_refused_and_leaves_no_folder(
     ("option", "why"),
     [
         (["--val-fraction", "1.5"], "--val-fraction must be in [0, 1] (got 1.5)"),
-        (["--split-block-s", "0"], "--split-block-s must be > 0 (got 0.0)"),
+        (["--split-block-s", "0"], "--split-block-s must be > 0 and at most 9.2e+09 s (got 0.0)"),
+        (["--split-block-s", "inf"], "--split-block-s must be > 0 and at most"),  # a traceback
         (["--min-visible", "1.5"], "--min-visible must be in [0, 1] (got 1.5)"),
         ([], "exists and is not an empty folder"),
     ],

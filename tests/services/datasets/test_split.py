@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from services.datasets.split import block_ns, split
+from services.datasets.split import block_ns, empty_set, split
 
 S = 1_000_000_000
 
@@ -54,3 +54,16 @@ def test_the_val_share_is_the_one_asked_for_to_within_a_block() -> None:
             assert subsets.count("val") / len(stamps) == fraction, (fraction, seed)
             blocks = split(stamps, seed=seed, val_fraction=fraction)  # 10 blocks of 0.98 s
             assert abs(blocks.count("val") / len(stamps) - fraction) <= 0.1, (fraction, seed)
+
+
+def test_a_split_that_leaves_a_set_empty_is_said() -> None:
+    """30 s of frames in one 100 s block: 150 train, 0 val, and the export line said nothing."""
+    stamps = [k * 200_000_000 for k in range(150)]
+    subsets = split(stamps, seed=1, val_fraction=0.2, block_s=100.0)
+    assert set(subsets) == {"train"}
+    assert empty_set(subsets, 0.2) == (
+        "; the val set is empty: the frames fall in one block of the split (--split-block-s; "
+        "give a shorter one)"
+    )
+    assert empty_set(split(stamps, seed=1, val_fraction=0.2), 0.2) == ""  # ten blocks
+    assert empty_set(subsets, 0.0) == ""  # asked for: the CLI says so itself
