@@ -24,6 +24,7 @@ from catabot.config.scenario import Scenario
 from catabot.errors import CataBotError
 
 STOP_S = 10.0  # a clean stop takes well under a second; after this, kill
+FAILURE_WAIT_S = 3.0  # for a failing run to print its cause
 
 
 class RunError(CataBotError, RuntimeError):
@@ -55,13 +56,19 @@ class SimProcess:
         return self.proc.poll() is None
 
     def failure(self) -> str:
-        """Why the run stopped, from its console (the launcher's summary names the cause);
-        its folder is kept from now on, so the log named here is still there to read."""
-        self.failed, code = True, self.proc.poll()
+        """Why the run stopped, from its console (the launcher's summary names the cause:
+        its `run failed:` line alone where there is one; a run still ending is given a few
+        seconds to say it, where its start's lines had been quoted instead); its folder is
+        kept from now on, so the log named here is still there to read."""
+        self.failed = True
+        with contextlib.suppress(subprocess.TimeoutExpired):
+            self.proc.wait(timeout=FAILURE_WAIT_S)
+        code = self.proc.poll()
         try:
-            tail = self.log.read_text(errors="replace").strip().splitlines()[-8:]
+            lines = self.log.read_text(errors="replace").strip().splitlines()
         except OSError:  # its folder removed already
-            tail = ["(its log is gone)"]
+            lines = ["(its log is gone)"]
+        tail = [line for line in lines if line.startswith("run failed:")] or lines[-8:]
         status = "still running" if code is None else f"exit code {code}"
         return f"catabot run ({status}, log {self.log}, kept): " + " | ".join(tail)
 

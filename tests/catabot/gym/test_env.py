@@ -152,7 +152,9 @@ def test_a_run_that_fails_mid_episode_is_a_clear_error_and_reset_recovers(env: g
     assert env.observation_space.contains(obs)
     assert info["endpoint"].startswith("tcp/127.0.0.1:")  # for `catabot view --connect`
     assert info["collision"] is None and info["reached"] is False  # step's outcome keys too
-    log = Path(re.findall(r"log (/\S+/run\.log), kept", str(failed.value))[0])
+    said = str(failed.value)  # the run's cause, not the start's lines ("waiting for gym ...")
+    assert "run failed: participant 'physics'" in said and "waiting for" not in said, said
+    log = Path(re.findall(r"log (/\S+/run\.log), kept", said)[0])
     assert log.is_file() and "physics" in log.read_text()  # named, and still there to read
     shutil.rmtree(log.parent)
 
