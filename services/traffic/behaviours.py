@@ -237,7 +237,8 @@ class Behaviours:
         """Boats meeting boats: each takes the course change and speed that keeps clear at
         least cost under the rules of the road (colregs.py); the buoys are checked after."""
         surge, rate = order
-        vel = sog[:, None] * np.column_stack((np.cos(chi), np.sin(chi)))
+        cruise = np.maximum(sog, surge)  # a slowed boat's candidates at the speed it resumes
+        vel = cruise[:, None] * np.column_stack((np.cos(chi), np.sin(chi)))
         own = Movers(pos, vel, chi, rate, self.clear.width)  # on its own law's arc
         v = obstacles.velocity
         course = np.arctan2(v[:, 1], v[:, 0])

@@ -8,7 +8,9 @@ touched in a minute. This is scenario-based collision avoidance (Johansen, Perez
 Cristofaro 2016, "Ship collision avoidance and COLREGS compliance using simulation-based
 control behavior selection"), one step of it at every guidance tick, for all boats at once:
 - candidates: course changes of OFFSETS from the boat's course, each at a part of its speed
-  (SPEEDS); the first is the boat's own law unchanged (a boat whose law meets no hazard
+  (SPEEDS: of the speed its law resumes, for a boat that has slowed: at its speed left, a
+  slowed boat's turns went nowhere, and two boats head-on at 2.5 m/s stopped bow to bow);
+  the first is the boat's own law unchanged (a boat whose law meets no hazard
   keeps it, so most boats weigh nothing);
 - each candidate against each other boat under way near it: the closest point of approach
   (CPA), each boat on the arc it is turning on (predict.py: the own law's turn for the
@@ -16,7 +18,8 @@ control behavior selection"), one step of it at every guidance tick, for all boa
   CPA closer than both footprints plus the clearance within `horizon_s` is a hazard,
   costlier the sooner it comes;
 - the rules of the road (COLREGs 13-17) as costs: a boat that gives way (the other is
-  head-on, crosses from starboard, or is being overtaken by it) must not turn to port; one
+  head-on, crosses from starboard, or is being overtaken by it) must not turn to port, and
+  head-on must turn to starboard (slowing alone had won: it pushed the hazard out); one
   that stands on (the other crosses from its port side or overtakes it) pays STAND_ON for
   leaving its course and speed until the hazard is nearer than URGENT of the horizon, so
   the giving-way boat acts first (rules 16, 17);
@@ -167,6 +170,5 @@ def _rules(
     gives = head_on | from_starboard | overtaking | adrift
     stands = ~gives & (soon_now > URGENT * horizon_s)
     changed = (OFFSETS != 0.0) | (SPEEDS != 1.0)
-    return np.asarray(
-        WRONG_WAY * (gives[:, None] & (OFFSETS > 0.0)) + STAND_ON * (stands[:, None] & changed)
-    )
+    wrong = (gives[:, None] & (OFFSETS > 0.0)) | (head_on[:, None] & (OFFSETS >= 0.0))
+    return np.asarray(WRONG_WAY * wrong + STAND_ON * (stands[:, None] & changed))

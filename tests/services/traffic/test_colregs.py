@@ -93,17 +93,17 @@ def test_boats_that_pass_clear_keep_their_own_law() -> None:
 DT = 0.01
 
 
-def _meeting(starts: list[tuple[float, float, float]], *, rules: bool) -> float:
+def _meeting(starts: list[tuple[float, float, float]], *, rules: bool, speed: float = 5.0) -> float:
     """Monohulls (the default traffic boat) from `starts` (x, y, yaw in degrees), each on a
-    straight path of 200 m at 5 m/s, keeping clear of each other or not; the least gap (m)
-    between their hull boxes seen from above over 45 s (< 0: they touched)."""
+    straight path of 200 m at `speed` m/s, keeping clear of each other or not; the least gap
+    (m) between their hull boxes seen from above over 45 s (< 0: they touched)."""
     model = load_vessel_model("monohull")
     boats, bodies = [], []
     for i, (x, y, degrees) in enumerate(starts):
         heading = math.radians(degrees)
         far = (x + 200.0 * math.cos(heading), y + 200.0 * math.sin(heading))
         pose = Pose(x_m=x, y_m=y, yaw_rad=heading)
-        boats.append(Boat(f"b{i}", "monohull", pose, "waypoints", 5.0, path=((x, y), far)))
+        boats.append(Boat(f"b{i}", "monohull", pose, "waypoints", speed, path=((x, y), far)))
         bodies.append((f"b{i}", model, (x, y, 0.0, heading)))
     n, r = len(starts), footprint_m(model)
     world = PhysicsWorld(bodies, dt_s=DT)
@@ -138,6 +138,12 @@ CROSSING = [(0.0, 0.0, 0.0), (70.0, -70.0, 90.0)]
 def test_two_boats_head_on_pass_each_other_clear() -> None:
     assert _meeting(HEAD_ON, rules=True) > 1.0
     assert _meeting(HEAD_ON, rules=False) < 0.0  # the same boats without the rules collide
+
+
+def test_slow_boats_head_on_turn_and_pass_clear() -> None:
+    """At 2.5 m/s both only slowed (a turn's candidates went at the speed a slowed boat had
+    left, and stopping put the hazard past the horizon) and met bow to bow."""
+    assert _meeting([(0.0, 0.0, 0.0), (120.0, 0.0, 180.0)], rules=True, speed=2.5) > 1.0
 
 
 def test_two_boats_crossing_pass_each_other_clear() -> None:
