@@ -32,6 +32,8 @@ def parse_mix(text: str) -> dict[str, float]:
             raise GenerateError(
                 f"--mix: unknown behaviour {name!r} (allowed: {', '.join(BEHAVIOURS)})"
             )
+        if name.strip() in mix:  # the last one was kept, silently
+            raise GenerateError(f"--mix: {name.strip()!r} given twice")
         try:
             mix[name.strip()] = float(weight)
         except ValueError:

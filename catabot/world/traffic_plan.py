@@ -182,7 +182,9 @@ class Planner:
                 f"draws): give it a start (traffic.boats[].x_m, y_m) or a nearer region"
             )
         raise ScenarioError(f"traffic: no free open water for boat {index} in {TRIES} draws: "
-                            "give a larger traffic.region or fewer boats")  # fmt: skip
+                            "give a larger traffic.region (on the terrain's water, if it "
+                            "has one) or fewer boats (traffic.count "
+                            f"{self.cfg.count})")  # fmt: skip
 
     def _pick(self, names: list[str], weights: list[float]) -> str:
         p = np.asarray(weights, dtype=np.float64)

@@ -24,6 +24,8 @@ def test_generated_scenario_is_valid_and_has_the_traffic(tmp_path: Path) -> None
 def test_an_unknown_behaviour_is_refused(capsys: pytest.CaptureFixture[str]) -> None:
     assert main(["scenario", "generate", "--mix", "zigzag=1"]) == 2
     assert "unknown behaviour 'zigzag'" in capsys.readouterr().err
+    assert main(["scenario", "generate", "--mix", "circle=0.5,circle=0.5"]) == 2  # kept one
+    assert "--mix: 'circle' given twice" in capsys.readouterr().err
 
 
 def test_the_bundled_bay_comes_with_the_harbours_heights_and_scale(tmp_path: Path) -> None:

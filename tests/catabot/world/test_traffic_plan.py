@@ -92,7 +92,7 @@ def test_a_start_that_is_not_free_says_what_it_overlaps() -> None:
                        r"by .* m \(seen from above\)"):  # fmt: skip
         _plan(2, boats=[on_ego])
     with pytest.raises(ScenarioError, match=r"no free open water for boat .* give a larger "
-                       r"traffic.region or fewer boats"):  # fmt: skip
+                       r"traffic.region .* or fewer boats \(traffic.count 40\)"):  # fmt: skip
         _plan(40, region={"size_m": [30.0, 30.0]})
 
 
