@@ -11,6 +11,7 @@ import math
 import numbers
 from collections.abc import Sequence
 from dataclasses import dataclass
+from typing import Any
 
 from catabot.bus import checks
 from catabot.bus.messages import Message, ThrustCmd, TwistCmd, WaypointsCmd
@@ -97,7 +98,7 @@ def _floats(values: Sequence[float]) -> tuple[float, ...]:
 def _path(command: Waypoints) -> tuple[float, ...]:
     """The points as the wire's flat x0, y0, x1, ... after checking them as given: the
     bus's words for a flat list ("need x0, y0, x1, ...") answered a list of pairs."""
-    pairs = [_pair(i, p) for i, p in enumerate(command.points)]
+    pairs = [_pair(i, p) for i, p in enumerate(list(command.points))]
     if not pairs and command.mode != "release":
         raise ValueError("points: give at least one (x, y) point, or mode 'release'")
     for i, (x, y) in enumerate(pairs):
@@ -106,8 +107,9 @@ def _path(command: Waypoints) -> tuple[float, ...]:
     return tuple(c for pair in pairs for c in pair)
 
 
-def _pair(i: int, point: object) -> tuple[float, float]:
-    if isinstance(point, str | bytes) or not isinstance(point, Sequence) or len(point) != 2:
+def _pair(i: int, point: Any) -> tuple[float, float]:
+    """A pair: a tuple, a list or a NumPy row (a planner's output is an array)."""
+    if isinstance(point, str | bytes) or not hasattr(point, "__len__") or len(point) != 2:
         raise ValueError(f"points.{i}: a waypoint is (x, y) in m, not {point!r}; give "
                          "points as [(x0, y0), (x1, y1), ...]")  # fmt: skip
     return _number(point[0], f"points.{i}'s x"), _number(point[1], f"points.{i}'s y")

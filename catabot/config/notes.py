@@ -87,8 +87,8 @@ def terrain_notes(scenario: Scenario) -> list[str]:
 
 def _bundled_original(image: Path) -> Path | None:
     """The bundled image with a scale file that `image` is a byte-for-byte copy of."""
-    if not image.is_file():
-        return None
+    if not image.is_file() or image.resolve().parent == TERRAINS.resolve():
+        return None  # the bundled image itself: its scale is the scenario's to change
     size = image.stat().st_size
     for bundled in sorted(TERRAINS.glob("*.png")):
         same_size = bundled.stat().st_size == size and bundled.with_suffix(".json").is_file()

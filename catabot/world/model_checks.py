@@ -13,10 +13,12 @@ from __future__ import annotations
 import numpy as np
 
 from catabot.config.vessel import VesselModel
+from catabot.config.waves import GRAVITY
 from catabot.world.course import top_speed_mps, unstable_above_mps
 from catabot.world.shapes import vessel_mesh
 from catabot.world.stability import metacentric_heights
 
+THRUST_TO_WEIGHT = 5.0  # over this a note: racing craft stay under 2, a jet ski near 1
 SPREAD = 3.0  # a mesh this many times larger (or smaller) than the hulls is suspect
 THRUSTER_ROOM_M = 0.5  # a thruster this far outside every hull's box is suspect
 TINY_GYRATION = 0.02  # of the length: the bundled models' smallest is 0.10
@@ -95,7 +97,12 @@ def _mesh(model: VesselModel, source: str) -> list[str]:
 
 def _thrusters(model: VesselModel) -> list[str]:
     lo, hi = model.hull_box()
-    notes = []
+    notes, weight = [], model.mass_kg * GRAVITY
+    push = max(sum(t.max_forward_n for t in model.thrusters),
+               sum(t.max_reverse_n for t in model.thrusters))  # fmt: skip
+    if push > THRUST_TO_WEIGHT * weight:
+        notes.append(f"its thrusters together push {push:g} N, {push / weight:.3g} times its "
+                     f"weight: racing craft stay under 2 (thrust in N, mass in kg?)")  # fmt: skip
     for i, t in enumerate(model.thrusters):
         x, y, _ = t.position_m
         off = max(lo[0] - x, x - hi[0], lo[1] - y, y - hi[1])

@@ -3,6 +3,7 @@
 
 from __future__ import annotations
 
+import numpy as np
 import pytest
 
 from catabot.bus.messages import ThrustCmd, TwistCmd, WaypointsCmd
@@ -21,6 +22,9 @@ def test_good_commands_become_their_messages() -> None:
     assert message(Twist(1.0, -0.2), EGO) == TwistCmd(1.0, -0.2, -1, 0)
     way = message(Waypoints([(10, 0), (20, 5)], speed=1.5), EGO)
     assert way == WaypointsCmd((10.0, 0.0, 20.0, 5.0), 1.5, 2.0, "back_and_forth", -1, 0)
+    planned = np.array([[10.0, 0.0], [20.0, 5.0]])  # a planner's output
+    assert message(Waypoints(planned, speed=1.5), EGO) == way  # type: ignore[arg-type]
+    assert message(Waypoints(list(planned), speed=1.5), EGO) == way
     assert message(Waypoints([], mode="release"), EGO).mode == "release"  # type: ignore[attr-defined]
     assert [kind_of(c) for c in (Thrust([0, 0]), Twist(0, 0), Waypoints([]))] == [
         "thrust", "twist", "waypoints"]  # fmt: skip

@@ -89,6 +89,11 @@ def test_a_copy_given_the_bundled_scale_or_an_edited_copy_is_not_said(tmp_path: 
     assert len(scenario_notes(load_scenario(tmp_path / "s.json"))) == 1
     (tmp_path / "bay.png").write_bytes((tmp_path / "bay.png").read_bytes() + b"edited")
     assert scenario_notes(load_scenario(tmp_path / "s.json")) == []  # its own image now
+    (tmp_path / "s.json").write_text(json.dumps(
+        {"name": "s", "terrain": {"elevation_image": str(BAY), "metres_per_pixel": 3.0},
+         "vessels": [{"id": "e"}]}
+    ))  # fmt: skip
+    assert scenario_notes(load_scenario(tmp_path / "s.json")) == []  # the bundled one itself
 
 
 def test_relative_paths_are_written_without_dot_dot(tmp_path: Path) -> None:

@@ -42,6 +42,8 @@ def test_the_bundled_models_have_nothing_to_note() -> None:
         ({"shape": {"mesh": {"file": "hull.obj", "rpy_deg": [0, 90, 0]}}}, "longest along z"),
         ({"mass_kg": 0.055, "thrusters": []},  # with them: refused, 133 times its weight
          "radius of gyration about z is 17.7 m, more than its length"),
+        ({"thrusters": [CATAMARAN["thrusters"][0] | {"max_forward_n": 1e4}]},  # thrown 25 m up
+         "its thrusters together push 10000 N, 18.5 times its weight: racing craft stay under 2"),
         ({"added_mass": [2.75, 21, 79000, 12.8, 23.9, 6.4]}, "is 1.44e+03 times its mass"),
         ({"added_mass": [0, 0, 0.079, 0, 0, 0]}, "is 0.00144 times its mass"),
         ({"thrusters": [{**CATAMARAN["thrusters"][0], "position_m": [3.0, 0.4, -0.1]}]},

@@ -174,12 +174,13 @@ def _bad_model(tmp_path: Path, catabot: VesselModel, edit: dict[str, object]) ->
             {"thrusters.1.position_m": [-0.9, -0.4, 0.0]},
             r"thrusters\.1\.position_m: z = 0 m: a thruster pushes only under water",
         ),
-        (  # a trial's 1 GN ended the run at 0.08 s blaming buoyancy; 10 kN threw it 25 m up
-            {"thrusters.1.max_forward_n": 1e4},
-            r"thrusters\.1\.max_forward_n: the thrusters together give 10036 N, 18\.6 times the "
-            r"boat's weight \(539\.6 N for mass_kg 55\); no surface vessel has over 5",
+        (  # a trial's 1 GN ended the run at 0.08 s blaming buoyancy
+            {"thrusters.1.max_forward_n": 1e6},
+            r"thrusters\.1\.max_forward_n: the thrusters together give 1\.00004e\+06 N, 1\.85e\+03 "
+            r"times the boat's weight \(539\.6 N for mass_kg 55\), over 100: the thrust \(N\) or "
+            r"mass_kg in another unit\?",
         ),
-        ({"thrusters.0.max_reverse_n": 3000}, r"thrusters\.0\.max_reverse_n: the thrusters tog"),
+        ({"thrusters.0.max_reverse_n": 6e4}, r"thrusters\.0\.max_reverse_n: the thrusters tog"),
     ],
 )
 def test_bad_vessel_model_names_the_field(
