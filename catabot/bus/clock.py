@@ -13,6 +13,7 @@ consumer step up to L ticks ahead of the producer instead of waiting for it ever
 
 from __future__ import annotations
 
+import math
 from collections.abc import Callable, Collection
 from dataclasses import dataclass, field
 from enum import StrEnum
@@ -195,6 +196,10 @@ class ClockLimits:
     digest: str = ""  # the scenario's (config/load.py); "" checks none
     deadline_s: float = 10.0  # the conductor's per-tick deadline (a waiting participant acks
     # within a quarter of it: participant.py)
+
+    def __post_init__(self) -> None:
+        if not (math.isfinite(self.deadline_s) and self.deadline_s > 0):  # 0: a busy loop
+            raise ValueError(f"deadline_s {self.deadline_s}: must be a finite number > 0")
 
     @property
     def idle_s(self) -> float:

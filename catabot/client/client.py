@@ -13,6 +13,7 @@ the lockstep (`join`, `run_lockstep`: deterministic) or free-running (`run_free`
 from __future__ import annotations
 
 import argparse
+import math
 from collections.abc import Callable, Sequence
 from types import TracebackType
 
@@ -134,7 +135,8 @@ class Client:
         `controller.participant` or `clock.external_participants`). `vessel`: the one to
         observe and, if `name` is its controller, to command (default: the vessel `name`
         controls); `sensors`: that vessel's sensors to wait for. The control period is the
-        controller's rate, else `rate_hz` (default every tick). `name` None: the controller
+        controller's rate, else `rate_hz` (default every tick); a `rate_hz` the clock cannot
+        step, or that differs from the controller's, is WrongRate. `name` None: the controller
         participant of `vessel` (`--participant` left out, as add_stack_args says)."""
         info = find_world(self.session, self.info.name, self.timeout_s, self._where)  # fresh
         name = name if name is not None else _controller_of(info, vessel)
@@ -187,6 +189,8 @@ class Client:
         c = target.controller if target is not None else None
         if rate_hz is None:
             return c.period_ticks if c is not None and c.participant == name else 1
+        if not (math.isfinite(rate_hz) and rate_hz > 0):  # 0: ZeroDivisionError, traced
+            raise WrongRate(f"rate_hz {rate_hz}: must be a finite number > 0")
         try:  # the rule every rate follows (DESIGN.md §4)
             period = period_in_ticks(
                 round(NS_PER_S / rate_hz), info.dt_ns, what=f"rate_hz {rate_hz}"

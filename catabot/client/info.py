@@ -167,7 +167,7 @@ def _parse(d: Mapping[str, Any]) -> WorldInfo:
             int(c["ticks"]),
             int(c["window"]),
             str(c.get("digest", "")),
-            float(c.get("deadline_s") or 10.0),
+            float(c.get("deadline_s", 10.0)),
         ),
         participants=tuple(map(str, p["stepping"])),
         external=tuple(map(str, p["external"])),

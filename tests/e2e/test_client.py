@@ -173,6 +173,9 @@ def test_a_stack_leaving_mid_run_is_named_and_the_run_ends(tmp_path: Path) -> No
                 sim.join("stack", rate_hz=5)  # taken silently, and stepped at 10 Hz
             with pytest.raises(WrongRate, match=r"rate_hz 7: period 142857143 ns is not a whole"):
                 sim.join("stack", rate_hz=7)  # a plain ValueError, not a ClientError
+            for bad in (0.0, float("nan")):  # a ZeroDivisionError, a ValueError
+                with pytest.raises(WrongRate, match=r"must be a finite number > 0"):
+                    sim.join("stack", rate_hz=bad)
             stack = sim.join("stack", rate_hz=10)
             with pytest.raises(ClientError, match=r"stack: act\(\) first: one act\(\) answers"):
                 stack.act(Thrust([0.2, 0.2]))

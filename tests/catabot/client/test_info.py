@@ -90,6 +90,8 @@ def _without(data: dict[str, Any], *path: str) -> dict[str, Any]:
         (lambda d: d["vessels"][0]["sensors"][0].update(message="nope"), "KeyError 'nope'"),
         (lambda d: d.update(bodies="x"), "TypeError"),
         (lambda d: d["clock"].update(ticks="many"), "ValueError"),
+        (lambda d: d["clock"].update(deadline_s=0), "deadline_s 0.0: must be a finite number > 0"),
+        (lambda d: d["clock"].update(deadline_s=None), "TypeError"),
         (lambda d: d["roster"].update(physics="0xZZ"), "RosterError zid '0xZZ' is not"),
     ],
 )
