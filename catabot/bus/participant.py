@@ -79,7 +79,8 @@ class Participant(Outputs):
         self.events: queue.SimpleQueue[Event] = queue.SimpleQueue()
         self.run_id, self._orphaned_at = "", 0.0
         self._warned_tick, self._met = -1, False  # _met: every peer seen present once
-        self._waiting_since, self._idle_s = time.monotonic(), limits.idle_s if limits else 1.0
+        self._idle_s = limits.idle_s if limits else 1.0
+        self._waiting_since = self._check_at = time.monotonic()  # _check_at: next _ack_waiting
         self._start = StartWait(session, keys, name, roster=self.roster, events=self.events,
                                 digest=limits.digest if limits else "")  # fmt: skip
         self._subs = [
@@ -114,8 +115,6 @@ class Participant(Outputs):
     def present(self) -> set[str]:
         return set(self.members.present)
 
-    # -- the loop ------------------------------------------------------------------------
-
     def run(self, step: StepFn, on_end: EndFn | None = None) -> End:
         """Step every granted tick until the run ends; its End (`LOST`: the conductor vanished)."""
         while True:
@@ -129,8 +128,8 @@ class Participant(Outputs):
             if end is not None:
                 return self._finish(end, on_end)
             self._step_ready(step)
-            if event[0] == "idle" or self._asked:
-                self._ack_waiting()
+            if event[0] == "idle" or self._asked or time.monotonic() >= self._check_at:
+                self._ack_waiting()  # by the clock too: events without end (junk) held it
 
     def _take(self, event: Event) -> End | None:
         kind, key, payload, sender = event
@@ -162,15 +161,14 @@ class Participant(Outputs):
                 self._ack_through(grant, k)
             self._waiting_since = time.monotonic()
 
-    def _ack_through(self, grant: Tick, k: int) -> None:
-        self.put(self._ack, codec.encode(Ack(grant.run, k)))
+    def _ack_through(self, grant: Tick, k: int, *, end: str = "") -> None:
+        """Ack tick k; `end`: and ask the conductor to end the run after it."""
+        self.put(self._ack, codec.encode(Ack(grant.run, k, end=end)))
         self._acked = k
 
     def _end_before(self, grant: Tick, k: int, reason: str) -> None:
-        """Ask the conductor to end the run after tick k - 1 (an Ack with a reason)."""
         self._ended = True
-        self.put(self._ack, codec.encode(Ack(grant.run, k - 1, end=end_reason(reason))))
-        self._acked = k - 1
+        self._ack_through(grant, k - 1, end=end_reason(reason))
 
     def report_fault(self, why: str) -> None:
         """Tell the conductor why this participant stops (its own fault): every host's cause."""
@@ -182,6 +180,7 @@ class Participant(Outputs):
     def _ack_waiting(self) -> None:
         """Ticks stepped since the last ack wait for inputs (no events for `idle_s`, or the
         run is ending): ack them now, or a missed deadline names whoever waits for data."""
+        self._check_at = time.monotonic() + self._idle_s
         if self._grant is None:
             self._start.idle(self.present)
         elif self.next_tick - 1 > self._acked:

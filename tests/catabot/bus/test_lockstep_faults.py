@@ -53,15 +53,16 @@ def test_a_step_past_the_deadline_ends_the_run_naming_it(
     world.members["stuck"].join()
 
 
-@pytest.mark.parametrize("deadline_s", [2.5, 1.0])
+@pytest.mark.parametrize(("deadline_s", "junk"), [(2.5, False), (0.5, False), (2.5, True)])
 def test_a_participant_waiting_for_a_late_ones_data_is_not_named(
-    world: World, deadline_s: float
+    world: World, deadline_s: float, junk: bool
 ) -> None:
     """`cons` needs `slow`'s output of each tick before; `slow` sleeps in tick 13. Acks come
     every half window, so `cons` had stepped 12 and 13 unacknowledged and looked as late as
     `slow`: the deadline named it, the first in the list (as physics for a slow stack). A
     quarter of the deadline (at most a second) without events, it acks what it has stepped
-    (a second, under a trial's 1 s deadline: physics was named for the stack)."""
+    (a second, under a trial's 1 s deadline: physics was named for the stack), junk on its
+    input from a stranger (refused samples, `junk`) coming faster or not."""
     release = threading.Event()
     key = world.keys.vessel_state("ego")
     names = ["cons", "slow"]
@@ -75,10 +76,20 @@ def test_a_participant_waiting_for_a_late_ones_data_is_not_named(
     limits = ClockLimits(DT_NS, 100, 8, deadline_s=deadline_s)
     world.member("cons", inputs=[Stream(key, VesselState, "slow", 1)], peers=names, limits=limits)
     holder["p"] = world.member("slow", slow, peers=names).participant
+    stranger = world.open().declare_publisher(key)
+
+    def spam_it() -> None:
+        while junk and not release.is_set():
+            stranger.put(b"x")  # refused: not from `slow`'s session
+            time.sleep(0.05)
+
+    spam = threading.Thread(target=spam_it)
+    spam.start()
     try:
         result = world.run(names, 100, deadline_s=deadline_s, start_timeout_s=5.0, window_ticks=8)
     finally:
         release.set()
+        spam.join()
     assert result.error == f"participant 'slow' missed the {deadline_s:g} s deadline of tick 12"
 
 

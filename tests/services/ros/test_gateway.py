@@ -196,6 +196,14 @@ def test_a_lockstep_controller_takes_the_reply_to_its_tick(sessions: Any) -> Non
         gateway.close()
 
 
+def _matched(session: zenoh.Session, key: str) -> zenoh.Publisher:
+    """A publisher the gateway's subscriber has matched: a put before that was lost now and
+    then on a loaded machine (the reply never came)."""
+    pub = session.declare_publisher(key)
+    assert _until(lambda: pub.matching_status.matching), f"nobody subscribes to {key}"
+    return pub
+
+
 def test_a_second_reply_to_one_clock_is_refused_and_the_first_taken(sessions: Any) -> None:
     """The newest reply was taken: which of two came last varied, and so did the run."""
     ours, ros = sessions
@@ -203,12 +211,11 @@ def test_a_second_reply_to_one_clock_is_refused_and_the_first_taken(sessions: An
     _, gateway, sent = _lockstep(ours, refused)
     layout = ROSBAGS.types["std_msgs/msg/MultiArrayLayout"](dim=[], data_offset=0)
     array = ROSBAGS.types["std_msgs/msg/Float64MultiArray"]
+    pub = _matched(ros, "other/thrust")
     try:
         for value in (0.5, 0.25):
             msg = array(layout=layout, data=np.array([value, value]))
-            ros.put(
-                "other/thrust", bytes(ROSBAGS.serialize_cdr(msg, "std_msgs/msg/Float64MultiArray"))
-            )
+            pub.put(bytes(ROSBAGS.serialize_cdr(msg, "std_msgs/msg/Float64MultiArray")))
         both = lambda: (gateway.commands(), refused.totals == {REFUSED: 1})[1]  # noqa: E731
         assert _until(both)  # both here before the tick takes them (0.3 s was not, loaded)
         gateway.commands(Tick("r", 0, 0, 10_000_000))
@@ -227,7 +234,7 @@ def test_a_malformed_reply_is_the_reply_the_last_command_holds_at_once(sessions:
     clock = ros.declare_subscriber("clock", lambda _: None)  # the stack, on sim time
     try:
         assert _until(lambda: gateway.clock.watched)
-        ros.put("other/thrust", b"junk")  # the reply to tick 10's /clock, malformed
+        _matched(ros, "other/thrust").put(b"junk")  # the reply to tick 10's /clock, malformed
         start = time.monotonic()
         gateway.commands(Tick("r", 10, 100_000_000, 10_000_000))
         assert time.monotonic() - start < 4.0
