@@ -32,6 +32,8 @@ ASK_TIMEOUT_S = 5.0
 
 
 class StartWait:
+    """A participant's side of the wait for tick 0 (its own thread calls `idle`)."""
+
     def __init__(
         self,
         session: zenoh.Session,
