@@ -14,6 +14,7 @@ from pydantic import Field, StrictBool, field_validator, model_validator
 from catabot.config.base import Angle, FieldProblem, Seed, Strict
 
 BEHAVIOURS = ("circle", "waypoints", "hold")
+MAX_YAW_RATE = 0.35  # rad/s: the traffic's turn rate limit (a 5 m/s boat, about 20 deg/s)
 Behaviour = Literal["circle", "waypoints", "hold"]
 Point = tuple[float, float]
 

@@ -16,7 +16,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
-from catabot.config.traffic import TrafficConfig
+from catabot.config.traffic import MAX_YAW_RATE, TrafficConfig
 from catabot.world.rotations import wrap
 from catabot.world.traffic_plan import Boat
 from services.traffic.avoid import (
@@ -35,7 +35,6 @@ Array = NDArray[np.float64]
 CIRCLE, WAYPOINTS, HOLD = 0, 1, 2
 KINDS = {"circle": CIRCLE, "waypoints": WAYPOINTS, "hold": HOLD}
 YAW_GAIN = 1.0  # 1/s: yaw rate per radian of course error (pursuit, hold)
-MAX_YAW_RATE = 0.35  # rad/s: what a 5 m/s traffic boat can turn (about 20 deg/s)
 CIRCLE_LOOKAHEAD_M = 8.0  # radial error at which the correction reaches 45 degrees
 # 1/s: the circle's course loop. Half of YAW_GAIN because the vector field's own turn rate is
 # fed forward: 1.0 left a limit cycle with set-points held 0.1 s (a 10 Hz guidance rate).
