@@ -1,0 +1,31 @@
+"""Notes on traffic set faster than its boats go (catabot/world/traffic_notes.py)."""
+
+from __future__ import annotations
+
+from typing import Any
+
+from catabot.config.load import parse_scenario
+from catabot.world.traffic_notes import speed_notes
+from catabot.world.world import World
+
+
+def _notes(**traffic: Any) -> list[str]:
+    data = {"name": "t", "duration_s": 1.0, "vessels": [{"id": "ego"}], "traffic": traffic}
+    return speed_notes(World.resolve(parse_scenario(data)))
+
+
+def test_boats_set_faster_than_they_go_are_said() -> None:
+    """A trial's circle.speed_mps 8 was taken, and the monohulls held 5.96 m/s unsaid."""
+    (note,) = _notes(count=4, circle={"speed_mps": 8.0})
+    assert note == (
+        "note: traffic.circle.speed_mps 8: 4 circle boat(s) of model 'monohull' reach 6 m/s "
+        "at most (full thrust against their damping), so they go that fast"
+    )
+    mixed = _notes(count=6, behaviour_mix={"circle": 0.5, "waypoints": 0.5},
+                   waypoints={"speed_mps": 9.0, "buoys": False})  # fmt: skip
+    assert [n.split(":")[1].strip() for n in mixed] == ["traffic.waypoints.speed_mps 9"]
+
+
+def test_the_defaults_and_no_traffic_say_nothing() -> None:
+    assert _notes(count=4) == []
+    assert _notes(count=0, circle={"speed_mps": 8.0}) == []
