@@ -10,6 +10,8 @@ numbers look like; a note refuses nothing, as such a boat may be meant.
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 
 from catabot.config.vessel import VesselModel
@@ -68,10 +70,13 @@ def _course(model: VesselModel) -> list[str]:
     top, limit = top_speed_mps(model), unstable_above_mps(model)
     if limit >= top:
         return []
-    return [f"it cannot hold a straight course above {limit:.2f} m/s, below its top speed "
-            f"({top:.2f} m/s): the added mass's Munk moment (A22 - A11) u v outgrows the sway "
-            "and yaw damping Y_v N_r; give the hull's lift damping.lift_uv [Y_uv, N_uv] "
-            "(N_uv > 0 cancels the Munk moment) or more yaw damping"]  # fmt: skip
+    reach = (f"below its top speed ({top:.2f} m/s)" if math.isfinite(top) else
+             "and has no top speed (no surge damping: only the air's drag, if it has wind "
+             "areas, limits it)")  # fmt: skip
+    return [f"it cannot hold a straight course above {limit:.2f} m/s, {reach}: the added "
+            "mass's Munk moment (A22 - A11) u v outgrows the sway and yaw damping Y_v N_r; "
+            "give the hull's lift damping.lift_uv [Y_uv, N_uv] (N_uv > 0 cancels the Munk "
+            "moment) or more yaw damping"]  # fmt: skip
 
 
 def _mesh(model: VesselModel, source: str) -> list[str]:
