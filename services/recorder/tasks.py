@@ -119,7 +119,7 @@ class Thrust:
         self.force = np.zeros(len(bodies))
         self.known = np.ones(len(bodies), dtype=bool)
         self.impulse = np.zeros(len(bodies))
-        self.unknown_s = np.zeros(len(bodies))
+        self.unknown_ticks = np.zeros(len(bodies), dtype=np.int64)  # counted, not summed in s
         self.pending = 0  # ticks driven by the current forces, not yet added up
         self.began = -1  # the stamp the last tick began at (a released vessel's script step)
         for i in range(len(bodies)):
@@ -144,15 +144,16 @@ class Thrust:
         self.pending += 1  # added up when a force changes: nothing per tick
 
     def totals(self) -> tuple[Array, Array]:
-        """(thrust impulse N s, seconds under velocity control) per vessel, so far."""
+        """(thrust impulse N s, seconds under velocity control) per vessel, so far. The
+        seconds from a count of ticks: summed in seconds, 30 s came out 29.990000000000155."""
         self._settle()
-        return self.impulse, self.unknown_s
+        return self.impulse, self.unknown_ticks * self.dt_ns / NS_PER_S
 
     def _settle(self) -> None:
         if self.pending:
             span = self.pending * self.dt_s
             self.impulse += self.force * span
-            self.unknown_s += ~self.known * span
+            self.unknown_ticks += ~self.known * self.pending
             self.pending = 0
 
     def _resolve(self, i: int, began: int) -> None:

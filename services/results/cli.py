@@ -15,7 +15,7 @@ import csv
 import json
 import sys
 from pathlib import Path
-from typing import Any
+from typing import Any, TextIO
 
 from catabot.config.base import ConfigError
 from catabot.config.differences import one_scenario
@@ -33,7 +33,12 @@ def parser() -> argparse.ArgumentParser:
     p = OneLineParser(prog="catabot results", description=__doc__.split("\n")[0])
     p.add_argument("runs", nargs="+", metavar="RUN",
                    help="run folders, or folders of runs (a sweep's --out)")  # fmt: skip
-    p.add_argument("--csv", metavar="FILE", help="also write every column to this CSV file")
+    p.add_argument(
+        "--csv",
+        metavar="FILE",
+        help="also write every column to this CSV file "
+        "(- : the CSV on stdout instead of the table)",
+    )
     return p
 
 
@@ -43,10 +48,17 @@ def main(argv: list[str] | None = None) -> int:
 
 
 def results(paths: list[str], csv_path: str | None) -> str:
-    out = output_file(csv_path, flag="--csv") if csv_path else None  # before reading runs
+    """`--csv -`: the CSV on stdout instead of the console table, the count on stderr (it
+    wrote a file named "-")."""
+    piped = csv_path == "-"
+    out = output_file(csv_path, flag="--csv") if csv_path and not piped else None  # first
     records = _readable(run_folders(paths))
     _mixed(records)
     header, table = rows.table(records)
+    if piped:
+        _csv_rows(sys.stdout, header, table)
+        print(f"{_count(len(records), 'run')}, {_count(len(table), 'row')}", file=sys.stderr)
+        return ""
     print(text_table(header, table))
     if out is not None:
         write_csv(out, header, table)
@@ -114,9 +126,13 @@ def _shown(value: Any, *, set_as: bool = False) -> str:
 
 def write_csv(path: Path, header: list[str], table: list[dict[str, Any]]) -> None:
     with path.open("w", newline="") as f:
-        writer = csv.writer(f, lineterminator="\n")
-        writer.writerow(header)
-        writer.writerows([_cell(r.get(c)) for c in header] for r in table)
+        _csv_rows(f, header, table)
+
+
+def _csv_rows(f: TextIO, header: list[str], table: list[dict[str, Any]]) -> None:
+    writer = csv.writer(f, lineterminator="\n")
+    writer.writerow(header)
+    writer.writerows([_cell(r.get(c)) for c in header] for r in table)
 
 
 def _cell(value: Any) -> Any:

@@ -170,7 +170,20 @@ def test_thrust_impulse_of_script_and_bus_commands(tmp_path: Path) -> None:
     v0 = _record(metrics, tmp_path)["vessels"]["v0"]
     # 10 ticks at 0.5*36 + 1*28 = 46 N, 10 ticks at 72 N, then nothing; then 5 ticks unknown
     assert v0["thrust_impulse_Ns"] == pytest.approx(0.1 * 46 + 0.1 * 72)
-    assert v0["thrust_unknown_s"] == pytest.approx(0.05)
+    assert v0["thrust_unknown_s"] == 0.05  # exactly: ticks counted (summed, float noise)
+
+
+def test_seconds_under_velocity_control_carry_no_float_noise(tmp_path: Path) -> None:
+    """A trial's 30 s run said 29.990000000000155: spans of seconds summed at each change."""
+    world = _world(vessels=[{"id": "v0", "pose": {"x_m": 0.0, "y_m": 0.0}}])
+    orders = Orders()
+    metrics = Metrics(world, orders)
+    for tick in range(3000):
+        if tick % 7 == 0:  # a stack's twist, repeated: each one settles the sums so far
+            _hear(orders, metrics, TwistCmd(1.0 + tick % 2, 0.0))
+        metrics.add(_states(world, tick, [(0.0, 0.0)]))
+    unknown = _record(metrics, tmp_path)["vessels"]["v0"]["thrust_unknown_s"]
+    assert unknown == round(unknown, 6) and 29.9 < unknown <= 30.0, unknown
 
 
 def test_a_path_hands_an_outside_commands_vessel_back_to_its_script(tmp_path: Path) -> None:

@@ -3,6 +3,7 @@
 
 from __future__ import annotations
 
+import io
 import json
 from pathlib import Path
 from typing import Any
@@ -80,6 +81,18 @@ def test_the_csv_has_every_column_and_pandas_reads_numbers_as_numbers(sweep: Pat
     assert table["error"].fillna("").tolist() == ["", "", "", "", "stack crashed"]
     assert table["closest_approach_m"].tolist()[:4] == [8.0] * 4
     assert table.loc[1, "collisions"] == 1 and table.loc[0, "goal_reached"]
+
+
+def test_csv_dash_is_the_csv_on_stdout(
+    sweep: Path, capsys: pytest.CaptureFixture[str], monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """It wrote a file named "-"; now a pipe gets the CSV alone, the count on stderr."""
+    monkeypatch.chdir(sweep)
+    assert cli.main([str(sweep), "--csv", "-"]) == 0
+    said = capsys.readouterr()
+    table = pd.read_csv(io.StringIO(said.out))
+    assert len(table) == 5 and "time_to_goal_s" in table.columns
+    assert said.err == "3 runs, 5 rows\n" and not (sweep / "-").exists()
 
 
 def test_runs_named_one_by_one_keep_their_order_and_count_once(
