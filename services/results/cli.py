@@ -54,6 +54,7 @@ def results(paths: list[str], csv_path: str | None) -> str:
     out = output_file(csv_path, flag="--csv") if csv_path and not piped else None  # first
     records = _readable(run_folders(paths))
     _mixed(records)
+    _versions(records)
     header, table = rows.table(records)
     if piped:
         _csv_rows(sys.stdout, header, table)
@@ -79,6 +80,16 @@ def _mixed(records: list[rows.RunRecord]) -> None:
         print(f"catabot results: runs of {len(names)} scenarios ({', '.join(names)}): their "
               "differences are field by field; tabulate each scenario's runs apart for a "
               "sweep's columns", file=sys.stderr)  # fmt: skip
+
+
+def _versions(records: list[rows.RunRecord]) -> None:
+    """Runs of different commits (a sweep run while the code changed): said, as their
+    differences may be the code's; the CSV's git_commit column says which is which."""
+    commits = sorted({str(r.run.get("git_commit")) for r in records if r.run})
+    if len(commits) > 1:
+        print(f"catabot results: runs of {len(commits)} versions of the code ("
+              f"{', '.join(c[:12] for c in commits)}): see the CSV's git_commit column",
+              file=sys.stderr)  # fmt: skip
 
 
 def _readable(found: list[Path]) -> list[rows.RunRecord]:

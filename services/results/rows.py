@@ -28,7 +28,7 @@ VESSEL_COLUMNS = (
     "nearest_buoy_m", "nearest_shore_m", "collisions", "groundings", "capsizes",
     "thrust_impulse_Ns", "thrust_unknown_s", "distance_m", "max_speed_mps",
 )  # fmt: skip
-AFTER = ("closest_approach_m", "traffic_collisions")
+AFTER = ("closest_approach_m", "traffic_collisions", "git_commit")
 
 
 @dataclass(frozen=True)
@@ -115,6 +115,7 @@ def _run_cells(record: RunRecord) -> dict[str, Any]:
         "error": run.get("error") or None,
         "sim_s": run.get("sim_s", (record.metrics or {}).get("sim_time_s")),
         "wall_s": run.get("wall_s"),
+        "git_commit": run.get("git_commit"),  # a sweep may span a commit (results says so)
     }
 
 

@@ -95,6 +95,20 @@ def test_csv_dash_is_the_csv_on_stdout(
     assert said.err == "3 runs, 5 rows\n" and not (sweep / "-").exists()
 
 
+def test_runs_of_two_code_versions_are_said_and_the_csv_says_which(
+    sweep: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """A trial's sweep spanned a commit, and nothing in the table or the CSV told."""
+    for name, commit in (("sweep-1", "d9b360c0ffee+dirty"), ("sweep-2", "e3863f0c0ffee")):
+        path = sweep / name / "log" / "run.json"
+        path.write_text(json.dumps(json.loads(path.read_text()) | {"git_commit": commit}))
+    assert cli.main([str(sweep), "--csv", str(sweep / "t.csv")]) == 0
+    err = capsys.readouterr().err
+    assert "runs of 3 versions of the code (None, d9b360c0ffee, e3863f0c0ffe)" in err
+    commits = pd.read_csv(sweep / "t.csv")["git_commit"].fillna("").tolist()
+    assert commits == ["d9b360c0ffee+dirty"] * 2 + ["e3863f0c0ffee"] * 2 + [""]
+
+
 def test_runs_named_one_by_one_keep_their_order_and_count_once(
     sweep: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
