@@ -63,7 +63,7 @@ def plot_compared(folders: list[str], out: Path | None) -> str:
         fig.savefig(out / f"{name}.png", metadata=PNG)
         files[name] = f"{name}.png"
     compare.report(out / "compare.html", runs, files)
-    return f"{len(runs)} runs compared in {out}"
+    return f"{len(runs)} run{'' if len(runs) == 1 else 's'} compared in {out}"
 
 
 def main(argv: list[str] | None = None) -> int:
