@@ -217,7 +217,8 @@ def thrust(data: RunSeries) -> Figure | None:
             for c, name in enumerate(series.names):  # thinner each: equal ones both show
                 ax.step(t, held[:, c], style, where="post", label=name, lw=max(2.8 - c, 1.0))
         ax.set(title=f"{vid}: commands (solid: thrust, -1..1; dashed: twist set-points)",
-               xlabel="simulated time [s]", xlim=(0, end))  # fmt: skip
+               xlabel="simulated time [s]", xlim=(0, end),
+               ylabel="thrust [-1..1]; set-point [m/s, rad/s]")  # fmt: skip
         ax.grid(alpha=0.3)
         ax.legend(fontsize=8, loc="best")
     return fig
