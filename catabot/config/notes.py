@@ -19,15 +19,13 @@ from pathlib import Path
 from catabot.config import live
 from catabot.config.load import TERRAINS
 from catabot.config.scenario import Scenario
-from catabot.config.traffic import MAX_YAW_RATE
 
 FIELDS_OF_VIEW = ("hfov_deg", "vertical_fov_deg")
 
 
 def scenario_notes(scenario: Scenario) -> list[str]:
     """Every note, said by `scenario validate` and before a run alike."""
-    return [*shared_notes(scenario), *angle_notes(scenario), *terrain_notes(scenario),
-            *circle_notes(scenario)]  # fmt: skip
+    return [*shared_notes(scenario), *angle_notes(scenario), *terrain_notes(scenario)]
 
 
 def shared_notes(scenario: Scenario) -> list[str]:
@@ -63,21 +61,6 @@ def angle_notes(scenario: Scenario) -> list[str]:
                         f"{math.degrees(value):.4g} degrees: give that"
                     )
     return notes
-
-
-def circle_notes(scenario: Scenario) -> list[str]:
-    """Circles tighter than the traffic can turn at their speed: taken (the boats circle
-    wider), but said; a trial's 2-4 m circles came out at 16 m, unsaid."""
-    traffic = scenario.traffic
-    circle, least = traffic.circle, traffic.circle.speed_mps / MAX_YAW_RATE
-    drawn = traffic.behaviour_mix.get("circle", 0.0) > 0.0
-    if not (drawn or any(b.behaviour == "circle" for b in traffic.boats)):
-        return []
-    if not traffic.count or circle.radius_m[0] >= least:
-        return []
-    return [f"note: traffic.circle.radius_m {list(circle.radius_m)}: at speed_mps "
-            f"{circle.speed_mps:g} a traffic boat turns at most {MAX_YAW_RATE:g} rad/s, a "
-            f"circle of {least:.3g} m at least, so smaller circles come out that wide"]  # fmt: skip
 
 
 SCALE_FIELDS = ("metres_per_pixel", "min_elevation_m", "max_elevation_m")

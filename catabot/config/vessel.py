@@ -227,16 +227,22 @@ class VesselModel(Strict):
         and its first tick ended the run blaming buoyancy. Over 5 times the weight is a note
         (world/model_checks.py): a 2 kg hull with two 51 N thrusters is 5.2."""
         weight = self.mass_kg * GRAVITY
-        for field in ("max_forward_n", "max_reverse_n"):
-            forces = [getattr(t, field) for t in self.thrusters]
-            if sum(forces) > MAX_THRUST_TO_WEIGHT * weight:
+        for field, total in self.thrust_totals().items():
+            if total > MAX_THRUST_TO_WEIGHT * weight:
+                forces = [getattr(t, field) for t in self.thrusters]
                 raise FieldProblem(
                     f"thrusters.{int(np.argmax(forces))}.{field}",
-                    f"the thrusters together give {sum(forces):g} N, {sum(forces) / weight:.3g} "
+                    f"the thrusters together give {total:g} N, {total / weight:.3g} "
                     f"times the boat's weight ({weight:.4g} N for mass_kg {self.mass_kg:g}), "
                     f"over {MAX_THRUST_TO_WEIGHT:g}: the thrust (N) or mass_kg in another unit?",
                 )
         return self
+
+    def thrust_totals(self) -> dict[str, float]:
+        """Every thruster's force summed, ahead and astern (N): the one figure the
+        refusal above and the note of model_checks.py weigh against the weight."""
+        return {f: float(sum(getattr(t, f) for t in self.thrusters))
+                for f in ("max_forward_n", "max_reverse_n")}  # fmt: skip
 
     @model_validator(mode="after")
     def _shape_hulls(self) -> VesselModel:

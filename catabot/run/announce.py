@@ -9,7 +9,7 @@ from subprocess import Popen
 from catabot.bus.session import port_open
 from catabot.config.notes import scenario_notes
 from catabot.run import programs
-from catabot.world.traffic_notes import speed_notes
+from catabot.world.traffic_notes import traffic_notes
 from catabot.world.world import World
 
 LISTEN_WAIT_S = 10.0  # the conductor's endpoint opens ≈1-2 s after start on a busy machine
@@ -27,7 +27,7 @@ def announce(
     name = world.scenario.name
     print(f"zenoh: clients connect to {endpoint} (world {name!r}, keys catabot/{name}/...)",
           flush=True)  # fmt: skip
-    for note in [*scenario_notes(world.scenario), *speed_notes(world)]:
+    for note in [*scenario_notes(world.scenario), *traffic_notes(world)]:
         print(note, flush=True)
     _waits_for(world, scenario_file, endpoint)
 

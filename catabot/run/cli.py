@@ -24,7 +24,7 @@ from catabot.run.companions import VIEW_MODES
 from catabot.run.generate import ONLY_GENERATE, generate
 from catabot.run.generate import add_arguments as add_generate_arguments
 from catabot.world.model_checks import displacement, model_notes
-from catabot.world.traffic_notes import speed_notes
+from catabot.world.traffic_notes import traffic_notes
 
 
 def _run(args: argparse.Namespace) -> int:
@@ -163,7 +163,7 @@ def _scenario(args: argparse.Namespace) -> int:
         f"{len(world.buoys)} buoy(s), {len(world.sensors)} sensor(s), {s.ticks} ticks"
     )
     print(f"{args.file or 'default'}: valid ({counts})")
-    for note in [*scenario_notes(s), *speed_notes(world)]:
+    for note in [*scenario_notes(s), *traffic_notes(world)]:
         print(note)
     for text in [*late_settings(s), *late_steps(s)]:  # at a run: the conductor's, physics'
         print(f"note: {text}")

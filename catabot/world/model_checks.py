@@ -103,8 +103,7 @@ def _mesh(model: VesselModel, source: str) -> list[str]:
 def _thrusters(model: VesselModel) -> list[str]:
     lo, hi = model.hull_box()
     notes, weight = [], model.mass_kg * GRAVITY
-    push = max(sum(t.max_forward_n for t in model.thrusters),
-               sum(t.max_reverse_n for t in model.thrusters))  # fmt: skip
+    push = max(model.thrust_totals().values())
     if push > THRUST_TO_WEIGHT * weight:
         notes.append(f"its thrusters together push {push:g} N, {push / weight:.3g} times its "
                      f"weight: racing craft stay under 2 (thrust in N, mass in kg?)")  # fmt: skip

@@ -11,10 +11,31 @@ from __future__ import annotations
 
 from collections import Counter
 
+from catabot.config.traffic import MAX_YAW_RATE
 from catabot.world.course import top_speed_mps
 from catabot.world.world import World
 
 MOVING = ("circle", "waypoints")
+
+
+def traffic_notes(world: World) -> list[str]:
+    """Every note on the plan: its circles, then its speeds."""
+    return [*circle_notes(world), *speed_notes(world)]
+
+
+def circle_notes(world: World) -> list[str]:
+    """Circles tighter than the traffic can turn at their speed: taken (the boats circle
+    wider), but said; a trial's 2-4 m circles came out at 16 m, unsaid. From the plan, so
+    per-boat behaviours and radii count as drawn."""
+    tight = [b for b in world.traffic.boats
+             if b.behaviour == "circle" and b.radius_m < b.speed_mps / MAX_YAW_RATE]  # fmt: skip
+    if not tight:
+        return []
+    speed = max(b.speed_mps for b in tight)
+    return [f"note: traffic.circle.radius_m: {len(tight)} circling boat(s) with radii from "
+            f"{min(b.radius_m for b in tight):.3g} m; at speed_mps {speed:g} a traffic boat "
+            f"turns at most {MAX_YAW_RATE:g} rad/s, a circle of {speed / MAX_YAW_RATE:.3g} m "
+            "at least, so smaller circles come out that wide"]  # fmt: skip
 
 
 def speed_notes(world: World) -> list[str]:

@@ -204,15 +204,3 @@ def test_degrees_given_to_a_bounded_radians_field_are_named_as_such() -> None:
     data = _base()
     data["vessels"][0]["pose"] = {"x_m": 0.0, "y_m": 0.0, "roll_rad": 30}
     assert "roll_rad: must be <= 3.14159 (got 30) (degrees? 30° is 0.5236 rad)" in _refusal(data)
-
-
-def test_circles_tighter_than_the_traffic_can_turn_are_said() -> None:
-    """A trial's 2-4 m circles at 5 m/s came out at 16 m without a word."""
-    data = _base() | {"traffic": {"count": 3, "circle": {"radius_m": [2.0, 4.0]}}}
-    (note,) = scenario_notes(parse_scenario(data))
-    assert note.startswith("note: traffic.circle.radius_m [2.0, 4.0]: at speed_mps 5 a traffic ")
-    assert "a circle of 14.3 m at least" in note
-    data["traffic"]["circle"]["speed_mps"] = 0.5  # 1.4 m at 0.5 m/s: 2 m fits
-    assert scenario_notes(parse_scenario(data)) == []
-    data["traffic"] |= {"behaviour_mix": {"waypoints": 1.0}, "circle": {"radius_m": [2.0, 4.0]}}
-    assert scenario_notes(parse_scenario(data)) == []  # nobody circles
