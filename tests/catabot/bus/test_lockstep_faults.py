@@ -117,9 +117,9 @@ def test_the_late_one_does_not_blame_whom_it_waited_for(
     try:
         with caplog.at_level("WARNING", logger="catabot.bus.participant"):
             result = world.run(names, 100, deadline_s=2.5, start_timeout_s=5.0, window_ticks=8)
+            world.members["cons"].join()  # before `slow` steps on: its sample had raced the End
             release.set()  # the End is out: the late one steps on, then finds it
             world.members["slow"].join()
-            world.members["cons"].join()
     finally:
         release.set()
     assert result.error == "participant 'slow' missed the 2.5 s deadline of tick 12"
