@@ -20,6 +20,7 @@ import zenoh
 
 from catabot.bus import codec
 from catabot.bus.clock import CONDUCTOR, ClockError, ClockLimits, EndRun, Stream, blames, end_reason
+from catabot.bus.grants import Grants
 from catabot.bus.identity import Roster, sender_of, shown
 from catabot.bus.inbox import Inbox, Inputs
 from catabot.bus.keys import Keys
@@ -27,7 +28,6 @@ from catabot.bus.members import Members, claim
 from catabot.bus.messages import Ack, End, Tick
 from catabot.bus.outputs import Outputs
 from catabot.bus.rejections import Rejected, Rejections
-from catabot.bus.settings import from_wire, settings_problem
 from catabot.bus.start_wait import StartWait
 
 log = logging.getLogger("catabot.bus.participant")
@@ -69,15 +69,12 @@ class Participant(Outputs):
         self.members = Members(keys, self.roster)
         self.rejections = Rejections(log, name)
         self.peers, self.drain_s = set(peers) - {name}, drain_s
-        self._everyone = self.peers | {name}  # the peers a tick may name as dropped
+        self._grants = Grants(limits=limits, everyone=self.peers | {name})
         self.next_tick, self._acked = 0, -1  # the next tick to step, the last acked
         self._ended = False  # asked the conductor to end the run: no more steps
-        self._asked = False  # a repeated grant: ack progress as it comes from then on
-        self._grant: Tick | None = None
-        self._settings: dict[int, list[str]] = {}  # changes granted, by the tick they apply
         self._held_clock: list[Event] = []  # until the conductor's session is known
         self.events: queue.SimpleQueue[Event] = queue.SimpleQueue()
-        self.run_id, self._orphaned_at = "", 0.0
+        self._orphaned_at = 0.0
         self._warned_tick, self._met = -1, False  # _met: every peer seen present once
         self._idle_s = limits.idle_s if limits else 1.0
         self._waiting_since = self._check_at = time.monotonic()  # _check_at: next _ack_waiting
@@ -105,7 +102,11 @@ class Participant(Outputs):
 
     @property
     def granted(self) -> int:  # the last tick granted so far (-1 before the first grant)
-        return self._grant.tick if self._grant is not None else -1
+        return self._grants.tick
+
+    @property
+    def run_id(self) -> str:  # the conductor's run, once a tick of it was believed
+        return self._grants.run_id
 
     def _on_live(self, sample: zenoh.Sample) -> None:
         kind = "join" if sample.kind == zenoh.SampleKind.PUT else "leave"
@@ -128,7 +129,7 @@ class Participant(Outputs):
             if end is not None:
                 return self._finish(end, on_end)
             self._step_ready(step)
-            if event[0] == "idle" or self._asked or time.monotonic() >= self._check_at:
+            if event[0] == "idle" or self._grants.repeated or time.monotonic() >= self._check_at:
                 self._ack_waiting()  # by the clock too: events without end (junk) held it
 
     def _take(self, event: Event) -> End | None:
@@ -146,13 +147,13 @@ class Participant(Outputs):
     def _step_ready(self, step: StepFn) -> None:
         """Step every granted tick whose inputs are complete, in order, acking every
         `ack_every` ticks and at the grant's end."""
-        grant = self._grant
+        grant = self._grants.last
         while grant is not None and self.next_tick <= grant.tick and not self._ended:
             k = self.next_tick
             if not self._ready(k):
                 break
             try:
-                step(self._tick_of(grant, k), self.inbox.release(k))
+                step(self._grants.tick_of(k), self.inbox.release(k))
             except EndRun as request:
                 self._end_before(grant, k, str(request))
                 return
@@ -181,15 +182,11 @@ class Participant(Outputs):
         """Ticks stepped since the last ack wait for inputs (no events for `idle_s`, or the
         run is ending): ack them now, or a missed deadline names whoever waits for data."""
         self._check_at = time.monotonic() + self._idle_s
-        if self._grant is None:
+        grant = self._grants.last
+        if grant is None:
             self._start.idle(self.present)
         elif self.next_tick - 1 > self._acked:
-            self._ack_through(self._grant, self.next_tick - 1)
-
-    def _tick_of(self, grant: Tick, k: int) -> Tick:
-        stamp = grant.stamp_ns - (grant.tick - k) * grant.dt_ns
-        changes = tuple(self._settings.pop(k, ()))
-        return Tick(grant.run, k, stamp, grant.dt_ns, grant.dropped, grant.ack_every, changes)
+            self._ack_through(grant, self.next_tick - 1)
 
     def _next(self) -> Event:
         """The next event; an End may trail the conductor's token, so allow it a grace."""
@@ -245,7 +242,7 @@ class Participant(Outputs):
             if kind == "tick":
                 self._take_tick(codec.decode(payload, Tick))
                 return self._dropped()
-            return self._checked_end(codec.decode(payload, End))
+            return self._grants.end(codec.decode(payload, End))
         except codec.CodecError as exc:
             self.rejections.add(key, Rejected("malformed", str(exc)))
         except Rejected as exc:
@@ -253,52 +250,20 @@ class Participant(Outputs):
         return None
 
     def _take_tick(self, tick: Tick) -> None:
-        if self.run_id and tick.run != self.run_id:
-            raise Rejected("tick of another run", tick.run)
-        self.run_id = tick.run  # the conductor's (its session checked): a fault names this run
-        if self.limits is not None:
-            self.limits.check_digest(tick.digest)  # raises: another scenario than the conductor's
-        problem = self._tick_problem(tick)
-        if problem:
-            raise Rejected("tick the clock cannot send", problem)
-        for text in tick.settings:
-            self._settings.setdefault(from_wire(text).tick, []).append(text)
+        dry = self.next_tick > self._grants.tick  # it had run dry: a wait begins
+        self._grants.take(tick, next_tick=self.next_tick)  # Rejected: the clock cannot send it
         self.inbox.drop_producers(tick.dropped)
         self.peers -= set(tick.dropped)  # a dropped peer that crashed will never be present
-        if self._grant is None or self.next_tick > self._grant.tick:
-            self._waiting_since = time.monotonic()  # it had run dry: a wait begins
-        was = self._grant  # the same grant again, no one dropped: the run is ending
-        self._asked |= was is not None and (was.tick, was.dropped) == (tick.tick, tick.dropped)
-        self._grant = tick  # grants only grow (checked); a repeat carries a new dropped list
+        if dry:
+            self._waiting_since = time.monotonic()
 
     def _dropped(self) -> End | None:
         """Its own End once a grant names it dropped (policy drop): a slow stack had stepped
         45 s of queued ticks whose commands nobody took, then heard "completed"."""
-        if self._grant is not None and self.name in self._grant.dropped:
+        if self._grants.drops(self.name):
             why = f"{self.name} was dropped (clock.policy drop): the run goes on without it"
             return End(self.run_id, self.next_tick - 1, DROPPED, why)
         return None
-
-    def _tick_problem(self, tick: Tick) -> str:
-        grant = self._grant.tick if self._grant is not None else -1
-        if self.limits is not None:
-            problem = self.limits.problem(tick, next_tick=self.next_tick, grant=grant)
-            if problem:
-                return problem
-        if tick.ack_every < 1:
-            return f"ack_every {tick.ack_every}"
-        unknown = set(tick.dropped) - self._everyone
-        if unknown:
-            return f"drops unknown participants {sorted(unknown)}"
-        return settings_problem(tick.settings, tick.tick, after=max(grant, self.next_tick - 1))
-
-    def _checked_end(self, end: End) -> End:
-        if self.run_id and end.run != self.run_id:
-            raise Rejected("end of another run", end.run)
-        granted = self._grant.tick if self._grant is not None else -1
-        if not -1 <= end.tick <= granted:
-            raise Rejected("end the clock cannot send", f"tick {end.tick}, granted {granted}")
-        return end
 
     def _ready(self, tick: int) -> bool:
         """Every due input in, and each peer seen once (it knows our subscriptions); one gone
