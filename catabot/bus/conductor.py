@@ -16,11 +16,11 @@ import zenoh
 
 from catabot.bus import clock, codec
 from catabot.bus.clock import CONDUCTOR, ClockError, ClockSpec, Policy, Progress, RunResult
+from catabot.bus.clock_watch import ClockOutputs
 from catabot.bus.identity import Roster, sender_of, shown
 from catabot.bus.keys import Keys
 from catabot.bus.members import Members, claim
 from catabot.bus.messages import Ack, End, Tick
-from catabot.bus.outputs import Outputs
 from catabot.bus.rejections import Rejected, Rejections
 from catabot.bus.session import LEASE_MS
 from catabot.bus.settings import Schedule
@@ -60,11 +60,10 @@ class Conductor:
         self._told = ""  # the fault a participant told (Ack.fault): the run's error
         self._done, self._granted = 0, -1  # ticks every active one acked; the last granted
         self._acked = {name: -1 for name in spec.participants}
-        self._t0, self._out = self._created, Outputs(session)  # ticks and ends, signed
+        self._t0, self._out = self._created, ClockOutputs(session, keys, self.events)  # forged?
         self._token = session.liveliness().declare_token(keys.live(CONDUCTOR, str(session.zid())))
-        # Acks arrive on a FIFO channel (no Python callback per ack: the hot path); rare
-        # events (a participant leaving, a deadline passing, a stop) go to `events`, and the
-        # watchdog thread wakes the tick loop by publishing a poke on the conductor's own ack key.
+        # Acks on a FIFO channel (no Python callback per ack); rare events (one leaving, a stop)
+        # to `events`: the watchdog wakes the loop with a poke on the conductor's own ack key.
         self._acks = session.declare_subscriber(keys.acks(), zenoh.handlers.FifoChannel(4096))
         self._poke_key = keys.ack(CONDUCTOR)
         self._poke_pub = session.declare_publisher(self._poke_key)
@@ -223,8 +222,7 @@ class Conductor:
         self._advance()
 
     def _end_request(self, name: str, ack: Ack, *, fault: str = "") -> None:
-        """A participant ends the run after `ack.tick` (first wins): no more grants, a repeated
-        one (ack as you go), the End once all stepped it; a told `fault` alike, but failed."""
+        """A participant ends the run after `ack.tick` (first wins; a told `fault` fails it)."""
         if self._stop_reason:
             return
         self._end_at = max(min(ack.tick, self._granted), self._done - 1)
@@ -263,11 +261,13 @@ class Conductor:
         wait = self.spec.deadline_s + self.settings.grace(self._done, self._granted)
         self._deadline = time.monotonic() + wait if self._done <= self._granted else None
 
-    def _active(self) -> list[str]:
+    def _active(self) -> list[str]:  # the participants not dropped
         return [n for n in sorted(self._acked) if n not in self.dropped]
 
     def _check_events(self) -> None:
         """Apply pending membership events (a stop is noted in `_stop_reason`) and the deadline."""
+        if self._out.forged:  # before who left: a forged End makes them leave
+            raise ClockError(self._out.forged)
         gone = self._now_gone()
         if gone:  # a lost link takes every token behind it: name them together
             gone = self._settled_gone()
@@ -338,13 +338,13 @@ class Conductor:
         return event
 
     @property
-    def members(self) -> set[str]:
-        """The participants whose token is alive (and bound to them)."""
+    def members(self) -> set[str]:  # the participants whose token is alive (and bound)
         return set(self._members.present)
 
     def close(self) -> None:
         self._closed.set()
         self._watchdog.join()
         self._acks.undeclare()
+        self._out.close()
         self._live.undeclare()
         self._token.undeclare()

@@ -78,6 +78,10 @@ class Roster:
     def zid(self, name: str) -> str | None:
         return self.fixed.get(name) or self.learnt.get(name)
 
+    def knows(self, zid: str) -> bool:
+        """Whether `zid` is one of the run's sessions (called for every sample: no copies)."""
+        return zid in self.fixed.values() or zid in self.learnt.values()
+
     def bind(self, name: str, zid: str) -> bool:
         """Learn `name` from a token; False (ignore the token) if it contradicts a binding."""
         known = self.zid(name)

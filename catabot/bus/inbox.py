@@ -39,6 +39,13 @@ WILDCARD = "a put on a key expression with wildcards; a command goes to one key"
 ORDERS = (ThrustCmd, TwistCmd, WaypointsCmd)
 
 
+class Conflict(Rejected):
+    """Two different samples for one tick of a stream, both from its producer's session: one
+    is forged (a session's id is what a sample states: identity.py) or the producer broke the
+    protocol. Taking either would make the run depend on which came first, so the participant
+    ends the run saying so (a trial's forged states were recorded in place of physics's)."""
+
+
 class Inbox:
     def __init__(
         self, streams: Sequence[Stream], *, roster: Roster | None = None, dt_ns: int = 0
@@ -49,6 +56,7 @@ class Inbox:
         self.roster = roster if roster is not None else Roster()
         self.dt_ns = dt_ns  # 0: stamps are not checked (no clock limits known)
         self.latest = {key: -1 for key in self.streams}
+        self._payload: dict[str, bytes] = {}  # each clocked stream's last, for `Conflict`
         self.held: dict[str, list[Message]] = {key: [] for key in self.streams}
         self.dropped: set[str] = set()
         self.handed: set[str] = set()  # dropped producers past their stall (stalled_by)
@@ -84,12 +92,14 @@ class Inbox:
             return  # held until the producer's session is known
         msg = _decoded(payload, stream)
         tick = _tick_of(msg)
+        if stream.period is not None and tick == self.latest[key] >= 0:
+            self._second(key, tick, payload)
         self._check_tag(stream, msg, tick, horizon)
         try:
             _check_content(stream, msg)
         except Rejected as exc:
             if stream.period is not None and isinstance(msg, ORDERS):
-                self.latest[key] = tick  # answered, without the order: nobody waits for it
+                self.latest[key], self._payload[key] = tick, payload  # answered, no order
                 raise Rejected(
                     exc.reason, f"{exc.detail}; tick {tick} goes on without it"
                 ) from None
@@ -97,6 +107,17 @@ class Inbox:
         self.held[key].append(msg)
         self._holding.add(key)
         self.latest[key] = max(self.latest[key], tick)
+        if stream.period is not None:
+            self._payload[key] = payload
+
+    def _second(self, key: str, tick: int, payload: bytes) -> None:
+        """A second sample for a tick already taken: the same bytes again are refused as
+        such; other bytes are a `Conflict`."""
+        if payload != self._payload.get(key, payload):
+            producer = self.streams[key].producer
+            raise Conflict("two different samples for one tick", f"tick {tick} of {key}, both "
+                           f"in {producer}'s session's name: one is forged, or {producer} sent "
+                           "two (one a tick at most)")  # fmt: skip
 
     def _from_producer(self, stream: Stream, key: str, payload: bytes, sender: str) -> bool:
         producer = self.roster.zid(stream.producer)

@@ -22,8 +22,9 @@ from catabot.bus import codec
 from catabot.bus.clock import CONDUCTOR, ClockError, ClockLimits, EndRun, Stream, blames, end_reason
 from catabot.bus.grants import Grants
 from catabot.bus.identity import Roster, sender_of, shown
-from catabot.bus.inbox import Inbox, Inputs
+from catabot.bus.inbox import Conflict, Inbox, Inputs
 from catabot.bus.keys import Keys
+from catabot.bus.lanes import Event, Lanes
 from catabot.bus.members import Members, claim
 from catabot.bus.messages import Ack, End, Tick
 from catabot.bus.outputs import Outputs
@@ -40,7 +41,6 @@ this process lost its link or was frozen (the conductor's own error says which)"
 MAX_HELD_CLOCK = 64  # clock messages held while the conductor's session is not known yet
 StepFn = Callable[[Tick, Inputs], None]
 EndFn = Callable[[End, Inputs], None]
-Event = tuple[str, str, bytes, str]  # kind, key, payload, sender zid
 
 
 class Stopped(ClockError):
@@ -73,7 +73,7 @@ class Participant(Outputs):
         self.next_tick, self._acked = 0, -1  # the next tick to step, the last acked
         self._ended = False  # asked the conductor to end the run: no more steps
         self._held_clock: list[Event] = []  # until the conductor's session is known
-        self.events: queue.SimpleQueue[Event] = queue.SimpleQueue()
+        self.events = Lanes(trusted=self.roster.knows)  # a stranger's flood: lanes.py
         self._orphaned_at = 0.0
         self._warned_tick, self._met = -1, False  # _met: every peer seen present once
         self._idle_s = limits.idle_s if limits else 1.0
@@ -91,9 +91,11 @@ class Participant(Outputs):
 
     def _push(self, kind: str) -> Callable[[zenoh.Sample], None]:
         def on_sample(sample: zenoh.Sample) -> None:
-            self.events.put(
-                (kind, str(sample.key_expr), sample.payload.to_bytes(), sender_of(sample))
-            )
+            key, sender, payload = str(sample.key_expr), sender_of(sample), sample.payload
+            if self.events.admits(kind, sender, len(payload)):  # before copying the payload
+                self.events.put((kind, key, payload.to_bytes(), sender))
+            else:
+                self.events.refuse(key, sender)
 
         return on_sample
 
@@ -125,9 +127,13 @@ class Participant(Outputs):
             event = self._next()
             if event[0] == "stop":
                 raise Stopped(f"{self.name} left the run at tick {self.next_tick}")
+            started = time.perf_counter()
             end = self._take(event)
+            self.events.spent(event, time.perf_counter() - started)  # a stranger's: budgeted
             if end is not None:
                 return self._finish(end, on_end)
+            if self.events.dropped:
+                self._report_floods()
             self._step_ready(step)
             if event[0] == "idle" or self._grants.repeated or time.monotonic() >= self._check_at:
                 self._ack_waiting()  # by the clock too: events without end (junk) held it
@@ -205,7 +211,14 @@ class Participant(Outputs):
         elif kind == "leave" and name == CONDUCTOR:
             self._orphaned_at = time.monotonic()
         elif kind == "join":
+            self.events.joined(self.roster.zid(name) or "")  # its laned samples first
             self._retry_held(name)
+
+    def _report_floods(self) -> None:
+        """Samples a stranger's lane could not hold (lanes.py), counted like any refusal."""
+        for sender, (count, key) in self.events.take_dropped().items():
+            why = f"{count} from {shown(sender)} dropped unread: sent faster than they are taken"
+            self.rejections.add(key, Rejected("flood", why), count=count)
 
     def _retry_held(self, name: str) -> None:
         """Samples and clock messages held until `name`'s session was known."""
@@ -225,6 +238,9 @@ class Participant(Outputs):
     def _take_data(self, key: str, payload: bytes, sender: str) -> None:
         try:
             self.inbox.add(key, payload, sender=sender, horizon=self._horizon())
+        except Conflict as exc:  # the run would depend on which came first: it ends here
+            self.rejections.add(key, exc)
+            self.report_fault(str(exc))
         except Rejected as exc:
             self.rejections.add(key, exc)
 

@@ -36,10 +36,11 @@ class Rejections:
         self._last: dict[tuple[str, str], float] = {}
         self._details: dict[tuple[str, str], set[str]] = {}
 
-    def add(self, key: str, rejected: Rejected) -> None:
-        self.totals[rejected.reason] += 1
+    def add(self, key: str, rejected: Rejected, *, count: int = 1) -> None:
+        """`count`: samples this refusal stands for (a flood's, counted where it arrived)."""
+        self.totals[rejected.reason] += count
         item = (key, rejected.reason)
-        self._since[item] += 1
+        self._since[item] += count
         now = time.monotonic()
         if self._new_detail(item, rejected.detail) or (
             now - self._last.get(item, -self.every_s) >= self.every_s

@@ -14,9 +14,8 @@ from __future__ import annotations
 
 import json
 import logging
-import queue
 import time
-from typing import Any
+from typing import Any, Protocol
 
 import zenoh
 
@@ -31,6 +30,12 @@ NO_CLOCK = "; is its conductor on this router (--connect), or has its run ended?
 ASK_TIMEOUT_S = 5.0
 
 
+class Sink(Protocol):
+    """Where a digest that differs goes: the participant's events (lanes.py), or a queue."""
+
+    def put(self, item: Any, /) -> None: ...
+
+
 class StartWait:
     """A participant's side of the wait for tick 0 (its own thread calls `idle`)."""
 
@@ -41,7 +46,7 @@ class StartWait:
         name: str,
         *,
         roster: Roster,
-        events: queue.SimpleQueue[Any],
+        events: Sink,
         digest: str,
     ) -> None:
         """`digest`: this process's scenario's ("" asks nothing); a conductor's that is

@@ -22,8 +22,12 @@ def watch_strays(participant: Participant, pattern: str, why: Callable[[str], st
     def on_sample(sample: zenoh.Sample) -> None:
         key = str(sample.key_expr)
         if key not in known:  # the streams' own samples: a set lookup, nothing queued
+            sender = sender_of(sample)
+            if not events.admits("stray", sender, 0):  # a stranger's flood (lanes.py)
+                events.refuse(key, sender)
+                return
             reason = shape_problem(key, pattern) or why(key)
-            events.put(("stray", key, reason.encode(), sender_of(sample)))
+            events.put(("stray", key, reason.encode(), sender))
 
     participant.keep(participant.session.declare_subscriber(pattern, on_sample))
     # only now, the watch declared: a wildcard put the inbox leaves to it is heard by it

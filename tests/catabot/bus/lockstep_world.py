@@ -16,7 +16,6 @@ from typing import Any
 
 import zenoh
 
-from catabot.bus import codec
 from catabot.bus.clock import ClockLimits, Stream
 from catabot.bus.conductor import ClockSpec, Conductor, RunResult
 from catabot.bus.inbox import Inputs
@@ -153,11 +152,10 @@ class World:
         return self.result
 
     def close(self) -> None:
-        # Stop any participant still running (a failed test) with an End of its own run.
+        # Stop any participant still running (a failed test, one the test left waiting).
         for m in self.members.values():
             if m.thread.is_alive():
-                end = End(m.participant.run_id, -1, "teardown")
-                m.participant.events.put(("end", self.keys.end(), codec.encode(end)))
+                m.participant.stop()
                 m.thread.join(3.0)
         for m in self.members.values():
             _quietly(m.participant.close)

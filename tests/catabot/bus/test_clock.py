@@ -8,7 +8,7 @@ from catabot.bus import checks, codec
 from catabot.bus import inbox as inbox_module
 from catabot.bus.clock import ClockError, Policy, Stream, period_in_ticks, ticks_for
 from catabot.bus.identity import Roster
-from catabot.bus.inbox import Inbox
+from catabot.bus.inbox import Conflict, Inbox
 from catabot.bus.messages import GpsFix, ImuSample, ThrustCmd, TwistBatch, TwistCmd, VesselState
 from catabot.bus.rejections import Rejected
 from tests.catabot.bus.inbox_samples import (
@@ -207,6 +207,21 @@ def test_a_late_or_repeated_sample_is_refused_and_keeps_the_mark() -> None:
         _add(inbox, STATE, _state(5))
     assert inbox.latest[STATE] == 5
     assert STATE not in inbox.missing(6)
+
+
+def test_a_different_second_sample_for_a_tick_is_a_conflict() -> None:
+    """A trial copied physics's session id and sent its own states for each tick: whichever
+    came first was recorded. Two different samples for one tick are a `Conflict`, which
+    ends the run (the same bytes twice stay a plain refusal)."""
+    inbox = _inbox()
+    _add(inbox, STATE, _state(0))
+    forged = codec.encode(
+        VesselState(0, 0, (600.0, 0.0, 0.0), (0.0, 0.0, 0.0, 1.0), *[(0.0,) * 3] * 4)
+    )
+    said = "in physics's session's name: one is forged, or physics sent two"
+    with pytest.raises(Conflict, match=f"two different samples for one tick: tick 0 of .*{said}"):
+        _add(inbox, STATE, forged)
+    assert [m.position for m in inbox.release(1)[STATE]] == [(0.0, 0.0, 0.0)]
 
 
 def test_dropped_producers_are_not_waited_for() -> None:
