@@ -217,7 +217,7 @@ class Participant(Outputs):
     def _report_floods(self) -> None:
         """Samples a stranger's lane could not hold (lanes.py), counted like any refusal."""
         for sender, (count, key) in self.events.take_dropped().items():
-            why = f"{count} from {shown(sender)} dropped unread: sent faster than they are taken"
+            why = f"from {shown(sender)}, dropped unread: sent faster than they are taken"
             self.rejections.add(key, Rejected("flood", why), count=count)
 
     def _retry_held(self, name: str) -> None:
