@@ -252,18 +252,21 @@ def _bytes(values: np.ndarray) -> np.ndarray:
 
 
 class TfBatch:
-    """`tf2_msgs/msg/TFMessage` of many bodies (map -> body), filled array-wide: the frame
-    ids never change, so the message is a template whose stamps and poses sit at offsets
-    found once."""
+    """`tf2_msgs/msg/TFMessage` of many frames (map -> body, or one parent per frame), filled
+    array-wide: the frame ids never change, so the message is a template whose stamps and
+    poses sit at offsets found once."""
 
-    def __init__(self, frame_id: str, child_frame_ids: typing.Sequence[str]) -> None:
+    def __init__(
+        self, frame_id: str | typing.Sequence[str], child_frame_ids: typing.Sequence[str]
+    ) -> None:
         layout, args = Layout(), [ENCAPSULATION, len(child_frame_ids)]
         layout.add("I", 4)  # sequence length
         stamps, poses = [], []
-        for child in child_frame_ids:
+        parents = [frame_id] * len(child_frame_ids) if isinstance(frame_id, str) else frame_id
+        for parent, child in zip(parents, child_frame_ids, strict=True):
             layout.align(4)
             stamps.append(layout.offset)
-            frame = header(layout, frame_id)
+            frame = header(layout, parent)
             name = layout.string(child)
             layout.align(_FLOAT64)
             poses.append(layout.offset)
@@ -277,7 +280,7 @@ class TfBatch:
         self._pose_at = (np.array(poses, np.intp)[:, None] + head + np.arange(56)).ravel()
 
     def encode(self, stamp_ns: int, position: np.ndarray, orientation: np.ndarray) -> bytes:
-        """position (N, 3) and orientation (N, 4, x y z w) of the bodies, in `map`."""
+        """position (N, 3) and orientation (N, 4, x y z w) of the frames, in their parents."""
         if position.shape != (self.size, 3) or orientation.shape != (self.size, 4):
             raise ValueError(
                 f"tf of {position.shape} positions and {orientation.shape} orientations "

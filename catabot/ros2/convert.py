@@ -4,8 +4,10 @@ types, frames and bytes.
 
 - `world/states` (BodyStates) -> each vessel's `odom` (nav_msgs/Odometry in `map`, child
   `<ns>/base_link`, body-frame velocities, zero covariance: the state is exact) and one
-  `/tf` TFMessage of every body (map -> `<ns>/base_link`, buoys included);
-- the sensors' samples -> convert_sensors.py; `/tf_static`: base_link -> every sensor frame;
+  `/tf` TFMessage of every body (map -> `<ns>/base_link`, buoys included) and every radar
+  (base_link -> its level frame: frames.py);
+- the sensors' samples -> convert_sensors.py; `/tf_static`: base_link -> every other sensor
+  frame;
 - twist and thrust commands -> `cmd_vel` (geometry_msgs/Twist: linear.x surge, angular.z
   yaw rate) and `thrust` (std_msgs/Float64MultiArray, one value per thruster, -1..1);
 - the buoys -> `/buoys` (visualization_msgs/MarkerArray): one box per buoy, in the buoy's own
@@ -21,10 +23,10 @@ import numpy as np
 from catabot.bus.messages import BodyStates, Message, ThrustCmd, TwistBatch, TwistCmd, check_ids
 from catabot.config.ros import RosConfig
 from catabot.ros2 import types
-from catabot.ros2.cdr import OdometryBatch, TfBatch
+from catabot.ros2.cdr import OdometryBatch
 from catabot.ros2.cdr_more import clock, twist, twist_rows
 from catabot.ros2.convert_sensors import Convert, Out, Want, converter, everything
-from catabot.ros2.frames import static_transforms, tf_message
+from catabot.ros2.frames import BodyFrames, static_transforms, tf_message
 from catabot.ros2.names import BUOYS, CLOCK, MAP, TF_STATIC, Names
 from catabot.world.world import World
 
@@ -40,7 +42,7 @@ class Converter:
         self.odom_rows = np.array([b.row for b in odom], dtype=np.intp)
         self.odom_topics = tuple(names.odom(b.id) for b in odom)
         self._odometry = OdometryBatch(MAP, [names.base_link(b.id) for b in odom])
-        self._tf = TfBatch(MAP, [names.base_link(b.id) for b in world.bodies])
+        self._tf = BodyFrames(names, world.bodies)
         self.boat_twist_topics = tuple(names.topic(b, "cmd_vel") for b in world.boat_ids)
         self._sensors: dict[str, Convert] = {
             world.keys.relative(s.key): converter(names, s) for s in world.sensors
@@ -63,8 +65,9 @@ class Converter:
         return out
 
     def tf(self, batch: BodyStates) -> bytes:
-        """Every body's frame in `map`, one TFMessage (rows checked by `odometry_groups`)."""
-        return self._tf.encode(batch.stamp_ns, batch.position, batch.orientation)
+        """Every body's frame in `map` and every radar's on its vessel, one TFMessage (rows
+        checked by `odometry_groups`)."""
+        return self._tf.encode(batch)
 
     def static_tf(self) -> Out | None:
         """base_link -> every sensor frame, stamped 0 (static); None without sensors."""

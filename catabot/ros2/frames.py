@@ -3,7 +3,10 @@
 The mount geometry is each sensor type's own (services/sensors: the models' docstrings);
 it is restated here from the parameters because the library never imports a service, and
 tests/catabot/ros2/test_frames.py checks every type against the model's own pose, so the
-two cannot drift. One `tf2_msgs/TFMessage` of all of them goes on `/tf_static` once.
+two cannot drift. One `tf2_msgs/TFMessage` of the fixed mounts goes on `/tf_static` once.
+A radar is stabilised (its sweep level, turned with the heading only), so its frame moves
+against its vessel as the vessel rolls and pitches: `BodyFrames` sends it on `/tf` beside
+the bodies, with the state it was swept from.
 """
 
 from __future__ import annotations
@@ -12,10 +15,12 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from catabot.bus.messages import BodyStates
 from catabot.ros2 import types
-from catabot.ros2.names import Names
+from catabot.ros2.cdr import TfBatch
+from catabot.ros2.names import MAP, Names
 from catabot.world import rotations
-from catabot.world.world import MountedSensor
+from catabot.world.world import Body, MountedSensor
 
 OPTICAL = np.array([[0.0, 0.0, 1.0], [-1.0, 0.0, 0.0], [0.0, -1.0, 0.0]])
 """The ROS optical frame (z forward, x right, y down) in the camera's FLU frame."""
@@ -52,10 +57,12 @@ def _xyz(values: tuple[float, ...]) -> tuple[float, float, float]:
 
 
 def static_transforms(names: Names) -> list[Transform]:
-    """base_link -> every sensor frame of every scenario vessel; cameras also frame ->
-    optical frame (their images' frame)."""
+    """base_link -> every fixed sensor frame of every scenario vessel (not the radars:
+    `BodyFrames`); cameras also frame -> optical frame (their images' frame)."""
     out = []
     for sensor in names.world.sensors:
+        if sensor.config.type == "radar":
+            continue
         xyz, rot = mount(sensor)
         frame = names.sensor_frame(sensor)
         quat = rotations.quaternion_of_matrix(rot)
@@ -86,3 +93,29 @@ def tf_message(transforms: list[Transform], stamp_ns: int) -> bytes:
 
 def _fields(names: str, values: tuple[float, ...]) -> dict[str, float]:
     return dict(zip(names, values, strict=True))
+
+
+class BodyFrames:
+    """One `/tf` message of some bodies' frames (map -> base_link) and of their radars'
+    (base_link -> the level frame at the antenna, turned with the heading: `levelling`)."""
+
+    def __init__(self, names: Names, bodies: list[Body] | tuple[Body, ...]) -> None:
+        rows = [b.row for b in bodies]
+        self.rows = None if rows == list(range(len(names.world.bodies))) else np.array(rows)
+        on = {b.id for b in bodies}
+        radars = [s for s in names.world.sensors if s.config.type == "radar" and s.vessel in on]
+        self.radar_rows = np.array([names.world.body(s.vessel).row for s in radars], np.intp)
+        self.antennas = np.array([mount(s)[0] for s in radars], np.float64).reshape(-1, 3)
+        parents = [MAP] * len(bodies) + [names.base_link(s.vessel) for s in radars]
+        children = [names.base_link(b.id) for b in bodies] + [names.sensor_frame(s) for s in radars]
+        self._batch = TfBatch(parents, children)
+
+    def encode(self, batch: BodyStates) -> bytes:
+        position, orientation = batch.position, batch.orientation
+        if self.rows is not None:
+            position, orientation = position[self.rows], orientation[self.rows]
+        if len(self.radar_rows):
+            level = rotations.levelling(batch.orientation[self.radar_rows])
+            position = np.concatenate((position, self.antennas))
+            orientation = np.concatenate((orientation, level))
+        return self._batch.encode(batch.stamp_ns, position, orientation)

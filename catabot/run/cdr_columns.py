@@ -66,9 +66,11 @@ class _Walk:
 
 @dataclass(frozen=True)
 class Poses:
-    """Per message: `frames` (N,) child frames, `pose` (T, N, 7) x y z qx qy qz qw."""
+    """Per message: `frames` (N,) child frames, `parents` (N,) theirs, `pose` (T, N, 7) x y
+    z qx qy qz qw."""
 
     frames: tuple[str, ...]
+    parents: tuple[str, ...]
     pose: F64
 
 
@@ -102,15 +104,15 @@ def tf_poses(rows: NDArray[np.uint8], what: str = "/tf") -> Poses:
     count_at = walk.pos
     count = walk.u32()
     walk.fixed.append((count_at, walk.pos))
-    frames, offsets = [], []
+    frames, parents, offsets = [], [], []
     for _ in range(count):
         walk.stamp()
-        walk.string()  # the parent frame
+        parents.append(walk.string())
         frames.append(walk.string())
         offsets.append(walk.floats(_POSE))
     _check_fixed(rows, walk, what)
     pose = _gather(rows, offsets, _POSE) if offsets else np.empty((len(rows), 0, _POSE))
-    return Poses(tuple(frames), pose)
+    return Poses(tuple(frames), tuple(parents), pose)
 
 
 def odometry(rows: NDArray[np.uint8], what: str = "odometry") -> Odometry:

@@ -2,7 +2,8 @@
 
 The recorder writes every body's frame at the ticks of `recording.traffic_rate_hz` and the
 scenario vessels' alone at the ticks between (services/recorder/thinning.py), so `/tf` has
-messages of a few lengths. Each length is one layout, decoded array-wide; a body's poses
+messages of a few lengths; a radar's frame rides along under its vessel (not a body: skipped,
+catabot/ros2/frames.py). Each length is one layout, decoded array-wide; a body's poses
 between two of its samples are interpolated (position linearly, orientation by normalised
 linear interpolation on the shorter arc), after its last sample held, and `sampled` says
 which were recorded.
@@ -16,6 +17,7 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import NDArray
 
+from catabot.ros2.names import MAP
 from catabot.run.cdr_columns import tf_poses
 
 F64 = NDArray[np.float64]
@@ -36,10 +38,11 @@ def track(
     column = {f: j for j, f in enumerate(frames)}
     for index, rows in groups:
         poses = tf_poses(rows)
-        if not set(poses.frames) <= column.keys():
+        bodies = [j for j, parent in enumerate(poses.parents) if parent == MAP]
+        if not {poses.frames[j] for j in bodies} <= column.keys():
             raise ValueError("/tf frames are not this scenario's bodies")
-        cols = np.array([column[f] for f in poses.frames], dtype=np.intp)
-        pose[index[:, None], cols] = poses.pose
+        cols = np.array([column[poses.frames[j]] for j in bodies], dtype=np.intp)
+        pose[index[:, None], cols] = poses.pose[:, bodies]
         sampled[index[:, None], cols] = True
     if not sampled.any(axis=0).all():
         raise ValueError("/tf never has some of this scenario's bodies")

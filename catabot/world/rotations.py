@@ -102,6 +102,16 @@ def yaw_of_quaternions(q: Array) -> Array:
     return np.arctan2(2 * (w * z + x * y), 1 - 2 * (y * y + z * z))
 
 
+def levelling(q: Array) -> Array:
+    """Quaternions (N, 4) of the level frame that turns with each body's heading, seen from
+    the body (conj(q), then the heading's turn): where a stabilised sensor (the radar) looks
+    from, so a body tilted by `q` and this turn together are its heading alone."""
+    half = yaw_of_quaternions(q) / 2
+    zero = np.zeros(len(q))
+    heading = np.column_stack((zero, zero, np.sin(half), np.cos(half)))
+    return product(q * np.array([-1.0, -1.0, -1.0, 1.0]), heading)
+
+
 def wrap(angle: Array) -> Array:
     """Angles (rad) into [-pi, pi): the signed difference between two headings."""
     return np.asarray((angle + np.pi) % (2 * np.pi) - np.pi)

@@ -27,6 +27,12 @@ FRAMES = ("body: the vessel's FLU frame (x forward, y left, z up) at its origin;
           "at (u, v), as OpenCV and ROS CameraInfo")  # fmt: skip
 
 
+STABILISED = (
+    "level, turned with the vessel's heading only: body_from_sensor's rotation is a "
+    "level hull's; a tilted hull's radar frame is on /tf"
+)
+
+
 def calibration(world: World) -> dict[str, Any]:
     """Every scenario sensor by `<vessel>.<name>` (the dataset's and exports' names)."""
     sensors = {f"{s.vessel}.{s.config.name}": _sensor(s) for s in world.sensors}
@@ -37,6 +43,8 @@ def _sensor(sensor: MountedSensor) -> dict[str, Any]:
     xyz, rot = mount(sensor)
     out: dict[str, Any] = {"type": sensor.config.type, "vessel": sensor.vessel,
                            "body_from_sensor": _matrix(rot, xyz)}  # fmt: skip
+    if sensor.config.type == "radar":
+        out["stabilised"] = STABILISED
     if sensor.config.type == "camera":
         p = sensor.params
         out |= {"body_from_optical": _matrix(rot @ OPTICAL, xyz), "width": p.width,

@@ -14,8 +14,9 @@ import numpy as np
 
 from catabot.bus.messages import BodyStates
 from catabot.config.rates import traffic_record_period
-from catabot.ros2.cdr import OdometryBatch, TfBatch
+from catabot.ros2.cdr import OdometryBatch
 from catabot.ros2.convert import Converter
+from catabot.ros2.frames import BodyFrames
 from catabot.ros2.names import MAP
 
 
@@ -31,7 +32,7 @@ class Thinning:
         self.streams = tuple(f"vessel/{b.id}/state" for b in own)
         self.topics = tuple(names.odom(b.id) for b in own)
         frames = [names.base_link(b.id) for b in own]
-        self._odometry, self._tf = OdometryBatch(MAP, frames), TfBatch(MAP, frames)
+        self._odometry, self._tf = OdometryBatch(MAP, frames), BodyFrames(names, own)
 
     def every_body(self, tick: int) -> bool:
         """Each tick whose state is stamped on the rate's grid, the start state (tag -1,
@@ -52,6 +53,4 @@ class Thinning:
         return self._odometry.encode_groups(stamp_ns, np.ascontiguousarray(table[:, :13]))
 
     def tf(self, batch: BodyStates) -> bytes:
-        return self._tf.encode(
-            batch.stamp_ns, batch.position[self.rows], batch.orientation[self.rows]
-        )
+        return self._tf.encode(batch)

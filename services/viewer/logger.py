@@ -4,7 +4,8 @@ replay (so `run.rrd`, `catabot view RUN` and `catabot run --view` show the same 
 Per `BodyStates`: every body's pose as an instance of its model's mesh (one log call per
 model and colour, not one per body: `static.body_groups`),
 each scenario vessel's transform (its sensors hang below it, so a LiDAR scan is drawn from
-the pose it was taken at) and its speed and heading. At most every `TRAIL_S` of simulated
+the pose it was taken at; a radar's level frame is logged with it: catabot/ros2/frames.py)
+and its speed and heading. At most every `TRAIL_S` of simulated
 time: the vessels' positions for the trails and the closest approach between two vessels;
 every `WATER_S`: the wave surface around the first vessel. Sensors: LiDAR points coloured by
 intensity (rain in magenta), radar sector and echoes in 3D and on the north-up minimap,
@@ -39,6 +40,8 @@ class RunLogger:
         self.groups = body_groups(world)
         self.vessels = len(world.vessels)
         self.own = [world.body(v.id) for v in world.scenario.vessels]
+        self.radars = [s for s in world.sensors if s.config.type == "radar"]
+        self.radar_rows = [world.body(s.vessel).row for s in self.radars]
         self.waves = world.waves
         self._last = {"trail": -math.inf, "water": -math.inf}
         self._closest = math.inf
@@ -90,10 +93,19 @@ class RunLogger:
             self.rec.log(paths.series("speed", body.id), rr.Scalars(speed))
             compass = (90.0 - math.degrees(heading)) % 360.0
             self.rec.log(paths.series("heading", body.id), rr.Scalars(compass))
+        self._radar_frames(quat)
         if self._due("trail", batch.stamp_ns, TRAIL_S):
             self._trails(pos[: self.vessels])
         if not self.waves.is_calm and self.own and self._due("water", batch.stamp_ns, WATER_S):
             self._water(pos[self.own[0].row], batch.stamp_ns)
+
+    def _radar_frames(self, quat: np.ndarray) -> None:
+        """Each radar's frame on its vessel: level at the antenna, turned with the heading."""
+        level = rotations.levelling(quat[self.radar_rows]) if self.radars else quat[:0]
+        for sensor, turn in zip(self.radars, level, strict=True):
+            at = (0.0, 0.0, sensor.params.antenna_height_m)
+            pose = rr.Transform3D(translation=at, quaternion=rr.Quaternion(xyzw=turn))
+            self.rec.log(paths.sensor(sensor.vessel, sensor.config.name), pose)
 
     def _due(self, what: str, stamp_ns: int, every_s: float) -> bool:
         """Whether `every_s` of simulated time passed since `what` was last logged."""

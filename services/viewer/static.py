@@ -4,7 +4,8 @@ Everything here is static (timeless) in rerun: the terrain mesh with its height 
 each model's shape as a mesh, once per colour it is drawn in (catabot/world/shapes.py; the
 hull box for a model without one), whose instances the logger poses per tick (rerun's
 InstancePoses3D: one log call per model and colour, not per body), each sensor's mount
-under its vessel (LiDAR and radar frames, each camera's pinhole in the ROS optical frame),
+under its vessel (LiDAR frames, each camera's pinhole in the ROS optical frame; a radar's
+level frame turns against its hull, so the logger logs it with every state),
 the radar screens' range rings, the label classes' names and colours, and the scripted
 commands (known from the scenario before the run starts).
 """
@@ -113,8 +114,7 @@ def _mount(rec: rr.RecordingStream, sensor: MountedSensor) -> None:
     if isinstance(params, LidarParams):
         rot = rotations.rpy(0.0, params.mount_pitch_deg, params.mount_yaw_deg)
         rec.log(path, rr.Transform3D(translation=params.mount_xyz, mat3x3=rot), static=True)
-    elif isinstance(params, RadarParams):
-        rec.log(path, rr.Transform3D(translation=(0, 0, params.antenna_height_m)), static=True)
+    elif isinstance(params, RadarParams):  # its frame moves with the heading: logger.py
         rings = [_circle(params.range_m * k / 4) for k in (1, 2, 3, 4)]
         r = params.range_m
         cross = [np.array([(-r, 0.0), (r, 0.0)]), np.array([(0.0, -r), (0.0, r)])]

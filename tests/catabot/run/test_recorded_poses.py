@@ -62,3 +62,13 @@ def test_unknown_frames_and_bodies_never_recorded_are_refused() -> None:
         track(groups, FRAMES[:1], 5)
     with pytest.raises(ValueError, match="never has"):
         track(groups, [*FRAMES, "buoy_0/base_link"], 5)
+
+
+def test_a_radar_frame_under_its_vessel_is_not_a_body() -> None:
+    """/tf carries base_link -> radar beside the bodies (catabot/ros2/frames.py): skipped."""
+    radar = TfBatch(["map", "ego/base_link"], ["ego/base_link", "ego/radar"])
+    pos = np.array([[[4.0, 1.0, 0.0], [0.0, 0.0, 3.0]]])
+    quat = np.tile([0.0, 0.0, 0.0, 1.0], (1, 2, 1))
+    rows = np.frombuffer(radar.encode(0, pos[0], quat[0]), np.uint8)[None]
+    got = track([(np.array([0]), rows)], FRAMES[:1], 1)
+    np.testing.assert_array_equal(got.pose[0, 0, :3], (4.0, 1.0, 0.0))

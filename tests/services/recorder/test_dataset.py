@@ -80,6 +80,7 @@ def test_a_radar_only_dataset_says_where_its_radar_sits(tmp_path: Path) -> None:
     Dataset(tmp_path, world)
     sensors = json.loads((tmp_path / "calibration.json").read_text())["sensors"]
     assert list(sensors) == ["ego.radar"] and "body_from_sensor" in sensors["ego.radar"]
+    assert "heading only" in sensors["ego.radar"]["stabilised"]
 
 
 def test_a_lidar_only_dataset_says_where_its_lidar_sits(tmp_path: Path) -> None:

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import dataclasses
 import json
 import math
 from pathlib import Path
@@ -15,6 +16,7 @@ from catabot.bus import codec
 from catabot.bus.messages import BodyStates, LidarScan, RadarSweep
 from catabot.config.load import parse_scenario
 from catabot.config.vessel import load_vessel_model
+from catabot.world import rotations
 from catabot.world.world import World
 from services.viewer import palette
 from services.viewer.logger import RunLogger
@@ -153,3 +155,19 @@ def test_twist_set_points_are_step_lines_with_their_values(tmp_path: Path) -> No
     assert _column(got["/series/setpoint/ego"], ":scalars") == [[1.0, 0.1], [1.5, -0.2]]
     names = _column(got["/series/setpoint/ego"], ":names")
     assert names == [["ego surge [m/s]", "ego yaw rate [rad/s]"]]
+
+
+def test_the_radar_frame_stays_level_on_a_rolling_hull(tmp_path: Path) -> None:
+    """Its echoes hang below it: a static identity turn tilted them with the hull."""
+    tilted = rotations.from_rpy(math.radians(15.0), math.radians(-5.0), 0.5)
+
+    def log(logger: RunLogger, world: World) -> None:
+        states = _decoded_states(world, 0)
+        quat = np.tile(tilted, (len(world.bodies), 1))
+        logger.states(dataclasses.replace(states, orientation=quat))
+
+    batches = _record(tmp_path / "t.rrd", log)["/world/vessels/ego/radar"]
+    ((turn,),) = [q for q in _column(batches, ":quaternion") if q]
+    level = rotations.matrix(tilted) @ rotations.matrix(turn)  # type: ignore[operator]
+    assert np.allclose(level, rotations.rpy(0.0, 0.0, math.degrees(0.5)), atol=1e-6)
+    assert _column(batches, ":translation")[-1] == [[0.0, 0.0, 3.0]]  # the default antenna
