@@ -20,13 +20,13 @@ from numpy.typing import NDArray
 from catabot.config.scenario import Scenario
 from catabot.config.task import TaskConfig
 from catabot.world.world import World
+from services.plots.marks import boat_names, mark_places, mark_times
 from services.plots.series import RunSeries
 
 SEA = ["#0a1e5a", "#2870be", "#96d2e6"]
 LAND = ["#468c46", "#96a050", "#8c6e46", "#c8c8c8"]
 OWN_COLORS = ["#ff8c00", "#d62728", "#9467bd", "#8c564b", "#e377c2", "#17becf"]
 MARGIN_M = 40.0
-NAMED_BOATS = 40  # traffic boats numbered on the trajectories, at most
 
 
 def _figure(rows: int = 1, cols: int = 1, *, size: tuple[float, float] = (10, 4)) -> Figure:
@@ -87,13 +87,14 @@ def _trajectories(data: RunSeries, lo: np.ndarray, hi: np.ndarray, title: str) -
                    marker="s", edgecolors="black", lw=0.4, zorder=3)  # fmt: skip
     if vessels > len(own):
         ax.plot([], [], color="white", lw=0.8, label=f"traffic ({vessels - len(own)} boats)")
-    _boat_names(ax, world, xy)
+    boat_names(ax, world, xy)
     for k, vid in enumerate(data.own):
         row = world.body(vid).row
         ax.plot(xy[:, row, 0], xy[:, row, 1], color=_color(k), lw=2.2, label=vid)
         ax.plot(*xy[0, row], "o", color=_color(k), ms=7, mec="black")
         ax.plot(*xy[-1, row], "s", color=_color(k), ms=7, mec="black")
         draw_task(ax, world.scenario.vessels[row].task, _color(k), vid)
+    mark_places(ax, data)
     if world.buoys:
         b = xy[-1, vessels:]
         ax.scatter(b[:, 0], b[:, 1], s=14, c="#fac81e", edgecolors="black", lw=0.4,
@@ -102,18 +103,6 @@ def _trajectories(data: RunSeries, lo: np.ndarray, hi: np.ndarray, title: str) -
            title=f"{title}, {data.t[-1]:.1f} s (o start, ■ end)", aspect="equal")  # fmt: skip
     ax.legend(loc="best", fontsize=8, framealpha=0.9, facecolor="#9fb0c0")  # white shows
     return fig
-
-
-def _boat_names(ax: Axes, world: World, xy: np.ndarray) -> None:
-    """Each traffic boat's number where its track ends (up to `NAMED_BOATS`): which white
-    track is boat_007's, to read beside its CSV or a takeover."""
-    first = len(world.scenario.vessels)
-    if len(world.vessels) - first > NAMED_BOATS:
-        return
-    for row in range(first, len(world.vessels)):
-        number = world.vessels[row].id.rsplit("_", 1)[-1].lstrip("0") or "0"
-        ax.annotate(number, xy[-1, row], fontsize=6, color="white", xytext=(3, 3),
-                    textcoords="offset points")  # fmt: skip
 
 
 def task_points(world: World, own: Any) -> np.ndarray:
@@ -317,6 +306,7 @@ def metrics(data: RunSeries) -> Figure | None:
     else:  # one vessel alone: an empty 0..1 panel read as a plot gone wrong
         gap.text(0.5, 0.5, "one vessel: no pair to measure", ha="center", va="center",
                  transform=gap.transAxes, color="gray")  # fmt: skip
+    mark_times(gap, data)
     gap.set(title="Closest approach to another vessel (dashed: own pairs)",
             xlabel="simulated time [s]", ylabel="distance [m]")  # fmt: skip
     gap.grid(alpha=0.3)

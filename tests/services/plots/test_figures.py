@@ -14,7 +14,6 @@ from catabot.config.load import parse_scenario
 from catabot.world.world import World
 from services.plots.compare import run_labels
 from services.plots.figures import (
-    _boat_names,
     _changes,
     _in_force,
     _view,
@@ -22,6 +21,7 @@ from services.plots.figures import (
     rain_steps,
     task_points,
 )
+from services.plots.marks import boat_names
 from services.plots.series import _thruster_names, own_pairs
 
 
@@ -63,7 +63,7 @@ def test_trajectories_mark_the_task_and_number_the_boats() -> None:
     fig, ax = plt.subplots()
     draw_task(ax, world.scenario.vessels[0].task, "#ff8c00", "ego")
     xy = np.zeros((2, len(world.bodies), 2))
-    _boat_names(ax, world, xy)
+    boat_names(ax, world, xy)
     (goal,) = [p for p in ax.patches if isinstance(p, Circle)]
     assert goal.center == (60.0, 20.0) and goal.radius == 4.0 and goal.get_label() == "ego goal"
     assert [line.get_label() for line in ax.lines] == ["ego route"]

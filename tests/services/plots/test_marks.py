@@ -1,0 +1,68 @@
+"""Contacts and groundings drawn where and when they began (services/plots/marks.py): a run
+whose summary counted collisions drew none of them."""
+
+from __future__ import annotations
+
+from types import SimpleNamespace
+from typing import Any
+
+import matplotlib.pyplot as plt
+import numpy as np
+
+from catabot.config.load import parse_scenario
+from catabot.world.world import World
+from services.plots.marks import episodes, mark_places, mark_times
+
+WORLD = World.resolve(parse_scenario({
+    "name": "marks", "vessels": [{"id": "ego"}, {"id": "other", "pose": {"x_m": 10.0}}],
+    "buoys": [{"id": "b1", "x_m": 20.0, "y_m": 0.0}],
+}))  # fmt: skip
+METRICS = {
+    "collisions": [{"bodies": ["ego", "b1"], "start_s": 1.0, "end_s": 1.5},
+                   {"bodies": ["ego", "other"], "start_s": 2.0, "end_s": None}],
+    "groundings": [{"vessel": "other", "start_s": 0.5, "end_s": 3.0}],
+    "traffic_collisions": [{"bodies": ["ego"], "start_s": "soon", "end_s": 1.0}],  # malformed
+}  # fmt: skip
+
+
+def _data(metrics: dict[str, Any]) -> Any:
+    """Bodies moving along x: body i at x = 10 i + t."""
+    t = np.arange(0.0, 3.01, 0.5)
+    pos = np.zeros((len(t), 3, 3))
+    pos[:, :, 0] = 10.0 * np.arange(3)[None, :] + t[:, None]
+    return SimpleNamespace(run=SimpleNamespace(world=WORLD), states=SimpleNamespace(position=pos),
+                           t=t, metrics=metrics)  # fmt: skip
+
+
+def test_every_kind_is_read_and_a_malformed_entry_skipped() -> None:
+    got = episodes(METRICS)
+    assert [(e.kind, e.bodies, e.end_s) for e in got] == [
+        ("collisions", ("ego", "b1"), 1.5),
+        ("collisions", ("ego", "other"), None),  # still touching at the end
+        ("groundings", ("other",), 3.0),
+    ]
+    assert episodes(None) == [] and episodes({"collisions": [{"bodies": ["ego"]}]}) == []
+
+
+def test_each_episode_is_marked_where_it_began() -> None:
+    fig, ax = plt.subplots()
+    mark_places(ax, _data(METRICS))
+    marks = {c.get_label(): c.get_offsets().tolist() for c in ax.collections}
+    assert marks == {
+        "collisions (2)": [[11.0, 0.0], [7.0, 0.0]],  # ego-b1 at 1 s: (1 + 21) / 2; ego-other
+        "groundings (1)": [[10.5, 0.0]],
+    }
+    plt.close(fig)
+
+
+def test_own_contacts_are_shaded_over_time_to_the_runs_end() -> None:
+    fig, ax = plt.subplots()
+    mark_times(ax, _data(METRICS))
+    spans = [(p.get_x(), p.get_x() + p.get_width()) for p in ax.patches]  # type: ignore[attr-defined]
+    assert spans == [(1.0, 1.5), (2.0, 3.0)]
+    assert ax.get_legend() is not None
+    plt.close(fig)
+    fig, ax = plt.subplots()
+    mark_times(ax, _data({}))
+    assert not ax.patches and ax.get_legend() is None
+    plt.close(fig)
