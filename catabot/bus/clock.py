@@ -245,6 +245,9 @@ class ClockLimits:
 # A stop for a fault (SIGUSR1: `catabot run` saw a process of the run die) is one: two
 # programs failing at one tick had ended the run "interrupted", as Ctrl-C does.
 FAULT_STOP = "stopped by its launcher: a process of the run ended"
+# The conductor's stdout gone: `catabot run` was killed outright. Said, not "interrupted"
+# as for Ctrl-C, so the folder of a run nobody stopped on purpose says what happened.
+LAUNCHER_GONE = "interrupted: its launcher, catabot run, was killed"
 
 
 class WorldMismatch(CataBotError):

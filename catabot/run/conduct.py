@@ -20,7 +20,7 @@ from typing import NoReturn
 import zenoh
 
 from catabot.bus.blas import single_thread_blas
-from catabot.bus.clock import Policy
+from catabot.bus.clock import LAUNCHER_GONE, Policy
 from catabot.bus.conductor import ClockSpec, Conductor, Progress
 from catabot.bus.heap import keep_heap
 from catabot.bus.identity import add_roster_args
@@ -146,7 +146,7 @@ def main(argv: list[str] | None = None) -> int:
         # Without its launcher the run has no one to report to: end it cleanly (services
         # flush and exit) rather than tick on as orphans.
         if not emit("progress", **asdict(p)):
-            conductor.stop("interrupted")
+            conductor.stop(LAUNCHER_GONE)
 
     result = conductor.run(progress)
     desk.close()

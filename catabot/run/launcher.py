@@ -33,6 +33,7 @@ from catabot.run.announce import announce
 from catabot.run.child import Child
 from catabot.run.companions import Viewer, after_run, start_viewer
 from catabot.run.progress import PlanningProgress, ProgressBar
+from catabot.run.provenance import write_started
 from catabot.run.summary import summarise
 from catabot.run.supervisor import Stops, Supervisor
 from catabot.world.mounts import check_mounts
@@ -175,6 +176,7 @@ def make_run_dir(out: Path, scenario: Scenario, *, exact: Path | None = None) ->
 def _filled(run_dir: Path, scenario: Scenario) -> Path:
     (run_dir / "log").mkdir()
     (run_dir / "scenario.json").write_text(scenario_json(scenario))
+    write_started(run_dir, scenario)
     return run_dir
 
 

@@ -9,13 +9,17 @@ path only), and a sweep's table had to join three files to label a row with its 
 from __future__ import annotations
 
 import hashlib
+import json
+import os
 import subprocess
 import sys
+from datetime import datetime
 from importlib import metadata
 from pathlib import Path
 from typing import Any
 
 from catabot.config.scenario import Scenario
+from catabot.run.ending import RUNNING
 
 PACKAGE = Path(__file__).resolve().parents[2]  # the source tree (a git work tree, if cloned)
 
@@ -29,6 +33,15 @@ def provenance(scenario: Scenario) -> dict[str, Any]:
         "git_commit": _commit(),
         "programs": _programs(scenario),
     }
+
+
+def write_started(run_dir: Path, scenario: Scenario) -> None:
+    """`log/run.json` as the run starts: its reason RUNNING, when and by which process, and
+    the provenance, so a run killed outright (SIGKILL, a machine lost) still says what it
+    was; the launcher's account replaces it at the end (summary.py)."""
+    record = {"reason": RUNNING, "started": datetime.now().astimezone().isoformat(),
+              "launcher_pid": os.getpid(), **provenance(scenario)}  # fmt: skip
+    (run_dir / "log" / "run.json").write_text(json.dumps(record, indent=2) + "\n")
 
 
 def _version() -> str:

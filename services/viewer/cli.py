@@ -39,7 +39,7 @@ from catabot.client.discover import find_world
 from catabot.config.load import load_scenario, parse_scenario
 from catabot.errors import CataBotError
 from catabot.run.answer import OneLineParser, output_file
-from catabot.run.ending import end_reason, run_record
+from catabot.run.ending import end_reason, finished, run_record
 from catabot.run.recorded import RecordedRun
 from catabot.world.world import World
 from services.viewer.blueprint import blueprint
@@ -173,7 +173,7 @@ def _ending(args: argparse.Namespace, end: End | None, view: LiveView) -> tuple[
         return "stopped before the run ended", 0
     folder, where = _run_folder(args), list(args.connect)
     record = run_record(folder) if folder is not None else None
-    if record is None:
+    if not finished(record):
         return (f"catabot view: the run at {where} went away (or never answered) before its "
                 "end reached the view, and no run folder says how it ended; what it drew is "
                 "kept"), 2  # fmt: skip

@@ -30,7 +30,7 @@ from catabot.bus.messages import BodyStates, End, Message, ThrustCmd, TwistCmd
 from catabot.bus.session import linked
 from catabot.bus.vanished import ConductorWatch
 from catabot.config.sensors import SENSOR_TYPES
-from catabot.run.ending import run_record
+from catabot.run.ending import finished, run_record
 from catabot.world.world import MountedSensor, World
 from services.viewer.logger import RunLogger
 
@@ -105,7 +105,7 @@ class LiveView:
             self._linked_at, self.ever_linked = now, True
             return False
         self.conductor.left_at = None  # a token lost with the link is no word on the run
-        over = run_dir is not None and run_record(run_dir) is not None
+        over = run_dir is not None and finished(run_record(run_dir))
         return now - self._linked_at > (LOST_S if over else LINK_S)
 
     def _tick(self, logger: RunLogger) -> None:

@@ -28,10 +28,12 @@ from conftest import (
 )
 
 from catabot.bus import codec
+from catabot.bus.clock import LAUNCHER_GONE
 from catabot.bus.keys import Keys
 from catabot.bus.messages import ThrustCmd
 from catabot.bus.session import Connection, free_port, open_session
 from catabot.config.scenario import ClockConfig
+from catabot.run.recorded import RecordedRun
 from services.recorder.mcap_read import read_mcap_messages
 
 HERE = Path(__file__).parent
@@ -226,7 +228,8 @@ def test_a_stop_before_the_services_join_ends_the_run_cleanly(tmp_path: Path, ou
 
 def test_killed_launcher_leaves_no_orphans(tmp_path: Path, out: Path) -> None:
     """SIGKILL of `catabot run` (no handler runs): the conductor finds its stdout gone at
-    the next progress line and ends the run, so every service flushes and exits."""
+    the next progress line and ends the run, so every service flushes and exits. Its
+    log/run.json, written at the start, still says what ran (it had none at all)."""
     proc = start("run", str(_long(tmp_path)), "--out", str(out), "--quiet")
     wait_for_line(proc, "zenoh:")
     _wait_for_rows(out, 20)
@@ -235,7 +238,12 @@ def test_killed_launcher_leaves_no_orphans(tmp_path: Path, out: Path) -> None:
     proc.communicate(timeout=10)
     _, alive = psutil.wait_procs(children, timeout=30)
     assert not alive, [c.cmdline()[2:4] for c in alive]
-    _assert_readable(only_run_dir(out))
+    run = only_run_dir(out)
+    _assert_readable(run)
+    record = json.loads((run / "log" / "run.json").read_text())
+    assert record["reason"] == "running" and record["launcher_pid"] == proc.pid
+    assert record["scenario"] == "faults" and record["command"][:2] == ["catabot", "run"]
+    assert RecordedRun(run).end_reason() == LAUNCHER_GONE  # the recorder's account
 
 
 def test_malformed_and_non_finite_commands_are_logged_and_survived(

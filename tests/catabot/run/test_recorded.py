@@ -27,7 +27,7 @@ def test_an_interrupted_or_killed_run_says_so(tmp_path: Path) -> None:
     for name, metrics, said in [
         ("a", {"end_reason": "interrupted"}, "interrupted, of 30 s planned"),
         ("b", {"end_reason": "completed"}, "completed"),
-        ("c", None, "killed (no log/run.json), of 30 s planned"),
+        ("c", None, "killed (log/run.json has no ending), of 30 s planned"),
     ]:
         (tmp_path / name).mkdir()
         assert _folder(tmp_path / name, metrics).ended() == said

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import json
 from concurrent.futures import ThreadPoolExecutor
 from pathlib import Path
 
@@ -9,6 +10,7 @@ import pytest
 
 from catabot.config.load import parse_scenario
 from catabot.run.cli import main
+from catabot.run.ending import KILLED, end_reason, finished
 from catabot.run.launcher import LaunchError, RunOptions, make_run_dir, prepare
 
 
@@ -27,6 +29,11 @@ def test_a_run_dir_given_is_the_run_folder_itself_new_or_empty(tmp_path: Path) -
     scenario = parse_scenario({"name": "exact", "vessels": [{"id": "ego"}]})
     made = make_run_dir(tmp_path / "runs", scenario, exact=tmp_path / "sweep" / "gain2")
     assert made == tmp_path / "sweep" / "gain2" and (made / "scenario.json").is_file()
+    started = json.loads((made / "log" / "run.json").read_text())  # a kill -9 still says
+    assert started["reason"] == "running" and started["scenario"] == "exact"
+    assert {"started", "launcher_pid", "seed", "command", "git_commit"} <= started.keys()
+    assert not finished(started) and end_reason(started, None) == KILLED
+    assert end_reason(started, {"end_reason": "completed"}) == "completed"  # the recorder's
     with pytest.raises(LaunchError, match=r"--run-dir .*gain2: not empty; a run folder holds"):
         prepare(RunOptions(run_dir=made))
     (tmp_path / "file").write_text("x")
