@@ -15,13 +15,28 @@ from __future__ import annotations
 
 import math
 
+from catabot.config.environment import WindConfig
 from catabot.config.vessel import VesselModel
 
+STILL_AIR = WindConfig().air_density_kg_m3  # the scenario's default air
 
-def top_speed_mps(model: VesselModel) -> float:
-    """The steady surge speed at full forward thrust along the body x axis (0: none)."""
-    push = sum(t.max_forward_n * math.cos(t.yaw_rad) for t in model.thrusters)
+
+def surge_drag(model: VesselModel, *, air_density: float = STILL_AIR) -> tuple[float, float]:
+    """The linear and quadratic surge drag (N per m/s, per (m/s)^2) in still air: the hull's
+    damping, and its windage's 1/2 rho_a A_F C_x u^2 in the apparent wind (a model with wind
+    areas, services/physics/wind.py). The top speed and the velocity controller's
+    feed-forward both hold a speed against it."""
     linear, quadratic = model.damping.linear[0], model.damping.quadratic[0]
+    if model.wind is not None:
+        quadratic += 0.5 * air_density * model.wind.frontal_area_m2 * model.wind.coefficients[0]
+    return linear, quadratic
+
+
+def top_speed_mps(model: VesselModel, *, air_density: float = STILL_AIR) -> float:
+    """The steady surge speed at full forward thrust along the body x axis (0: none), in
+    still air (`surge_drag`)."""
+    push = sum(t.max_forward_n * math.cos(t.yaw_rad) for t in model.thrusters)
+    linear, quadratic = surge_drag(model, air_density=air_density)
     if push <= 0.0:
         return 0.0
     if quadratic <= 0.0:

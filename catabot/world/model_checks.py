@@ -71,8 +71,7 @@ def _course(model: VesselModel) -> list[str]:
     if limit >= top:
         return []
     reach = (f"below its top speed ({top:.2f} m/s)" if math.isfinite(top) else
-             "and has no top speed (no surge damping: only the air's drag, if it has wind "
-             "areas, limits it)")  # fmt: skip
+             "and has no top speed (no surge damping nor wind areas)")  # fmt: skip
     return [f"it cannot hold a straight course above {limit:.2f} m/s, {reach}: the added "
             "mass's Munk moment (A22 - A11) u v outgrows the sway and yaw damping Y_v N_r; "
             "give the hull's lift damping.lift_uv [Y_uv, N_uv] (N_uv > 0 cancels the Munk "

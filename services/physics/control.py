@@ -1,8 +1,9 @@
 """Velocity control: desired surge speed and yaw rate → normalised thruster commands.
 
-Feed-forward from the vessel's own damping law (the thrust that holds that speed in
-steady state) plus a PI term on the error, scaled by the effective inertia (rigid plus
-added mass), then an allocation over the thrusters' surge force and yaw moment arms.
+Feed-forward from the vessel's own damping law and its windage in still air (the thrust
+that holds that speed in steady state, catabot/world/course.py) plus a PI term on the
+error, scaled by the effective inertia (rigid plus added mass), then an allocation over the
+thrusters' surge force and yaw moment arms.
 
 Allocation gives the yaw moment priority: when the thrusters cannot deliver both, the
 surge part is scaled down until every thruster is within its limits (a boat that must
@@ -20,6 +21,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from catabot.config.vessel import VesselModel
+from catabot.world.course import surge_drag
 from services.physics import kernels
 
 Array = NDArray[np.float64]
@@ -30,7 +32,7 @@ class TwistController:
         self, model: VesselModel, *, dt_s: float, kp: float = 2.0, ki: float = 0.5
     ) -> None:
         lin, quad = model.damping.linear, model.damping.quadratic
-        self.damp = np.array([[lin[0], quad[0]], [lin[5], quad[5]]])
+        self.damp = np.array([surge_drag(model), [lin[5], quad[5]]])
         # Effective surge mass and yaw inertia about the body origin, added mass included.
         x_g, y_g, _ = model.cog_m
         yaw_inertia = model.inertia_kgm2[2] + model.mass_kg * (x_g * x_g + y_g * y_g)

@@ -30,7 +30,7 @@ def test_a_scripted_twist_beyond_reach_is_told_on_the_console(tmp_path: Path) ->
     told = [line for line in result.stderr.splitlines() if "beyond its thrusters" in line]
     assert len(told) == 1, result.stderr  # the console notes, as refusals
     assert told[0].startswith("physics: fast: the scripted twist 3 m/s at 0 rad/s is beyond")
-    assert "about 1.88 m/s straight ahead" in told[0]
+    assert "about 1.87 m/s straight ahead" in told[0]
     assert told[0].split("physics: ", 1)[1] in (only_run_dir(out) / "log/physics.log").read_text()
     late = "physics: slow: its script step at 2 s comes after the run's last tick (0.49 s), so it"
     assert late in result.stderr

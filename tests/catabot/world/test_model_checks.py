@@ -49,9 +49,11 @@ def test_the_bundled_models_have_nothing_to_note() -> None:
         ({"thrusters": [{**CATAMARAN["thrusters"][0], "position_m": [3.0, 0.4, -0.1]}]},
          "thruster 0 at (3, 0.4) m is 2.05 m outside every hull"),
         ({"damping": CATAMARAN["damping"] | {"lift_uv": [0.0, 0.0]}},
-         "cannot hold a straight course above 1.74 m/s, below its top speed (1.88 m/s)"),
-        ({"damping": {"linear": [0.0] * 6, "quadratic": [0.0] * 6}},  # said "top speed (inf m/s)"
-         "above 0.00 m/s, and has no top speed (no surge damping: only the air's drag"),
+         "cannot hold a straight course above 1.74 m/s, below its top speed (1.87 m/s)"),
+        ({"damping": {"linear": [0.0] * 6, "quadratic": [0.0] * 6}, "wind": None},  # "inf m/s"
+         "above 0.00 m/s, and has no top speed (no surge damping nor wind areas)"),
+        ({"damping": {"linear": [0.0] * 6, "quadratic": [0.0] * 6}},  # the air's drag alone
+         "above 0.00 m/s, below its top speed (25.56 m/s)"),
         ({"cog_m": [5.0, 0.0, 0.19]},  # a trial's model: capsized in 2 s, validate said valid
          "its centre of gravity (5, 0) m lies outside every hull in plan view"),
         ({"hulls": [h | {"center_m": [h["center_m"][0], h["center_m"][1], 2.0]}

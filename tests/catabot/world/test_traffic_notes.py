@@ -15,10 +15,11 @@ def _notes(**traffic: Any) -> list[str]:
 
 
 def test_boats_set_faster_than_they_go_are_said() -> None:
-    """A trial's circle.speed_mps 8 was taken, and the monohulls held 5.96 m/s unsaid."""
+    """A trial's circle.speed_mps 8 was taken, and the monohulls held 5.96 m/s unsaid (the
+    note said 6 before the top speed counted the still air's drag)."""
     (note,) = _notes(count=4, circle={"speed_mps": 8.0})
     assert note == (
-        "note: traffic.circle.speed_mps 8: 4 circle boat(s) of model 'monohull' reach 6 m/s "
+        "note: traffic.circle.speed_mps 8: 4 circle boat(s) of model 'monohull' reach 5.96 m/s "
         "at most (full thrust against their damping), so they go that fast"
     )
     mixed = _notes(count=6, behaviour_mix={"circle": 0.5, "waypoints": 0.5},

@@ -11,8 +11,10 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
+from catabot.config.environment import WindConfig
 from catabot.config.vessel import VesselModel, load_vessel_model
 from catabot.world.course import top_speed_mps, unstable_above_mps
+from catabot.world.environment import WindField
 from services.physics.world import PhysicsWorld
 
 BUNDLED = ("catabot", "monohull", "wamv")
@@ -31,7 +33,8 @@ def test_the_criterion_is_the_munk_moment_against_the_damping() -> None:
         update={"lift_uv": (0.0, 0.0)})})  # fmt: skip
     assert unstable_above_mps(bare) == pytest.approx(np.sqrt(40 * 80 / (57.75 * 18.25)))
     assert unstable_above_mps(bare) == pytest.approx(1.74, abs=0.005)
-    assert top_speed_mps(model) == pytest.approx(1.879, abs=0.001)  # 72 N = 12 u + 14 u^2
+    # 72 N = 12 u + (14 + 1/2 rho_a A_F C_x) u^2: the hull's damping and the still air's drag
+    assert top_speed_mps(model) == pytest.approx(1.8734, abs=0.0001)
 
 
 def _pushed(model: VesselModel, seconds: float) -> np.ndarray:
@@ -59,3 +62,17 @@ def test_without_the_lift_it_circles_as_the_criterion_says() -> None:
         update={"lift_uv": (0.0, 0.0)})})  # fmt: skip
     rate = _pushed(bare, 30.0)
     assert np.abs(rate[-500:]).min() > 0.02 and np.ptp(rate[-500:]) < 2e-3
+
+
+@pytest.mark.parametrize("name", ["catabot", "monohull"])
+def test_the_top_speed_is_where_full_thrust_settles_in_still_air(name: str) -> None:
+    """The notes quote it: a trial's monohulls told 'reach 6 m/s' held 5.96 (the windage's
+    drag in still air was left out of the figure, not of the physics)."""
+    model = load_vessel_model(name)
+    wind = WindField(WindConfig(), seed=0)
+    world = PhysicsWorld([("boat", model, (0.0, 0.0, 0.0, 0.0))], dt_s=0.01, wind=wind)
+    world.set_thrust("boat", np.ones(len(model.thrusters)))
+    for _ in range(6000):
+        world.step()
+    surge = world.surge_and_yaw_rate(np.array([0]))[0, 0]
+    assert surge == pytest.approx(top_speed_mps(model), rel=1e-3)

@@ -30,9 +30,12 @@ def _advice(caplog: pytest.LogCaptureFixture) -> list[str]:
 def test_the_top_speed_told_is_the_damping_law_at_full_thrust(
     caplog: pytest.LogCaptureFixture,
 ) -> None:
+    """The hull's damping and the windage's drag in still air (1/2 rho_a A_F C_x)."""
     model = load_vessel_model("wamv")
     thrust = sum(t.max_forward_n for t in model.thrusters)
+    assert model.wind is not None
     lin, quad = model.damping.linear[0], model.damping.quadratic[0]
+    quad += 0.5 * 1.225 * model.wind.frontal_area_m2 * model.wind.coefficients[0]
     top = (-lin + math.sqrt(lin * lin + 4 * quad * thrust)) / (2 * quad)  # lin u + quad u^2 = T
     reach = _reach(("ego", "wamv", ()))
     assert not reach.beyond("ego", top - 1e-3, 0.0) and reach.beyond("ego", top + 1e-3, 0.0)
@@ -49,13 +52,13 @@ def test_told_once_a_vessel_and_never_for_a_set_point_in_reach(
     reach = _reach(("a", "catabot", ()), ("b", "catabot", ()))
     with caplog.at_level(logging.WARNING):
         reach.heard("a", [TwistCmd(surge=1.5, yaw_rate=0.0), ThrustCmd(thrust=(1.0, 1.0))])
-        assert _advice(caplog) == []  # 1.5 m/s of its 1.88 straight ahead
+        assert _advice(caplog) == []  # 1.5 m/s of its 1.87 straight ahead
         reach.heard("a", [TwistCmd(surge=1.0, yaw_rate=0.3)])  # the README's turn
         reach.heard("a", [TwistCmd(surge=3.0, yaw_rate=0.0)])
         reach.heard("b", [TwistCmd(surge=0.0, yaw_rate=-2.0)])
     said = _advice(caplog)
     assert [s.split(":")[0] for s in said] == ["a", "b"]
-    assert "1.88 m/s straight ahead, 1.62 m/s astern, 0.27 rad/s turning in place" in said[0]
+    assert "1.87 m/s straight ahead, 1.61 m/s astern, 0.27 rad/s turning in place" in said[0]
 
 
 def test_a_scripted_twist_beyond_reach_is_told_at_the_start(
