@@ -114,8 +114,8 @@ class BodyFrames:
         position, orientation = batch.position, batch.orientation
         if self.rows is not None:
             position, orientation = position[self.rows], orientation[self.rows]
-        if len(self.radar_rows):
-            level = rotations.levelling(batch.orientation[self.radar_rows])
+        if len(self.radar_rows):  # a radar or two: Python floats beat arrays (rotations.py)
+            level = [rotations.levelling(q) for q in batch.orientation[self.radar_rows].tolist()]
             position = np.concatenate((position, self.antennas))
             orientation = np.concatenate((orientation, level))
         return self._batch.encode(batch.stamp_ns, position, orientation)

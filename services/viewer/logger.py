@@ -101,7 +101,7 @@ class RunLogger:
 
     def _radar_frames(self, quat: np.ndarray) -> None:
         """Each radar's frame on its vessel: level at the antenna, turned with the heading."""
-        level = rotations.levelling(quat[self.radar_rows]) if self.radars else quat[:0]
+        level = [rotations.levelling(q) for q in quat[self.radar_rows].tolist()]
         for sensor, turn in zip(self.radars, level, strict=True):
             at = (0.0, 0.0, sensor.params.antenna_height_m)
             pose = rr.Transform3D(translation=at, quaternion=rr.Quaternion(xyzw=turn))
