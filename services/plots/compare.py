@@ -23,6 +23,7 @@ from services.plots.series import RunSeries
 
 STYLES = ["-", "--", ":", "-."]
 COLORS = colormaps["tab20"]  # 20 runs apart by colour
+SAME_M = 0.01  # tracks this close at every sample are one track drawn twice
 
 
 def figures(runs: list[RunSeries]) -> dict[str, Figure]:
@@ -65,14 +66,19 @@ def _short(parts: list[str], budget: int = 100) -> str:
 def _tracks(runs: list[RunSeries], labels: list[str]) -> Figure:
     fig = Figure(figsize=(9, 9 + 0.18 * len(labels)), dpi=110, layout="constrained")
     ax = fig.subplots()
-    seen = []
+    seen: list[np.ndarray] = []
+    drawn: list[tuple[str, np.ndarray]] = []  # (legend name, track)
     for k, (data, label) in enumerate(zip(runs, labels, strict=True)):
         xy = data.states.position[:, :, :2]
         for j, vid in enumerate(data.own):
             row = data.run.world.body(vid).row
-            ax.plot(xy[:, row, 0], xy[:, row, 1], lw=1.8, label=f"{label}: {vid}",
-                    **_style(k, j))  # fmt: skip
-            ax.plot(*xy[-1, row], "s", color=_style(k, j)["color"], ms=6, mec="black")
+            name, style = f"{label}: {vid}", _style(k, j)
+            twin = same_track(xy[:, row], drawn)
+            if twin is not None:  # dashed over the first, so both colours show
+                name, style = f"{name} (the same track as {twin})", style | DASHED
+            ax.plot(xy[:, row, 0], xy[:, row, 1], lw=1.8, label=name, **style)
+            ax.plot(*xy[-1, row], "s", color=style["color"], ms=6, mec="black")
+            drawn.append((f"{data.run.folder.name}: {vid}", xy[:, row]))
             seen.append(xy[:, row])
             draw_task(ax, data.run.world.scenario.vessels[row].task, _style(k, j)["color"], vid)
         seen.append(task_points(data.run.world, data.own))
@@ -83,6 +89,18 @@ def _tracks(runs: list[RunSeries], labels: list[str]) -> Figure:
     ax.grid(alpha=0.3)
     fig.legend(*_own_entries(ax), fontsize=7, loc="outside lower left")
     return fig
+
+
+DASHED = {"ls": (0, (4, 4))}
+
+
+def same_track(xy: np.ndarray, drawn: list[tuple[str, np.ndarray]]) -> str | None:
+    """The name of the first track drawn that `xy` (T, 2) lies on within `SAME_M` at every
+    sample: two runs a setting did not change had one line, the second hidden under it."""
+    for name, other in drawn:
+        if other.shape == xy.shape and np.allclose(other, xy, rtol=0.0, atol=SAME_M):
+            return name
+    return None
 
 
 def _buoys(ax: Any, runs: list[RunSeries]) -> np.ndarray:

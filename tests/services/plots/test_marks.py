@@ -1,8 +1,10 @@
-"""Contacts and groundings drawn where and when they began (services/plots/marks.py): a run
-whose summary counted collisions drew none of them."""
+"""What the plots mark besides the tracks: contacts and groundings where and when they began
+(services/plots/marks.py; a run whose summary counted collisions drew none of them), and a
+compared track that lies on another (compare.py)."""
 
 from __future__ import annotations
 
+from pathlib import Path
 from types import SimpleNamespace
 from typing import Any
 
@@ -11,6 +13,7 @@ import numpy as np
 
 from catabot.config.load import parse_scenario
 from catabot.world.world import World
+from services.plots.compare import _tracks, same_track
 from services.plots.marks import episodes, mark_places, mark_times
 
 WORLD = World.resolve(parse_scenario({
@@ -66,3 +69,24 @@ def test_own_contacts_are_shaded_over_time_to_the_runs_end() -> None:
     mark_times(ax, _data({}))
     assert not ax.patches and ax.get_legend() is None
     plt.close(fig)
+
+
+def test_a_track_drawn_twice_is_named_as_the_first() -> None:
+    """Two runs a setting did not change drew one line: the second hid under the first."""
+    t = np.linspace(0.0, 1.0, 50)
+    track = np.stack([10 * t, np.sin(t)], axis=1)
+    drawn = [("a: ego", track), ("a: other", track + 5.0)]
+    assert same_track(track + 0.004, drawn) == "a: ego"  # within 1 cm everywhere
+    assert same_track(track + np.array([0.02, 0.0]), drawn) is None
+    assert same_track(track[:-1], drawn) is None  # a shorter run is another track
+
+    def run(name: str, shift: float) -> Any:
+        pos = np.zeros((50, 1, 3))
+        pos[:, 0, :2] = track + shift
+        return SimpleNamespace(run=SimpleNamespace(world=World.resolve(parse_scenario(
+            {"name": "c", "vessels": [{"id": "ego"}]})), folder=Path(name)),
+            states=SimpleNamespace(position=pos), own=["ego"])  # fmt: skip
+
+    fig = _tracks([run("a", 0.0), run("b", 0.0), run("c", 1.0)], ["a", "b (x=1)", "c"])
+    names = [t.get_text() for t in fig.legends[0].get_texts()]
+    assert names == ["a: ego", "b (x=1): ego (the same track as a: ego)", "c: ego"]
