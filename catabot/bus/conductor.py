@@ -14,10 +14,11 @@ from collections.abc import Callable
 
 import zenoh
 
-from catabot.bus import clock, codec
+from catabot.bus import clock
+from catabot.bus.ack_check import checked_ack
 from catabot.bus.clock import CONDUCTOR, ClockError, ClockSpec, Policy, Progress, RunResult
 from catabot.bus.clock_watch import ClockOutputs
-from catabot.bus.identity import Roster, sender_of, shown
+from catabot.bus.identity import Roster
 from catabot.bus.keys import Keys
 from catabot.bus.members import Members, claim
 from catabot.bus.messages import Ack, End, Tick
@@ -209,7 +210,8 @@ class Conductor:
         if key == self._poke_key:
             return
         try:
-            name, ack = self._checked_ack(key, sample)
+            name, ack = checked_ack(key, sample, keys=self.keys, members=self._members,
+                                    expected=self._acked, run_id=self.run_id)  # fmt: skip
         except Rejected as exc:
             self.rejections.add(key, exc)
             return
@@ -230,24 +232,6 @@ class Conductor:
         self._told = fault
         log.info("run %s", fault or self._stop_reason)
         self._grant(self._granted, again=True)
-
-    def _checked_ack(self, key: str, sample: zenoh.Sample) -> tuple[str, Ack]:
-        """An ack believed only from the session whose token names its participant."""
-        name = self.keys.participant_of(key)
-        if name not in self._acked:
-            raise Rejected("ack of no participant", name)
-        if not self._members.sender_is(name, sender_of(sample)):
-            raise Rejected("ack from a stranger", shown(sender_of(sample)))
-        try:
-            ack = codec.decode(sample.payload.to_bytes(), Ack)
-        except codec.CodecError as exc:
-            raise Rejected("malformed", str(exc)) from None
-        if ack.run != self.run_id or ack.tick < -1:
-            raise Rejected("ack of another run or tick", f"run {ack.run}, tick {ack.tick}")
-        for text, what in ((ack.end, "end request"), (ack.fault, "fault")):
-            if text and clock.end_reason_problem(text):
-                raise Rejected(f"{what} with a bad reason", clock.end_reason_problem(text))
-        return name, ack
 
     def _advance(self) -> None:
         """Every active participant has acked up to `_done - 1`: restart the deadline."""
