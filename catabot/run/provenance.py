@@ -35,12 +35,13 @@ def provenance(scenario: Scenario) -> dict[str, Any]:
     }
 
 
-def write_started(run_dir: Path, scenario: Scenario) -> None:
+def write_started(run_dir: Path, scenario: Scenario, *, writer: str = "launcher") -> None:
     """`log/run.json` as the run starts: its reason RUNNING, when and by which process, and
     the provenance, so a run killed outright (SIGKILL, a machine lost) still says what it
-    was; the launcher's account replaces it at the end (summary.py)."""
+    was; the launcher's account replaces it at the end (summary.py), or in a split run the
+    recorder's (services/recorder/split_record.py)."""
     record = {"reason": RUNNING, "started": datetime.now().astimezone().isoformat(),
-              "launcher_pid": os.getpid(), **provenance(scenario)}  # fmt: skip
+              f"{writer}_pid": os.getpid(), **provenance(scenario)}  # fmt: skip
     (run_dir / "log" / "run.json").write_text(json.dumps(record, indent=2) + "\n")
 
 

@@ -41,6 +41,7 @@ from services.recorder.dataset import Dataset
 from services.recorder.mcap_recording import McapRecording
 from services.recorder.metrics import Metrics
 from services.recorder.scripts import ScriptedCommands
+from services.recorder.split_record import SplitRecord
 
 log = logging.getLogger("recorder")
 FLUSH_EVERY_S = 0.1
@@ -75,6 +76,7 @@ class Recorder:
         rec = ctx.scenario.recording
         ctx.run_dir.mkdir(parents=True, exist_ok=True)
         _fresh_folder(ctx.run_dir, ctx.scenario)
+        self.account = SplitRecord(ctx.run_dir, ctx.scenario)
         self.keys = ctx.keys
         world = ctx.world
         convert = Converter(world, ctx.scenario.ros)  # the gateway's topics and frames
@@ -248,6 +250,7 @@ class Recorder:
         if self.mcap is not None:
             self.mcap.close()
         self.metrics.write(self.run_dir / "metrics.json", end_reason=end.reason)
+        self.account.end(end)
         more = f" ({past} ticks stepped past the end left out)" if past else ""
         when = f"after tick {end.tick}" if end.tick >= 0 else "before the first tick"
         log.info("recorder closed its files %s%s", when, more)

@@ -8,8 +8,9 @@ what a user gets wrong there is refused at once and named, not left to a deadlin
   stops at its first note that no tick came;
 - a second physics, or a second conductor, of a world already running stops; the run that
   was there goes on;
-- the recorder leaves the scenario in its run folder, so `catabot plot` and the other tools
-  read a split run's folder.
+- the recorder leaves the scenario and `log/run.json` (how the run ended, what ran it) in its
+  run folder, so `catabot plot`, `catabot results` and the other tools read a split run's
+  folder.
 """
 
 from __future__ import annotations
@@ -130,6 +131,10 @@ def test_a_second_physics_or_conductor_stops_and_the_run_goes_on(tmp_path: Path)
         recorder.communicate(timeout=60)
         assert json.loads((run / "scenario.json").read_text())["name"] == "split"
         assert (run / "vessel.ego.state.csv").is_file()
+        record = json.loads((run / "log" / "run.json").read_text())  # no launcher wrote one
+        assert (record["reason"], record["ticks"], record["sim_s"]) == ("completed", 200, 2.0)
+        assert record["written_by"].startswith("recorder") and record["seed"] == 1
+        assert record["command"][:3] == ["catabot", "service", "recorder"]
         kept = (run / "run.mcap").read_bytes()
         twice = catabot("service", "recorder", "--scenario", str(scenario), "--listen",
                         f"tcp/127.0.0.1:{free_port()}", "--run-dir", str(run))  # fmt: skip
