@@ -55,6 +55,16 @@ class Lanes:
             full = len(lane) >= LANE_EVENTS or self._bytes[sender] + size > LANE_BYTES
         return not full
 
+    def offer(
+        self, kind: str, key: str, sender: str, size: int, payload: Callable[[], bytes]
+    ) -> None:
+        """A Zenoh callback's event: `payload()` (a copy, or work) is called only if `admits`
+        takes it; a refused one is counted, unread."""
+        if self.admits(kind, sender, size):
+            self.put((kind, key, payload(), sender))
+        else:
+            self.refuse(key, sender)
+
     def put(self, event: Event) -> None:
         kind, key, payload, sender = event
         if kind in OWN or self.trusted(sender):

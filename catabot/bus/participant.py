@@ -91,11 +91,9 @@ class Participant(Outputs):
 
     def _push(self, kind: str) -> Callable[[zenoh.Sample], None]:
         def on_sample(sample: zenoh.Sample) -> None:
-            key, sender, payload = str(sample.key_expr), sender_of(sample), sample.payload
-            if self.events.admits(kind, sender, len(payload)):  # before copying the payload
-                self.events.put((kind, key, payload.to_bytes(), sender))
-            else:
-                self.events.refuse(key, sender)
+            payload = sample.payload  # copied only if its sender's lane has room (lanes.py)
+            self.events.offer(kind, str(sample.key_expr), sender_of(sample), len(payload),
+                              payload.to_bytes)  # fmt: skip
 
         return on_sample
 

@@ -22,12 +22,10 @@ def watch_strays(participant: Participant, pattern: str, why: Callable[[str], st
     def on_sample(sample: zenoh.Sample) -> None:
         key = str(sample.key_expr)
         if key not in known:  # the streams' own samples: a set lookup, nothing queued
-            sender = sender_of(sample)
-            if not events.admits("stray", sender, 0):  # a stranger's flood (lanes.py)
-                events.refuse(key, sender)
-                return
-            reason = shape_problem(key, pattern) or why(key)
-            events.put(("stray", key, reason.encode(), sender))
+            events.offer("stray", key, sender_of(sample), 0, lambda: _reason(key))  # lanes.py
+
+    def _reason(key: str) -> bytes:  # worked out only for a stray its sender's lane takes
+        return (shape_problem(key, pattern) or why(key)).encode()
 
     participant.keep(participant.session.declare_subscriber(pattern, on_sample))
     # only now, the watch declared: a wildcard put the inbox leaves to it is heard by it

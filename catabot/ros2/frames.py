@@ -27,6 +27,14 @@ OPTICAL = np.array([[0.0, 0.0, 1.0], [-1.0, 0.0, 0.0], [0.0, -1.0, 0.0]])
 IDENTITY = (0.0, 0.0, 0.0, 1.0)
 
 
+STABILISED = frozenset({"radar"})
+"""Sensor types whose frame is level, turned with the heading only (not the hull's turn)."""
+
+
+def stabilised(sensor: MountedSensor) -> bool:
+    return sensor.config.type in STABILISED
+
+
 @dataclass(frozen=True)
 class Transform:
     parent: str
@@ -61,7 +69,7 @@ def static_transforms(names: Names) -> list[Transform]:
     `BodyFrames`); cameras also frame -> optical frame (their images' frame)."""
     out = []
     for sensor in names.world.sensors:
-        if sensor.config.type == "radar":
+        if stabilised(sensor):
             continue
         xyz, rot = mount(sensor)
         frame = names.sensor_frame(sensor)
@@ -103,7 +111,7 @@ class BodyFrames:
         rows = [b.row for b in bodies]
         self.rows = None if rows == list(range(len(names.world.bodies))) else np.array(rows)
         on = {b.id for b in bodies}
-        radars = [s for s in names.world.sensors if s.config.type == "radar" and s.vessel in on]
+        radars = [s for s in names.world.sensors if stabilised(s) and s.vessel in on]
         self.radar_rows = np.array([names.world.body(s.vessel).row for s in radars], np.intp)
         self.antennas = np.array([mount(s)[0] for s in radars], np.float64).reshape(-1, 3)
         parents = [MAP] * len(bodies) + [names.base_link(s.vessel) for s in radars]

@@ -31,5 +31,5 @@ def finished(record: dict[str, Any] | None) -> bool:
 def end_reason(run: dict[str, Any] | None, metrics: dict[str, Any] | None) -> str:
     """Why a run ended, the one rule every tool reads it by: its `log/run.json`'s reason,
     else its `metrics.json`'s (a recorder's account), else neither was written: killed."""
-    told = run.get("reason") if run is not None and finished(run) else None
+    told = (run or {}).get("reason") if finished(run) else None
     return str(told or (metrics or {}).get("end_reason") or KILLED)

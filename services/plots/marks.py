@@ -74,8 +74,9 @@ def where(data: RunSeries, episode: Episode) -> np.ndarray | None:
 
 def mark_places(ax: Axes, data: RunSeries) -> None:
     """A marker per episode where it began, one legend entry per kind with its count."""
+    listed = episodes(data.metrics)
     for kind, (text, marker, color) in KINDS.items():
-        found = [where(data, e) for e in episodes(data.metrics) if e.kind == kind]
+        found = [where(data, e) for e in listed if e.kind == kind]
         points = np.array([p for p in found if p is not None]).reshape(-1, 2)
         if len(points):
             ax.scatter(points[:, 0], points[:, 1], s=90, marker=marker, c=color, zorder=5,

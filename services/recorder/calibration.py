@@ -19,7 +19,7 @@ from typing import Any
 import numpy as np
 
 from catabot.ros2.convert_sensors import camera_matrix
-from catabot.ros2.frames import OPTICAL, mount
+from catabot.ros2.frames import OPTICAL, mount, stabilised
 from catabot.world.world import MountedSensor, World
 
 FRAMES = ("body: the vessel's FLU frame (x forward, y left, z up) at its origin; a camera's "
@@ -43,7 +43,7 @@ def _sensor(sensor: MountedSensor) -> dict[str, Any]:
     xyz, rot = mount(sensor)
     out: dict[str, Any] = {"type": sensor.config.type, "vessel": sensor.vessel,
                            "body_from_sensor": _matrix(rot, xyz)}  # fmt: skip
-    if sensor.config.type == "radar":
+    if stabilised(sensor):
         out["stabilised"] = STABILISED
     if sensor.config.type == "camera":
         p = sensor.params

@@ -23,6 +23,7 @@ import numpy as np
 import rerun as rr
 
 from catabot.bus.messages import LABEL_CLASSES, BodyStates, ImuSample, LidarScan, RadarSweep
+from catabot.ros2.frames import mount, stabilised
 from catabot.world import rotations
 from catabot.world.terrain_grid import grid_triangles
 from catabot.world.world import MountedSensor, World
@@ -40,7 +41,7 @@ class RunLogger:
         self.groups = body_groups(world)
         self.vessels = len(world.vessels)
         self.own = [world.body(v.id) for v in world.scenario.vessels]
-        self.radars = [s for s in world.sensors if s.config.type == "radar"]
+        self.radars = [s for s in world.sensors if stabilised(s)]  # frames that move: logged
         self.radar_rows = [world.body(s.vessel).row for s in self.radars]
         self.waves = world.waves
         self._last = {"trail": -math.inf, "water": -math.inf}
@@ -103,7 +104,7 @@ class RunLogger:
         """Each radar's frame on its vessel: level at the antenna, turned with the heading."""
         level = [rotations.levelling(q) for q in quat[self.radar_rows].tolist()]
         for sensor, turn in zip(self.radars, level, strict=True):
-            at = (0.0, 0.0, sensor.params.antenna_height_m)
+            at = mount(sensor)[0]
             pose = rr.Transform3D(translation=at, quaternion=rr.Quaternion(xyzw=turn))
             self.rec.log(paths.sensor(sensor.vessel, sensor.config.name), pose)
 
