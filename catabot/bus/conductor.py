@@ -52,7 +52,7 @@ class Conductor:
         self.events: queue.SimpleQueue[tuple[str, str, bytes]] = queue.SimpleQueue()
         roster = roster if roster is not None else Roster()
         claim(session, keys, CONDUCTOR, roster)  # NameTaken: a second conductor stops
-        self._members = Members(keys, roster)
+        self._members = Members(keys, roster, expected={*spec.participants, CONDUCTOR})
         self.rejections = Rejections(log, CONDUCTOR)
         self.dropped: dict[str, str] = {}  # name: why (policy drop)
         self._left: set[str] = set()  # dropped for a token gone without words
@@ -318,7 +318,7 @@ class Conductor:
             return ("late", "", b"")
         kind, key, _ = event
         if kind in ("join", "leave") and self._members.token(key, alive=kind == "join") is None:
-            self.rejections.add(key, Rejected("token contradicts the roster", key))
+            self.rejections.add(key, Rejected(self._members.refusal(key), key))
         return event
 
     @property

@@ -2,10 +2,16 @@
 
 The conductor and every participant keep one: a token that contradicts a binding (a second
 session claiming a name already bound, or a name the roster gives another zid) is ignored,
-so a stray client cannot join as `physics`, nor make the real physics look absent.
+so a stray client cannot join as `physics`, nor make the real physics look absent. Nor is a
+name the run does not have bound (`expected`): a bound session is one of the run's, whose
+samples skip the lanes that keep a stranger's flood off the run (lanes.py), and a client's
+token `live/helper/<its zid>` had made its 63 KB junk commands one of the run's own (an
+audit's flood stalled physics until the conductor killed it as hung).
 """
 
 from __future__ import annotations
+
+from collections.abc import Collection
 
 import zenoh
 
@@ -22,8 +28,13 @@ class NameTaken(CataBotError):
 
 
 class Members:
-    def __init__(self, keys: Keys, roster: Roster) -> None:
+    def __init__(
+        self, keys: Keys, roster: Roster, *, expected: Collection[str] | None = None
+    ) -> None:
+        """`expected`: the names the run has (its participants and the conductor); None:
+        any name (a watcher that only follows who is present)."""
         self.keys, self.roster = keys, roster
+        self.expected = None if expected is None else frozenset(expected)
         self.present: dict[str, str] = {}  # name -> zid of the live token
 
     def token(self, key: str, *, alive: bool) -> str | None:
@@ -37,10 +48,22 @@ class Members:
                 return None
             del self.present[name]
             return name
+        if self.expected is not None and name not in self.expected:
+            return None
         if not self.roster.bind(name, zid):
             return None
         self.present[name] = zid
         return name
+
+    def refusal(self, key: str) -> str:
+        """Why `token` ignored the token at `key`, as its refusal names it."""
+        try:
+            name, _ = self.keys.member_of(key)
+        except KeyNameError:
+            return "not a member's token"
+        if self.expected is not None and name not in self.expected:
+            return "token of no participant of this run"
+        return "token contradicts the roster"
 
     def sender_is(self, name: str, sender: str) -> bool:
         """Whether `sender` is the session bound to `name`."""

@@ -66,9 +66,10 @@ class Participant(Outputs):
         self.limits = limits
         self.inbox = Inbox(inputs, roster=self.roster, dt_ns=limits.dt_ns if limits else 0)
         claim(session, keys, name, self.roster)  # NameTaken: a second physics stops
-        self.members = Members(keys, self.roster)
-        self.rejections = Rejections(log, name)
         self.peers, self.drain_s = set(peers) - {name}, drain_s
+        producers = {stream.producer for stream in self.inbox.streams.values()}
+        self.members = Members(keys, self.roster, expected={*peers, *producers, name, CONDUCTOR})
+        self.rejections = Rejections(log, name)
         self._grants = Grants(limits=limits, everyone=self.peers | {name})
         self.next_tick, self._acked = 0, -1  # the next tick to step, the last acked
         self._ended = False  # asked the conductor to end the run: no more steps
@@ -205,7 +206,7 @@ class Participant(Outputs):
     def _membership(self, kind: str, key: str) -> None:
         name = self.members.token(key, alive=kind == "join")
         if name is None:
-            self.rejections.add(key, Rejected("token contradicts the roster", key))
+            self.rejections.add(key, Rejected(self.members.refusal(key), key))
         elif kind == "leave" and name == CONDUCTOR:
             self._orphaned_at = time.monotonic()
         elif kind == "join":

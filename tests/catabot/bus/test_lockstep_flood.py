@@ -9,6 +9,8 @@ import subprocess
 import sys
 import threading
 
+import pytest
+
 from catabot.bus import codec, lanes
 from catabot.bus.clock import Stream
 from catabot.bus.inbox import Inputs
@@ -23,17 +25,24 @@ conf = zenoh.Config()
 conf.insert_json5("mode", '"client"')
 conf.insert_json5("connect/endpoints", '["' + sys.argv[1] + '"]')
 session = zenoh.open(conf)
+if len(sys.argv) > 3:  # a token under a name the run does not have: not one of the run's
+    token = session.liveliness().declare_token(sys.argv[3] + str(session.zid()))
 pub = session.declare_publisher(sys.argv[2])
 junk = msgpack.packb(list(range(16000)))  # 47 KB that reads as msgpack: decoded, then refused
 print("flooding", flush=True)
-while True:
-    pub.put(junk)
+n = 0
+while True:  # its own session's id, as a CataBot publisher states it (identity.py)
+    pub.put(junk, source_info=zenoh.SourceInfo(pub.id, n))
+    n += 1
 """
 
 
+@pytest.mark.parametrize("token", [False, True], ids=["no-token", "token-of-no-participant"])
 def test_a_flood_of_junk_commands_neither_stops_the_run_nor_hides_a_clients_command(
-    world: World,
+    world: World, token: bool
 ) -> None:
+    """With a token too: a client's `live/helper/<its zid>` was bound like a participant's,
+    its flood skipped the lanes and stalled physics until it was killed as hung (an audit)."""
     cmd, state = world.keys.cmd_thrust("ego"), world.keys.vessel_state("prod")
     names, holder, heard = ["prod", "cons"], dict[str, Participant](), list[ThrustCmd]()
 
@@ -48,7 +57,8 @@ def test_a_flood_of_junk_commands_neither_stops_the_run_nor_hides_a_clients_comm
     cons = world.member("cons", consume, inputs=streams, peers=names).participant
     client = world.open().declare_publisher(cmd)
     stop, longest = threading.Event(), [0]
-    flooder = subprocess.Popen([sys.executable, "-c", FLOODER, world.endpoint, cmd],
+    posing = [world.keys.live("helper", "")] if token else []
+    flooder = subprocess.Popen([sys.executable, "-c", FLOODER, world.endpoint, cmd, *posing],
                                stdout=subprocess.PIPE, text=True)  # fmt: skip
     assert flooder.stdout is not None and flooder.stdout.readline() == "flooding\n"
 
@@ -77,3 +87,4 @@ def test_a_flood_of_junk_commands_neither_stops_the_run_nor_hides_a_clients_comm
     assert heard and heard[-1].thrust == (0.25, 0.5)
     assert cons.rejections.totals["malformed"] > 0  # the junk that was read: refused
     assert longest[0] <= lanes.LANE_EVENTS
+    assert cons.rejections.totals["token of no participant of this run"] == int(token)
