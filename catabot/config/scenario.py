@@ -225,7 +225,7 @@ class Scenario(Strict):
         10_000_000,
         ge=100_000,
         le=100_000_000,
-        description="physics tick, integer nanoseconds (0.1 ms to 100 ms: stable hydrodynamics)",
+        description="physics tick, integer ns (0.1 ms to 100 ms, or a stiff model's own limit)",
     )
     clock: ClockConfig = ClockConfig()
     origin: Origin = Origin()

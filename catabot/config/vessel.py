@@ -18,13 +18,7 @@ from typing import Annotated, Any, Literal
 
 import numpy as np
 from numpy.typing import NDArray
-from pydantic import (
-    BeforeValidator,
-    Field,
-    ValidationError,
-    field_validator,
-    model_validator,
-)
+from pydantic import BeforeValidator, Field, ValidationError, field_validator, model_validator
 from pydantic.types import FiniteFloat
 
 from catabot.config.base import ConfigError, FieldProblem, Strict, explain, read_json
@@ -51,14 +45,8 @@ Vec3 = Annotated[tuple[FiniteFloat, FiniteFloat, FiniteFloat], _length(3, " [x, 
 Inertia3 = Annotated[
     tuple[PositiveFloat, PositiveFloat, PositiveFloat], _length(3, " [Ixx, Iyy, Izz]")
 ]
-_Six = tuple[
-    NonNegativeFloat,
-    NonNegativeFloat,
-    NonNegativeFloat,
-    NonNegativeFloat,
-    NonNegativeFloat,
-    NonNegativeFloat,
-]
+_N = NonNegativeFloat
+_Six = tuple[_N, _N, _N, _N, _N, _N]
 Dof6 = Annotated[_Six, _length(6, " [X_u, Y_v, Z_w, K_p, M_q, N_r]")]
 AddedMass6 = Annotated[_Six, _length(6, " [X_udot, Y_vdot, Z_wdot, K_pdot, M_qdot, N_rdot]")]
 WindCoefficients3 = Annotated[
@@ -238,9 +226,20 @@ class VesselModel(Strict):
                 )
         return self
 
+    @model_validator(mode="after")
+    def _righting_columns(self) -> VesselModel:
+        """Buoyancy columns all on one line give no righting moment about it: an audit's
+        monohull with `columns_across: 1` fell from a 3 degree heel onto its side."""
+        for i, field, turn in ((1, "columns_across", "roll"), (0, "columns_along", "pitch")):
+            count = max(h.across if i else h.columns_along for h in self.hulls)
+            if count == 1 and len({h.center_m[i] for h in self.hulls}) == 1:
+                raise FieldProblem(f"hulls.0.{field}", f"every buoyancy column lies at "
+                                   f"{'xy'[i]} = {self.hulls[0].center_m[i]:g}, one line: no "
+                                   f"righting moment in {turn}; give a hull 2 or more")  # fmt: skip
+        return self
+
     def thrust_totals(self) -> dict[str, float]:
-        """Every thruster's force summed, ahead and astern (N): the one figure the
-        refusal above and the note of model_checks.py weigh against the weight."""
+        """Every thruster's force summed (N): the refusal above and model_checks.py's note."""
         return {f: float(sum(getattr(t, f) for t in self.thrusters))
                 for f in ("max_forward_n", "max_reverse_n")}  # fmt: skip
 

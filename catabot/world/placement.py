@@ -31,18 +31,23 @@ def scenario_models(scenario: Scenario) -> dict[str, VesselModel]:
     """Each model the scenario names, read once (the placement, the traffic plan and the
     bodies share them), and the buoy's; a model that does not load is named by the field
     that named it."""
-    named: list[tuple[str, str | None]]
-    named = [(f"vessels.{i}.model", v.model) for i, v in enumerate(scenario.vessels)]
-    named += [(f"traffic.models.{i}.model", m.model) for i, m in enumerate(scenario.traffic.models)]
-    named += [(f"traffic.boats.{i}.model", b.model) for i, b in enumerate(scenario.traffic.boats)]
     models: dict[str, VesselModel] = {}
-    for where, ref in [*named, ("buoys", BUOY_MODEL)]:
+    for where, ref in model_fields(scenario):
         try:
             if ref is not None and ref not in models:
                 models[ref] = load_vessel_model(ref)
         except VesselModelError as exc:
             raise ScenarioError(f"{where}: {exc}") from None
     return models
+
+
+def model_fields(scenario: Scenario) -> list[tuple[str, str | None]]:
+    """(the field, the model it names) for every model reference, the buoys' last."""
+    named: list[tuple[str, str | None]]
+    named = [(f"vessels.{i}.model", v.model) for i, v in enumerate(scenario.vessels)]
+    named += [(f"traffic.models.{i}.model", m.model) for i, m in enumerate(scenario.traffic.models)]
+    named += [(f"traffic.boats.{i}.model", b.model) for i, b in enumerate(scenario.traffic.boats)]
+    return [*named, ("buoys", BUOY_MODEL)]
 
 
 def keel_depth_m(model: VesselModel) -> float:

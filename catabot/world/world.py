@@ -50,6 +50,7 @@ from catabot.world.placement import (
 )
 from catabot.world.shapes import ShapeMesh, vessel_mesh
 from catabot.world.shards import blocks, sensor_owners
+from catabot.world.step_limits import check_step
 from catabot.world.streams import Streams
 from catabot.world.terrain import Terrain, load_terrain
 from catabot.world.traffic_plan import Progress, TrafficPlan, plan_traffic
@@ -125,6 +126,7 @@ class World:
         `progress(k, n)` hears of each planned traffic boat (a long plan's progress)."""
         given = digest(scenario)  # as the conductor, which loads the same file, has it
         models = scenario_models(scenario)
+        check_step(scenario, models)
         terrain = _terrain(scenario)
         current = CurrentField.from_config(scenario.water.current)
         scenario = resolve_poses(scenario, terrain, models=models)
