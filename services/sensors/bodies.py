@@ -82,6 +82,7 @@ class Bodies:
         self.pos = np.full((n, 3), np.nan)  # unposed bodies are not in the scene
         self.rot = np.tile(np.eye(3), (n, 1, 1))
         self._posed: tuple[F64, F64] | None = None  # (centres, corners) of the poses now
+        self._last_cones: tuple[tuple[F64, F64], tuple[bytes, float], Cones] | None = None
 
     def place(self, poses: Poses) -> None:
         """Every named body at once (one by one cost ~0.6 ms a tick for 100); a bad pose is
@@ -165,11 +166,18 @@ class Bodies:
 
     def cones(self, origin: F64, max_range: float) -> Cones:
         """The posed bodies within `max_range` of `origin` and, for each, the cone from the
-        origin that holds its box (cull.corner_cone)."""
+        origin that holds its box (cull.corner_cone); the last answer is kept for the same
+        poses, origin and range (a radar's cast, then its fill: radar_fill.py)."""
+        placed, key = self.placed(), (origin.tobytes(), max_range)  # placed: new each update
+        last = self._last_cones
+        if last is not None and last[0] is placed and last[1] == key:
+            return last[2]
         keep = self._in_range(origin, origin, max_range)
-        oc = self.placed()[0][keep] - origin
+        oc = placed[0][keep] - origin
         dist = np.linalg.norm(oc, axis=1)
-        return Cones(keep, oc, dist, corner_cone(self.placed()[1][keep] - origin, oc, dist))
+        cones = Cones(keep, oc, dist, corner_cone(placed[1][keep] - origin, oc, dist))
+        self._last_cones = (placed, key, cones)
+        return cones
 
     def _in_range(self, lo: F64, hi: F64, max_range: float) -> NDArray[np.intp]:
         """Posed bodies whose bounding sphere comes within max_range of the box lo..hi."""

@@ -9,7 +9,9 @@ j is emitted at j T / n, T the rotation period), so the sweep is the same howeve
 period divides the turn. Each beam is `sub_rays` rays across its width times a fan of
 elevations: a down-looking fan spaced so that no boat `fan_target_height_m` tall slips between
 two rays at any range (from 3 m a 0.3 m boat at 200 m spans 0.78-0.86 deg down), plus
-`elevations_deg` at and above the horizon for shores and tall ships.
+`elevations_deg` at and above the horizon for shores and tall ships. A body narrower than
+the gap between a beam's rays, that they passed, is cast again at its own bearing
+(radar_fill.py): a buoy far off shows on every beam whose width holds it.
 
 Echoes. Returns from the water are sea clutter and are dropped by default (`sea_clutter`);
 rain does not attenuate X-band returns at these ranges in this model. Each ray's range gets
@@ -22,7 +24,7 @@ Ranges are slant ranges from the antenna (a buoy 29.75 m off reads 29.83 m from 
 from __future__ import annotations
 
 import math
-from typing import ClassVar
+from typing import ClassVar, cast
 
 import numpy as np
 from numpy.typing import NDArray
@@ -34,6 +36,8 @@ from catabot.world import rotations, seeding
 from services.sensors.camera import CastScene
 from services.sensors.common import SensorError, rotation_from_quaternion
 from services.sensors.mount import Mount
+from services.sensors.radar_fill import Beams, fill
+from services.sensors.scene import Hits, Scene
 
 F64 = NDArray[np.float64]
 
@@ -74,6 +78,9 @@ class RadarModel:
         if self.elevations.size == 0:
             raise SensorError(f"radar {name!r} has no rays: give elevations_deg or a fan")
         self._rng = seeding.rng(seed, name)
+        self._fill_rng = seeding.rng(seed, f"{name}/fill")  # radar_fill.py: its own stream
+        self._cones = cast(Scene, scene)  # the scene's cones and corners (radar_fill.py)
+        self._instances: NDArray[np.int32] | None = None  # of the scene's bodies, once
 
     def beam_indices(self, stamp_ns: int) -> NDArray[np.int64]:
         """Beams emitted in [stamp - period, stamp): j with j T / n in that interval."""
@@ -126,20 +133,60 @@ class RadarModel:
         intensity = np.zeros((nb, p.range_bins), dtype=np.uint8)
         if hits is None:
             return intensity, ranges
+        beam_of = np.arange(flat.shape[0]) // per_beam
+        echoes = [self._echoes(hits, flat, draws, beam_of)]
+        echoes.append(self._fill(origin, bearings, hits.instance.reshape(nb, per_beam)))
+        beam, strength, clean, noisy = (np.concatenate(part) for part in zip(*echoes, strict=True))
+        bins = np.minimum((noisy / p.range_m * p.range_bins).astype(np.intp), p.range_bins - 1)
+        echo = np.bincount(beam * p.range_bins + bins, strength, minlength=nb * p.range_bins)
+        intensity[:] = np.rint(255.0 * (1.0 - np.exp(-echo))).reshape(nb, p.range_bins)
+        ranges[:] = _first_returns(nb, beam, clean, noisy)
+        return intensity, ranges
+
+    def _echoes(
+        self,
+        hits: Hits,
+        dirs: F64,
+        draws: F64,
+        beam_of: Ints,
+        body: NDArray[np.int32] | None = None,
+    ) -> Echoes:
+        """(beam, strength, true range, noisy range) of the rays that return an echo; `body`:
+        only those that met that instance (a fill's rays)."""
+        p = self.params
         r = hits.range.astype(np.float64)
         if self.noise:
             r = r + p.range_noise_sigma_m * draws
         ok = (hits.cls != CLASS_NONE) & np.isfinite(r) & (r >= 0.0) & (r < p.range_m)
         if not p.sea_clutter:
             ok &= hits.cls != CLASS_WATER
+        if body is not None:
+            ok &= hits.instance == body
         idx = np.flatnonzero(ok)
-        beam = idx // per_beam
-        strength = 0.3 + 0.7 * np.abs(np.sum(hits.normal[idx] * flat[idx], axis=1))
-        bins = np.minimum((r[idx] / p.range_m * p.range_bins).astype(np.intp), p.range_bins - 1)
-        echo = np.bincount(beam * p.range_bins + bins, strength, minlength=nb * p.range_bins)
-        intensity[:] = np.rint(255.0 * (1.0 - np.exp(-echo))).reshape(nb, p.range_bins)
-        ranges[:] = _first_returns(nb, beam, hits.range[idx], r[idx])
-        return intensity, ranges
+        strength = 0.3 + 0.7 * np.abs(np.sum(hits.normal[idx] * dirs[idx], axis=1))
+        return beam_of[idx], strength, hits.range[idx], r[idx]
+
+    def _fill(self, origin: F64, bearings: F64, met: NDArray[np.int32]) -> Echoes:
+        """The echoes of thin bodies within a beam's width that its rays missed
+        (radar_fill.py)."""
+        p = self.params
+        width = math.radians(p.beam_width_deg)
+        beams = Beams(bearings, width, width / p.sub_rays, self.elevations, met)
+        if self._instances is None:
+            self._instances = np.array([b.instance for b in self._cones.bodies], dtype=np.int32)
+        cones = self._cones.cones(origin, p.range_m)
+        rays = fill(origin, cones, self._cones.corners(), self._instances, beams,
+                    near_m=p.fan_min_range_m)  # fmt: skip
+        if rays.dirs.shape[0] == 0:
+            return _NO_ECHO
+        hits = self._cones.cast(origin, rays.dirs, p.range_m)
+        draws = self._fill_rng.standard_normal(size=(rays.dirs.shape[0],))
+        return self._echoes(hits, rays.dirs, draws, rays.beam, rays.instance)
+
+
+Ints = NDArray[np.intp]
+Echoes = tuple[Ints, F64, NDArray[np.float32], F64]
+_NO_ECHO: Echoes = (np.empty(0, np.intp), np.empty(0), np.empty(0, np.float32), np.empty(0))
 
 
 def _first_returns(
