@@ -15,6 +15,14 @@ Errors, per axis and independent (ImuModel's defaults):
 - bias random walk (rad/s/sqrt(s), m/s^2/sqrt(s)): off by default, because it grows
   without bound over long runs; turn it on to model rate random walk.
 With `noise=False` the IMU is ideal. Orientation is passed through from the state.
+
+A sample describes the interval since the one before, as a real IMU's samples integrate (or
+filter and decimate) what happened between them. The state's rates describe the last
+physics tick, so an IMU as fast as the tick reads them; a slower one averages over its own
+interval T: the angular rate from the turn R_prevᵀ R over T, the acceleration from the
+world-frame change of velocity over T, in the axes of the interval's middle. An audit's
+10 Hz IMU in a 0.6 m sea read the last tick alone: 0.14 / 0.12 / 0.32 m/s² rms off the
+interval's mean on x / y / z, and dead reckoning on it was 0.19 m/s off after 18 s.
 """
 
 from __future__ import annotations
@@ -59,6 +67,8 @@ class ImuModel:
         self._markov = self.bias_sigma[:, None] * self._rng.standard_normal((2, 3))
         self._walked = np.zeros((2, 3))
         self._last_stamp_ns: int | None = None
+        self._averages = 0 < mount.tick_ns < mount.period_ns  # slower than the physics tick
+        self._before: VesselState | None = None  # the state at the previous sample
 
     @property
     def bias(self) -> Array:
@@ -75,12 +85,29 @@ class ImuModel:
         acc_sensor = acc + rotations.cross(alpha, r) + rotations.cross(w, rotations.cross(w, r))
         return w, acc_sensor + self.gravity * (rot.T @ UP)  # f = a - g, g = -gravity * up
 
+    def averaged(self, before: VesselState, state: VesselState, dt: float) -> tuple[Array, Array]:
+        """The ideal angular rate and specific force averaged over the `dt` seconds from
+        `before` to `state`, body axes of the interval's middle."""
+        rot0, rot1 = (rotation_from_quaternion(s.orientation) for s in (before, state))
+        turn = rotations.to_rotvec(np.array([rotations.quaternion_of_matrix(rot0.T @ rot1)]))[0]
+        w = turn / dt
+        mid = rot0 @ rotations.matrices(rotations.from_rotvec(0.5 * turn[None, :]))[0]
+        dv = rot1 @ _linear(state) - rot0 @ _linear(before)  # world frame
+        alpha = (_angular(state) - _angular(before)) / dt
+        r = self.lever_arm
+        lever = rotations.cross(alpha, r) + rotations.cross(w, rotations.cross(w, r))
+        return w, mid.T @ (dv / dt) + lever + self.gravity * (mid.T @ UP)
+
     def sample(
         self, state: VesselState, *, tick: int, stamp_ns: int, dt_s: float | None = None
     ) -> ImuSample:
         """One sample; `dt_s` (time since the last sample) defaults to the stamp difference."""
         dt = self._elapsed(stamp_ns, dt_s)
-        rate, force = self.ideal(state)
+        before, self._before = self._before, state
+        if self._averages and before is not None and dt > 0.0:
+            rate, force = self.averaged(before, state, dt)
+        else:
+            rate, force = self.ideal(state)
         if self.noise:
             draws = self._rng.standard_normal((3, 2, 3))  # fixed count: stream stays aligned
             self._propagate_bias(dt, draws[1], draws[2])
@@ -112,3 +139,11 @@ class ImuModel:
             self.bias_sigma[:, None] * math.sqrt(1.0 - phi * phi) * markov_draw
         )
         self._walked = self._walked + self.walk[:, None] * math.sqrt(dt) * walk_draw
+
+
+def _linear(state: VesselState) -> Array:
+    return finite_vector(state.linear_velocity, "linear_velocity (m/s)")
+
+
+def _angular(state: VesselState) -> Array:
+    return finite_vector(state.angular_velocity, "angular_velocity (rad/s)")

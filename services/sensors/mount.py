@@ -20,5 +20,6 @@ class Mount:
     seed: int = 0
     noise: bool = True
     period_ns: int = 0
+    tick_ns: int = 0  # the physics tick (0: unknown): an IMU slower than it averages (imu.py)
     scene: Any = None  # services.sensors.scene.Scene for the ray-casting types
     origin: Origin = field(default_factory=Origin)

@@ -43,6 +43,7 @@ def build_sensor(sensor: MountedSensor, world: World, *, scene: Any = None) -> S
         seed=scenario.seed,
         noise=sensor.config.noise,
         period_ns=sensor.config.period_ns,
+        tick_ns=scenario.dt_ns,
         scene=scene,
         origin=scenario.origin,
     )
