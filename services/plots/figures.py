@@ -298,8 +298,13 @@ def metrics(data: RunSeries) -> Figure | None:
     if finite.any():
         gap.plot(data.t, data.closest, color="#1f77b4", label="own vessel to any other")
         k = int(np.nanargmin(np.where(finite, data.closest, np.nan)))
-        gap.plot(data.t[k], data.closest[k], "v", color="red",
-                 label=f"minimum {data.closest[k]:.2f} m at {data.t[k]:.1f} s")  # fmt: skip
+        close = (data.metrics or {}).get("closest_approach")  # every tick's, not interpolated
+        d, t = (
+            (close["distance_m"], close["stamp_ns"] / 1e9)
+            if close
+            else (data.closest[k], data.t[k])
+        )
+        gap.plot(t, d, "v", color="red", label=f"minimum {d:.2f} m at {t:.2f} s")
         for k, (pair, apart) in enumerate(data.pairs.items()):
             gap.plot(data.t, apart, lw=0.9, ls="--", color=_color(k), label=pair)
         gap.legend(fontsize=8)

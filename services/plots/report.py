@@ -33,9 +33,10 @@ def summary(data: RunSeries) -> list[tuple[str, Any]]:
     sensors = ", ".join(f"{m.vessel}.{m.config.name} ({m.config.type}, {m.config.rate_hz:g} Hz)"
                         for m in world.sensors) or "none"  # fmt: skip
     waves = s.water.waves.preset or f"Hs {s.water.waves.significant_height_m:g} m"
+    ticks = len(data.t) - 1  # the rows hold the start state too
     return [
         ("scenario", s.name), ("seed", s.seed),
-        ("simulated", f"{data.t[-1]:.2f} s recorded ({len(data.t)} ticks of {s.dt_ns / 1e6:g} ms)"),
+        ("simulated", f"{data.t[-1]:.2f} s recorded ({ticks} ticks of {s.dt_ns / 1e6:g} ms)"),
         ("ended", data.run.ended()),
         ("vessels", ", ".join(data.own)), ("traffic boats", len(world.boat_ids)),
         ("buoys", len(world.buoys)), ("sensors", sensors),

@@ -109,8 +109,9 @@ def _commands(run: RecordedRun, out: RunSeries) -> None:
             values = np.array([[*v, *[np.nan] * (n - len(v))] for _, v in both])
             names = _thruster_names(body.model.thrusters, n)
             out.thrust[vid] = Series(np.array([t for t, _ in both]), values, names)
+        end = run.world.scenario.duration_s  # a step after a shortened run's end: not drawn
         scripted = [(s.t_s, (s.twist.surge_mps, s.twist.yaw_rate_radps))
-                    for s in body.script if s.twist is not None]  # fmt: skip
+                    for s in body.script if s.twist is not None and s.t_s <= end]  # fmt: skip
         given = [(stamp_ns / 1e9, (c.surge, c.yaw_rate)) for stamp_ns, c in run.twist(vid)]
         twist = given or scripted  # every one recorded (sent, scripted), else the script's
         if twist:
