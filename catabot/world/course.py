@@ -9,6 +9,9 @@ Straight at surge u > 0, the linearised sway and yaw (Fossen 2011, §7.1, no rud
     (I + A66) r' = -N_r r + (A11 - A22 + N_uv) u v
 (the Munk moment -(A22 - A11) u v and the hull's lift Y_uv |u| v, N_uv u v; the COG on the
 centreline at the origin), stable while (Y_v - Y_uv u) N_r > (m + A11) (A22 - A11 - N_uv) u^2.
+In still air the windage's yaw moment -2 k_n u v (services/physics/wind.py, k_n = 1/2 rho_a
+A_L L C_n) adds to the Munk moment: A22 - A11 - N_uv + 2 k_n (an audit found it left out:
+the monohull's limit 7.2 m/s, not 7.9).
 """
 
 from __future__ import annotations
@@ -44,11 +47,14 @@ def top_speed_mps(model: VesselModel, *, air_density: float = STILL_AIR) -> floa
     return (-linear + math.sqrt(linear * linear + 4.0 * quadratic * push)) / (2.0 * quadratic)
 
 
-def unstable_above_mps(model: VesselModel) -> float:
+def unstable_above_mps(model: VesselModel, *, air_density: float = STILL_AIR) -> float:
     """The surge speed above which a straight course is unstable (inf: at no speed): the
-    positive root of a u^2 + Y_uv N_r u - Y_v N_r = 0."""
+    positive root of a u^2 + Y_uv N_r u - Y_v N_r = 0, in still air."""
     lift_y, lift_n = model.damping.lift_uv
-    a = (model.mass_kg + model.added_mass[0]) * (model.added_mass[1] - model.added_mass[0] - lift_n)
+    w = model.wind
+    windage = 0.0 if w is None else air_density * w.lateral_area_m2 * w.length_m * w.coefficients[2]
+    munk = model.added_mass[1] - model.added_mass[0] - lift_n + windage  # 2 k_n = rho_a A_L L C_n
+    a = (model.mass_kg + model.added_mass[0]) * munk
     if a <= 0.0:
         return math.inf
     n_r = model.damping.linear[5]

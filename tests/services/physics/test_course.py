@@ -27,12 +27,20 @@ def test_every_bundled_model_keeps_a_straight_course_at_any_speed_it_reaches(nam
 
 
 def test_the_criterion_is_the_munk_moment_against_the_damping() -> None:
-    """Without the lift the catamaran's limit is the naval architect's 1.74 m/s."""
+    """Without the lift and the windage the catamaran's limit is the naval architect's 1.74
+    m/s; the windage's yaw moment in still air, -2 k_n u v, adds 2 k_n to the Munk moment's
+    A22 - A11 (an audit found it left out)."""
     model = load_vessel_model("catabot")
-    bare = model.model_copy(update={"damping": model.damping.model_copy(
-        update={"lift_uv": (0.0, 0.0)})})  # fmt: skip
+    lifted = model.damping.model_copy(update={"lift_uv": (0.0, 0.0)})
+    bare = model.model_copy(update={"damping": lifted, "wind": None})
     assert unstable_above_mps(bare) == pytest.approx(np.sqrt(40 * 80 / (57.75 * 18.25)))
     assert unstable_above_mps(bare) == pytest.approx(1.74, abs=0.005)
+    w = model.wind
+    assert w is not None
+    two_k_n = 1.225 * w.lateral_area_m2 * w.length_m * w.coefficients[2]
+    windy = model.model_copy(update={"damping": lifted})
+    expected = np.sqrt(40 * 80 / (57.75 * (18.25 + two_k_n)))
+    assert unstable_above_mps(windy) == pytest.approx(expected) and two_k_n > 0
     # 72 N = 12 u + (14 + 1/2 rho_a A_F C_x) u^2: the hull's damping and the still air's drag
     assert top_speed_mps(model) == pytest.approx(1.8734, abs=0.0001)
 
