@@ -128,9 +128,9 @@ class Damping(Strict):
 
     linear: Dof6
     quadratic: Dof6
-    lift_uv: tuple[float, float] = Field(
-        (0.0, 0.0), description="[Y_uv, N_uv]: Y += Y_uv |u| v (N s^2/m^2), N += N_uv u v (kg)"
-    )
+    lift_uv: tuple[Annotated[FiniteFloat, Field(le=0)], FiniteFloat] = Field(
+        (0.0, 0.0), description="[Y_uv <= 0, N_uv]: Y += Y_uv |u| v (N s^2/m^2), N += N_uv u v (kg)"
+    )  # Y_uv > 0 pushed a hull along its sideslip: negative sway damping above |u| = Y_v / Y_uv
 
 
 class Thruster(Strict):
