@@ -42,7 +42,8 @@ class Malformed(CommandError):
 
 def decode(payload: bytes, typename: str) -> Any:
     """The message in `payload`, strictly: CDR little-endian of `typename` and nothing else
-    (re-encoding it gives the payload back, but for at most 3 bytes of final padding)."""
+    (re-encoding it gives the payload back, but for the final padding to a 4-byte boundary:
+    a Twist's 52 bytes take none, so a String one byte longer no longer read as a Twist)."""
     if len(payload) > MAX_PAYLOAD:
         raise Malformed(f"{len(payload)} bytes: too big for a {typename}")
     if payload[:4] != ENCAPSULATION:
@@ -52,7 +53,7 @@ def decode(payload: bytes, typename: str) -> Any:
         again = types.serialize(msg, typename)
     except Exception as exc:  # rosbags raises several types for truncated or garbled data
         raise Malformed(f"not a {typename}: {type(exc).__name__}: {exc}") from None
-    if not 0 <= len(payload) - len(again) <= 3 or payload[: len(again)] != again:
+    if len(payload) - len(again) not in (0, -len(again) % 4) or payload[: len(again)] != again:
         raise Malformed(f"not a {typename} ({len(payload)} bytes, {len(again)} expected)")
     return msg
 

@@ -52,12 +52,18 @@ def test_twist_drives_surge_and_yaw_rate() -> None:
     assert commands.twist(_twist(1.5, -0.25, y=9.0)) == TwistCmd(surge=1.5, yaw_rate=-0.25)
 
 
-def test_padded_payloads_are_taken() -> None:
-    assert commands.twist(_twist(1.0, 0.0) + b"\0\0") == TwistCmd(surge=1.0, yaw_rate=0.0)
-
-
 def _string(text: str) -> bytes:
     return bytes(ROSBAGS.serialize_cdr(T["std_msgs/msg/String"](data=text), "std_msgs/msg/String"))
+
+
+def test_only_the_padding_to_a_4_byte_boundary_is_taken() -> None:
+    """A String's 14 bytes may come padded to 16; a Twist's 52 take no padding, so a String
+    one byte longer (an audit's, on a bridge key, which names no type) is no Twist."""
+    assert commands.decode(_string("hello") + b"\0\0", "std_msgs/msg/String").data == "hello"
+    with pytest.raises(commands.Malformed):
+        commands.decode(_string("hello") + b"\0", "std_msgs/msg/String")
+    with pytest.raises(commands.Malformed, match="53 bytes, 52 expected"):
+        commands.twist(_string("?" * 44))
 
 
 @pytest.mark.parametrize(
