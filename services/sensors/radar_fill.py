@@ -51,6 +51,9 @@ class Fill:
     dirs: F64
 
 
+NO_FILL = Fill(np.empty(0, np.intp), np.empty(0, np.int32), np.empty((0, 3)))
+
+
 def fill(
     origin: F64, cones: Cones, corners: F64, instances: NDArray[np.int32], beams: Beams,
     *, near_m: float,
@@ -65,6 +68,8 @@ def fill(
     spread = np.abs(wrap(np.arctan2(rel[..., 1], rel[..., 0]) - centre[held, None])).max(axis=1)
     thin = np.zeros(centre.size, dtype=bool)
     thin[held] = (plan >= near_m) & (2.0 * spread < beams.gap)
+    if not thin.any():  # most samples: nothing to fill, a tenth of a millisecond spared
+        return NO_FILL
     inst = instances[cones.body]
     keep = thin[k] & ~(beams.met[beam] == inst[k, None]).any(axis=1)
     beam, k = beam[keep], k[keep]
