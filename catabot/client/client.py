@@ -260,10 +260,14 @@ class Client:
     def __exit__(
         self, kind: type[BaseException] | None, exc: BaseException | None, tb: TracebackType | None
     ) -> None:
-        """An exception of the stack's own (not the run's end, not Ctrl-C) is the run's
-        cause in its words, as `run_lockstep` tells it."""
-        told = exc is not None and not isinstance(exc, RunEnded | KeyboardInterrupt | SystemExit)
-        self.close(fault=_told(exc) if told and exc is not None else "")
+        """An exception of the stack's own (not the run's end) is the run's cause in its
+        words, as `run_lockstep` tells it; Ctrl-C is told as the interruption it is (it read
+        "left the run without a word", as a crash or a lost link does)."""
+        if isinstance(exc, KeyboardInterrupt | SystemExit):  # its own words, not a crash's
+            self.close(fault=f"interrupted ({type(exc).__name__} in the stack)")
+        else:
+            told = exc is not None and not isinstance(exc, RunEnded)
+            self.close(fault=_told(exc) if told and exc is not None else "")
 
 
 def _one_vessel(info: WorldInfo, name: str, vessel: str | None) -> None:

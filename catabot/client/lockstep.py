@@ -66,6 +66,9 @@ class Observation:
         return float(yaw_of_quaternions(np.array([self.state.orientation]))[0])
 
 
+CLOSED = "closed by its stack before the run's end"
+
+
 class Joined:
     """A stack in the lockstep: `observe()` blocks until the next control period's inputs
     are in, `act(command)` sends its command; RunEnded when the run is over."""
@@ -280,8 +283,8 @@ class Joined:
         if self._closed:
             return
         self._closed = True
-        if fault and self._thread.is_alive():
-            self.participant.report_fault(fault)
+        if self._thread.is_alive():  # mid-run: said, or the run's error read "without a word"
+            self.participant.report_fault(fault or CLOSED)
         if self._thread.is_alive():
             self._commands.put(_LEAVE)
             self.participant.stop()

@@ -191,7 +191,8 @@ def test_a_stack_leaving_mid_run_is_named_and_the_run_ends(tmp_path: Path) -> No
             stack.close()  # while the participant waits for this period's command
             assert time.monotonic() - started < 6
         out, err = run.proc.communicate(timeout=60)
-        assert run.proc.returncode == 1 and "participant 'stack' left the run" in err, out + err
+        said = "participant 'stack' stopped at tick 30: closed by its stack before the run's end"
+        assert run.proc.returncode == 1 and said in err, out + err  # not "without a word"
     finally:
         run.kill()
 
