@@ -164,6 +164,8 @@ class Behaviours:
         b = self.boats[i]
         self.kind[i], self.speed[i] = KINDS[b.behaviour], b.speed_mps
         self.tol[i], self.loop[i] = b.tolerance_m, b.loop
+        self.centre[i], self.radius[i] = b.center, max(b.radius_m, 1.0)  # set_behaviour's
+        self.hold_yaw[i] = b.pose.yaw_rad  # were kept: a circle came back about a hold point
         self._store_path(i, np.array(b.path, dtype=np.float64).reshape(-1, 2))
         self.index[i], self.step[i] = place
 

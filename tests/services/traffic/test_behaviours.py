@@ -196,3 +196,18 @@ def test_a_release_resumes_the_boats_own_path_where_it_left_it() -> None:
     behaviours.release(0)
     assert behaviours.index.tolist() == [2] and behaviours.speed.tolist() == [5.0]
     assert behaviours.paths[0, :3].tolist() == [list(p) for p in path]
+
+
+def test_a_release_after_a_behaviour_change_restores_the_boats_own_circle_and_hold() -> None:
+    """`catabot set traffic.<boat>.behaviour` moved the centre; a release kept it, and a
+    circling boat came back circling its hold point (an audit's run: 5.6-35.2 m off)."""
+    circle = Boat("c", "monohull", Pose(yaw_rad=0.0), "circle", 5.0, (0.0, 19.1), 19.1, 1)
+    hold = Boat("h", "monohull", Pose(x_m=100.0, yaw_rad=0.3), "hold", 2.0, (100.0, 0.0))
+    behaviours = Behaviours([circle, hold])
+    cfg = TrafficConfig()
+    behaviours.set_behaviour(0, "hold", np.array([40.0, 40.0]), 1.0, cfg)
+    behaviours.set_behaviour(1, "circle", np.array([100.0, 0.0]), 0.0, cfg)
+    behaviours.release(0)
+    behaviours.release(1)
+    assert behaviours.centre.tolist() == [[0.0, 19.1], [100.0, 0.0]]
+    assert behaviours.radius[0] == 19.1 and behaviours.hold_yaw.tolist() == [0.0, 0.3]
