@@ -108,7 +108,10 @@ def test_a_slow_program_dropped_under_policy_drop_is_told_and_stops(tmp_path: Pa
     assert code == 0 and run is not None, said
     assert "stack: dropped, the run went on without it" in said
     log = (run / "log" / "stack.log").read_text()
-    assert re.search(r"^stack ended at tick 10\d \(dropped\)$", log, re.M) and "waited" not in log
+    # within a window (40 ticks) of its sleep at 100, far from the run's end at 299: a loaded
+    # machine had it step the grants queued before the one naming it dropped (139)
+    assert re.search(r"^stack ended at tick 1[0-4]\d \(dropped\)$", log, re.M), log
+    assert "waited" not in log
 
 
 def test_a_program_that_ends_before_joining_fails_the_run_at_once(tmp_path: Path) -> None:

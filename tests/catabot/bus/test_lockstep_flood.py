@@ -87,4 +87,5 @@ def test_a_flood_of_junk_commands_neither_stops_the_run_nor_hides_a_clients_comm
     assert heard and heard[-1].thrust == (0.25, 0.5)
     assert cons.rejections.totals["malformed"] > 0  # the junk that was read: refused
     assert longest[0] <= lanes.LANE_EVENTS
-    assert cons.rejections.totals["token of no participant of this run"] == int(token)
+    refused = cons.rejections.totals["token of no participant of this run"]
+    assert refused >= 1 if token else refused == 0  # its join, and its leave if seen
