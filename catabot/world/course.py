@@ -24,15 +24,24 @@ from catabot.config.vessel import VesselModel
 STILL_AIR = WindConfig().air_density_kg_m3  # the scenario's default air
 
 
+def windage(model: VesselModel, air_density: float) -> tuple[float, float, float]:
+    """The wind law's gains [k_x, k_y, k_n] (services/physics/wind.py): 1/2 rho_a A_F C_x,
+    1/2 rho_a A_L C_y and 1/2 rho_a A_L L C_n; zeros for a model without windage."""
+    w = model.wind
+    if w is None:
+        return 0.0, 0.0, 0.0
+    c_x, c_y, c_n = w.coefficients
+    half_rho = 0.5 * air_density
+    return (half_rho * w.frontal_area_m2 * c_x, half_rho * w.lateral_area_m2 * c_y,
+            half_rho * w.lateral_area_m2 * w.length_m * c_n)  # fmt: skip
+
+
 def surge_drag(model: VesselModel, *, air_density: float = STILL_AIR) -> tuple[float, float]:
     """The linear and quadratic surge drag (N per m/s, per (m/s)^2) in still air: the hull's
     damping, and its windage's 1/2 rho_a A_F C_x u^2 in the apparent wind (a model with wind
     areas, services/physics/wind.py). The top speed and the velocity controller's
     feed-forward both hold a speed against it."""
-    linear, quadratic = model.damping.linear[0], model.damping.quadratic[0]
-    if model.wind is not None:
-        quadratic += 0.5 * air_density * model.wind.frontal_area_m2 * model.wind.coefficients[0]
-    return linear, quadratic
+    return model.damping.linear[0], model.damping.quadratic[0] + windage(model, air_density)[0]
 
 
 def top_speed_mps(model: VesselModel, *, air_density: float = STILL_AIR) -> float:
@@ -51,9 +60,7 @@ def unstable_above_mps(model: VesselModel, *, air_density: float = STILL_AIR) ->
     """The surge speed above which a straight course is unstable (inf: at no speed): the
     positive root of a u^2 + Y_uv N_r u - Y_v N_r = 0, in still air."""
     lift_y, lift_n = model.damping.lift_uv
-    w = model.wind
-    windage = 0.0 if w is None else air_density * w.lateral_area_m2 * w.length_m * w.coefficients[2]
-    munk = model.added_mass[1] - model.added_mass[0] - lift_n + windage  # 2 k_n = rho_a A_L L C_n
+    munk = model.added_mass[1] - model.added_mass[0] - lift_n + 2.0 * windage(model, air_density)[2]
     a = (model.mass_kg + model.added_mass[0]) * munk
     if a <= 0.0:
         return math.inf

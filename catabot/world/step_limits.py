@@ -49,9 +49,13 @@ def step_limit(model: VesselModel, density: float) -> StepLimit:
 def check_step(scenario: Scenario, models: Models) -> None:
     """ScenarioError naming the first model the scenario's step `dt_ns` is too long for."""
     dt, density = scenario.dt_ns * 1e-9, scenario.water.density_kg_m3
+    checked: set[str] = set()  # a model several fields name (traffic models, boats): once
     for where, ref in model_fields(scenario):
-        if ref is None or not _in_run(where, scenario) or models[ref].sinks_in(density):
-            continue  # a model that sinks: its own refusal (world.py) names it
+        if ref is None or ref in checked or not _in_run(where, scenario):
+            continue
+        checked.add(ref)
+        if models[ref].sinks_in(density):
+            continue  # its own refusal (world.py) names it
         limit = step_limit(models[ref], density)
         if dt > limit.dt_s:
             raise ScenarioError(_too_long(where, ref, dt, limit))

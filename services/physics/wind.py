@@ -16,23 +16,14 @@ from collections.abc import Sequence
 import numpy as np
 
 from catabot.config.vessel import VesselModel
+from catabot.world.course import windage
 from services.physics.hydro import Array
 
 
 def wind_gains(models: Sequence[VesselModel], air_density: float) -> Array:
-    """(N, 3) gains [k_x, k_y, k_n] per vessel; zeros for a model without windage."""
-    gains = np.zeros((len(models), 3))
-    for i, model in enumerate(models):
-        w = model.wind
-        if w is not None:
-            c_x, c_y, c_n = w.coefficients
-            half_rho = 0.5 * air_density
-            gains[i] = (
-                half_rho * w.frontal_area_m2 * c_x,
-                half_rho * w.lateral_area_m2 * c_y,
-                half_rho * w.lateral_area_m2 * w.length_m * c_n,
-            )
-    return gains
+    """(N, 3) gains [k_x, k_y, k_n] per vessel (catabot/world/course.py's `windage`, which
+    the top speed and the course-stability limit read too); zeros without windage."""
+    return np.array([windage(m, air_density) for m in models], dtype=np.float64).reshape(-1, 3)
 
 
 def wind_wrench(gains: Array, rot: Array, wind_world_xy: Array, nu: Array) -> Array:

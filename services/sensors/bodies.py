@@ -78,6 +78,7 @@ class Bodies:
         self._shape, self._shapes = _shapes_of(self.bodies, lo, hi)
         self._cls = np.array([b.cls for b in self.bodies], dtype=np.uint8)
         self._inst = np.array([b.instance for b in self.bodies], dtype=np.int32)
+        self._inst.flags.writeable = False
         n = len(self.bodies)
         self.pos = np.full((n, 3), np.nan)  # unposed bodies are not in the scene
         self.rot = np.tile(np.eye(3), (n, 1, 1))
@@ -163,6 +164,10 @@ class Bodies:
                 points = np.einsum("kij,vj->kvi", rot, local) + self.pos[bodies, None, :]
             groups.append((sel, points))
         return groups
+
+    @property
+    def instances(self) -> NDArray[np.int32]:
+        return self._inst
 
     def cones(self, origin: F64, max_range: float) -> Cones:
         """The posed bodies within `max_range` of `origin` and, for each, the cone from the

@@ -78,12 +78,10 @@ class ImuModel:
     def ideal(self, state: VesselState) -> tuple[Array, Array]:
         """Error-free angular rate (rad/s) and specific force (m/s^2) at the sensor, body axes."""
         rot = rotation_from_quaternion(state.orientation)
-        w = finite_vector(state.angular_velocity, "angular_velocity (rad/s)")
+        w = _angular(state)
         alpha = finite_vector(state.angular_acceleration, "angular_acceleration (rad/s^2)")
         acc = finite_vector(state.linear_acceleration, "linear_acceleration (m/s^2)")
-        r = self.lever_arm
-        acc_sensor = acc + rotations.cross(alpha, r) + rotations.cross(w, rotations.cross(w, r))
-        return w, acc_sensor + self.gravity * (rot.T @ UP)  # f = a - g, g = -gravity * up
+        return w, acc + self._lever(w, alpha) + self.gravity * (rot.T @ UP)  # f = a - g
 
     def averaged(self, before: VesselState, state: VesselState, dt: float) -> tuple[Array, Array]:
         """The ideal angular rate and specific force averaged over the `dt` seconds from
@@ -94,9 +92,12 @@ class ImuModel:
         mid = rot0 @ rotations.matrices(rotations.from_rotvec(0.5 * turn[None, :]))[0]
         dv = rot1 @ _linear(state) - rot0 @ _linear(before)  # world frame
         alpha = (_angular(state) - _angular(before)) / dt
+        return w, mid.T @ (dv / dt) + self._lever(w, alpha) + self.gravity * (mid.T @ UP)
+
+    def _lever(self, w: Array, alpha: Array) -> Array:
+        """What the sensor at `lever_arm` feels beyond the origin: alpha x r + w x (w x r)."""
         r = self.lever_arm
-        lever = rotations.cross(alpha, r) + rotations.cross(w, rotations.cross(w, r))
-        return w, mid.T @ (dv / dt) + lever + self.gravity * (mid.T @ UP)
+        return rotations.cross(alpha, r) + rotations.cross(w, rotations.cross(w, r))
 
     def sample(
         self, state: VesselState, *, tick: int, stamp_ns: int, dt_s: float | None = None

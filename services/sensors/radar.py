@@ -24,7 +24,7 @@ Ranges are slant ranges from the antenna (a buoy 29.75 m off reads 29.83 m from 
 from __future__ import annotations
 
 import math
-from typing import ClassVar, cast
+from typing import ClassVar, Protocol
 
 import numpy as np
 from numpy.typing import NDArray
@@ -35,11 +35,22 @@ from catabot.config.sensors import RadarParams
 from catabot.world import rotations, seeding
 from services.sensors.camera import CastScene
 from services.sensors.common import SensorError, rotation_from_quaternion
+from services.sensors.cull import Cones
 from services.sensors.mount import Mount
-from services.sensors.radar_fill import Beams, fill
-from services.sensors.scene import Hits, Scene
+from services.sensors.radar_fill import Beams, directions, fill
+from services.sensors.scene import Hits
 
 F64 = NDArray[np.float64]
+
+
+class RadarScene(CastScene, Protocol):
+    """What a radar needs of the scene: a camera's, and the bodies' cones and instance ids
+    for the fill of thin bodies (radar_fill.py)."""
+
+    @property
+    def instances(self) -> NDArray[np.int32]: ...
+
+    def cones(self, origin: F64, max_range: float) -> Cones: ...
 
 
 def fan(p: RadarParams) -> F64:
@@ -61,7 +72,7 @@ class RadarModel:
     message: ClassVar[type[Message]] = RadarSweep
 
     def __init__(self, params: RadarParams, mount: Mount) -> None:
-        scene: CastScene | None = mount.scene
+        scene: RadarScene | None = mount.scene
         noise, seed, name, period_ns = mount.noise, mount.seed, mount.name, mount.period_ns
         if period_ns <= 0:
             raise SensorError(f"radar {name!r} needs its sample period (got {period_ns} ns)")
@@ -79,8 +90,6 @@ class RadarModel:
             raise SensorError(f"radar {name!r} has no rays: give elevations_deg or a fan")
         self._rng = seeding.rng(seed, name)
         self._fill_rng = seeding.rng(seed, f"{name}/fill")  # radar_fill.py: its own stream
-        self._cones = cast(Scene, scene)  # the scene's cones and corners (radar_fill.py)
-        self._instances: NDArray[np.int32] | None = None  # of the scene's bodies, once
 
     def beam_indices(self, stamp_ns: int) -> NDArray[np.int64]:
         """Beams emitted in [stamp - period, stamp): j with j T / n in that interval."""
@@ -116,9 +125,7 @@ class RadarModel:
     def rays(self, bearings: F64) -> F64:
         """Unit directions (beams x sub-rays x elevations, 3) of beams at map bearings."""
         b = bearings[:, None, None] + self.offsets[None, :, None]
-        e = self.elevations[None, None, :]
-        b, e = np.broadcast_arrays(b, e)
-        return np.stack([np.cos(e) * np.cos(b), np.cos(e) * np.sin(b), np.sin(e)], axis=-1)
+        return directions(b, self.elevations[None, None, :])
 
     def sweep(self, origin: F64, bearings: F64) -> tuple[NDArray[np.uint8], NDArray[np.float32]]:
         """Echo profiles (beams, range_bins) uint8 and first-return ranges (beams,) float32."""
@@ -172,14 +179,13 @@ class RadarModel:
         p = self.params
         width = math.radians(p.beam_width_deg)
         beams = Beams(bearings, width, width / p.sub_rays, self.elevations, met)
-        if self._instances is None:
-            self._instances = np.array([b.instance for b in self._cones.bodies], dtype=np.int32)
-        cones = self._cones.cones(origin, p.range_m)
-        rays = fill(origin, cones, self._cones.corners(), self._instances, beams,
+        scene = self.scene
+        cones = scene.cones(origin, p.range_m)
+        rays = fill(origin, cones, scene.corners(), scene.instances, beams,
                     near_m=p.fan_min_range_m)  # fmt: skip
         if rays.dirs.shape[0] == 0:
             return _NO_ECHO
-        hits = self._cones.cast(origin, rays.dirs, p.range_m)
+        hits = scene.cast(origin, rays.dirs, p.range_m)
         draws = self._fill_rng.standard_normal(size=(rays.dirs.shape[0],))
         return self._echoes(hits, rays.dirs, draws, rays.beam, rays.instance)
 

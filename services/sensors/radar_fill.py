@@ -78,6 +78,11 @@ def fill(
     rise[held] = np.stack([up.min(axis=1), up.max(axis=1)], axis=1)
     e = beams.elevations[None, :]
     pair, el = np.nonzero((e >= rise[k, :1]) & (e <= rise[k, 1:]))  # rays through the box
-    b, up_e = centre[k][pair], beams.elevations[el]
-    dirs = np.stack([np.cos(up_e) * np.cos(b), np.cos(up_e) * np.sin(b), np.sin(up_e)], axis=-1)
-    return Fill(beam[pair], inst[k][pair], dirs.reshape(-1, 3))
+    dirs = directions(centre[k][pair], beams.elevations[el])
+    return Fill(beam[pair], inst[k][pair], dirs)
+
+
+def directions(bearing: F64, elevation: F64) -> F64:
+    """Unit directions (..., 3) at map bearings and elevations (rad), broadcast together."""
+    b, e = np.broadcast_arrays(bearing, elevation)
+    return np.stack([np.cos(e) * np.cos(b), np.cos(e) * np.sin(b), np.sin(e)], axis=-1)

@@ -123,6 +123,11 @@ class Scene:
             return
         self.time_s = float(time_s)
 
+    @property
+    def instances(self) -> NDArray[np.int32]:
+        """Every body's instance id, in `bodies` order (read-only)."""
+        return self._bodies.instances
+
     def corners(self) -> F64:
         """(n, 8, 3) map-frame corners of every body's box, in `bodies` order (NaN where not
         yet posed): a camera projects them to find the pixels that may see each body."""
